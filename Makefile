@@ -1,0 +1,67 @@
+# Build, test and example targets. Outputs go to build/ (git-ignored).
+#
+#   make test      every test program in every configuration of the matrix below, then one
+#                  line "N passed, N failed" (test cases summed over the matrix)
+#   make examples  the example programs, into build/examples/
+#   make clean     remove build/
+#
+# The matrix: gcc -std=c99, g++ (the same test sources compiled as C++) and clang -std=c99,
+# each in double and in float; gcc with -fopenmp run with OMP_NUM_THREADS=2; gcc under
+# AddressSanitizer + UndefinedBehaviorSanitizer. All with -Wall -Wextra -pedantic -Werror.
+
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+WARN := -Wall -Wextra -pedantic -Werror
+HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/test.h
+FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
+
+CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
+
+CC_gcc-double   := gcc -std=c99 -O2
+CC_gcc-float    := gcc -std=c99 -O2 $(FLOAT)
+CC_gxx-double   := g++ -std=c++11 -O2 -x c++
+CC_gxx-float    := g++ -std=c++11 -O2 -x c++ $(FLOAT)
+CC_clang-double := clang -std=c99 -O2
+CC_clang-float  := clang -std=c99 -O2 $(FLOAT)
+CC_omp-double   := gcc -std=c99 -O2 -fopenmp
+# Sanitizer builds run the same assertions on reduced sizes (TEST_QUICK, see tests/test.h).
+CC_asan-double  := gcc -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
+                   -fno-sanitize-recover=all -DTEST_QUICK
+
+ENV_omp-double := OMP_NUM_THREADS=2
+
+TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
+EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
+
+.PHONY: all test test-run examples clean
+all: test
+
+test:
+	@rm -f $(foreach c,$(CONFIGS),$(foreach t,$(TESTS),build/$(c)/$(t).result))
+	@$(MAKE) --no-print-directory -k -j$(JOBS) test-run examples; true
+	@sh tests/summarize.sh "$(CONFIGS)" "$(TESTS)"
+
+test-run: $(foreach c,$(CONFIGS),$(foreach t,$(TESTS),build/$(c)/$(t).result))
+
+# One compile rule and one run rule per configuration. A run never fails the make: its
+# RESULT line (or its absence, for a crash) is read by tests/summarize.sh.
+define CONFIG_RULES
+build/$(1)/%: tests/%.c $(HEADERS)
+	@mkdir -p build/$(1)
+	$$(CC_$(1)) $(WARN) -o $$@ $$< -lm
+
+build/$(1)/%.result: build/$(1)/%
+	@mkdir -p build/tmp/$(1)
+	@TEST_TMPDIR=build/tmp/$(1) $$(ENV_$(1)) ./$$< > build/$(1)/$$*.log 2>&1; \
+	  echo "$$$$?" > build/$(1)/$$*.status; \
+	  grep '^RESULT ' build/$(1)/$$*.log > $$@ || echo "RESULT 0 1 crashed" > $$@
+endef
+$(foreach c,$(CONFIGS),$(eval $(call CONFIG_RULES,$(c))))
+
+examples: $(foreach e,$(EXAMPLES),build/examples/$(e))
+
+build/examples/%: examples/%.c $(HEADERS)
+	@mkdir -p build/examples
+	gcc -std=c99 -O2 $(WARN) -o $@ $< -lm
+
+clean:
+	rm -rf build

@@ -1,0 +1,405 @@
+/* tetmesh.h - mesh generators, TetGen/Gmsh readers and VTK/OBJ writers for the examples,
+   tests and bench of this project. Not part of the model headers (they never include it).
+
+   Do this in exactly one file:
+       #define TETMESH_IMPLEMENTATION
+       #include "tetmesh.h"
+   TETMESH_STATIC makes every function static.
+
+   Coordinates are double whatever precision a model uses; the writers take either float
+   or double arrays (TETMESH_TYPE_OF). Tetrahedra are 4 node indices, zero-based,
+   positively oriented: (p1 - p0) . ((p2 - p0) x (p3 - p0)) > 0. Every function returns
+   TETMESH_OK (0) or a negative TETMESH_ERR_* code and, on failure, leaves its output
+   meshes empty and allocates nothing that outlives the call. */
+#ifndef TETMESH_H
+#define TETMESH_H
+
+#include <stddef.h>
+
+#ifdef TETMESH_STATIC
+#define TETMESHDEF static
+#else
+#define TETMESHDEF extern
+#endif
+
+enum {
+    TETMESH_OK = 0,
+    TETMESH_ERR_ARG = -1,    /* a NULL pointer, a non-positive size or another bad argument */
+    TETMESH_ERR_ALLOC = -2,  /* out of memory */
+    TETMESH_ERR_IO = -3,     /* the file could not be opened, read or written */
+    TETMESH_ERR_PARSE = -4,  /* malformed or truncated text, or an unsupported format version */
+    TETMESH_ERR_COUNT = -5,  /* a negative, inconsistent or unreasonably huge count */
+    TETMESH_ERR_RANGE = -6,  /* a node index or tag outside the declared range */
+    TETMESH_ERR_DEGENERATE = -7 /* a tetrahedron of (near) zero volume */
+};
+
+/* A tetrahedral mesh owning its arrays (free with tetmesh_free). */
+typedef struct tetmesh {
+    int node_count;
+    int tet_count;
+    double *nodes; /* 3 * node_count coordinates, m */
+    int *tets;     /* 4 * tet_count node indices, positively oriented */
+} tetmesh;
+
+/* A hexahedral grid owning its arrays (free with hexmesh_free). Hex node order is the
+   usual trilinear one: node (a, b, c) of the cell, a, b, c in {0, 1}, is local index
+   a + 2 b + 4 c (x fastest). */
+typedef struct hexmesh {
+    int node_count;
+    int hex_count;
+    double *nodes; /* 3 * node_count coordinates, m */
+    int *hexes;    /* 8 * hex_count node indices */
+} hexmesh;
+
+/* How the box generator splits each cube. */
+enum { TETMESH_SPLIT5 = 5, TETMESH_SPLIT6 = 6 };
+
+/* Element types for writer arrays. */
+enum { TETMESH_DOUBLE = 0, TETMESH_FLOAT = 1 };
+#define TETMESH_TYPE_OF(x) (sizeof(x) == sizeof(float) ? TETMESH_FLOAT : TETMESH_DOUBLE)
+
+/* A point-data field for the VTK writer: `components` (1 or 3) values per node. */
+typedef struct tetmesh_field {
+    const char *name; /* no spaces */
+    int components;   /* 1 (scalar) or 3 (vector) */
+    int type;         /* TETMESH_DOUBLE or TETMESH_FLOAT */
+    const void *data; /* components * node_count values */
+} tetmesh_field;
+
+/* Name of an error code. */
+TETMESHDEF const char *tetmesh_error_string(int code);
+
+/* ---- generators ---------------------------------------------------------------------- */
+
+/* Box [lo, hi] split in nx * ny * nz cubes (cells), each cut into 5 or 6 tetrahedra
+   (split = TETMESH_SPLIT5 or TETMESH_SPLIT6), conforming across cells. Node (i, j, k)
+   has index i + (nx + 1) * (j + (ny + 1) * k). */
+TETMESHDEF int tetmesh_box(tetmesh *out, const double lo[3], const double hi[3], int nx, int ny,
+                           int nz, int split);
+
+/* Beam along +x: [0, length] x [-width/2, width/2] x [-height/2, height/2], clamped face at
+   x = 0 by convention (REFERENCES.md), nx * ny * nz cells split as in tetmesh_box. */
+TETMESHDEF int tetmesh_beam(tetmesh *out, double length, double width, double height, int nx,
+                            int ny, int nz, int split);
+
+/* Cylinder of the given radius along +z from z = 0 to z = length: `rings` rings of cells
+   around the axis, `segments` cells around (>= 3), `layers` cells along the axis. */
+TETMESHDEF int tetmesh_cylinder(tetmesh *out, double radius, double length, int rings,
+                                int segments, int layers);
+
+/* Hexahedral grid of the box [lo, hi], nx * ny * nz cells; node numbering as tetmesh_box. */
+TETMESHDEF int hexmesh_grid(hexmesh *out, const double lo[3], const double hi[3], int nx, int ny,
+                            int nz);
+
+/* ---- readers ------------------------------------------------------------------------- */
+
+/* TetGen .node and .ele files (first index 0 or 1, attributes and boundary markers
+   skipped; 4-node tetrahedra only). */
+TETMESHDEF int tetmesh_read_tetgen(tetmesh *out, const char *node_path, const char *ele_path);
+/* The same from text in memory (not necessarily NUL-terminated). */
+TETMESHDEF int tetmesh_parse_tetgen(tetmesh *out, const char *node_text, size_t node_len,
+                                    const char *ele_text, size_t ele_len);
+
+/* Gmsh .msh ASCII, format 2.2 or 4.1: nodes and 4-node tetrahedra (type 4); other
+   elements are skipped. Node tags are mapped to zero-based indices. */
+TETMESHDEF int tetmesh_read_gmsh(tetmesh *out, const char *path);
+TETMESHDEF int tetmesh_parse_gmsh(tetmesh *out, const char *text, size_t len);
+
+/* ---- writers ------------------------------------------------------------------------- */
+
+/* Legacy VTK unstructured grid (ASCII) of the tetrahedra with point-data fields.
+   points: 3 * node_count values of points_type. tets may be NULL with tet_count 0 to write
+   a point cloud (one VTK_VERTEX cell per node). */
+TETMESHDEF int tetmesh_write_vtk(const char *path, const void *points, int points_type,
+                                 int node_count, const int *tets, int tet_count,
+                                 const tetmesh_field *fields, int field_count);
+
+/* Wavefront OBJ of a triangle surface (e.g. from tetmesh_boundary or a model's boundary
+   list). */
+TETMESHDEF int tetmesh_write_obj(const char *path, const void *points, int points_type,
+                                 int node_count, const int *tris, int tri_count);
+
+/* ---- utilities ----------------------------------------------------------------------- */
+
+/* Boundary triangles of a tetrahedral mesh (faces held by one tetrahedron), oriented
+   outwards, in a deterministic order. *tris is allocated (free with free()). */
+TETMESHDEF int tetmesh_boundary(const int *tets, int tet_count, int node_count, int **tris,
+                                int *tri_count);
+
+/* Swaps two nodes of every negatively oriented tetrahedron; *flipped (may be NULL) counts
+   them. Refuses (TETMESH_ERR_DEGENERATE) a tetrahedron whose volume is below 1e-12 times
+   the cube of its longest edge. */
+TETMESHDEF int tetmesh_orient(tetmesh *m, int *flipped);
+
+/* Signed volume of the tetrahedron (a, b, c, d). */
+TETMESHDEF double tetmesh_tet_volume(const double *a, const double *b, const double *c,
+                                     const double *d);
+
+/* Index of the node nearest to p. */
+TETMESHDEF int tetmesh_nearest_node(const tetmesh *m, const double p[3]);
+
+TETMESHDEF void tetmesh_free(tetmesh *m);
+TETMESHDEF void hexmesh_free(hexmesh *m);
+
+#endif /* TETMESH_H */
+
+#if defined(TETMESH_IMPLEMENTATION) && !defined(TETMESH_IMPLEMENTATION_ONCE)
+#define TETMESH_IMPLEMENTATION_ONCE
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+TETMESHDEF const char *tetmesh_error_string(int code)
+{
+    switch (code) {
+    case TETMESH_OK: return "ok";
+    case TETMESH_ERR_ARG: return "bad argument";
+    case TETMESH_ERR_ALLOC: return "out of memory";
+    case TETMESH_ERR_IO: return "file could not be opened, read or written";
+    case TETMESH_ERR_PARSE: return "malformed or truncated mesh text";
+    case TETMESH_ERR_COUNT: return "negative, inconsistent or huge count";
+    case TETMESH_ERR_RANGE: return "node index out of range";
+    case TETMESH_ERR_DEGENERATE: return "degenerate tetrahedron";
+    default: return "unknown error";
+    }
+}
+
+/* >>generators */
+
+TETMESHDEF double tetmesh_tet_volume(const double *a, const double *b, const double *c,
+                                     const double *d)
+{
+    double u[3], v[3], w[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+            u[2] * (v[0] * w[1] - v[1] * w[0])) /
+           6.0;
+}
+
+static void tetmesh__orient_one(const double *nodes, int *t)
+{
+    if (tetmesh_tet_volume(nodes + 3 * t[0], nodes + 3 * t[1], nodes + 3 * t[2],
+                           nodes + 3 * t[3]) < 0.0) {
+        int s = t[2];
+        t[2] = t[3];
+        t[3] = s;
+    }
+}
+
+TETMESHDEF int tetmesh_box(tetmesh *out, const double lo[3], const double hi[3], int nx, int ny,
+                           int nz, int split)
+{
+    /* Cell corners by local index a + 2b + 4c. SPLIT6 is the Kuhn split (the six paths
+       from corner 0 to corner 7), identical in every cell and hence conforming. SPLIT5
+       cuts one centre tetrahedron and four corner ones, mirrored on odd cells so the
+       face diagonals of neighbouring cells agree. */
+    static const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                                   {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+    static const int five_even[5][4] = {
+        {1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}, {0, 3, 5, 6}};
+    static const int five_odd[5][4] = {
+        {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}, {1, 2, 4, 7}};
+    int i, j, k, n, t = 0;
+    long long nn, nt;
+    memset(out, 0, sizeof *out);
+    if (!lo || !hi || nx < 1 || ny < 1 || nz < 1 || (split != 5 && split != 6))
+        return TETMESH_ERR_ARG;
+    if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])) return TETMESH_ERR_ARG;
+    nn = (long long)(nx + 1) * (ny + 1) * (nz + 1);
+    nt = (long long)nx * ny * nz * split;
+    if (nn > 100000000 || nt > 400000000) return TETMESH_ERR_COUNT;
+    out->nodes = (double *)malloc((size_t)nn * 3 * sizeof(double));
+    out->tets = (int *)malloc((size_t)nt * 4 * sizeof(int));
+    if (!out->nodes || !out->tets) {
+        tetmesh_free(out);
+        return TETMESH_ERR_ALLOC;
+    }
+    out->node_count = (int)nn;
+    out->tet_count = (int)nt;
+    for (k = 0; k <= nz; k++)
+        for (j = 0; j <= ny; j++)
+            for (i = 0; i <= nx; i++) {
+                double *p = out->nodes + 3 * (i + (nx + 1) * (j + (ny + 1) * k));
+                p[0] = lo[0] + (hi[0] - lo[0]) * i / nx;
+                p[1] = lo[1] + (hi[1] - lo[1]) * j / ny;
+                p[2] = lo[2] + (hi[2] - lo[2]) * k / nz;
+            }
+    for (k = 0; k < nz; k++)
+        for (j = 0; j < ny; j++)
+            for (i = 0; i < nx; i++) {
+                int corner[8], c;
+                const int(*pattern)[4] =
+                    split == 6 ? kuhn : (((i + j + k) & 1) ? five_odd : five_even);
+                for (c = 0; c < 8; c++)
+                    corner[c] =
+                        (i + (c & 1)) + (nx + 1) * ((j + ((c >> 1) & 1)) + (ny + 1) * (k + (c >> 2)));
+                for (n = 0; n < split; n++, t++) {
+                    int q;
+                    for (q = 0; q < 4; q++) out->tets[4 * t + q] = corner[pattern[n][q]];
+                    tetmesh__orient_one(out->nodes, out->tets + 4 * t);
+                }
+            }
+    return TETMESH_OK;
+}
+
+TETMESHDEF int tetmesh_beam(tetmesh *out, double length, double width, double height, int nx,
+                            int ny, int nz, int split)
+{
+    double lo[3], hi[3];
+    lo[0] = 0.0;
+    lo[1] = -0.5 * width;
+    lo[2] = -0.5 * height;
+    hi[0] = length;
+    hi[1] = 0.5 * width;
+    hi[2] = 0.5 * height;
+    return tetmesh_box(out, lo, hi, nx, ny, nz, split);
+}
+
+/* >>utilities */
+
+TETMESHDEF int tetmesh_orient(tetmesh *m, int *flipped)
+{
+    int t, count = 0;
+    if (flipped) *flipped = 0;
+    if (!m || (m->tet_count > 0 && (!m->tets || !m->nodes))) return TETMESH_ERR_ARG;
+    for (t = 0; t < m->tet_count; t++) {
+        int *q = m->tets + 4 * t, a, b;
+        double v = tetmesh_tet_volume(m->nodes + 3 * q[0], m->nodes + 3 * q[1],
+                                      m->nodes + 3 * q[2], m->nodes + 3 * q[3]);
+        double longest = 0.0;
+        for (a = 0; a < 4; a++)
+            for (b = a + 1; b < 4; b++) {
+                const double *pa = m->nodes + 3 * q[a], *pb = m->nodes + 3 * q[b];
+                double dx = pa[0] - pb[0], dy = pa[1] - pb[1], dz = pa[2] - pb[2];
+                double l = sqrt(dx * dx + dy * dy + dz * dz);
+                if (l > longest) longest = l;
+            }
+        if (!(fabs(v) > 1e-12 * longest * longest * longest)) return TETMESH_ERR_DEGENERATE;
+        if (v < 0.0) {
+            int s = q[2];
+            q[2] = q[3];
+            q[3] = s;
+            count++;
+        }
+    }
+    if (flipped) *flipped = count;
+    return TETMESH_OK;
+}
+
+typedef struct tetmesh__face {
+    int key[3]; /* sorted node indices */
+    int tri[3]; /* outward orientation as seen from the owning tetrahedron */
+} tetmesh__face;
+
+static int tetmesh__face_cmp(const void *pa, const void *pb)
+{
+    const tetmesh__face *a = (const tetmesh__face *)pa, *b = (const tetmesh__face *)pb;
+    int k;
+    for (k = 0; k < 3; k++)
+        if (a->key[k] != b->key[k]) return a->key[k] < b->key[k] ? -1 : 1;
+    /* tie-break on orientation so the order is fully deterministic */
+    for (k = 0; k < 3; k++)
+        if (a->tri[k] != b->tri[k]) return a->tri[k] < b->tri[k] ? -1 : 1;
+    return 0;
+}
+
+TETMESHDEF int tetmesh_boundary(const int *tets, int tet_count, int node_count, int **tris,
+                                int *tri_count)
+{
+    /* Face opposite local node f of a positive tet (0,1,2,3), wound outwards. */
+    static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    tetmesh__face *faces;
+    int t, f, n = 0, out = 0, i;
+    if (tris) *tris = NULL;
+    if (tri_count) *tri_count = 0;
+    if (!tets || !tris || !tri_count || tet_count < 0 || node_count < 0) return TETMESH_ERR_ARG;
+    if (tet_count == 0) return TETMESH_OK;
+    faces = (tetmesh__face *)malloc((size_t)tet_count * 4 * sizeof *faces);
+    if (!faces) return TETMESH_ERR_ALLOC;
+    for (t = 0; t < tet_count; t++)
+        for (f = 0; f < 4; f++, n++) {
+            int a, b, c, s;
+            for (i = 0; i < 3; i++) {
+                int v = tets[4 * t + face[f][i]];
+                if (v < 0 || v >= node_count) {
+                    free(faces);
+                    return TETMESH_ERR_RANGE;
+                }
+                faces[n].tri[i] = v;
+            }
+            a = faces[n].tri[0];
+            b = faces[n].tri[1];
+            c = faces[n].tri[2];
+            if (a > b) { s = a; a = b; b = s; }
+            if (b > c) { s = b; b = c; c = s; }
+            if (a > b) { s = a; a = b; b = s; }
+            faces[n].key[0] = a;
+            faces[n].key[1] = b;
+            faces[n].key[2] = c;
+        }
+    qsort(faces, (size_t)n, sizeof *faces, tetmesh__face_cmp);
+    *tris = (int *)malloc((size_t)n * 3 * sizeof(int));
+    if (!*tris) {
+        free(faces);
+        return TETMESH_ERR_ALLOC;
+    }
+    for (i = 0; i < n;) {
+        int j = i + 1;
+        while (j < n && faces[j].key[0] == faces[i].key[0] && faces[j].key[1] == faces[i].key[1] &&
+               faces[j].key[2] == faces[i].key[2])
+            j++;
+        if (j - i == 1) {
+            memcpy(*tris + 3 * out, faces[i].tri, 3 * sizeof(int));
+            out++;
+        }
+        i = j;
+    }
+    free(faces);
+    *tri_count = out;
+    return TETMESH_OK;
+}
+
+TETMESHDEF int tetmesh_nearest_node(const tetmesh *m, const double p[3])
+{
+    int i, best = -1;
+    double best_d = 0.0;
+    for (i = 0; i < m->node_count; i++) {
+        const double *q = m->nodes + 3 * i;
+        double d = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                   (q[2] - p[2]) * (q[2] - p[2]);
+        if (best < 0 || d < best_d) {
+            best = i;
+            best_d = d;
+        }
+    }
+    return best;
+}
+
+TETMESHDEF void tetmesh_free(tetmesh *m)
+{
+    if (!m) return;
+    free(m->nodes);
+    free(m->tets);
+    memset(m, 0, sizeof *m);
+}
+
+TETMESHDEF void hexmesh_free(hexmesh *m)
+{
+    if (!m) return;
+    free(m->nodes);
+    free(m->hexes);
+    memset(m, 0, sizeof *m);
+}
+
+/* >>readers: to do (tetmesh_parse_tetgen, tetmesh_parse_gmsh, file wrappers) */
+/* >>writers: to do (tetmesh_write_vtk, tetmesh_write_obj) */
+/* >>more generators: to do (tetmesh_cylinder, hexmesh_grid) */
+
+#endif /* TETMESH_IMPLEMENTATION */
