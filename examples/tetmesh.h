@@ -10,7 +10,7 @@
    or double arrays (TETMESH_TYPE_OF). Tetrahedra are 4 node indices, zero-based,
    positively oriented: (p1 - p0) . ((p2 - p0) x (p3 - p0)) > 0. Every function returns
    TETMESH_OK (0) or a negative TETMESH_ERR_* code and, on failure, leaves its output
-   meshes empty and allocates nothing that outlives the call. */
+   meshes empty and allocates nothing that outlives the call. No global state, no printing. */
 #ifndef TETMESH_H
 #define TETMESH_H
 
@@ -83,7 +83,14 @@ TETMESHDEF int tetmesh_beam(tetmesh *out, double length, double width, double he
                             int ny, int nz, int split);
 
 /* Cylinder of the given radius along +z from z = 0 to z = length: `rings` rings of cells
-   around the axis, `segments` cells around (>= 3), `layers` cells along the axis. */
+   around the axis, `segments` cells around (>= 3), `layers` cells along the axis. A polar
+   grid: per layer the axis node then ring 1..rings, segment 0..segments-1 (node
+   1 + (ring - 1) * segments + segment), at angle 2 pi segment / segments; the innermost
+   ring is cut into one triangular prism per segment, the others into two per cell, and
+   each prism into 3 tetrahedra (3 (2 rings - 1) segments layers in all). The cross-section
+   is the inscribed regular polygon, so the volume is
+   segments / 2 sin(2 pi / segments) radius^2 length, which tends to pi radius^2 length as
+   O(segments^-2). */
 TETMESHDEF int tetmesh_cylinder(tetmesh *out, double radius, double length, int rings,
                                 int segments, int layers);
 
@@ -193,6 +200,56 @@ static void tetmesh__orient_one(const double *nodes, int *t)
     }
 }
 
+/* Largest meshes the generators and readers build (indices stay well inside int). */
+#define TETMESH__MAX_NODES 100000000LL
+#define TETMESH__MAX_TETS 400000000LL
+
+static int tetmesh__is_finite(double x) { return x - x == 0.0; }
+
+/* Validates the box and cell counts shared by tetmesh_box and hexmesh_grid. */
+static int tetmesh__grid_check(const double lo[3], const double hi[3], int nx, int ny, int nz)
+{
+    long long nodes;
+    int k;
+    if (!lo || !hi || nx < 1 || ny < 1 || nz < 1) return TETMESH_ERR_ARG;
+    for (k = 0; k < 3; k++)
+        if (!tetmesh__is_finite(lo[k]) || !tetmesh__is_finite(hi[k]) || !(hi[k] > lo[k]))
+            return TETMESH_ERR_ARG;
+    nodes = ((long long)nx + 1) * ((long long)ny + 1);
+    if (nodes > TETMESH__MAX_NODES) return TETMESH_ERR_COUNT;
+    nodes *= (long long)nz + 1;
+    return nodes > TETMESH__MAX_NODES ? TETMESH_ERR_COUNT : TETMESH_OK;
+}
+
+/* Index of grid node (i, j, k). */
+static int tetmesh__grid_node(int i, int j, int k, int nx, int ny)
+{
+    return i + (nx + 1) * (j + (ny + 1) * k);
+}
+
+/* Coordinates of the (nx + 1) (ny + 1) (nz + 1) grid nodes of the box [lo, hi]. */
+static void tetmesh__grid_nodes(double *nodes, const double lo[3], const double hi[3], int nx,
+                                int ny, int nz)
+{
+    int i, j, k;
+    for (k = 0; k <= nz; k++)
+        for (j = 0; j <= ny; j++)
+            for (i = 0; i <= nx; i++) {
+                double *p = nodes + 3 * tetmesh__grid_node(i, j, k, nx, ny);
+                p[0] = lo[0] + (hi[0] - lo[0]) * i / nx;
+                p[1] = lo[1] + (hi[1] - lo[1]) * j / ny;
+                p[2] = lo[2] + (hi[2] - lo[2]) * k / nz;
+            }
+}
+
+/* Global indices of the 8 corners of cell (i, j, k), local index a + 2b + 4c. */
+static void tetmesh__grid_cell(int i, int j, int k, int nx, int ny, int corner[8])
+{
+    int c;
+    for (c = 0; c < 8; c++)
+        corner[c] = tetmesh__grid_node(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2), nx, ny);
+}
+
 TETMESHDEF int tetmesh_box(tetmesh *out, const double lo[3], const double hi[3], int nx, int ny,
                            int nz, int split)
 {
@@ -206,15 +263,16 @@ TETMESHDEF int tetmesh_box(tetmesh *out, const double lo[3], const double hi[3],
         {1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}, {0, 3, 5, 6}};
     static const int five_odd[5][4] = {
         {0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}, {1, 2, 4, 7}};
-    int i, j, k, n, t = 0;
+    int i, j, k, n, t = 0, rc;
     long long nn, nt;
+    if (!out) return TETMESH_ERR_ARG;
     memset(out, 0, sizeof *out);
-    if (!lo || !hi || nx < 1 || ny < 1 || nz < 1 || (split != 5 && split != 6))
-        return TETMESH_ERR_ARG;
-    if (!(hi[0] > lo[0] && hi[1] > lo[1] && hi[2] > lo[2])) return TETMESH_ERR_ARG;
-    nn = (long long)(nx + 1) * (ny + 1) * (nz + 1);
+    if (split != TETMESH_SPLIT5 && split != TETMESH_SPLIT6) return TETMESH_ERR_ARG;
+    rc = tetmesh__grid_check(lo, hi, nx, ny, nz);
+    if (rc) return rc;
+    nn = ((long long)nx + 1) * (ny + 1) * (nz + 1);
     nt = (long long)nx * ny * nz * split;
-    if (nn > 100000000 || nt > 400000000) return TETMESH_ERR_COUNT;
+    if (nt > TETMESH__MAX_TETS) return TETMESH_ERR_COUNT;
     out->nodes = (double *)malloc((size_t)nn * 3 * sizeof(double));
     out->tets = (int *)malloc((size_t)nt * 4 * sizeof(int));
     if (!out->nodes || !out->tets) {
@@ -223,23 +281,14 @@ TETMESHDEF int tetmesh_box(tetmesh *out, const double lo[3], const double hi[3],
     }
     out->node_count = (int)nn;
     out->tet_count = (int)nt;
-    for (k = 0; k <= nz; k++)
-        for (j = 0; j <= ny; j++)
-            for (i = 0; i <= nx; i++) {
-                double *p = out->nodes + 3 * (i + (nx + 1) * (j + (ny + 1) * k));
-                p[0] = lo[0] + (hi[0] - lo[0]) * i / nx;
-                p[1] = lo[1] + (hi[1] - lo[1]) * j / ny;
-                p[2] = lo[2] + (hi[2] - lo[2]) * k / nz;
-            }
+    tetmesh__grid_nodes(out->nodes, lo, hi, nx, ny, nz);
     for (k = 0; k < nz; k++)
         for (j = 0; j < ny; j++)
             for (i = 0; i < nx; i++) {
-                int corner[8], c;
+                int corner[8];
                 const int(*pattern)[4] =
                     split == 6 ? kuhn : (((i + j + k) & 1) ? five_odd : five_even);
-                for (c = 0; c < 8; c++)
-                    corner[c] =
-                        (i + (c & 1)) + (nx + 1) * ((j + ((c >> 1) & 1)) + (ny + 1) * (k + (c >> 2)));
+                tetmesh__grid_cell(i, j, k, nx, ny, corner);
                 for (n = 0; n < split; n++, t++) {
                     int q;
                     for (q = 0; q < 4; q++) out->tets[4 * t + q] = corner[pattern[n][q]];
@@ -260,6 +309,153 @@ TETMESHDEF int tetmesh_beam(tetmesh *out, double length, double width, double he
     hi[1] = 0.5 * width;
     hi[2] = 0.5 * height;
     return tetmesh_box(out, lo, hi, nx, ny, nz, split);
+}
+
+TETMESHDEF int hexmesh_grid(hexmesh *out, const double lo[3], const double hi[3], int nx, int ny,
+                            int nz)
+{
+    int i, j, k, h = 0, rc;
+    long long nn, nh;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    rc = tetmesh__grid_check(lo, hi, nx, ny, nz);
+    if (rc) return rc;
+    nn = ((long long)nx + 1) * (ny + 1) * (nz + 1);
+    nh = (long long)nx * ny * nz;
+    out->nodes = (double *)malloc((size_t)nn * 3 * sizeof(double));
+    out->hexes = (int *)malloc((size_t)nh * 8 * sizeof(int));
+    if (!out->nodes || !out->hexes) {
+        hexmesh_free(out);
+        return TETMESH_ERR_ALLOC;
+    }
+    out->node_count = (int)nn;
+    out->hex_count = (int)nh;
+    tetmesh__grid_nodes(out->nodes, lo, hi, nx, ny, nz);
+    for (k = 0; k < nz; k++)
+        for (j = 0; j < ny; j++)
+            for (i = 0; i < nx; i++, h++) tetmesh__grid_cell(i, j, k, nx, ny, out->hexes + 8 * h);
+    return TETMESH_OK;
+}
+
+static void tetmesh__set_tet(int *tet, int a, int b, int c, int d)
+{
+    tet[0] = a;
+    tet[1] = b;
+    tet[2] = c;
+    tet[3] = d;
+}
+
+/* Splits the prism with bottom (v[0], v[1], v[2]) and top (v[3], v[4], v[5]), v[i + 3]
+   above v[i], into three positive tetrahedra written to tets. Each quadrilateral face is
+   cut by the diagonal through its smallest node index, so two prisms sharing a face cut
+   it alike whatever else they hold (Dompierre, Labbe, Vallet, Camarero 1999, "How to
+   subdivide pyramids, prisms and hexahedra into tetrahedra"). */
+static void tetmesh__split_prism(const double *nodes, const int v[6], int *tets)
+{
+    /* Symmetries of the prism taking vertex m to position 0, bottom and top kept paired. */
+    static const int turn[6][6] = {{0, 1, 2, 3, 4, 5}, {1, 2, 0, 4, 5, 3}, {2, 0, 1, 5, 3, 4},
+                                   {3, 5, 4, 0, 2, 1}, {4, 3, 5, 1, 0, 2}, {5, 4, 3, 2, 1, 0}};
+    int p[6], m = 0, i, t;
+    for (i = 1; i < 6; i++)
+        if (v[i] < v[m]) m = i;
+    for (i = 0; i < 6; i++) p[i] = v[turn[m][i]];
+    /* p[0] is the smallest: faces (0,1,4,3) and (0,2,5,3) are cut through it. The corner
+       tetrahedron (0,3,4,5) leaves the pyramid (1,2,5,4; apex 0), whose base is cut by
+       the diagonal through its own smallest node. */
+    tetmesh__set_tet(tets, p[0], p[3], p[4], p[5]);
+    if ((p[1] < p[5] ? p[1] : p[5]) < (p[2] < p[4] ? p[2] : p[4])) {
+        tetmesh__set_tet(tets + 4, p[0], p[1], p[2], p[5]);
+        tetmesh__set_tet(tets + 8, p[0], p[1], p[5], p[4]);
+    } else {
+        tetmesh__set_tet(tets + 4, p[0], p[1], p[2], p[4]);
+        tetmesh__set_tet(tets + 8, p[0], p[4], p[2], p[5]);
+    }
+    for (t = 0; t < 3; t++) tetmesh__orient_one(nodes, tets + 4 * t);
+}
+
+static void tetmesh__set_tri(int *tri, int a, int b, int c)
+{
+    tri[0] = a;
+    tri[1] = b;
+    tri[2] = c;
+}
+
+/* Index, within a layer of the cylinder, of ring r (0 = the axis node) at segment s. */
+static int tetmesh__cylinder_node(int r, int s, int segments)
+{
+    return r == 0 ? 0 : 1 + (r - 1) * segments + s % segments;
+}
+
+/* Nodes of the cylinder: per layer the axis node, then the rings from the inside out. */
+static void tetmesh__cylinder_nodes(double *nodes, double radius, double length, int rings,
+                                    int segments, int layers)
+{
+    const double two_pi = 6.28318530717958647692;
+    int k, r, s, per_layer = 1 + rings * segments;
+    for (k = 0; k <= layers; k++) {
+        double *layer = nodes + 3 * (size_t)per_layer * k, z = length * k / layers;
+        layer[0] = 0.0;
+        layer[1] = 0.0;
+        layer[2] = z;
+        for (r = 1; r <= rings; r++)
+            for (s = 0; s < segments; s++) {
+                double *p = layer + 3 * tetmesh__cylinder_node(r, s, segments);
+                double angle = two_pi * s / segments, rho = radius * r / rings;
+                p[0] = rho * cos(angle);
+                p[1] = rho * sin(angle);
+                p[2] = z;
+            }
+    }
+}
+
+TETMESHDEF int tetmesh_cylinder(tetmesh *out, double radius, double length, int rings,
+                                int segments, int layers)
+{
+    /* Polar grid: the cross-section is cut into triangles (one per segment around the
+       axis, two per quadrilateral cell of the outer rings), each triangle is extruded
+       into one prism per layer and every prism split by tetmesh__split_prism. */
+    long long per_layer, nn, nt;
+    int k, r, s, t = 0;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!tetmesh__is_finite(radius) || !tetmesh__is_finite(length) || !(radius > 0.0) ||
+        !(length > 0.0) || rings < 1 || segments < 3 || layers < 1)
+        return TETMESH_ERR_ARG;
+    per_layer = 1 + (long long)rings * segments;
+    if (per_layer > TETMESH__MAX_NODES) return TETMESH_ERR_COUNT;
+    nn = per_layer * ((long long)layers + 1);
+    nt = 3 * (2 * (long long)rings - 1) * segments * layers;
+    if (nn > TETMESH__MAX_NODES || nt > TETMESH__MAX_TETS) return TETMESH_ERR_COUNT;
+    out->nodes = (double *)malloc((size_t)nn * 3 * sizeof(double));
+    out->tets = (int *)malloc((size_t)nt * 4 * sizeof(int));
+    if (!out->nodes || !out->tets) {
+        tetmesh_free(out);
+        return TETMESH_ERR_ALLOC;
+    }
+    out->node_count = (int)nn;
+    out->tet_count = (int)nt;
+    tetmesh__cylinder_nodes(out->nodes, radius, length, rings, segments, layers);
+    for (k = 0; k < layers; k++)
+        for (s = 0; s < segments; s++)
+            for (r = 0; r < rings; r++) {
+                /* triangles of the cell between rings r and r + 1, segments s and s + 1 */
+                int a = tetmesh__cylinder_node(r, s, segments);
+                int b = tetmesh__cylinder_node(r + 1, s, segments);
+                int c = tetmesh__cylinder_node(r + 1, s + 1, segments);
+                int d = tetmesh__cylinder_node(r, s + 1, segments);
+                int tri[2][3], n, q;
+                tetmesh__set_tri(tri[0], a, b, c);
+                tetmesh__set_tri(tri[1], a, c, d);
+                for (n = 0; n < (r == 0 ? 1 : 2); n++, t += 3) {
+                    int v[6];
+                    for (q = 0; q < 3; q++) {
+                        v[q] = (int)(per_layer * k) + tri[n][q];
+                        v[q + 3] = v[q] + (int)per_layer;
+                    }
+                    tetmesh__split_prism(out->nodes, v, out->tets + 4 * t);
+                }
+            }
+    return TETMESH_OK;
 }
 
 /* >>utilities */
@@ -400,6 +596,4 @@ TETMESHDEF void hexmesh_free(hexmesh *m)
 
 /* >>readers: to do (tetmesh_parse_tetgen, tetmesh_parse_gmsh, file wrappers) */
 /* >>writers: to do (tetmesh_write_vtk, tetmesh_write_obj) */
-/* >>more generators: to do (tetmesh_cylinder, hexmesh_grid) */
-
 #endif /* TETMESH_IMPLEMENTATION */
