@@ -10,7 +10,25 @@
    or double arrays (TETMESH_TYPE_OF). Tetrahedra are 4 node indices, zero-based,
    positively oriented: (p1 - p0) . ((p2 - p0) x (p3 - p0)) > 0. Every function returns
    TETMESH_OK (0) or a negative TETMESH_ERR_* code and, on failure, leaves its output
-   meshes empty and allocates nothing that outlives the call. No global state, no printing. */
+   meshes empty and allocates nothing that outlives the call. No global state, no printing.
+
+   READERS take untrusted text. They never size an allocation by a count before checking
+   it against the length of the remaining text, and return
+     TETMESH_ERR_ARG        a NULL mesh or text;
+     TETMESH_ERR_IO         (file readers) a file that cannot be opened or read;
+     TETMESH_ERR_PARSE      a missing or non-numeric token, truncated text, a missing
+                            section, a non-finite coordinate, an unsupported version
+                            (Gmsh other than ASCII 2.2 / 4.1, TetGen dimension other than 3,
+                            nodes per tetrahedron other than 4 or 10), TetGen entries not
+                            numbered consecutively from 0 or 1, a Gmsh node tag given twice;
+     TETMESH_ERR_COUNT      a negative or huge count, a count the rest of the text cannot
+                            hold, Gmsh 4.1 block counts that do not add up to the total,
+                            no nodes or no tetrahedra at all;
+     TETMESH_ERR_RANGE      a tetrahedron naming a node that does not exist, a Gmsh node
+                            tag that is not positive;
+     TETMESH_ERR_DEGENERATE a tetrahedron of (near) zero volume (see tetmesh_orient).
+   Negatively oriented tetrahedra are flipped. Nodes keep their file order, including
+   nodes no tetrahedron uses. */
 #ifndef TETMESH_H
 #define TETMESH_H
 
@@ -100,15 +118,21 @@ TETMESHDEF int hexmesh_grid(hexmesh *out, const double lo[3], const double hi[3]
 
 /* ---- readers ------------------------------------------------------------------------- */
 
-/* TetGen .node and .ele files (first index 0 or 1, attributes and boundary markers
-   skipped; 4-node tetrahedra only). */
+/* TetGen .node and .ele files: '#' comments, entries numbered consecutively from 0 or 1
+   (the first .node entry decides for the node numbers), attributes and boundary markers
+   skipped, 4-node tetrahedra; 10-node (second-order) tetrahedra are reduced to their 4
+   corners, which TetGen lists first. Text after the last entry is ignored. Allocates
+   out's arrays (free with tetmesh_free); errors as listed at the top of this file. */
 TETMESHDEF int tetmesh_read_tetgen(tetmesh *out, const char *node_path, const char *ele_path);
 /* The same from text in memory (not necessarily NUL-terminated). */
 TETMESHDEF int tetmesh_parse_tetgen(tetmesh *out, const char *node_text, size_t node_len,
                                     const char *ele_text, size_t ele_len);
 
-/* Gmsh .msh ASCII, format 2.2 or 4.1: nodes and 4-node tetrahedra (type 4); other
-   elements are skipped. Node tags are mapped to zero-based indices. */
+/* Gmsh .msh ASCII, format 2.2 or 4.1 ($MeshFormat first, $Nodes before $Elements, other
+   sections skipped; binary files and other versions are refused): nodes and 4-node
+   tetrahedra (type 4); other elements are skipped, one line each. Node tags, which may be
+   any distinct positive integers, are mapped to zero-based indices in file order. Reading
+   stops at $EndElements. Allocates out's arrays (free with tetmesh_free). */
 TETMESHDEF int tetmesh_read_gmsh(tetmesh *out, const char *path);
 TETMESHDEF int tetmesh_parse_gmsh(tetmesh *out, const char *text, size_t len);
 
@@ -594,6 +618,617 @@ TETMESHDEF void hexmesh_free(hexmesh *m)
     memset(m, 0, sizeof *m);
 }
 
-/* >>readers: to do (tetmesh_parse_tetgen, tetmesh_parse_gmsh, file wrappers) */
+/* >>readers */
+
+/* A bounded tokenizer over text that need not be NUL-terminated: tokens are runs of
+   non-space bytes, and numbers are converted from a NUL-terminated copy of one token. */
+typedef struct tetmesh__lexer {
+    const char *text;
+    size_t len, pos;
+    int hash_comments; /* TetGen: '#' starts a comment that runs to the end of the line */
+} tetmesh__lexer;
+
+/* Longest number token accepted (a %.17g double takes 24 bytes). */
+#define TETMESH__TOKEN_MAX 128
+
+static void tetmesh__lexer_init(tetmesh__lexer *lx, const char *text, size_t len, int comments)
+{
+    lx->text = text;
+    lx->len = len;
+    lx->pos = 0;
+    lx->hash_comments = comments;
+}
+
+static int tetmesh__is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+}
+
+static int tetmesh__is_separator(const tetmesh__lexer *lx, char c)
+{
+    return tetmesh__is_space(c) || (lx->hash_comments && c == '#');
+}
+
+static void tetmesh__skip_space(tetmesh__lexer *lx)
+{
+    while (lx->pos < lx->len) {
+        char c = lx->text[lx->pos];
+        if (lx->hash_comments && c == '#')
+            while (lx->pos < lx->len && lx->text[lx->pos] != '\n') lx->pos++;
+        else if (tetmesh__is_space(c))
+            lx->pos++;
+        else
+            break;
+    }
+}
+
+/* The next token as (*start, *length); returns 0 at the end of the text. */
+static int tetmesh__next_token(tetmesh__lexer *lx, const char **start, size_t *length)
+{
+    size_t begin;
+    tetmesh__skip_space(lx);
+    begin = lx->pos;
+    while (lx->pos < lx->len && !tetmesh__is_separator(lx, lx->text[lx->pos])) lx->pos++;
+    *start = lx->text + begin;
+    *length = lx->pos - begin;
+    return *length > 0;
+}
+
+/* Copies the next token into buf, NUL-terminated; returns its length, 0 at the end of the
+   text or for a token too long to be a number. */
+static size_t tetmesh__copy_token(tetmesh__lexer *lx, char *buf)
+{
+    const char *start;
+    size_t length;
+    if (!tetmesh__next_token(lx, &start, &length) || length >= TETMESH__TOKEN_MAX) return 0;
+    memcpy(buf, start, length);
+    buf[length] = '\0';
+    return length;
+}
+
+/* An integer token; values beyond long long saturate (and then fail a count or range
+   check). */
+static int tetmesh__read_int(tetmesh__lexer *lx, long long *value)
+{
+    char buf[TETMESH__TOKEN_MAX], *end;
+    size_t length = tetmesh__copy_token(lx, buf);
+    if (length == 0) return TETMESH_ERR_PARSE;
+    *value = strtoll(buf, &end, 10);
+    return end == buf + length ? TETMESH_OK : TETMESH_ERR_PARSE;
+}
+
+/* A finite real token. */
+static int tetmesh__read_real(tetmesh__lexer *lx, double *value)
+{
+    char buf[TETMESH__TOKEN_MAX], *end;
+    size_t length = tetmesh__copy_token(lx, buf);
+    if (length == 0) return TETMESH_ERR_PARSE;
+    *value = strtod(buf, &end);
+    if (end != buf + length || !tetmesh__is_finite(*value)) return TETMESH_ERR_PARSE;
+    return TETMESH_OK;
+}
+
+static int tetmesh__skip_reals(tetmesh__lexer *lx, long long count)
+{
+    double ignored;
+    long long i;
+    int rc = TETMESH_OK;
+    for (i = 0; i < count && rc == TETMESH_OK; i++) rc = tetmesh__read_real(lx, &ignored);
+    return rc;
+}
+
+static int tetmesh__skip_ints(tetmesh__lexer *lx, long long count)
+{
+    long long i, ignored;
+    int rc = TETMESH_OK;
+    for (i = 0; i < count && rc == TETMESH_OK; i++) rc = tetmesh__read_int(lx, &ignored);
+    return rc;
+}
+
+/* Refuses a count that is negative, above limit, or larger than the rest of the text could
+   hold when each entry takes at least entry_bytes bytes (its tokens and their separators),
+   so that no allocation is ever sized by an untrusted count. */
+static int tetmesh__check_count(const tetmesh__lexer *lx, long long count, size_t entry_bytes,
+                                long long limit)
+{
+    size_t remaining = lx->len - lx->pos;
+    if (count < 0 || count > limit) return TETMESH_ERR_COUNT;
+    if ((unsigned long long)count > remaining / entry_bytes) return TETMESH_ERR_COUNT;
+    return TETMESH_OK;
+}
+
+/* Skips spaces up to the end of the line, which must hold nothing else. */
+static int tetmesh__expect_line_end(tetmesh__lexer *lx)
+{
+    while (lx->pos < lx->len &&
+           (lx->text[lx->pos] == ' ' || lx->text[lx->pos] == '\t' || lx->text[lx->pos] == '\r'))
+        lx->pos++;
+    return lx->pos >= lx->len || lx->text[lx->pos] == '\n' ? TETMESH_OK : TETMESH_ERR_PARSE;
+}
+
+/* Skips past the next newline. */
+static int tetmesh__skip_line(tetmesh__lexer *lx)
+{
+    while (lx->pos < lx->len && lx->text[lx->pos] != '\n') lx->pos++;
+    if (lx->pos >= lx->len) return TETMESH_ERR_PARSE;
+    lx->pos++;
+    return TETMESH_OK;
+}
+
+/* Allocates the node array of m for count nodes. */
+static int tetmesh__alloc_nodes(tetmesh *m, long long count)
+{
+    m->nodes = (double *)malloc((size_t)count * 3 * sizeof(double));
+    if (!m->nodes) return TETMESH_ERR_ALLOC;
+    m->node_count = (int)count;
+    return TETMESH_OK;
+}
+
+static int tetmesh__read_point(tetmesh__lexer *lx, double *p)
+{
+    int rc = tetmesh__read_real(lx, p);
+    if (rc == TETMESH_OK) rc = tetmesh__read_real(lx, p + 1);
+    if (rc == TETMESH_OK) rc = tetmesh__read_real(lx, p + 2);
+    return rc;
+}
+
+/* Finishes a reader: orients the tetrahedra, or empties the mesh after a failure. */
+static int tetmesh__finish_read(tetmesh *m, int rc)
+{
+    if (rc == TETMESH_OK) rc = tetmesh_orient(m, NULL);
+    if (rc != TETMESH_OK) tetmesh_free(m);
+    return rc;
+}
+
+/* >>readers: TetGen */
+
+/* Entry i of a TetGen list is numbered *first + i, with *first (set by entry 0) 0 or 1. */
+static int tetmesh__tetgen_number(tetmesh__lexer *lx, long long i, long long *first)
+{
+    long long number;
+    int rc = tetmesh__read_int(lx, &number);
+    if (rc) return rc;
+    if (i == 0) {
+        if (number != 0 && number != 1) return TETMESH_ERR_PARSE;
+        *first = number;
+    } else if (number != *first + i) {
+        return TETMESH_ERR_PARSE;
+    }
+    return TETMESH_OK;
+}
+
+/* .node: "<points> 3 <attributes> <markers 0|1>", then "<number> x y z [attributes]
+   [marker]" per point. */
+static int tetmesh__tetgen_nodes(tetmesh__lexer *lx, tetmesh *m, long long *first)
+{
+    long long count, dim, attributes, markers, i;
+    int rc = tetmesh__read_int(lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(lx, &dim);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(lx, &attributes);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(lx, &markers);
+    if (rc) return rc;
+    if (dim != 3 || (markers != 0 && markers != 1)) return TETMESH_ERR_PARSE;
+    if (attributes < 0 || (unsigned long long)attributes > lx->len) return TETMESH_ERR_COUNT;
+    rc = tetmesh__check_count(lx, count, 2 * (size_t)(4 + attributes + markers),
+                              TETMESH__MAX_NODES);
+    if (rc) return rc;
+    if (count == 0) return TETMESH_ERR_COUNT;
+    rc = tetmesh__alloc_nodes(m, count);
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        rc = tetmesh__tetgen_number(lx, i, first);
+        if (rc == TETMESH_OK) rc = tetmesh__read_point(lx, m->nodes + 3 * i);
+        if (rc == TETMESH_OK) rc = tetmesh__skip_reals(lx, attributes);
+        if (rc == TETMESH_OK) rc = tetmesh__skip_ints(lx, markers);
+    }
+    return rc;
+}
+
+/* .ele: "<tetrahedra> <4|10> <attributes>", then "<number> n0 .. n3 [n4 .. n9]
+   [attributes]" per tetrahedron; a 10-node tetrahedron keeps its 4 corners (TetGen lists
+   them first). Node numbers start at first_node, as in the .node file. */
+static int tetmesh__tetgen_tets(tetmesh__lexer *lx, tetmesh *m, long long first_node)
+{
+    long long count, per_tet, attributes, first = 0, i, k, node;
+    int rc = tetmesh__read_int(lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(lx, &per_tet);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(lx, &attributes);
+    if (rc) return rc;
+    if (per_tet != 4 && per_tet != 10) return TETMESH_ERR_PARSE;
+    if (attributes < 0 || (unsigned long long)attributes > lx->len) return TETMESH_ERR_COUNT;
+    rc = tetmesh__check_count(lx, count, 2 * (size_t)(1 + per_tet + attributes),
+                              TETMESH__MAX_TETS);
+    if (rc) return rc;
+    if (count == 0) return TETMESH_ERR_COUNT;
+    m->tets = (int *)malloc((size_t)count * 4 * sizeof(int));
+    if (!m->tets) return TETMESH_ERR_ALLOC;
+    m->tet_count = (int)count;
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        rc = tetmesh__tetgen_number(lx, i, &first);
+        for (k = 0; k < per_tet && rc == TETMESH_OK; k++) {
+            rc = tetmesh__read_int(lx, &node);
+            if (rc == TETMESH_OK && (node < first_node || node - first_node >= m->node_count))
+                rc = TETMESH_ERR_RANGE;
+            if (rc == TETMESH_OK && k < 4) m->tets[4 * i + k] = (int)(node - first_node);
+        }
+        if (rc == TETMESH_OK) rc = tetmesh__skip_reals(lx, attributes);
+    }
+    return rc;
+}
+
+TETMESHDEF int tetmesh_parse_tetgen(tetmesh *out, const char *node_text, size_t node_len,
+                                    const char *ele_text, size_t ele_len)
+{
+    tetmesh__lexer lx;
+    long long first_node = 0;
+    int rc;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!node_text || !ele_text) return TETMESH_ERR_ARG;
+    tetmesh__lexer_init(&lx, node_text, node_len, 1);
+    rc = tetmesh__tetgen_nodes(&lx, out, &first_node);
+    if (rc == TETMESH_OK) {
+        tetmesh__lexer_init(&lx, ele_text, ele_len, 1);
+        rc = tetmesh__tetgen_tets(&lx, out, first_node);
+    }
+    return tetmesh__finish_read(out, rc);
+}
+
+/* >>readers: Gmsh */
+
+/* A node tag and the zero-based index it maps to. */
+typedef struct tetmesh__tag {
+    long long tag;
+    int index;
+} tetmesh__tag;
+
+static int tetmesh__tag_cmp(const void *pa, const void *pb)
+{
+    const tetmesh__tag *a = (const tetmesh__tag *)pa, *b = (const tetmesh__tag *)pb;
+    return a->tag < b->tag ? -1 : a->tag > b->tag;
+}
+
+typedef struct tetmesh__gmsh {
+    tetmesh__lexer lx;
+    int version;          /* 2 (format 2.2) or 4 (format 4.1) */
+    tetmesh *mesh;        /* nodes filled by $Nodes */
+    tetmesh__tag *tags;   /* node_count tags, sorted by tag once $Nodes is read */
+    int *tets;            /* 4 * tet_count node indices, grown while $Elements is read */
+    long long tet_count, tet_capacity;
+} tetmesh__gmsh;
+
+/* The next token must be exactly word. */
+static int tetmesh__expect_word(tetmesh__lexer *lx, const char *word)
+{
+    const char *start;
+    size_t length;
+    if (!tetmesh__next_token(lx, &start, &length)) return TETMESH_ERR_PARSE;
+    return length == strlen(word) && memcmp(start, word, length) == 0 ? TETMESH_OK
+                                                                       : TETMESH_ERR_PARSE;
+}
+
+/* "$MeshFormat", "<version> <file-type> <data-size>", "$EndMeshFormat": ASCII (file
+   type 0) 2.2 or 4.1 only. */
+static int tetmesh__gmsh_format(tetmesh__gmsh *g)
+{
+    double version;
+    long long file_type, data_size;
+    int rc = tetmesh__expect_word(&g->lx, "$MeshFormat");
+    if (rc == TETMESH_OK) rc = tetmesh__read_real(&g->lx, &version);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &file_type);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &data_size);
+    if (rc) return rc;
+    if (file_type != 0) return TETMESH_ERR_PARSE;
+    if (version == 2.2)
+        g->version = 2;
+    else if (version == 4.1)
+        g->version = 4;
+    else
+        return TETMESH_ERR_PARSE;
+    return tetmesh__expect_word(&g->lx, "$EndMeshFormat");
+}
+
+/* Skips a section whose header "$<name>" has been read, up to its "$End<name>". */
+static int tetmesh__gmsh_skip_section(tetmesh__lexer *lx, const char *name, size_t name_len)
+{
+    const char *start;
+    size_t length;
+    while (tetmesh__next_token(lx, &start, &length))
+        if (length == name_len + 4 && memcmp(start, "$End", 4) == 0 &&
+            memcmp(start + 4, name, name_len) == 0)
+            return TETMESH_OK;
+    return TETMESH_ERR_PARSE;
+}
+
+static int tetmesh__gmsh_alloc_nodes(tetmesh__gmsh *g, long long count)
+{
+    int rc;
+    if (count == 0) return TETMESH_ERR_COUNT;
+    rc = tetmesh__alloc_nodes(g->mesh, count);
+    if (rc) return rc;
+    g->tags = (tetmesh__tag *)malloc((size_t)count * sizeof *g->tags);
+    return g->tags ? TETMESH_OK : TETMESH_ERR_ALLOC;
+}
+
+/* Node i's tag, which must be positive. */
+static int tetmesh__gmsh_read_tag(tetmesh__gmsh *g, long long i)
+{
+    int rc = tetmesh__read_int(&g->lx, &g->tags[i].tag);
+    if (rc) return rc;
+    g->tags[i].index = (int)i;
+    return g->tags[i].tag > 0 ? TETMESH_OK : TETMESH_ERR_RANGE;
+}
+
+/* 2.2 $Nodes: "<count>", then "<tag> x y z" per node. */
+static int tetmesh__gmsh_nodes2(tetmesh__gmsh *g)
+{
+    long long count, i;
+    int rc = tetmesh__read_int(&g->lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, count, 8, TETMESH__MAX_NODES);
+    if (rc == TETMESH_OK) rc = tetmesh__gmsh_alloc_nodes(g, count);
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        rc = tetmesh__gmsh_read_tag(g, i);
+        if (rc == TETMESH_OK) rc = tetmesh__read_point(&g->lx, g->mesh->nodes + 3 * i);
+    }
+    return rc;
+}
+
+/* One 4.1 node block: "<entity-dim> <entity-tag> <parametric> <count>", count tags,
+   then count lines "x y z" followed by entity-dim parametric coordinates when
+   parametric is 1. Fills nodes *filled onwards. */
+static int tetmesh__gmsh_node_block(tetmesh__gmsh *g, long long *filled)
+{
+    long long dim, entity, parametric, count, i;
+    int rc = tetmesh__read_int(&g->lx, &dim);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &entity);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &parametric);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &count);
+    if (rc) return rc;
+    if (dim < 0 || dim > 3 || (parametric != 0 && parametric != 1)) return TETMESH_ERR_PARSE;
+    if (count < 0 || count > g->mesh->node_count - *filled) return TETMESH_ERR_COUNT;
+    for (i = 0; i < count && rc == TETMESH_OK; i++) rc = tetmesh__gmsh_read_tag(g, *filled + i);
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        rc = tetmesh__read_point(&g->lx, g->mesh->nodes + 3 * (*filled + i));
+        if (rc == TETMESH_OK) rc = tetmesh__skip_reals(&g->lx, parametric * dim);
+    }
+    *filled += count;
+    return rc;
+}
+
+/* 4.1 $Nodes: "<blocks> <count> <min-tag> <max-tag>", then the blocks. */
+static int tetmesh__gmsh_nodes4(tetmesh__gmsh *g)
+{
+    long long blocks, count, min_tag, max_tag, b, filled = 0;
+    int rc = tetmesh__read_int(&g->lx, &blocks);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &min_tag);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &max_tag);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, blocks, 8, TETMESH__MAX_NODES);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, count, 8, TETMESH__MAX_NODES);
+    if (rc == TETMESH_OK) rc = tetmesh__gmsh_alloc_nodes(g, count);
+    for (b = 0; b < blocks && rc == TETMESH_OK; b++) rc = tetmesh__gmsh_node_block(g, &filled);
+    if (rc == TETMESH_OK && filled != count) rc = TETMESH_ERR_COUNT;
+    return rc;
+}
+
+/* Sorts the tags for lookup; a tag given twice is refused. */
+static int tetmesh__gmsh_sort_tags(tetmesh__gmsh *g)
+{
+    int i, n = g->mesh->node_count;
+    qsort(g->tags, (size_t)n, sizeof *g->tags, tetmesh__tag_cmp);
+    for (i = 1; i < n; i++)
+        if (g->tags[i].tag == g->tags[i - 1].tag) return TETMESH_ERR_PARSE;
+    return TETMESH_OK;
+}
+
+/* The zero-based index of the node with the given tag. */
+static int tetmesh__gmsh_lookup(const tetmesh__gmsh *g, long long tag, int *index)
+{
+    int lo = 0, hi = g->mesh->node_count - 1;
+    while (lo <= hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (g->tags[mid].tag == tag) {
+            *index = g->tags[mid].index;
+            return TETMESH_OK;
+        }
+        if (g->tags[mid].tag < tag)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return TETMESH_ERR_RANGE;
+}
+
+/* Reads the 4 node tags of a tetrahedron, which must end its line, and appends it. */
+static int tetmesh__gmsh_add_tet(tetmesh__gmsh *g)
+{
+    int k, rc = TETMESH_OK, *tet;
+    if (g->tet_count >= TETMESH__MAX_TETS) return TETMESH_ERR_COUNT;
+    if (g->tet_count == g->tet_capacity) {
+        long long capacity = g->tet_capacity ? 2 * g->tet_capacity : 64;
+        int *grown = (int *)realloc(g->tets, (size_t)capacity * 4 * sizeof(int));
+        if (!grown) return TETMESH_ERR_ALLOC;
+        g->tets = grown;
+        g->tet_capacity = capacity;
+    }
+    tet = g->tets + 4 * g->tet_count;
+    for (k = 0; k < 4 && rc == TETMESH_OK; k++) {
+        long long tag;
+        rc = tetmesh__read_int(&g->lx, &tag);
+        if (rc == TETMESH_OK) rc = tetmesh__gmsh_lookup(g, tag, tet + k);
+    }
+    if (rc == TETMESH_OK) rc = tetmesh__expect_line_end(&g->lx);
+    if (rc == TETMESH_OK) g->tet_count++;
+    return rc;
+}
+
+/* 2.2 $Elements: "<count>", then "<tag> <type> <ntags> <tags...> <nodes...>" per line;
+   lines of a type other than 4 are skipped whole. */
+static int tetmesh__gmsh_elements2(tetmesh__gmsh *g)
+{
+    long long count, i, tag, type, tags;
+    int rc = tetmesh__read_int(&g->lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, count, 6, TETMESH__MAX_TETS * 64);
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        rc = tetmesh__read_int(&g->lx, &tag);
+        if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &type);
+        if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &tags);
+        if (rc == TETMESH_OK && tags < 0) rc = TETMESH_ERR_COUNT; /* sizes no allocation */
+        if (rc == TETMESH_OK && type != 4) rc = tetmesh__skip_line(&g->lx);
+        if (rc == TETMESH_OK && type == 4) {
+            rc = tetmesh__skip_ints(&g->lx, tags);
+            if (rc == TETMESH_OK) rc = tetmesh__gmsh_add_tet(g);
+        }
+    }
+    return rc;
+}
+
+/* One 4.1 element block: "<entity-dim> <entity-tag> <type> <count>", then count lines
+   "<tag> <nodes...>"; blocks of a type other than 4 are skipped line by line. */
+static int tetmesh__gmsh_element_block(tetmesh__gmsh *g, long long *done, long long total)
+{
+    long long dim, entity, type, count, i, tag;
+    int rc = tetmesh__read_int(&g->lx, &dim);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &entity);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &type);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &count);
+    if (rc) return rc;
+    if (count < 0 || count > total - *done) return TETMESH_ERR_COUNT;
+    if (type != 4) rc = tetmesh__skip_line(&g->lx); /* the rest of the block header */
+    for (i = 0; i < count && rc == TETMESH_OK; i++) {
+        if (type != 4) {
+            rc = tetmesh__skip_line(&g->lx);
+        } else {
+            rc = tetmesh__read_int(&g->lx, &tag);
+            if (rc == TETMESH_OK) rc = tetmesh__gmsh_add_tet(g);
+        }
+    }
+    *done += count;
+    return rc;
+}
+
+/* 4.1 $Elements: "<blocks> <count> <min-tag> <max-tag>", then the blocks. */
+static int tetmesh__gmsh_elements4(tetmesh__gmsh *g)
+{
+    long long blocks, count, min_tag, max_tag, b, done = 0;
+    int rc = tetmesh__read_int(&g->lx, &blocks);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &count);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &min_tag);
+    if (rc == TETMESH_OK) rc = tetmesh__read_int(&g->lx, &max_tag);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, blocks, 8, TETMESH__MAX_TETS * 64);
+    if (rc == TETMESH_OK) rc = tetmesh__check_count(&g->lx, count, 4, TETMESH__MAX_TETS * 64);
+    for (b = 0; b < blocks && rc == TETMESH_OK; b++)
+        rc = tetmesh__gmsh_element_block(g, &done, count);
+    if (rc == TETMESH_OK && done != count) rc = TETMESH_ERR_COUNT;
+    return rc;
+}
+
+/* Reads sections up to $Elements: $Nodes must come first, others are skipped. */
+static int tetmesh__gmsh_sections(tetmesh__gmsh *g)
+{
+    const char *start;
+    size_t length;
+    int have_nodes = 0, rc = tetmesh__gmsh_format(g);
+    while (rc == TETMESH_OK) {
+        if (!tetmesh__next_token(&g->lx, &start, &length) || start[0] != '$')
+            return TETMESH_ERR_PARSE; /* a missing section, or stray text between sections */
+        if (length == 6 && memcmp(start, "$Nodes", 6) == 0) {
+            if (have_nodes) return TETMESH_ERR_PARSE;
+            rc = g->version == 2 ? tetmesh__gmsh_nodes2(g) : tetmesh__gmsh_nodes4(g);
+            if (rc == TETMESH_OK) rc = tetmesh__expect_word(&g->lx, "$EndNodes");
+            if (rc == TETMESH_OK) rc = tetmesh__gmsh_sort_tags(g);
+            have_nodes = 1;
+        } else if (length == 9 && memcmp(start, "$Elements", 9) == 0) {
+            if (!have_nodes) return TETMESH_ERR_PARSE;
+            rc = g->version == 2 ? tetmesh__gmsh_elements2(g) : tetmesh__gmsh_elements4(g);
+            if (rc == TETMESH_OK) rc = tetmesh__expect_word(&g->lx, "$EndElements");
+            return rc;
+        } else {
+            rc = tetmesh__gmsh_skip_section(&g->lx, start + 1, length - 1);
+        }
+    }
+    return rc;
+}
+
+TETMESHDEF int tetmesh_parse_gmsh(tetmesh *out, const char *text, size_t len)
+{
+    tetmesh__gmsh g;
+    int rc;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!text) return TETMESH_ERR_ARG;
+    memset(&g, 0, sizeof g);
+    tetmesh__lexer_init(&g.lx, text, len, 0);
+    g.mesh = out;
+    rc = tetmesh__gmsh_sections(&g);
+    if (rc == TETMESH_OK && g.tet_count == 0) rc = TETMESH_ERR_COUNT;
+    free(g.tags);
+    out->tets = g.tets; /* handed over, also on failure so that one free releases it */
+    out->tet_count = (int)g.tet_count;
+    return tetmesh__finish_read(out, rc);
+}
+
+/* >>readers: files */
+
+/* Reads a whole file into *text (free with free()). */
+static int tetmesh__read_file(const char *path, char **text, size_t *len)
+{
+    size_t capacity = 1 << 16, n = 0, got;
+    char *buf;
+    FILE *f;
+    *text = NULL;
+    *len = 0;
+    if (!path) return TETMESH_ERR_ARG;
+    f = fopen(path, "rb");
+    if (!f) return TETMESH_ERR_IO;
+    buf = (char *)malloc(capacity);
+    while (buf && (got = fread(buf + n, 1, capacity - n, f)) > 0) {
+        n += got;
+        if (n == capacity) {
+            char *grown = capacity <= (size_t)-1 / 2 ? (char *)realloc(buf, 2 * capacity) : NULL;
+            if (!grown) free(buf);
+            buf = grown;
+            capacity *= 2;
+        }
+    }
+    if (!buf || ferror(f)) {
+        int rc = buf ? TETMESH_ERR_IO : TETMESH_ERR_ALLOC;
+        free(buf);
+        fclose(f);
+        return rc;
+    }
+    fclose(f);
+    *text = buf;
+    *len = n;
+    return TETMESH_OK;
+}
+
+TETMESHDEF int tetmesh_read_tetgen(tetmesh *out, const char *node_path, const char *ele_path)
+{
+    char *node_text = NULL, *ele_text = NULL;
+    size_t node_len = 0, ele_len = 0;
+    int rc;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    rc = tetmesh__read_file(node_path, &node_text, &node_len);
+    if (rc == TETMESH_OK) rc = tetmesh__read_file(ele_path, &ele_text, &ele_len);
+    if (rc == TETMESH_OK) rc = tetmesh_parse_tetgen(out, node_text, node_len, ele_text, ele_len);
+    free(node_text);
+    free(ele_text);
+    return rc;
+}
+
+TETMESHDEF int tetmesh_read_gmsh(tetmesh *out, const char *path)
+{
+    char *text = NULL;
+    size_t len = 0;
+    int rc;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    rc = tetmesh__read_file(path, &text, &len);
+    if (rc == TETMESH_OK) rc = tetmesh_parse_gmsh(out, text, len);
+    free(text);
+    return rc;
+}
+
 /* >>writers: to do (tetmesh_write_vtk, tetmesh_write_obj) */
 #endif /* TETMESH_IMPLEMENTATION */
