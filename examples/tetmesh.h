@@ -138,15 +138,21 @@ TETMESHDEF int tetmesh_parse_gmsh(tetmesh *out, const char *text, size_t len);
 
 /* ---- writers ------------------------------------------------------------------------- */
 
-/* Legacy VTK unstructured grid (ASCII) of the tetrahedra with point-data fields.
+/* Legacy VTK unstructured grid (ASCII, "# vtk DataFile Version 3.0") of the tetrahedra
+   (cell type 10) with point-data fields (SCALARS or VECTORS, of their own type).
    points: 3 * node_count values of points_type. tets may be NULL with tet_count 0 to write
-   a point cloud (one VTK_VERTEX cell per node). */
+   a point cloud (one VTK_VERTEX cell, type 1, per node). Values are printed with enough
+   digits to read back exactly (%.17g for double, %.9g for float), non-finite ones as the
+   C library prints them. Refuses bad arguments (TETMESH_ERR_ARG) and out-of-range
+   indices (TETMESH_ERR_RANGE) before creating the file; a failed write removes it
+   (TETMESH_ERR_IO). */
 TETMESHDEF int tetmesh_write_vtk(const char *path, const void *points, int points_type,
                                  int node_count, const int *tets, int tet_count,
                                  const tetmesh_field *fields, int field_count);
 
 /* Wavefront OBJ of a triangle surface (e.g. from tetmesh_boundary or a model's boundary
-   list). */
+   list): "v x y z" per node, "f a b c" (1-based) per triangle; tris may be NULL with
+   tri_count 0. Errors as tetmesh_write_vtk. */
 TETMESHDEF int tetmesh_write_obj(const char *path, const void *points, int points_type,
                                  int node_count, const int *tris, int tri_count);
 
@@ -1230,5 +1236,146 @@ TETMESHDEF int tetmesh_read_gmsh(tetmesh *out, const char *path)
     return rc;
 }
 
-/* >>writers: to do (tetmesh_write_vtk, tetmesh_write_obj) */
+/* >>writers */
+
+/* Value i of a float or double array, as double. */
+static double tetmesh__value(const void *data, int type, size_t i)
+{
+    return type == TETMESH_FLOAT ? (double)((const float *)data)[i] : ((const double *)data)[i];
+}
+
+/* Enough significant digits for the value to read back bit-identical. */
+static const char *tetmesh__format(int type) { return type == TETMESH_FLOAT ? "%.9g" : "%.17g"; }
+
+static const char *tetmesh__type_name(int type) { return type == TETMESH_FLOAT ? "float" : "double"; }
+
+static int tetmesh__valid_type(int type) { return type == TETMESH_DOUBLE || type == TETMESH_FLOAT; }
+
+/* Every index of count cells of per_cell nodes is in [0, node_count). */
+static int tetmesh__check_cells(const int *cells, int count, int per_cell, int node_count)
+{
+    size_t i, n = (size_t)count * per_cell;
+    for (i = 0; i < n; i++)
+        if (cells[i] < 0 || cells[i] >= node_count) return TETMESH_ERR_RANGE;
+    return TETMESH_OK;
+}
+
+static int tetmesh__check_fields(const tetmesh_field *fields, int field_count)
+{
+    int f;
+    const char *c;
+    if (field_count < 0 || (field_count > 0 && !fields)) return TETMESH_ERR_ARG;
+    for (f = 0; f < field_count; f++) {
+        const tetmesh_field *field = fields + f;
+        if (!field->name || !field->name[0] || !field->data || !tetmesh__valid_type(field->type) ||
+            (field->components != 1 && field->components != 3))
+            return TETMESH_ERR_ARG;
+        for (c = field->name; *c; c++)
+            if (tetmesh__is_space(*c)) return TETMESH_ERR_ARG;
+    }
+    return TETMESH_OK;
+}
+
+/* Writes count tuples of `components` values, one tuple per line, after prefix. */
+static void tetmesh__write_tuples(FILE *f, const char *prefix, const void *data, int type,
+                                  int count, int components)
+{
+    const char *format = tetmesh__format(type);
+    int i, k;
+    for (i = 0; i < count; i++) {
+        fputs(prefix, f);
+        for (k = 0; k < components; k++) {
+            if (k) fputc(' ', f);
+            fprintf(f, format, tetmesh__value(data, type, (size_t)i * components + k));
+        }
+        fputc('\n', f);
+    }
+}
+
+/* Closes a file being written; on any write error reports it and removes the file. */
+static int tetmesh__close_written(FILE *f, const char *path)
+{
+    int failed = ferror(f) != 0;
+    if (fclose(f) != 0) failed = 1;
+    if (!failed) return TETMESH_OK;
+    remove(path);
+    return TETMESH_ERR_IO;
+}
+
+static void tetmesh__vtk_cells(FILE *f, const int *tets, int tet_count, int node_count)
+{
+    int i;
+    if (tets) {
+        fprintf(f, "CELLS %d %lld\n", tet_count, 5LL * tet_count);
+        for (i = 0; i < tet_count; i++)
+            fprintf(f, "4 %d %d %d %d\n", tets[4 * i], tets[4 * i + 1], tets[4 * i + 2],
+                    tets[4 * i + 3]);
+        fprintf(f, "CELL_TYPES %d\n", tet_count);
+        for (i = 0; i < tet_count; i++) fputs("10\n", f);
+    } else {
+        fprintf(f, "CELLS %d %lld\n", node_count, 2LL * node_count);
+        for (i = 0; i < node_count; i++) fprintf(f, "1 %d\n", i);
+        fprintf(f, "CELL_TYPES %d\n", node_count);
+        for (i = 0; i < node_count; i++) fputs("1\n", f);
+    }
+}
+
+static void tetmesh__vtk_fields(FILE *f, const tetmesh_field *fields, int field_count,
+                                int node_count)
+{
+    int i;
+    if (field_count > 0) fprintf(f, "POINT_DATA %d\n", node_count);
+    for (i = 0; i < field_count; i++) {
+        const tetmesh_field *field = fields + i;
+        if (field->components == 1)
+            fprintf(f, "SCALARS %s %s 1\nLOOKUP_TABLE default\n", field->name,
+                    tetmesh__type_name(field->type));
+        else
+            fprintf(f, "VECTORS %s %s\n", field->name, tetmesh__type_name(field->type));
+        tetmesh__write_tuples(f, "", field->data, field->type, node_count, field->components);
+    }
+}
+
+TETMESHDEF int tetmesh_write_vtk(const char *path, const void *points, int points_type,
+                                 int node_count, const int *tets, int tet_count,
+                                 const tetmesh_field *fields, int field_count)
+{
+    FILE *f;
+    int rc;
+    if (!path || !points || !tetmesh__valid_type(points_type) || node_count < 1 ||
+        tet_count < 0 || (!tets && tet_count != 0))
+        return TETMESH_ERR_ARG;
+    rc = tetmesh__check_fields(fields, field_count);
+    if (rc == TETMESH_OK && tets) rc = tetmesh__check_cells(tets, tet_count, 4, node_count);
+    if (rc) return rc;
+    f = fopen(path, "w");
+    if (!f) return TETMESH_ERR_IO;
+    fputs("# vtk DataFile Version 3.0\ntetmesh.h\nASCII\nDATASET UNSTRUCTURED_GRID\n", f);
+    fprintf(f, "POINTS %d %s\n", node_count, tetmesh__type_name(points_type));
+    tetmesh__write_tuples(f, "", points, points_type, node_count, 3);
+    tetmesh__vtk_cells(f, tets, tet_count, node_count);
+    tetmesh__vtk_fields(f, fields, field_count, node_count);
+    return tetmesh__close_written(f, path);
+}
+
+TETMESHDEF int tetmesh_write_obj(const char *path, const void *points, int points_type,
+                                 int node_count, const int *tris, int tri_count)
+{
+    FILE *f;
+    int i, rc;
+    if (!path || !points || !tetmesh__valid_type(points_type) || node_count < 1 ||
+        tri_count < 0 || (!tris && tri_count != 0))
+        return TETMESH_ERR_ARG;
+    rc = tris ? tetmesh__check_cells(tris, tri_count, 3, node_count) : TETMESH_OK;
+    if (rc) return rc;
+    f = fopen(path, "w");
+    if (!f) return TETMESH_ERR_IO;
+    fputs("# tetmesh.h\n", f);
+    tetmesh__write_tuples(f, "v ", points, points_type, node_count, 3);
+    for (i = 0; i < tri_count; i++)
+        fprintf(f, "f %d %d %d\n", tris[3 * i] + 1, tris[3 * i + 1] + 1, tris[3 * i + 2] + 1);
+    return tetmesh__close_written(f, path);
+}
+
+
 #endif /* TETMESH_IMPLEMENTATION */

@@ -1,5 +1,5 @@
-/* test_tetmesh.c - tests of examples/tetmesh.h: generators and TetGen/Gmsh readers
-   (including malformed input, one expected error code per case).
+/* test_tetmesh.c - tests of examples/tetmesh.h: generators, TetGen/Gmsh readers (including
+   malformed input, one expected error code per case), VTK/OBJ writers.
 
    Each case is listed in the table at the end and run by test_main() (tests/test.h):
 
@@ -240,6 +240,77 @@ static int write_text_file(const char *path, const char *text)
     if (!f) return 0;
     ok = fwrite(text, 1, n, f) == n;
     return fclose(f) == 0 && ok;
+}
+
+/* Reads a whole text file, NUL-terminated (free with free()); NULL on failure. */
+static char *read_text_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *text = NULL;
+    long size;
+    if (!f) return NULL;
+    if (fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0) {
+        text = (char *)malloc((size_t)size + 1);
+        if (text && fread(text, 1, (size_t)size, f) != (size_t)size) {
+            free(text);
+            text = NULL;
+        }
+        if (text) text[size] = '\0';
+    }
+    fclose(f);
+    return text;
+}
+
+/* The text after the line that starts with `key` (and the rest of that line), or NULL. */
+static const char *after_line(const char *text, const char *key)
+{
+    const char *p = text;
+    size_t n = strlen(key);
+    while (p && *p) {
+        if (strncmp(p, key, n) == 0) {
+            const char *end = strchr(p, '\n');
+            return end ? end + 1 : p + strlen(p);
+        }
+        p = strchr(p, '\n');
+        if (p) p++;
+    }
+    return NULL;
+}
+
+/* The line that starts with `key`, or NULL. */
+static const char *find_line(const char *text, const char *key)
+{
+    const char *p = text;
+    size_t n = strlen(key);
+    while (p && *p) {
+        if (strncmp(p, key, n) == 0) return p;
+        p = strchr(p, '\n');
+        if (p) p++;
+    }
+    return NULL;
+}
+
+/* The text n lines further on, or NULL. */
+static const char *skip_lines(const char *p, int n)
+{
+    while (p && n-- > 0) {
+        p = strchr(p, '\n');
+        if (p) p++;
+    }
+    return p;
+}
+
+static int count_lines_starting(const char *text, const char *key)
+{
+    const char *p = text;
+    size_t n = strlen(key);
+    int count = 0;
+    while (p && *p) {
+        if (strncmp(p, key, n) == 0) count++;
+        p = strchr(p, '\n');
+        if (p) p++;
+    }
+    return count;
 }
 
 /* >>generators */
@@ -1014,6 +1085,181 @@ static void test_gmsh_files(void)
     remove(path);
 }
 
+/* >>writers */
+
+static void test_write_vtk_mesh(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 2, 3};
+    char path[512];
+    char *text;
+    const char *p;
+    tetmesh m;
+    double *pressure;
+    float *velocity;
+    tetmesh_field fields[2];
+    int i, n = -1, size = -1, a = -1, b = -1, c = -1, d = -1, e = -1;
+    double x = -1.0, y = -1.0, z = -1.0;
+    temp_path(path, sizeof path, "mesh.vtk");
+    REQUIRE(tetmesh_box(&m, lo, hi, 2, 1, 1, TETMESH_SPLIT6) == TETMESH_OK);
+    pressure = (double *)malloc((size_t)m.node_count * sizeof(double));
+    velocity = (float *)malloc((size_t)m.node_count * 3 * sizeof(float));
+    REQUIRE(pressure && velocity);
+    for (i = 0; i < m.node_count; i++) {
+        pressure[i] = 0.1 * i + 1.0 / 3.0;
+        velocity[3 * i] = (float)i;
+        velocity[3 * i + 1] = -0.5f;
+        velocity[3 * i + 2] = 1.0f / 3.0f;
+    }
+    fields[0].name = "pressure";
+    fields[0].components = 1;
+    fields[0].type = TETMESH_TYPE_OF(pressure[0]);
+    fields[0].data = pressure;
+    fields[1].name = "velocity";
+    fields[1].components = 3;
+    fields[1].type = TETMESH_TYPE_OF(velocity[0]);
+    fields[1].data = velocity;
+    CHECK_INT(TETMESH_OK, tetmesh_write_vtk(path, m.nodes, TETMESH_DOUBLE, m.node_count, m.tets,
+                                            m.tet_count, fields, 2));
+    text = read_text_file(path);
+    REQUIRE(text != NULL);
+    CHECK(strncmp(text, "# vtk DataFile Version 3.0\n", 27) == 0);
+    CHECK(find_line(text, "ASCII") != NULL);
+    CHECK(find_line(text, "DATASET UNSTRUCTURED_GRID") != NULL);
+    CHECK(find_line(text, "POINTS 12 double") != NULL);
+    p = after_line(text, "POINTS");
+    CHECK(p && sscanf(p, "%lf %lf %lf", &x, &y, &z) == 3);
+    CHECK_NEAR(0.0, x, 0.0);
+    p = find_line(text, "CELLS");
+    CHECK(p && sscanf(p, "CELLS %d %d", &n, &size) == 2);
+    CHECK_INT(12, n);
+    CHECK_INT(60, size);
+    p = after_line(text, "CELLS");
+    CHECK(p && sscanf(p, "%d %d %d %d %d", &a, &b, &c, &d, &e) == 5);
+    CHECK_INT(4, a);
+    CHECK_INT(m.tets[0], b);
+    CHECK_INT(m.tets[3], e);
+    CHECK(find_line(text, "CELL_TYPES 12") != NULL);
+    CHECK_INT(12, count_lines_starting(after_line(text, "CELL_TYPES"), "10\n"));
+    CHECK(find_line(text, "POINT_DATA 12") != NULL);
+    CHECK(find_line(text, "SCALARS pressure double 1") != NULL);
+    p = after_line(text, "LOOKUP_TABLE default");
+    CHECK(p && sscanf(p, "%lf", &x) == 1);
+    CHECK(x == pressure[0]); /* printed with enough digits to read back exactly */
+    p = after_line(text, "VECTORS velocity float");
+    p = skip_lines(p, 11); /* node 11 */
+    CHECK(p && sscanf(p, "%lf %lf %lf", &x, &y, &z) == 3);
+    CHECK(x == 11.0 && y == -0.5 && (float)z == velocity[35]);
+    /* node 11 is grid node (2, 1, 1) */
+    p = after_line(text, "POINTS");
+    p = skip_lines(p, 11);
+    CHECK(p && sscanf(p, "%lf %lf %lf", &x, &y, &z) == 3);
+    CHECK(x == 1.0 && y == 2.0 && z == 3.0);
+    free(text);
+    free(pressure);
+    free(velocity);
+    tetmesh_free(&m);
+    remove(path);
+}
+
+static void test_write_vtk_point_cloud(void)
+{
+    const float points[9] = {0.1f, 0.2f, 0.3f, 1, 2, 3, -1, -2, -3.5f};
+    char path[512];
+    char *text;
+    const char *p;
+    double x = -1.0, y = -1.0, z = -1.0;
+    temp_path(path, sizeof path, "cloud.vtk");
+    CHECK_INT(TETMESH_OK, tetmesh_write_vtk(path, points, TETMESH_TYPE_OF(points[0]), 3, NULL, 0,
+                                            NULL, 0));
+    text = read_text_file(path);
+    REQUIRE(text != NULL);
+    CHECK(find_line(text, "POINTS 3 float") != NULL);
+    CHECK(find_line(text, "CELLS 3 6") != NULL);
+    CHECK(find_line(text, "CELL_TYPES 3") != NULL);
+    CHECK_INT(3, count_lines_starting(after_line(text, "CELL_TYPES"), "1\n"));
+    CHECK(find_line(text, "POINT_DATA") == NULL);
+    p = after_line(text, "POINTS");
+    CHECK(p && sscanf(p, "%lf %lf %lf", &x, &y, &z) == 3);
+    CHECK((float)x == points[0] && (float)y == points[1] && (float)z == points[2]);
+    free(text);
+    remove(path);
+}
+
+static void test_write_obj(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    char path[512];
+    char *text;
+    const char *p;
+    tetmesh m;
+    int *tris = NULL, tri_count = 0, a = 0, b = 0, c = 0, min_index = 1 << 30, max_index = 0;
+    temp_path(path, sizeof path, "surface.obj");
+    REQUIRE(tetmesh_box(&m, lo, hi, 2, 2, 2, TETMESH_SPLIT5) == TETMESH_OK);
+    REQUIRE(tetmesh_boundary(m.tets, m.tet_count, m.node_count, &tris, &tri_count) ==
+            TETMESH_OK);
+    CHECK_INT(TETMESH_OK,
+              tetmesh_write_obj(path, m.nodes, TETMESH_DOUBLE, m.node_count, tris, tri_count));
+    text = read_text_file(path);
+    REQUIRE(text != NULL);
+    CHECK_INT(m.node_count, count_lines_starting(text, "v "));
+    CHECK_INT(tri_count, count_lines_starting(text, "f "));
+    CHECK_INT(48, tri_count);
+    p = find_line(text, "f ");
+    CHECK(p && sscanf(p, "f %d %d %d", &a, &b, &c) == 3);
+    CHECK_INT(tris[0] + 1, a);
+    CHECK_INT(tris[1] + 1, b);
+    CHECK_INT(tris[2] + 1, c);
+    for (p = find_line(text, "f "); p; p = find_line(p + 1, "f ")) {
+        if (sscanf(p, "f %d %d %d", &a, &b, &c) != 3) break;
+        if (a < min_index) min_index = a;
+        if (b < min_index) min_index = b;
+        if (c < min_index) min_index = c;
+        if (a > max_index) max_index = a;
+        if (b > max_index) max_index = b;
+        if (c > max_index) max_index = c;
+    }
+    CHECK(min_index >= 1 && max_index <= m.node_count);
+    free(text);
+    free(tris);
+    tetmesh_free(&m);
+    remove(path);
+}
+
+static void test_writer_errors(void)
+{
+    const double points[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const int tet[4] = {0, 1, 2, 3}, bad_tet[4] = {0, 1, 2, 4}, tri[3] = {0, 2, 1};
+    const double scalar[4] = {1, 2, 3, 4};
+    tetmesh_field field;
+    char path[512], bad_dir[512];
+    FILE *f;
+    temp_path(path, sizeof path, "errors.vtk");
+    temp_path(bad_dir, sizeof bad_dir, "no_such_dir/x.vtk");
+    field.name = "has space";
+    field.components = 1;
+    field.type = TETMESH_DOUBLE;
+    field.data = scalar;
+    remove(path);
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(NULL, points, 0, 4, tet, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, NULL, 0, 4, tet, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 7, 4, tet, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 0, 0, tet, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 0, 4, NULL, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 0, 4, tet, 1, NULL, 1));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 0, 4, tet, 1, &field, 1));
+    field.name = "ok";
+    field.components = 2;
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_vtk(path, points, 0, 4, tet, 1, &field, 1));
+    CHECK_INT(TETMESH_ERR_RANGE, tetmesh_write_vtk(path, points, 0, 4, bad_tet, 1, NULL, 0));
+    f = fopen(path, "rb");
+    CHECK(f == NULL); /* refused before the file was created */
+    if (f) fclose(f);
+    CHECK_INT(TETMESH_ERR_IO, tetmesh_write_vtk(bad_dir, points, 0, 4, tet, 1, NULL, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_write_obj(path, points, 0, 4, NULL, 1));
+    CHECK_INT(TETMESH_ERR_RANGE, tetmesh_write_obj(path, points, 0, 2, tri, 1));
+    CHECK_INT(TETMESH_ERR_IO, tetmesh_write_obj(bad_dir, points, 0, 4, tri, 1));
+}
+
 static void test_error_strings(void)
 {
     CHECK(strcmp(tetmesh_error_string(TETMESH_OK), "ok") == 0);
@@ -1050,6 +1296,10 @@ static const test_case cases[] = {
     TEST(test_gmsh_malformed),
     TEST(test_gmsh_not_nul_terminated),
     TEST(test_gmsh_files),
+    TEST(test_write_vtk_mesh),
+    TEST(test_write_vtk_point_cloud),
+    TEST(test_write_obj),
+    TEST(test_writer_errors),
     TEST(test_error_strings),
 };
 
