@@ -33,6 +33,8 @@ TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 
 .PHONY: all test test-run examples clean
+# keep the test binaries between runs (they are intermediate files of the .result rules)
+.SECONDARY:
 all: test
 
 test:

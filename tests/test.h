@@ -34,18 +34,18 @@ typedef struct test_case {
    scope counter is fine here (the library itself keeps no global state). */
 static int test__failed_checks;
 
-static void test__fail_header(const char *file, int line, const char *what)
+static inline void test__fail_header(const char *file, int line, const char *what)
 {
     fprintf(stderr, "%s:%d: check failed: %s\n", file, line, what);
     test__failed_checks++;
 }
 
-static void test__check(int ok, const char *file, int line, const char *expr)
+static inline void test__check(int ok, const char *file, int line, const char *expr)
 {
     if (!ok) test__fail_header(file, line, expr);
 }
 
-static void test__check_int(long long expected, long long actual, const char *file, int line,
+static inline void test__check_int(long long expected, long long actual, const char *file, int line,
                             const char *expr)
 {
     if (expected != actual) {
@@ -55,7 +55,7 @@ static void test__check_int(long long expected, long long actual, const char *fi
 }
 
 /* |expected - actual| <= tol; a NaN on either side always fails. */
-static void test__check_near(double expected, double actual, double tol, const char *file,
+static inline void test__check_near(double expected, double actual, double tol, const char *file,
                              int line, const char *expr)
 {
     double diff = fabs(expected - actual);
@@ -67,7 +67,7 @@ static void test__check_near(double expected, double actual, double tol, const c
 }
 
 /* |expected - actual| <= rel * |expected|. */
-static void test__check_rel(double expected, double actual, double rel, const char *file, int line,
+static inline void test__check_rel(double expected, double actual, double rel, const char *file, int line,
                             const char *expr)
 {
     double diff = fabs(expected - actual);
