@@ -12,29 +12,39 @@
        #define TENSORMASS_IMPLEMENTATION
        #include "tensormass.h"
 
-   MINIMAL PROGRAM (a cube of 6 tets hanging from its top face; cc app.c -lm)
+   MINIMAL PROGRAM (examples/tensormass_hello.c: a cube of six tetrahedra hanging from its
+   top face; cc app.c -lm)
 
        #define TENSORMASS_IMPLEMENTATION
        #include "tensormass.h"
        #include <stdio.h>
+
        int main(void)
        {
-           static const tmass_real nodes[8 * 3] = {0,0,0, 1,0,0, 0,1,0, 1,1,0,
-                                                   0,0,1, 1,0,1, 0,1,1, 1,1,1};
-           static const int tets[6 * 4] = {0,1,3,7, 0,5,1,7, 0,3,2,7,
-                                           0,2,6,7, 0,4,5,7, 0,6,4,7};
+           static const tmass_real nodes[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,
+                                                   0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+           static const int tets[6 * 4] = {0, 1, 3, 7, 0, 5, 1, 7, 0, 3, 2, 7,
+                                           0, 2, 6, 7, 0, 4, 5, 7, 0, 6, 4, 7};
            tmass_desc d = tmass_default_desc();
            tmass_model *m;
            int i, err;
-           d.rest_positions = nodes; d.node_count = 8;
-           d.tets = tets;            d.tet_count = 6;
-           d.young_modulus = 1e5;    d.poisson_ratio = 0.3;  d.density = 1000;
-           d.time_step = 1e-3;       d.integrator = TMASS_IMPLICIT_EULER;
+           d.rest_positions = nodes;
+           d.node_count = 8;
+           d.tets = tets;
+           d.tet_count = 6;
+           d.young_modulus = 1e5; // Pa
+           d.poisson_ratio = 0.3;
+           d.density = 1000;      // kg/m^3
+           d.time_step = 1e-3;    // s
+           d.integrator = TMASS_IMPLICIT_EULER;
            err = tmass_create(&d, &m);
-           if (err) { printf("%s\n", tmass_error_string(err)); return 1; }
-           for (i = 4; i < 8; i++) tmass_fix_node(m, i);      // the face z = 1
-           for (i = 0; i < 1000; i++) tmass_step(m);           // one simulated second
-           printf("corner 0 sagged to z = %g m\n", tmass_positions(m)[2]);
+           if (err) {
+               printf("%s\n", tmass_error_string(err));
+               return 1;
+           }
+           for (i = 4; i < 8; i++) tmass_fix_node(m, i); // the face z = 1
+           for (i = 0; i < 1000; i++) tmass_step(m);     // one simulated second
+           printf("corner 0 sagged to z = %g m\n", (double)tmass_positions(m)[2]);
            tmass_destroy(m);
            return 0;
        }
@@ -430,6 +440,12 @@ TMASSDEF size_t tmass_memory_bytes(const tmass_model *m);
    ====================================================================================== */
 #if defined(TENSORMASS_IMPLEMENTATION) && !defined(TENSORMASS_IMPLEMENTATION_ONCE)
 #define TENSORMASS_IMPLEMENTATION_ONCE
+
+/* With TMASS_STATIC the functions a program does not call are unused statics. */
+#if defined(TMASS_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
 
 #include <float.h>
 #include <math.h>
@@ -2148,6 +2164,9 @@ TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real ou
     return TMASS_ERR_NO_EDGE;
 }
 
+#if defined(TMASS_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
 #endif /* TENSORMASS_IMPLEMENTATION */
 
 /*

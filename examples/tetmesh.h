@@ -183,6 +183,12 @@ TETMESHDEF void hexmesh_free(hexmesh *m);
 #if defined(TETMESH_IMPLEMENTATION) && !defined(TETMESH_IMPLEMENTATION_ONCE)
 #define TETMESH_IMPLEMENTATION_ONCE
 
+/* With TETMESH_STATIC the functions a program does not call are unused statics. */
+#if defined(TETMESH_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1378,4 +1384,7 @@ TETMESHDEF int tetmesh_write_obj(const char *path, const void *points, int point
 }
 
 
+#if defined(TETMESH_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
 #endif /* TETMESH_IMPLEMENTATION */
