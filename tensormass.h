@@ -75,8 +75,9 @@
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, time s, forces
    N, mass_damping 1/s, stiffness_damping s, gravity m/s^2 (default 9.81 along -z).
 
-   MEMORY: tmass_create makes one allocation (one block, 64-byte aligned arrays) through
-   the desc's allocator (or TMASS_MALLOC), plus temporary ones it frees before returning.
+   MEMORY: tmass_create makes one allocation (one block; every array in it 64-byte aligned)
+   through the desc's allocator (or TMASS_MALLOC), plus a temporary one it frees before
+   returning. A custom allocator must honour the alignment it is asked for (64).
    Nothing else allocates: stepping, forces, solves, cutting and tearing reuse that block
    (cutting only removes, so capacity never runs out). The description's arrays are read
    during tmass_create only. Pointers returned by tmass_positions and friends point into
@@ -149,12 +150,22 @@
    any enabled threshold of: relative volume change |V - V0| / V0, mean relative edge
    elongation, maximum relative edge elongation ((l - l0) / l0, positive in tension).
 
-   PERFORMANCE: the force loop reads, per live edge, two int node indices and one 3x3
-   tensor (8 + 72 bytes in double, 8 + 36 in float) and updates the two end vertices;
-   per vertex one 3x3 tensor (72 / 36 bytes) and its position. Edges are sorted by their
-   lower vertex and grouped in contiguous chunks, so the tensors stream from memory. Mesh
-   node numbering with locality (as the box generators and most meshers produce) keeps
-   the vertex accesses in cache.
+   PERFORMANCE: a force evaluation is one pass over the live edges. Per edge it reads two
+   int node indices and one 3x3 tensor (8 + 72 = 80 bytes in double, 8 + 36 = 44 in
+   float) and the displacements of both ends, and updates the forces of both ends; per
+   vertex it touches 3 displacements and 3 forces (zeroed, then accumulated). There is no
+   vertex pass: eq. 6 is evaluated in its difference form (see THE MODEL). Edges are sorted
+   by their lower vertex and grouped in contiguous chunks, so the tensors stream from
+   memory; a run of edges sharing their lower vertex accumulates in registers. Measured on
+   an AMD EPYC (Zen 5) core, gcc -O3 -march=native, double, beam meshes of 768 to 768,000
+   tetrahedra: 3.4 to 3.6 ns per edge (4.1 to 5.1 ns per tetrahedron), 1.5 to 1.6 times the
+   time to stream the 80 bytes per edge at the STREAM triad rate measured in the same run
+   (1.2 to 1.4 times when the vertex traffic is counted too). In ISO mode (-std=c99) gcc
+   does not contract multiply-adds into FMAs and the loop is about 8 % slower. Removing a
+   tetrahedron is constant work (ten tensor updates, its edges, faces and boundary
+   triangles): 0.26 us per tetrahedron on a 6,000-tet mesh, 1.4 us on a 1.3-million-tet
+   mesh with tetrahedra picked at random (cache misses). Number mesh nodes with locality
+   (as the box generators and most meshers do) to keep vertex accesses in cache.
 
    LIMITS
        - Linear elasticity: valid for small displacements (a few % strain). It is not
@@ -294,7 +305,7 @@ typedef struct tmass_desc {
     tmass_real gravity[3];       /* m/s^2, default (0, 0, -9.81) */
     tmass_real time_step;        /* s, default 1e-3, used by tmass_step */
     tmass_integrator integrator; /* default TMASS_IMPLICIT_EULER */
-    tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-8 (1e-5 float) */
+    tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-6 (1e-5 float) */
     int cg_max_iterations;       /* default 2000 */
 
     /* environment */
@@ -471,6 +482,12 @@ TMASSDEF size_t tmass_memory_bytes(const tmass_model *m);
 #define TMASS__RESTRICT restrict
 #endif
 
+#if defined(__GNUC__)
+#define TMASS__PREFETCH(p) __builtin_prefetch(p)
+#else
+#define TMASS__PREFETCH(p) ((void)0)
+#endif
+
 #define TMASS__COOKIE 0x544D4153u /* "TMAS" */
 #define TMASS__ALIGN 64
 #define TMASS__VEC_BLOCK 4096 /* reals per block of vector loops and dot partial sums */
@@ -642,19 +659,30 @@ static void tmass__run(const tmass_model *m, int count, tmass__range_fn fn, void
 
 /* >>memory ---------------------------------------------------------------------------- */
 
+/* The desc's allocator, or TMASS_MALLOC with the block aligned to TMASS__ALIGN by hand
+   (the pointer malloc returned is kept just before the aligned block). */
 static void *tmass__alloc(const tmass_allocator *a, size_t size)
 {
+    char *raw, *p;
     if (a->alloc) return a->alloc(size, TMASS__ALIGN, a->user);
-    return TMASS_MALLOC(size, a->user);
+    raw = (char *)TMASS_MALLOC(size + TMASS__ALIGN + sizeof(void *), a->user);
+    if (!raw) return NULL;
+    p = raw + sizeof(void *);
+    p += (TMASS__ALIGN - (size_t)p % TMASS__ALIGN) % TMASS__ALIGN;
+    memcpy(p - sizeof(void *), &raw, sizeof(void *));
+    return p;
 }
 
 static void tmass__free(const tmass_allocator *a, void *ptr, size_t size)
 {
+    void *raw;
     if (!ptr) return;
-    if (a->free)
+    if (a->free) {
         a->free(ptr, size, a->user);
-    else
-        TMASS_FREE(ptr, a->user);
+        return;
+    }
+    memcpy(&raw, (char *)ptr - sizeof(void *), sizeof(void *));
+    TMASS_FREE(raw, a->user);
 }
 
 /* Carves aligned arrays out of one block; with base NULL it only measures. */
@@ -1052,7 +1080,7 @@ TMASSDEF tmass_desc tmass_default_desc(void)
     d.gravity[2] = (tmass_real)-9.81;
     d.time_step = (tmass_real)1e-3;
     d.integrator = TMASS_IMPLICIT_EULER;
-    d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-8);
+    d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-6);
     d.cg_max_iterations = 2000;
     d.internal_cookie = TMASS__COOKIE;
     return d;
@@ -1244,6 +1272,7 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
                 const tmass_real *K = T + 9 * s, *pb = p + 3 * eb[s];
                 tmass_real *ob = out + 3 * eb[s];
                 tmass_real d0 = pb[0] - a0, d1 = pb[1] - a1, d2 = pb[2] - a2;
+                TMASS__PREFETCH(K + 9 * 24); /* the tensor stream, a few lines ahead */
                 f0 += K[0] * d0 + K[1] * d1 + K[2] * d2;
                 f1 += K[3] * d0 + K[4] * d1 + K[5] * d2;
                 f2 += K[6] * d0 + K[7] * d1 + K[8] * d2;
