@@ -247,13 +247,24 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_NODE_RANGE, -22, "node index out of range") \
     X(TMASS_ERR_TET_RANGE, -23, "tetrahedron index out of range") \
     X(TMASS_ERR_NODE_INACTIVE, -24, "node belongs to no tetrahedron any more") \
-    X(TMASS_ERR_NO_EDGE, -25, "the two nodes share no edge")
+    X(TMASS_ERR_NO_EDGE, -25, "the two nodes share no edge") \
+    X(TMASS_ERR_PRECOMPUTED, -26, "a precomputed (quasi-static) model or part cannot change topology") \
+    X(TMASS_ERR_NOT_PRECOMPUTED, -27, "node has no precomputed response (not one of the precomputed nodes)") \
+    X(TMASS_ERR_NODE_PINNED, -28, "node is pinned (a fixed boundary condition)") \
+    X(TMASS_ERR_CONTACTS, -29, "too many contact nodes, or one listed twice") \
+    X(TMASS_ERR_SINGULAR, -30, "singular system (contacts or connections not independent)") \
+    X(TMASS_ERR_CANCELLED, -31, "precomputation cancelled by the progress callback") \
+    X(TMASS_ERR_FILE_IO, -32, "file could not be opened, read or written") \
+    X(TMASS_ERR_FILE_FORMAT, -33, "not a precomputation file, or its contents are corrupted") \
+    X(TMASS_ERR_FILE_VERSION, -34, "precomputation file of another format version or real type") \
+    X(TMASS_ERR_FILE_MISMATCH, -35, "precomputation file made for another mesh, material or setting") \
+    X(TMASS_ERR_FILE_TRUNCATED, -36, "precomputation file or buffer is truncated")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -26
+    TMASS_ERR_LAST_ = -37
 };
 
 typedef enum tmass_model_kind {
@@ -444,6 +455,128 @@ TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real ou
 /* Bytes held by the model. */
 TMASSDEF size_t tmass_memory_bytes(const tmass_model *m);
 
+/* ---- precomputed quasi-static model (Cotin et al. sec. 4) ----
+
+   Precomputes, with its pinned nodes as fixed boundary conditions, the static response of
+   a tensor-mass model to a unit force on each precomputed node in each direction (one CG
+   solve each: the columns of the compliance C = K^-1 restricted to the output nodes), and
+   its static displacement g under gravity and the external forces (the preload). At run
+   time, imposed displacements u_I on a few contact nodes I give the contact forces f by
+   the small dense system C_II f = u_I - g_I (Cholesky), then every output node's
+   displacement u = g + C_{.,I} f: the imposed displacements are met exactly, and the cost
+   is 9 |I| |output nodes| multiply-adds plus (3 |I|)^3 / 3 for the solve. No allocation
+   per update. The model is linear and its topology is frozen (sec. 4: changing the mesh
+   would need a new precomputation). */
+typedef struct tmass_qs tmass_qs;
+
+typedef struct tmass_qs_desc {
+    const int *nodes;     /* nodes to precompute (contact candidates, output), or NULL for
+                             every node of the boundary triangles that is not pinned */
+    int node_count;
+    int all_nodes;        /* 0 (default): displacements are updated at the precomputed nodes;
+                             1: at every node (memory and update cost grow to 9 n per
+                             precomputed node instead of 9 |nodes|) */
+    int max_contacts;     /* most contact nodes in one update, default 16 */
+    tmass_real cg_tolerance; /* relative residual of each solve, default 1e-10 (1e-6 float) */
+    int cg_max_iterations;   /* default 20000 */
+    int (*progress)(int done, int total, void *user); /* called after each solve; return
+                                                         non-zero to cancel. May be NULL */
+    void *progress_user;
+    tmass_allocator allocator; /* NULL entries: TMASS_MALLOC / TMASS_FREE */
+    unsigned int internal_cookie;
+} tmass_qs_desc;
+
+/* Defaults as documented in the fields. */
+TMASSDEF tmass_qs_desc tmass_qs_default_desc(void);
+/* Precomputes the quasi-static model of the tensor-mass model m (its mesh, material, pinned
+   nodes, gravity and external forces at this moment). Costs 3 * |nodes| + 1 CG solves;
+   uses m's scratch memory but leaves its state unchanged. */
+TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out);
+TMASSDEF void tmass_qs_destroy(tmass_qs *qs);
+/* Imposes displacements (3 * count, m, from rest) on `count` precomputed nodes (the rest
+   are free) and updates the displacements; forces (3 * count, may be NULL) receives the
+   force applied to the body at each contact node to hold it there, N (the reaction a
+   haptic tool feels is its opposite). count = 0 gives the preload. */
+TMASSDEF int tmass_qs_update(tmass_qs *qs, const int *nodes, const tmass_real *displacements,
+                             int count, tmass_real *forces);
+/* Displacements and positions of every node (3n), valid after create/load and each
+   update; nodes outside the output set keep the preload. */
+TMASSDEF const tmass_real *tmass_qs_displacements(const tmass_qs *qs);
+TMASSDEF const tmass_real *tmass_qs_positions(const tmass_qs *qs);
+/* The precomputed nodes (*count of them). */
+TMASSDEF const int *tmass_qs_nodes(const tmass_qs *qs, int *count);
+/* Bytes held (the compliance is 9 |nodes| |output nodes| reals). */
+TMASSDEF size_t tmass_qs_memory_bytes(const tmass_qs *qs);
+/* Always TMASS_ERR_PRECOMPUTED: the precomputation fixes the topology (the paper's limit;
+   use the hybrid model to cut). */
+TMASSDEF int tmass_qs_remove_tets(tmass_qs *qs, const int *tets, int count);
+/* Saves the precomputation (versioned binary: header, preload, compliance, checksum). */
+TMASSDEF int tmass_qs_save(const tmass_qs *qs, const char *path);
+/* Loads a precomputation made for the same model state and description (mesh, material,
+   pinned nodes, loads, nodes, real type): anything else is refused with a TMASS_ERR_FILE_*
+   code. No CG solve. */
+TMASSDEF int tmass_qs_load(const tmass_model *m, const tmass_qs_desc *d, const char *path,
+                           tmass_qs **out);
+/* The same to and from memory: with buffer NULL, *size receives the bytes needed. */
+TMASSDEF int tmass_qs_save_memory(const tmass_qs *qs, void *buffer, size_t capacity, size_t *size);
+TMASSDEF int tmass_qs_load_memory(const tmass_model *m, const tmass_qs_desc *d, const void *buffer,
+                                  size_t size, tmass_qs **out);
+
+/* ---- hybrid model (Cotin et al. sec. 6) ----
+
+   One mesh split into a dynamic tensor-mass part (where cutting and tearing happen) and a
+   precomputed quasi-static part, sharing connection nodes. The loop of fig. 5: the
+   dynamic part imposes its displacements on the connection nodes of the quasi-static
+   part, which returns the forces on them. Beyond the paper, the quasi-static part's exact
+   stiffness at the connection nodes, S = (C_cc)^-1, is included implicitly in the dynamic
+   part's solve, so the coupling adds no stability limit; contacts on the quasi-static
+   part enter through the Schur complement of the contact block (exact at steady state,
+   lagged by one step in dynamics). The steady state equals that of one tensor-mass model
+   of the whole mesh. */
+typedef struct tmass_hybrid tmass_hybrid;
+
+typedef struct tmass_hybrid_desc {
+    tmass_desc model;                 /* the whole mesh, material, dynamics (tensor-mass) */
+    const unsigned char *tet_dynamic; /* tet_count flags: 1 dynamic part, 0 precomputed */
+    const int *fixed_nodes;           /* nodes pinned at rest (both parts), or NULL */
+    int fixed_count;
+    tmass_qs_desc precompute;         /* options of the precomputed part; its node list is
+                                         ignored (its boundary nodes are precomputed) */
+    unsigned int internal_cookie;
+} tmass_hybrid_desc;
+
+TMASSDEF tmass_hybrid_desc tmass_hybrid_default_desc(void);
+/* Splits the mesh, creates the dynamic part and precomputes the other (see
+   tmass_qs_create for the cost). Both parts must be non-empty. */
+TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out);
+TMASSDEF void tmass_hybrid_destroy(tmass_hybrid *h);
+/* One step of the loop (dynamic part: the description's time step and integrator, or
+   the given ones), then the precomputed part's displacements. */
+TMASSDEF int tmass_hybrid_step(tmass_hybrid *h);
+TMASSDEF int tmass_hybrid_step_ex(tmass_hybrid *h, tmass_real dt, tmass_integrator integrator);
+/* The steady state of the coupled model (one CG solve on the dynamic part). */
+TMASSDEF int tmass_hybrid_solve_static(tmass_hybrid *h);
+/* A user contact on any node of the mesh (node indices of the whole mesh): pinned at
+   rest + u in the dynamic part, or imposed on the precomputed part. */
+TMASSDEF int tmass_hybrid_set_displacement(tmass_hybrid *h, int node, const tmass_real u[3]);
+TMASSDEF int tmass_hybrid_release_node(tmass_hybrid *h, int node);
+/* Force applied to the body at a contact node to hold it (N); zero for a free node. */
+TMASSDEF int tmass_hybrid_contact_force(tmass_hybrid *h, int node, tmass_real f[3]);
+/* Cutting and tearing of the dynamic part (tet indices of the whole mesh). A tetrahedron
+   of the precomputed part gives TMASS_ERR_PRECOMPUTED and nothing is removed. */
+TMASSDEF int tmass_hybrid_remove_tets(tmass_hybrid *h, const int *tets, int count, int *removed);
+TMASSDEF int tmass_hybrid_tear(tmass_hybrid *h, const tmass_tear_criteria *c, int *removed);
+/* Positions of every node of the whole mesh (3N, m). */
+TMASSDEF const tmass_real *tmass_hybrid_positions(const tmass_hybrid *h);
+/* Boundary triangles of the whole live mesh (global node indices), outward; rebuilt on
+   each call (cost linear in the boundary, no allocation). */
+TMASSDEF const int *tmass_hybrid_boundary_triangles(tmass_hybrid *h, int *count);
+/* The parts, for diagnostics (their node and tet numbering is local). */
+TMASSDEF tmass_model *tmass_hybrid_dynamic_part(tmass_hybrid *h);
+TMASSDEF const tmass_qs *tmass_hybrid_precomputed_part(const tmass_hybrid *h);
+/* Number of connection nodes currently coupling the parts. */
+TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
+
 #endif /* TENSORMASS_H */
 
 /* ======================================================================================
@@ -553,6 +686,15 @@ struct tmass_model {
     int *tear_list;
 
     tmass_stats stats;
+
+    /* coupling stiffness (hybrid models): a dense symmetric block S over some nodes,
+       added to K in every force and K-product; allocated separately */
+    int coupling_count;  /* nodes */
+    int *coupling_nodes; /* node indices */
+    double *coupling;    /* (3c)^2, row-major, N/m */
+    double *coupling_x;  /* 2 * 3c scratch */
+    void *coupling_block;
+    size_t coupling_bytes;
 };
 
 /* >>math ------------------------------------------------------------------------------ */
@@ -1230,6 +1372,7 @@ TMASSDEF void tmass_destroy(tmass_model *m)
     tmass_allocator a;
     if (!m) return;
     a = m->allocator;
+    tmass__free(&a, m->coupling_block, m->coupling_bytes);
     tmass__free(&a, m->block, m->block_bytes);
 }
 
@@ -1288,6 +1431,23 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
     }
 }
 
+/* out += S p over the coupling nodes (serial: the block is small and dense). */
+static void tmass__coupling_matvec(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    int n3 = 3 * m->coupling_count, i, j;
+    double *x = m->coupling_x, *y = m->coupling_x + n3;
+    for (i = 0; i < m->coupling_count; i++)
+        for (j = 0; j < 3; j++) x[3 * i + j] = (double)p[3 * m->coupling_nodes[i] + j];
+    for (i = 0; i < n3; i++) {
+        const double *row = m->coupling + (size_t)i * n3;
+        double acc = 0.0;
+        for (j = 0; j < n3; j++) acc += row[j] * x[j];
+        y[i] = acc;
+    }
+    for (i = 0; i < m->coupling_count; i++)
+        for (j = 0; j < 3; j++) out[3 * m->coupling_nodes[i] + j] += (tmass_real)y[3 * i + j];
+}
+
 static void tmass__matvec(const tmass_model *m, const tmass_real *p, tmass_real *out)
 {
     tmass__matvec_ctx c;
@@ -1298,6 +1458,7 @@ static void tmass__matvec(const tmass_model *m, const tmass_real *p, tmass_real 
     for (c.colour = 0; c.colour < m->colour_count; c.colour++)
         tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
                    tmass__matvec_chunks, &c);
+    if (m->coupling_count) tmass__coupling_matvec(m, p, out);
 }
 
 /* Spring forces (eq. 7) with axial damping, into out (overwritten):
@@ -1546,6 +1707,16 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         pinv[i] = (tmass_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
         x[i] *= m->free_mask[i];
         bb += (double)b[i] * b[i] * m->free_mask[i];
+    }
+    for (i = 0; i < m->coupling_count; i++) { /* the coupling block's diagonal too */
+        int r, v = m->coupling_nodes[i], n3c = 3 * m->coupling_count;
+        for (r = 0; r < 3; r++) {
+            int dof = 3 * v + r;
+            double dgl = (diag ? (double)diag[dof] : 0.0) +
+                         c * ((double)m->vertex_tensor[9 * v + 4 * r] +
+                              m->coupling[(size_t)(3 * i + r) * n3c + 3 * i + r]);
+            pinv[dof] = (tmass_real)(m->free_mask[dof] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
+        }
     }
     m->stats.cg_iterations = 0;
     m->stats.cg_residual = 0;
@@ -2191,6 +2362,1232 @@ TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real ou
             }
         }
     return TMASS_ERR_NO_EDGE;
+}
+
+/* >>dense ----------------------------------------------------------------------------- */
+
+/* In-place Cholesky factorisation A = L L^T of a symmetric positive definite n x n
+   row-major matrix (the lower triangle receives L). Returns 0, or -1 if not positive
+   definite. */
+static int tmass__cholesky(double *A, int n)
+{
+    int i, j, k;
+    for (j = 0; j < n; j++) {
+        double d = A[(size_t)j * n + j];
+        for (k = 0; k < j; k++) d -= A[(size_t)j * n + k] * A[(size_t)j * n + k];
+        if (!(d > 0.0)) return -1;
+        d = sqrt(d);
+        A[(size_t)j * n + j] = d;
+        for (i = j + 1; i < n; i++) {
+            double s = A[(size_t)i * n + j];
+            for (k = 0; k < j; k++) s -= A[(size_t)i * n + k] * A[(size_t)j * n + k];
+            A[(size_t)i * n + j] = s / d;
+        }
+    }
+    return 0;
+}
+
+/* Solves L L^T x = b in place (x holds b on entry). */
+static void tmass__cholesky_solve(const double *L, int n, double *x)
+{
+    int i, k;
+    for (i = 0; i < n; i++) {
+        double s = x[i];
+        for (k = 0; k < i; k++) s -= L[(size_t)i * n + k] * x[k];
+        x[i] = s / L[(size_t)i * n + i];
+    }
+    for (i = n - 1; i >= 0; i--) {
+        double s = x[i];
+        for (k = i + 1; k < n; k++) s -= L[(size_t)k * n + i] * x[k];
+        x[i] = s / L[(size_t)i * n + i];
+    }
+}
+
+/* FNV-1a, 64 bits. */
+static unsigned long long tmass__hash(unsigned long long h, const void *data, size_t bytes)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    for (i = 0; i < bytes; i++) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+/* >>quasi-static ---------------------------------------------------------------------- */
+
+#define TMASS__QS_COOKIE 0x514D4153u /* "TMSQ" */
+#define TMASS__QS_VERSION 1u
+#define TMASS__FNV_BASIS 14695981039346656037ull
+
+struct tmass_qs {
+    int node_count, pre_count, out_count, max_contacts, all_nodes;
+    unsigned long long fingerprint;
+    tmass_allocator allocator;
+    void *block;
+    size_t block_bytes;
+    int *pre_nodes;         /* P: precomputed nodes */
+    int *out_nodes;         /* O: output nodes (P, or every node) */
+    int *row_of_node;       /* node -> index in O, or -1 */
+    int *col_of_node;       /* node -> index in P, or -1 */
+    tmass_real *rest, *preload, *disp, *pos; /* 3n each */
+    tmass_real *compliance; /* column j < 3|P| holds 3|O| rows: C[j * 3|O| + row] */
+    tmass_real *out_disp;   /* 3|O| accumulator */
+    double *dense;          /* (3 max_contacts)^2 */
+    double *rhs;            /* 3 max_contacts */
+    int *contact_cols;      /* 3 max_contacts column indices */
+};
+
+TMASSDEF tmass_qs_desc tmass_qs_default_desc(void)
+{
+    tmass_qs_desc d;
+    memset(&d, 0, sizeof d);
+    d.max_contacts = 16;
+    d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-6 : 1e-10);
+    d.cg_max_iterations = 20000;
+    d.internal_cookie = TMASS__QS_COOKIE;
+    return d;
+}
+
+static void tmass__qs_layout(tmass_qs *q, tmass__carver *c)
+{
+    size_t n = (size_t)q->node_count, p = (size_t)q->pre_count, o = (size_t)q->out_count;
+    size_t k = (size_t)q->max_contacts;
+    TMASS__CARVE(c, q->pre_nodes, int, p);
+    TMASS__CARVE(c, q->out_nodes, int, o);
+    TMASS__CARVE(c, q->row_of_node, int, n);
+    TMASS__CARVE(c, q->col_of_node, int, n);
+    TMASS__CARVE(c, q->rest, tmass_real, 3 * n);
+    TMASS__CARVE(c, q->preload, tmass_real, 3 * n);
+    TMASS__CARVE(c, q->disp, tmass_real, 3 * n);
+    TMASS__CARVE(c, q->pos, tmass_real, 3 * n);
+    TMASS__CARVE(c, q->compliance, tmass_real, 9 * p * o);
+    TMASS__CARVE(c, q->out_disp, tmass_real, 3 * o);
+    TMASS__CARVE(c, q->dense, double, 9 * k * k);
+    TMASS__CARVE(c, q->rhs, double, 3 * k);
+    TMASS__CARVE(c, q->contact_cols, int, 3 * k);
+}
+
+/* Everything a precomputation depends on: mesh, live tets, materials, pinned nodes and
+   their targets, loads, the node set, the output choice and the real type. */
+static unsigned long long tmass__qs_fingerprint(const tmass_model *m, const tmass_qs *q)
+{
+    unsigned long long h = TMASS__FNV_BASIS;
+    int t, i, real_size = (int)sizeof(tmass_real);
+    h = tmass__hash(h, &real_size, sizeof real_size);
+    h = tmass__hash(h, &m->node_count, sizeof m->node_count);
+    h = tmass__hash(h, &m->tet_count, sizeof m->tet_count);
+    h = tmass__hash(h, m->rest, sizeof(tmass_real) * 3 * (size_t)m->node_count);
+    for (t = 0; t < m->tet_count; t++) {
+        if (!m->tet_alive[t]) continue;
+        h = tmass__hash(h, &t, sizeof t);
+        h = tmass__hash(h, m->tet_nodes + 4 * t, 4 * sizeof(int));
+        h = tmass__hash(h, m->tet_lambda + t, sizeof(double));
+        h = tmass__hash(h, m->tet_mu + t, sizeof(double));
+    }
+    for (i = 0; i < m->node_count; i++)
+        if (m->node_state[i] == TMASS__PINNED) {
+            h = tmass__hash(h, &i, sizeof i);
+            h = tmass__hash(h, m->target + 3 * i, 3 * sizeof(tmass_real));
+        }
+    h = tmass__hash(h, m->gravity, sizeof m->gravity);
+    h = tmass__hash(h, m->ext, sizeof(tmass_real) * 3 * (size_t)m->node_count);
+    h = tmass__hash(h, &m->density, sizeof m->density);
+    h = tmass__hash(h, q->pre_nodes, sizeof(int) * (size_t)q->pre_count);
+    h = tmass__hash(h, &q->all_nodes, sizeof q->all_nodes);
+    return h;
+}
+
+/* Validates (m, d) and builds an empty quasi-static model with its node sets, rest and
+   fingerprint (no solve). */
+static int tmass__qs_prepare(const tmass_model *m, const tmass_qs_desc *d, tmass_qs **out)
+{
+    tmass_qs tmp, *q;
+    tmass__carver carver;
+    int i, k, count = 0;
+    tmass_real *mark;
+    *out = NULL;
+    if (!m || !d) return TMASS_ERR_ARG;
+    if (d->internal_cookie != TMASS__QS_COOKIE) return TMASS_ERR_DESC;
+    if (m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (d->max_contacts < 1 || d->max_contacts > 4096 || (d->nodes && d->node_count < 1) ||
+        (d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return TMASS_ERR_ARG;
+    if (!(tmass__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
+        return TMASS_ERR_SOLVER;
+    /* mark the precomputed nodes in a scratch vector of the model (3n reals) */
+    mark = m->scratch[9];
+    memset(mark, 0, sizeof(tmass_real) * (size_t)m->node_count);
+    if (d->nodes) {
+        for (i = 0; i < d->node_count; i++) {
+            int v = d->nodes[i];
+            if (v < 0 || v >= m->node_count) return TMASS_ERR_NODE_RANGE;
+            if (m->node_state[v] == TMASS__INACTIVE) return TMASS_ERR_NODE_INACTIVE;
+            if (m->node_state[v] == TMASS__PINNED) return TMASS_ERR_NODE_PINNED;
+            if (mark[v] != 0) return TMASS_ERR_ARG; /* listed twice */
+            mark[v] = 1;
+        }
+    } else {
+        for (i = 0; i < 3 * m->tri_count; i++)
+            if (m->node_state[m->tri[i]] == TMASS__FREE) mark[m->tri[i]] = 1;
+    }
+    for (i = 0; i < m->node_count; i++) count += mark[i] != 0;
+    if (count == 0) return TMASS_ERR_ARG;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.node_count = m->node_count;
+    tmp.pre_count = count;
+    tmp.all_nodes = d->all_nodes != 0;
+    tmp.out_count = tmp.all_nodes ? m->node_count : count;
+    tmp.max_contacts = d->max_contacts;
+    tmp.allocator = d->allocator;
+    carver.base = NULL;
+    carver.offset = sizeof(tmass_qs);
+    tmass__qs_layout(&tmp, &carver);
+    tmp.block_bytes = carver.offset;
+    tmp.block = tmass__alloc(&tmp.allocator, tmp.block_bytes);
+    if (!tmp.block) return TMASS_ERR_ALLOC;
+    memset(tmp.block, 0, tmp.block_bytes);
+    carver.base = (char *)tmp.block;
+    carver.offset = sizeof(tmass_qs);
+    tmass__qs_layout(&tmp, &carver);
+    q = (tmass_qs *)tmp.block;
+    *q = tmp;
+    for (i = 0, k = 0; i < m->node_count; i++) {
+        q->col_of_node[i] = mark[i] != 0 ? k : -1;
+        if (mark[i] != 0) q->pre_nodes[k++] = i;
+    }
+    for (i = 0; i < m->node_count; i++) q->row_of_node[i] = q->all_nodes ? i : q->col_of_node[i];
+    for (i = 0; i < q->out_count; i++) q->out_nodes[i] = q->all_nodes ? i : q->pre_nodes[i];
+    memcpy(q->rest, m->rest, sizeof(tmass_real) * 3 * (size_t)m->node_count);
+    q->fingerprint = tmass__qs_fingerprint(m, q);
+    *out = q;
+    return TMASS_OK;
+}
+
+static void tmass__qs_set_preload_state(tmass_qs *q)
+{
+    int i;
+    memcpy(q->disp, q->preload, sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    for (i = 0; i < 3 * q->node_count; i++) q->pos[i] = q->rest[i] + q->disp[i];
+}
+
+TMASSDEF void tmass_qs_destroy(tmass_qs *qs)
+{
+    tmass_allocator a;
+    if (!qs) return;
+    a = qs->allocator;
+    tmass__free(&a, qs->block, qs->block_bytes);
+}
+
+TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out)
+{
+    tmass_qs *q;
+    tmass_real *b, *x, *cg_scratch[5], saved_tol;
+    int err, i, j, saved_iter, total, n3, o3;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    err = tmass__qs_prepare(m, d, &q);
+    if (err) return err;
+    n3 = 3 * m->node_count;
+    o3 = 3 * q->out_count;
+    b = m->scratch[0];
+    x = m->scratch[1];
+    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[2 + i];
+    saved_tol = m->cg_tolerance;
+    saved_iter = m->cg_max_iterations;
+    m->cg_tolerance = d->cg_tolerance;
+    m->cg_max_iterations = d->cg_max_iterations;
+    total = 3 * q->pre_count + 1;
+    /* preload: K g = f_ext + M g_vec on the free nodes */
+    for (i = 0; i < n3; i++) {
+        b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3];
+        x[i] = 0;
+    }
+    err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
+    memcpy(q->preload, x, sizeof(tmass_real) * (size_t)n3);
+    if (!err && d->progress && d->progress(1, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
+    /* one column of the compliance per precomputed degree of freedom */
+    for (j = 0; j < 3 * q->pre_count && !err; j++) {
+        tmass_real *col = q->compliance + (size_t)j * o3;
+        memset(b, 0, sizeof(tmass_real) * (size_t)n3);
+        memset(x, 0, sizeof(tmass_real) * (size_t)n3);
+        b[3 * q->pre_nodes[j / 3] + j % 3] = 1;
+        err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
+        if (err) break;
+        for (i = 0; i < q->out_count; i++) {
+            const tmass_real *u = x + 3 * q->out_nodes[i];
+            col[3 * i] = u[0];
+            col[3 * i + 1] = u[1];
+            col[3 * i + 2] = u[2];
+        }
+        if (d->progress && d->progress(j + 2, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
+    }
+    m->cg_tolerance = saved_tol;
+    m->cg_max_iterations = saved_iter;
+    if (err) {
+        tmass_qs_destroy(q);
+        return err;
+    }
+    tmass__qs_set_preload_state(q);
+    *out = q;
+    return TMASS_OK;
+}
+
+/* Compliance entry between output row `row` and precomputed column `col`. */
+static double tmass__qs_entry(const tmass_qs *q, int row, int col)
+{
+    return (double)q->compliance[(size_t)col * 3 * q->out_count + row];
+}
+
+/* disp = preload + sum_j C[:, cols[j]] f[j] over the output nodes; positions follow. */
+static void tmass__qs_superpose(tmass_qs *q, const int *cols, const double *f, int ncols)
+{
+    int i, j, o3 = 3 * q->out_count;
+    tmass_real *acc = q->out_disp;
+    for (i = 0; i < q->out_count; i++) {
+        const tmass_real *g = q->preload + 3 * q->out_nodes[i];
+        acc[3 * i] = g[0];
+        acc[3 * i + 1] = g[1];
+        acc[3 * i + 2] = g[2];
+    }
+    for (j = 0; j < ncols; j++) {
+        const tmass_real *TMASS__RESTRICT col = q->compliance + (size_t)cols[j] * o3;
+        tmass_real *TMASS__RESTRICT a = acc;
+        tmass_real fj = (tmass_real)f[j];
+        for (i = 0; i < o3; i++) a[i] += fj * col[i];
+    }
+    for (i = 0; i < q->out_count; i++) {
+        int v = q->out_nodes[i], r;
+        for (r = 0; r < 3; r++) {
+            q->disp[3 * v + r] = acc[3 * i + r];
+            q->pos[3 * v + r] = q->rest[3 * v + r] + acc[3 * i + r];
+        }
+    }
+}
+
+TMASSDEF int tmass_qs_update(tmass_qs *q, const int *nodes, const tmass_real *u, int count,
+                             tmass_real *forces)
+{
+    int a, b, k3, *cols;
+    if (!q || count < 0 || (count > 0 && (!nodes || !u))) return TMASS_ERR_ARG;
+    if (count > q->max_contacts) return TMASS_ERR_CONTACTS;
+    for (a = 0; a < count; a++) {
+        if (nodes[a] < 0 || nodes[a] >= q->node_count) return TMASS_ERR_NODE_RANGE;
+        if (q->col_of_node[nodes[a]] < 0) return TMASS_ERR_NOT_PRECOMPUTED;
+        for (b = 0; b < a; b++)
+            if (nodes[b] == nodes[a]) return TMASS_ERR_CONTACTS;
+        if (!tmass__vec3_finite(u + 3 * a)) return TMASS_ERR_ARG;
+    }
+    k3 = 3 * count;
+    cols = q->contact_cols;
+    /* C_II f = u_I - g_I (rows of contact a, columns of contact b) */
+    for (a = 0; a < k3; a++) {
+        int va = nodes[a / 3], row = 3 * q->row_of_node[va] + a % 3;
+        for (b = 0; b < k3; b++)
+            q->dense[(size_t)a * k3 + b] =
+                tmass__qs_entry(q, row, 3 * q->col_of_node[nodes[b / 3]] + b % 3);
+        q->rhs[a] = (double)u[a] - (double)q->preload[3 * va + a % 3];
+    }
+    if (count && tmass__cholesky(q->dense, k3)) return TMASS_ERR_SINGULAR;
+    if (count) tmass__cholesky_solve(q->dense, k3, q->rhs);
+    for (a = 0; a < k3; a++)
+        if (!tmass__finite(q->rhs[a])) return TMASS_ERR_NOT_FINITE;
+    for (a = 0; a < k3; a++) cols[a] = 3 * q->col_of_node[nodes[a / 3]] + a % 3;
+    tmass__qs_superpose(q, cols, q->rhs, k3);
+    if (forces)
+        for (a = 0; a < k3; a++) forces[a] = (tmass_real)q->rhs[a];
+    return TMASS_OK;
+}
+
+TMASSDEF const tmass_real *tmass_qs_displacements(const tmass_qs *q) { return q ? q->disp : NULL; }
+TMASSDEF const tmass_real *tmass_qs_positions(const tmass_qs *q) { return q ? q->pos : NULL; }
+TMASSDEF size_t tmass_qs_memory_bytes(const tmass_qs *q) { return q ? q->block_bytes : 0; }
+
+TMASSDEF const int *tmass_qs_nodes(const tmass_qs *q, int *count)
+{
+    if (count) *count = q ? q->pre_count : 0;
+    return q ? q->pre_nodes : NULL;
+}
+
+TMASSDEF int tmass_qs_remove_tets(tmass_qs *q, const int *tets, int count)
+{
+    (void)tets;
+    (void)count;
+    return q ? TMASS_ERR_PRECOMPUTED : TMASS_ERR_ARG;
+}
+
+/* >>quasi-static-io ------------------------------------------------------------------- */
+
+/* File layout (native byte order, checked by the byte-order field):
+     char magic[8] "TMASSQS"    u32 version      u32 byte_order 0x01020304
+     u32 real_size              u32 all_nodes    i32 node_count, pre_count, out_count
+     u32 reserved               u64 fingerprint  u64 payload_bytes
+     payload: preload (3n reals), compliance (9 |P| |O| reals)
+     u64 FNV-1a checksum of the payload */
+#define TMASS__QS_HEADER_BYTES 56
+
+static size_t tmass__qs_payload_bytes(const tmass_qs *q)
+{
+    return sizeof(tmass_real) * (3 * (size_t)q->node_count + 9 * (size_t)q->pre_count * q->out_count);
+}
+
+static void tmass__put(unsigned char **p, const void *v, size_t n)
+{
+    memcpy(*p, v, n);
+    *p += n;
+}
+
+TMASSDEF int tmass_qs_save_memory(const tmass_qs *q, void *buffer, size_t capacity, size_t *size)
+{
+    unsigned char *p = (unsigned char *)buffer;
+    size_t payload, total;
+    unsigned int u32;
+    int i32;
+    unsigned long long u64, sum;
+    if (!q || !size) return TMASS_ERR_ARG;
+    payload = tmass__qs_payload_bytes(q);
+    total = TMASS__QS_HEADER_BYTES + payload + 8;
+    *size = total;
+    if (!buffer) return TMASS_OK;
+    if (capacity < total) return TMASS_ERR_ARG;
+    tmass__put(&p, "TMASSQS", 8);
+    u32 = TMASS__QS_VERSION;
+    tmass__put(&p, &u32, 4);
+    u32 = 0x01020304u;
+    tmass__put(&p, &u32, 4);
+    u32 = (unsigned int)sizeof(tmass_real);
+    tmass__put(&p, &u32, 4);
+    u32 = (unsigned int)q->all_nodes;
+    tmass__put(&p, &u32, 4);
+    i32 = q->node_count;
+    tmass__put(&p, &i32, 4);
+    i32 = q->pre_count;
+    tmass__put(&p, &i32, 4);
+    i32 = q->out_count;
+    tmass__put(&p, &i32, 4);
+    u32 = 0;
+    tmass__put(&p, &u32, 4);
+    tmass__put(&p, &q->fingerprint, 8);
+    u64 = (unsigned long long)payload;
+    tmass__put(&p, &u64, 8);
+    tmass__put(&p, q->preload, sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    tmass__put(&p, q->compliance, payload - sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    sum = tmass__hash(TMASS__FNV_BASIS, (const unsigned char *)buffer + TMASS__QS_HEADER_BYTES, payload);
+    tmass__put(&p, &sum, 8);
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_qs_load_memory(const tmass_model *m, const tmass_qs_desc *d, const void *buffer,
+                                  size_t size, tmass_qs **out)
+{
+    const unsigned char *p = (const unsigned char *)buffer;
+    tmass_qs *q;
+    unsigned int version, order, real_size, all_nodes, reserved;
+    int node_count, pre_count, out_count, err;
+    unsigned long long fingerprint, payload, sum, stored_sum;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!buffer) return TMASS_ERR_ARG;
+    if (size < 8) return TMASS_ERR_FILE_TRUNCATED;
+    if (memcmp(p, "TMASSQS", 8) != 0) return TMASS_ERR_FILE_FORMAT;
+    if (size < TMASS__QS_HEADER_BYTES) return TMASS_ERR_FILE_TRUNCATED;
+    memcpy(&version, p + 8, 4);
+    memcpy(&order, p + 12, 4);
+    memcpy(&real_size, p + 16, 4);
+    memcpy(&all_nodes, p + 20, 4);
+    memcpy(&node_count, p + 24, 4);
+    memcpy(&pre_count, p + 28, 4);
+    memcpy(&out_count, p + 32, 4);
+    memcpy(&reserved, p + 36, 4);
+    memcpy(&fingerprint, p + 40, 8);
+    memcpy(&payload, p + 48, 8);
+    if (order != 0x01020304u) return TMASS_ERR_FILE_VERSION; /* other byte order */
+    if (version != TMASS__QS_VERSION || real_size != sizeof(tmass_real)) return TMASS_ERR_FILE_VERSION;
+    err = tmass__qs_prepare(m, d, &q);
+    if (err) return err;
+    if ((int)all_nodes != q->all_nodes || node_count != q->node_count || pre_count != q->pre_count ||
+        out_count != q->out_count || fingerprint != q->fingerprint) {
+        tmass_qs_destroy(q);
+        return TMASS_ERR_FILE_MISMATCH;
+    }
+    if (payload != tmass__qs_payload_bytes(q) || reserved != 0) {
+        tmass_qs_destroy(q);
+        return TMASS_ERR_FILE_FORMAT;
+    }
+    if (size < TMASS__QS_HEADER_BYTES + payload + 8) {
+        tmass_qs_destroy(q);
+        return TMASS_ERR_FILE_TRUNCATED;
+    }
+    sum = tmass__hash(TMASS__FNV_BASIS, p + TMASS__QS_HEADER_BYTES, (size_t)payload);
+    memcpy(&stored_sum, p + TMASS__QS_HEADER_BYTES + payload, 8);
+    if (sum != stored_sum) {
+        tmass_qs_destroy(q);
+        return TMASS_ERR_FILE_FORMAT;
+    }
+    memcpy(q->preload, p + TMASS__QS_HEADER_BYTES, sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    memcpy(q->compliance, p + TMASS__QS_HEADER_BYTES + sizeof(tmass_real) * 3 * (size_t)q->node_count,
+           (size_t)payload - sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    tmass__qs_set_preload_state(q);
+    *out = q;
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_qs_save(const tmass_qs *q, const char *path)
+{
+    FILE *f;
+    size_t size;
+    void *buffer;
+    int err;
+    if (!q || !path) return TMASS_ERR_ARG;
+    tmass_qs_save_memory(q, NULL, 0, &size);
+    buffer = tmass__alloc(&q->allocator, size);
+    if (!buffer) return TMASS_ERR_ALLOC;
+    err = tmass_qs_save_memory(q, buffer, size, &size);
+    if (!err) {
+        f = fopen(path, "wb");
+        if (!f) {
+            err = TMASS_ERR_FILE_IO;
+        } else {
+            if (fwrite(buffer, 1, size, f) != size) err = TMASS_ERR_FILE_IO;
+            if (fclose(f) != 0) err = TMASS_ERR_FILE_IO;
+        }
+    }
+    tmass__free(&q->allocator, buffer, size);
+    return err;
+}
+
+TMASSDEF int tmass_qs_load(const tmass_model *m, const tmass_qs_desc *d, const char *path,
+                           tmass_qs **out)
+{
+    FILE *f;
+    long length;
+    size_t size;
+    void *buffer;
+    int err = TMASS_OK;
+    tmass_allocator a;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!path || !d) return TMASS_ERR_ARG;
+    a = d->allocator;
+    f = fopen(path, "rb");
+    if (!f) return TMASS_ERR_FILE_IO;
+    if (fseek(f, 0, SEEK_END) != 0 || (length = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return TMASS_ERR_FILE_IO;
+    }
+    size = (size_t)length;
+    buffer = tmass__alloc(&a, size ? size : 1);
+    if (!buffer) {
+        fclose(f);
+        return TMASS_ERR_ALLOC;
+    }
+    if (fread(buffer, 1, size, f) != size) err = TMASS_ERR_FILE_IO;
+    fclose(f);
+    if (!err) err = tmass_qs_load_memory(m, d, buffer, size, out);
+    tmass__free(&a, buffer, size ? size : 1);
+    return err;
+}
+
+/* >>hybrid ---------------------------------------------------------------------------- */
+
+#define TMASS__HY_COOKIE 0x59484D54u /* "TMHY" */
+
+struct tmass_hybrid {
+    int node_count, tet_count, dyn_tets;
+    tmass_allocator allocator;
+    void *block;
+    size_t block_bytes;
+    tmass_model *dyn;
+    tmass_qs *qs;
+    int *dyn_of, *qs_of;        /* whole-mesh node -> local node of each part, or -1 */
+    int *dyn_global;            /* dynamic-part node -> whole-mesh node */
+    int *tet_local;             /* whole-mesh tet -> tet of its part */
+    unsigned char *tet_dynamic; /* whole-mesh tet -> 1 dynamic, 0 precomputed */
+    unsigned char *fixed;       /* whole-mesh node -> pinned at rest */
+    /* connection nodes: shared by both parts, free, still active in the dynamic part */
+    int conn_count;
+    int *conn_qs;     /* their precomputed-part nodes */
+    double *S;        /* (3c)^2 row-major: (C_cc)^-1, the precomputed part's stiffness there */
+    double *g_conn;   /* 3c preload at the connections */
+    /* contacts on the precomputed part */
+    int contact_count, max_contacts, contacts_dirty;
+    int *contact_qs;        /* precomputed-part nodes */
+    tmass_real *contact_u;  /* 3K imposed displacements */
+    double *W;              /* 3c x 3K: S C_ck */
+    double *V;              /* 3K x 3c: Z^-1 W^T */
+    double *Z;              /* (3K)^2: Cholesky of C_kk - C_kc S C_ck */
+    double *f_contact;      /* 3K forces at the contacts */
+    double *f_all;          /* 3c + 3K forces at connections, then contacts */
+    double *work;           /* 3c + 3K */
+    int *cols;              /* 3c + 3K compliance columns */
+    tmass_real *pos;        /* 3N */
+    /* rendering: static faces of the precomputed part, interface faces (precomputed-side
+       orientation) with the dynamic tet across, flags on the dynamic part's faces */
+    int qs_tri_count, iface_count, tri_count, tri_capacity;
+    int *qs_tri, *iface_tri, *iface_dyn_tet, *tri;
+    unsigned char *dyn_face_iface;
+};
+
+TMASSDEF tmass_hybrid_desc tmass_hybrid_default_desc(void)
+{
+    tmass_hybrid_desc d;
+    memset(&d, 0, sizeof d);
+    d.model = tmass_default_desc();
+    d.precompute = tmass_qs_default_desc();
+    d.internal_cookie = TMASS__HY_COOKIE;
+    return d;
+}
+
+typedef struct tmass__hy_sizes {
+    int N, T, c, K, qs_tris, ifaces, dyn_tets, dyn_nodes, tri_capacity;
+} tmass__hy_sizes;
+
+static void tmass__hybrid_layout(tmass_hybrid *h, const tmass__hy_sizes *z, tmass__carver *c)
+{
+    size_t c3 = 3 * (size_t)z->c, K3 = 3 * (size_t)z->K;
+    TMASS__CARVE(c, h->dyn_of, int, z->N);
+    TMASS__CARVE(c, h->qs_of, int, z->N);
+    TMASS__CARVE(c, h->dyn_global, int, z->dyn_nodes);
+    TMASS__CARVE(c, h->tet_local, int, z->T);
+    TMASS__CARVE(c, h->tet_dynamic, unsigned char, z->T);
+    TMASS__CARVE(c, h->fixed, unsigned char, z->N);
+    TMASS__CARVE(c, h->conn_qs, int, z->c);
+    TMASS__CARVE(c, h->S, double, c3 * c3);
+    TMASS__CARVE(c, h->g_conn, double, c3);
+    TMASS__CARVE(c, h->contact_qs, int, z->K);
+    TMASS__CARVE(c, h->contact_u, tmass_real, K3);
+    TMASS__CARVE(c, h->W, double, c3 * K3);
+    TMASS__CARVE(c, h->V, double, K3 * c3);
+    TMASS__CARVE(c, h->Z, double, K3 * K3);
+    TMASS__CARVE(c, h->f_contact, double, K3);
+    TMASS__CARVE(c, h->f_all, double, c3 + K3);
+    TMASS__CARVE(c, h->work, double, c3 + K3);
+    TMASS__CARVE(c, h->cols, int, c3 + K3);
+    TMASS__CARVE(c, h->pos, tmass_real, 3 * (size_t)z->N);
+    TMASS__CARVE(c, h->qs_tri, int, 3 * (size_t)z->qs_tris);
+    TMASS__CARVE(c, h->iface_tri, int, 3 * (size_t)z->ifaces);
+    TMASS__CARVE(c, h->iface_dyn_tet, int, z->ifaces);
+    TMASS__CARVE(c, h->tri, int, 3 * (size_t)z->tri_capacity);
+    TMASS__CARVE(c, h->dyn_face_iface, unsigned char, 4 * (size_t)z->dyn_tets);
+}
+
+/* Compliance entry between two precomputed-part nodes' degrees of freedom. */
+static double tmass__hy_C(const tmass_hybrid *h, int row_node, int row_dir, int col_node, int col_dir)
+{
+    const tmass_qs *q = h->qs;
+    return tmass__qs_entry(q, 3 * q->row_of_node[row_node] + row_dir,
+                           3 * q->col_of_node[col_node] + col_dir);
+}
+
+/* Installs S' = S + W V (contacts on the precomputed part) as the dynamic part's coupling
+   stiffness; recomputes W, Z and V when the contact set changed. */
+static int tmass__hybrid_coupling(tmass_hybrid *h)
+{
+    int c3 = 3 * h->conn_count, K3 = 3 * h->contact_count, r, s, i, j;
+    double *Sp = h->dyn->coupling;
+    if (!h->contacts_dirty) return TMASS_OK;
+    memcpy(Sp, h->S, sizeof(double) * (size_t)c3 * c3);
+    if (K3 > 0) {
+        /* W = S C_ck, column by column */
+        for (j = 0; j < K3; j++) {
+            int kn = h->contact_qs[j / 3];
+            for (r = 0; r < c3; r++) h->work[r] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, kn, j % 3);
+            for (r = 0; r < c3; r++) {
+                const double *row = h->S + (size_t)r * c3;
+                double acc = 0.0;
+                for (s = 0; s < c3; s++) acc += row[s] * h->work[s];
+                h->W[(size_t)r * K3 + j] = acc;
+            }
+        }
+        /* Z = C_kk - C_kc W */
+        for (i = 0; i < K3; i++)
+            for (j = 0; j < K3; j++) {
+                double z = tmass__hy_C(h, h->contact_qs[i / 3], i % 3, h->contact_qs[j / 3], j % 3);
+                for (r = 0; r < c3; r++)
+                    z -= tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->contact_qs[i / 3], i % 3) *
+                         h->W[(size_t)r * K3 + j];
+                h->Z[(size_t)i * K3 + j] = z;
+            }
+        if (tmass__cholesky(h->Z, K3)) return TMASS_ERR_SINGULAR;
+        /* V = Z^-1 W^T, then S' = S + W V */
+        for (r = 0; r < c3; r++) {
+            for (i = 0; i < K3; i++) h->work[i] = h->W[(size_t)r * K3 + i];
+            tmass__cholesky_solve(h->Z, K3, h->work);
+            for (i = 0; i < K3; i++) h->V[(size_t)i * c3 + r] = h->work[i];
+        }
+        for (r = 0; r < c3; r++)
+            for (s = 0; s < c3; s++) {
+                double acc = 0.0;
+                for (i = 0; i < K3; i++) acc += h->W[(size_t)r * K3 + i] * h->V[(size_t)i * c3 + s];
+                Sp[(size_t)r * c3 + s] += acc;
+            }
+    }
+    h->dyn->coupling_count = h->conn_count;
+    h->contacts_dirty = 0;
+    return TMASS_OK;
+}
+
+/* The constant part of the connection forces felt by the dynamic part:
+   S' g_c + V^T (u_k - g_k), written into its external forces. */
+static void tmass__hybrid_loads(tmass_hybrid *h)
+{
+    int c3 = 3 * h->conn_count, K3 = 3 * h->contact_count, r, s, i;
+    const tmass_qs *q = h->qs;
+    for (r = 0; r < c3; r++) {
+        const double *row = h->dyn->coupling + (size_t)r * c3;
+        double acc = 0.0;
+        for (s = 0; s < c3; s++) acc += row[s] * h->g_conn[s];
+        for (i = 0; i < K3; i++)
+            acc += h->V[(size_t)i * c3 + r] *
+                   ((double)h->contact_u[i] - (double)q->preload[3 * h->contact_qs[i / 3] + i % 3]);
+        h->dyn->ext[3 * h->dyn->coupling_nodes[r / 3] + r % 3] = (tmass_real)acc;
+    }
+}
+
+/* After the dynamic part moved: forces on the precomputed part at connections and
+   contacts, its displacements, and the positions of the whole mesh. */
+static void tmass__hybrid_finish(tmass_hybrid *h)
+{
+    int c3 = 3 * h->conn_count, K3 = 3 * h->contact_count, r, s, i, n;
+    const tmass_qs *q = h->qs;
+    double *rc = h->work; /* u_c - g_c */
+    for (r = 0; r < c3; r++)
+        rc[r] = (double)h->dyn->disp[3 * h->dyn->coupling_nodes[r / 3] + r % 3] - h->g_conn[r];
+    if (K3 > 0) { /* f_k = Z^-1 (u_k - g_k - W^T r_c) */
+        for (i = 0; i < K3; i++) {
+            double acc = (double)h->contact_u[i] - (double)q->preload[3 * h->contact_qs[i / 3] + i % 3];
+            for (r = 0; r < c3; r++) acc -= h->W[(size_t)r * K3 + i] * rc[r];
+            h->f_contact[i] = acc;
+        }
+        tmass__cholesky_solve(h->Z, K3, h->f_contact);
+    }
+    for (r = 0; r < c3; r++) { /* f_c = S r_c - W f_k */
+        const double *row = h->S + (size_t)r * c3;
+        double acc = 0.0;
+        for (s = 0; s < c3; s++) acc += row[s] * rc[s];
+        for (i = 0; i < K3; i++) acc -= h->W[(size_t)r * K3 + i] * h->f_contact[i];
+        h->f_all[r] = acc;
+        h->cols[r] = 3 * q->col_of_node[h->conn_qs[r / 3]] + r % 3;
+    }
+    for (i = 0; i < K3; i++) {
+        h->f_all[c3 + i] = h->f_contact[i];
+        h->cols[c3 + i] = 3 * q->col_of_node[h->contact_qs[i / 3]] + i % 3;
+    }
+    tmass__qs_superpose(h->qs, h->cols, h->f_all, c3 + K3);
+    for (n = 0; n < h->node_count; n++) {
+        /* a node cut off the dynamic part follows the precomputed part if it belongs to it */
+        int d = h->dyn_of[n], in_dyn = d >= 0 && h->dyn->node_state[d] != TMASS__INACTIVE;
+        const tmass_real *p = in_dyn || (d >= 0 && h->qs_of[n] < 0) ? h->dyn->pos + 3 * d
+                                                                   : q->pos + 3 * h->qs_of[n];
+        memcpy(h->pos + 3 * n, p, 3 * sizeof(tmass_real));
+    }
+}
+
+/* Removes connection nodes whose dynamic node has no tetrahedron left: the inverse of a
+   principal submatrix of C from its inverse S, S_rr - S_rd S_dd^-1 S_dr, one node at a
+   time (a rank-3 update), then compaction. */
+static void tmass__hybrid_drop_connections(tmass_hybrid *h)
+{
+    int k = 0;
+    while (k < h->conn_count) {
+        int v = h->dyn->coupling_nodes[k], c3 = 3 * h->conn_count, a, b, r, s, w;
+        double A[9], inv[9], det;
+        if (h->dyn->node_state[v] != TMASS__INACTIVE) {
+            k++;
+            continue;
+        }
+        for (a = 0; a < 3; a++)
+            for (b = 0; b < 3; b++) A[3 * a + b] = h->S[(size_t)(3 * k + a) * c3 + 3 * k + b];
+        inv[0] = A[4] * A[8] - A[5] * A[7];
+        inv[1] = A[2] * A[7] - A[1] * A[8];
+        inv[2] = A[1] * A[5] - A[2] * A[4];
+        inv[3] = A[5] * A[6] - A[3] * A[8];
+        inv[4] = A[0] * A[8] - A[2] * A[6];
+        inv[5] = A[2] * A[3] - A[0] * A[5];
+        inv[6] = A[3] * A[7] - A[4] * A[6];
+        inv[7] = A[1] * A[6] - A[0] * A[7];
+        inv[8] = A[0] * A[4] - A[1] * A[3];
+        det = A[0] * inv[0] + A[1] * inv[3] + A[2] * inv[6];
+        for (a = 0; a < 9; a++) inv[a] /= det;
+        for (r = 0; r < c3; r++) {
+            double t[3];
+            if (r / 3 == k) continue;
+            for (a = 0; a < 3; a++) { /* t = S_r,d S_dd^-1 */
+                t[a] = 0.0;
+                for (b = 0; b < 3; b++) t[a] += h->S[(size_t)r * c3 + 3 * k + b] * inv[3 * b + a];
+            }
+            for (s = 0; s < c3; s++) {
+                if (s / 3 == k) continue;
+                h->S[(size_t)r * c3 + s] -= t[0] * h->S[(size_t)(3 * k) * c3 + s] +
+                                            t[1] * h->S[(size_t)(3 * k + 1) * c3 + s] +
+                                            t[2] * h->S[(size_t)(3 * k + 2) * c3 + s];
+            }
+        }
+        /* compact rows and columns (in place, destinations never pass their sources) */
+        for (r = 0, w = 0; r < c3; r++) {
+            if (r / 3 == k) continue;
+            for (s = 0; s < c3; s++)
+                if (s / 3 != k) h->S[w++] = h->S[(size_t)r * c3 + s];
+        }
+        for (r = 3 * k; r < c3 - 3; r++) h->g_conn[r] = h->g_conn[r + 3];
+        for (r = k; r < h->conn_count - 1; r++) {
+            h->conn_qs[r] = h->conn_qs[r + 1];
+            h->dyn->coupling_nodes[r] = h->dyn->coupling_nodes[r + 1];
+        }
+        memset(h->dyn->ext + 3 * v, 0, 3 * sizeof(tmass_real));
+        h->conn_count--;
+        h->contacts_dirty = 1;
+    }
+    h->dyn->coupling_count = h->contacts_dirty ? 0 : h->conn_count;
+}
+
+typedef struct tmass__face_key {
+    int key[3], tri[3], source, owner; /* source 0 precomputed part, 1 dynamic part */
+} tmass__face_key;
+
+static int tmass__face_key_cmp(const void *pa, const void *pb)
+{
+    const tmass__face_key *a = (const tmass__face_key *)pa, *b = (const tmass__face_key *)pb;
+    int k;
+    for (k = 0; k < 3; k++)
+        if (a->key[k] != b->key[k]) return a->key[k] < b->key[k] ? -1 : 1;
+    return a->source - b->source;
+}
+
+static void tmass__sort3(const int *t, int *key)
+{
+    int a = t[0], b = t[1], c = t[2], s;
+    if (a > b) { s = a; a = b; b = s; }
+    if (b > c) { s = b; b = c; c = s; }
+    if (a > b) { s = a; a = b; b = s; }
+    key[0] = a;
+    key[1] = b;
+    key[2] = c;
+}
+
+/* Sub-description of one part: its tets (and per-tet materials) with local node numbers. */
+static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, int part, const int *local_of,
+                                  int node_total, tmass_real *rest, int *tets, tmass_real *young,
+                                  tmass_real *poisson, tmass_desc *sub)
+{
+    int t, j, n = 0, i;
+    *sub = d->model;
+    for (i = 0; i < d->model.node_count; i++)
+        if (local_of[i] >= 0) memcpy(rest + 3 * local_of[i], d->model.rest_positions + 3 * i, 3 * sizeof(tmass_real));
+    for (t = 0; t < d->model.tet_count; t++) {
+        if ((d->tet_dynamic[t] != 0) != (part == 1)) continue;
+        for (j = 0; j < 4; j++) tets[4 * n + j] = local_of[d->model.tets[4 * t + j]];
+        if (d->model.tet_young_modulus) young[n] = d->model.tet_young_modulus[t];
+        if (d->model.tet_poisson_ratio) poisson[n] = d->model.tet_poisson_ratio[t];
+        n++;
+    }
+    sub->rest_positions = rest;
+    sub->node_count = node_total;
+    sub->tets = tets;
+    sub->tet_count = n;
+    sub->tet_young_modulus = d->model.tet_young_modulus ? young : NULL;
+    sub->tet_poisson_ratio = d->model.tet_poisson_ratio ? poisson : NULL;
+}
+
+TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
+{
+    tmass_hybrid tmp, *h;
+    tmass__hy_sizes z;
+    tmass__carver carver;
+    tmass_desc sub;
+    tmass_qs_desc qd;
+    tmass_model *dyn = NULL, *src = NULL;
+    tmass_qs *qs = NULL;
+    tmass_allocator a;
+    int err, i, t, N, T, n_dyn = 0, n_qs = 0, t_dyn = 0, c0 = 0, faces = 0, k;
+    int *dyn_of = NULL, *qs_of = NULL, *itmp = NULL;
+    unsigned char *fixed = NULL;
+    tmass_real *rtmp = NULL;
+    tmass__face_key *keys = NULL;
+    size_t tmp_bytes;
+    char *tmp_block;
+
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!d) return TMASS_ERR_ARG;
+    if (d->internal_cookie != TMASS__HY_COOKIE) return TMASS_ERR_DESC;
+    err = tmass__validate(&d->model);
+    if (err) return err;
+    if (d->model.kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (!d->tet_dynamic || d->fixed_count < 0 || (d->fixed_count > 0 && !d->fixed_nodes))
+        return TMASS_ERR_ARG;
+    N = d->model.node_count;
+    T = d->model.tet_count;
+    a = d->model.allocator;
+    for (i = 0; i < d->fixed_count; i++)
+        if (d->fixed_nodes[i] < 0 || d->fixed_nodes[i] >= N) return TMASS_ERR_NODE_RANGE;
+
+    /* temporary: two node maps, fixed flags, a rest copy, tets and per-tet materials of a
+       part, face keys of both boundaries */
+    tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N +
+                sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
+                4 * TMASS__ALIGN;
+    tmp_block = (char *)tmass__alloc(&a, tmp_bytes);
+    if (!tmp_block) return TMASS_ERR_ALLOC;
+    carver.base = tmp_block;
+    carver.offset = 0;
+    keys = (tmass__face_key *)tmass__carve(&carver, sizeof(tmass__face_key) * 8 * (size_t)T);
+    rtmp = (tmass_real *)tmass__carve(&carver, sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T));
+    dyn_of = (int *)tmass__carve(&carver, sizeof(int) * (2 * (size_t)N + 4 * (size_t)T));
+    qs_of = dyn_of + N;
+    itmp = qs_of + N;
+    fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
+    memset(fixed, 0, (size_t)N);
+    for (i = 0; i < d->fixed_count; i++) fixed[d->fixed_nodes[i]] = 1;
+    for (i = 0; i < N; i++) dyn_of[i] = qs_of[i] = -1;
+    for (t = 0; t < T; t++) {
+        int *map = d->tet_dynamic[t] ? dyn_of : qs_of;
+        t_dyn += d->tet_dynamic[t] != 0;
+        for (k = 0; k < 4; k++) map[d->model.tets[4 * t + k]] = 1;
+    }
+    for (i = 0; i < N; i++) {
+        if (dyn_of[i] >= 0) dyn_of[i] = n_dyn++;
+        if (qs_of[i] >= 0) qs_of[i] = n_qs++;
+    }
+    err = t_dyn == 0 || t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
+    /* the dynamic part */
+    if (!err) {
+        tmass__hybrid_subdesc(d, 1, dyn_of, n_dyn, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
+        err = tmass_create(&sub, &dyn);
+    }
+    for (i = 0; i < N && !err; i++)
+        if (fixed[i] && dyn_of[i] >= 0) err = tmass_fix_node(dyn, dyn_of[i]);
+    /* the precomputed part */
+    if (!err) {
+        tmass__hybrid_subdesc(d, 0, qs_of, n_qs, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
+        err = tmass_create(&sub, &src);
+    }
+    for (i = 0; i < N && !err; i++)
+        if (fixed[i] && qs_of[i] >= 0) err = tmass_fix_node(src, qs_of[i]);
+    if (!err) {
+        qd = d->precompute;
+        qd.nodes = NULL;
+        qd.node_count = 0;
+        qd.allocator = a;
+        err = tmass_qs_create(src, &qd, &qs);
+    }
+    if (!err) {
+        /* interface faces: triangles on both parts' boundaries (global numbering; itmp
+           holds each part's local -> global map in turn) */
+        int nk = 0, f;
+        for (i = 0; i < N; i++)
+            if (qs_of[i] >= 0) itmp[qs_of[i]] = i;
+        for (f = 0; f < src->tri_count; f++, nk++) {
+            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[src->tri[3 * f + k]];
+            keys[nk].source = 0;
+            keys[nk].owner = f;
+        }
+        for (i = 0; i < N; i++)
+            if (dyn_of[i] >= 0) itmp[dyn_of[i]] = i;
+        for (f = 0; f < dyn->tri_count; f++, nk++) {
+            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[dyn->tri[3 * f + k]];
+            keys[nk].source = 1;
+            keys[nk].owner = dyn->tri_owner[f];
+        }
+        for (f = 0; f < nk; f++) tmass__sort3(keys[f].tri, keys[f].key);
+        qsort(keys, (size_t)nk, sizeof *keys, tmass__face_key_cmp);
+        faces = nk;
+        for (i = 0; i < N; i++)
+            if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) c0++;
+    }
+    if (!err) {
+        /* the hybrid block */
+        int ifaces = 0, qs_tris = 0;
+        for (i = 0; i < faces; i++) {
+            int shared = (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) ||
+                         (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0);
+            if (keys[i].source == 0) {
+                if (shared)
+                    ifaces++;
+                else
+                    qs_tris++;
+            }
+        }
+        memset(&tmp, 0, sizeof tmp);
+        z.N = N;
+        z.T = T;
+        z.c = c0;
+        z.K = d->precompute.max_contacts;
+        z.qs_tris = qs_tris;
+        z.ifaces = ifaces;
+        z.dyn_tets = t_dyn;
+        z.dyn_nodes = n_dyn;
+        z.tri_capacity = qs_tris + ifaces + 4 * t_dyn;
+        carver.base = NULL;
+        carver.offset = sizeof(tmass_hybrid);
+        tmass__hybrid_layout(&tmp, &z, &carver);
+        tmp.block_bytes = carver.offset;
+        tmp.block = tmass__alloc(&a, tmp.block_bytes);
+        if (!tmp.block) err = TMASS_ERR_ALLOC;
+    }
+    if (!err) {
+        size_t cb;
+        memset(tmp.block, 0, tmp.block_bytes);
+        carver.base = (char *)tmp.block;
+        carver.offset = sizeof(tmass_hybrid);
+        tmass__hybrid_layout(&tmp, &z, &carver);
+        h = (tmass_hybrid *)tmp.block;
+        *h = tmp;
+        h->allocator = a;
+        h->node_count = N;
+        h->tet_count = T;
+        h->dyn_tets = t_dyn;
+        h->dyn = dyn;
+        h->qs = qs;
+        h->max_contacts = z.K;
+        h->tri_capacity = z.tri_capacity;
+        memcpy(h->dyn_of, dyn_of, sizeof(int) * (size_t)N);
+        memcpy(h->qs_of, qs_of, sizeof(int) * (size_t)N);
+        memcpy(h->fixed, fixed, (size_t)N);
+        for (i = 0; i < N; i++)
+            if (dyn_of[i] >= 0) h->dyn_global[dyn_of[i]] = i;
+        {
+            int nd = 0, nq = 0;
+            for (t = 0; t < T; t++) {
+                h->tet_dynamic[t] = d->tet_dynamic[t] != 0;
+                h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
+            }
+        }
+        /* the coupling block lives in the dynamic model (freed with it) */
+        cb = sizeof(int) * (size_t)c0 + sizeof(double) * (9 * (size_t)c0 * c0 + 6 * (size_t)c0) + 2 * TMASS__ALIGN;
+        dyn->coupling_block = tmass__alloc(&a, cb);
+        if (!dyn->coupling_block) err = TMASS_ERR_ALLOC;
+        if (!err) {
+            tmass__carver cc;
+            dyn->coupling_bytes = cb;
+            cc.base = (char *)dyn->coupling_block;
+            cc.offset = 0;
+            dyn->coupling = (double *)tmass__carve(&cc, sizeof(double) * 9 * (size_t)c0 * c0);
+            dyn->coupling_x = (double *)tmass__carve(&cc, sizeof(double) * 6 * (size_t)c0);
+            dyn->coupling_nodes = (int *)tmass__carve(&cc, sizeof(int) * (size_t)c0);
+            for (i = 0, k = 0; i < N; i++)
+                if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) {
+                    h->conn_qs[k] = qs_of[i];
+                    dyn->coupling_nodes[k] = dyn_of[i];
+                    if (qs->col_of_node[qs_of[i]] < 0) err = TMASS_ERR_NOT_PRECOMPUTED;
+                    k++;
+                }
+            h->conn_count = c0;
+        }
+        if (!err && c0 > 0) {
+            /* S = (C_cc)^-1 by Cholesky, column by column */
+            int c3 = 3 * c0, r, s;
+            double *L = dyn->coupling; /* scratch for the factor */
+            for (r = 0; r < c3; r++)
+                for (s = 0; s < c3; s++) L[(size_t)r * c3 + s] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->conn_qs[s / 3], s % 3);
+            if (tmass__cholesky(L, c3)) err = TMASS_ERR_SINGULAR;
+            for (s = 0; s < c3 && !err; s++) {
+                for (r = 0; r < c3; r++) h->work[r] = r == s;
+                tmass__cholesky_solve(L, c3, h->work);
+                for (r = 0; r < c3; r++) h->S[(size_t)r * c3 + s] = h->work[r];
+            }
+            for (r = 0; r < c3 && !err; r++) /* exact symmetry */
+                for (s = 0; s < r; s++) {
+                    double v = 0.5 * (h->S[(size_t)r * c3 + s] + h->S[(size_t)s * c3 + r]);
+                    h->S[(size_t)r * c3 + s] = h->S[(size_t)s * c3 + r] = v;
+                }
+            for (r = 0; r < c3; r++) h->g_conn[r] = (double)qs->preload[3 * h->conn_qs[r / 3] + r % 3];
+        }
+        if (!err) {
+            /* rendering lists */
+            int nq = 0, ni = 0;
+            for (i = 0; i < faces; i++) {
+                int partner = -1;
+                if (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) partner = i + 1;
+                if (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0) partner = i - 1;
+                if (keys[i].source == 0 && partner < 0) {
+                    memcpy(h->qs_tri + 3 * nq++, keys[i].tri, 3 * sizeof(int));
+                } else if (keys[i].source == 0) {
+                    memcpy(h->iface_tri + 3 * ni, keys[i].tri, 3 * sizeof(int));
+                    h->iface_dyn_tet[ni++] = keys[partner].owner / 4;
+                } else if (partner >= 0) {
+                    h->dyn_face_iface[keys[i].owner] = 1;
+                }
+            }
+            h->qs_tri_count = nq;
+            h->iface_count = ni;
+            h->contacts_dirty = 1;
+            err = tmass__hybrid_coupling(h);
+        }
+        if (err) {
+            tmass__free(&a, tmp.block, tmp.block_bytes);
+        } else {
+            tmass__hybrid_loads(h);
+            tmass__hybrid_finish(h);
+            *out = h;
+        }
+    }
+    tmass_destroy(src);
+    if (err) {
+        tmass_destroy(dyn);
+        tmass_qs_destroy(qs);
+    }
+    tmass__free(&a, tmp_block, tmp_bytes);
+    return err;
+}
+
+TMASSDEF void tmass_hybrid_destroy(tmass_hybrid *h)
+{
+    tmass_allocator a;
+    if (!h) return;
+    a = h->allocator;
+    tmass_destroy(h->dyn);
+    tmass_qs_destroy(h->qs);
+    tmass__free(&a, h->block, h->block_bytes);
+}
+
+TMASSDEF int tmass_hybrid_step_ex(tmass_hybrid *h, tmass_real dt, tmass_integrator integrator)
+{
+    int err;
+    if (!h) return TMASS_ERR_ARG;
+    err = tmass__hybrid_coupling(h);
+    if (err) return err;
+    tmass__hybrid_loads(h);
+    err = tmass_step_ex(h->dyn, dt, integrator);
+    if (err) return err;
+    tmass__hybrid_finish(h);
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_hybrid_step(tmass_hybrid *h)
+{
+    if (!h) return TMASS_ERR_ARG;
+    return tmass_hybrid_step_ex(h, h->dyn->time_step, h->dyn->integrator);
+}
+
+TMASSDEF int tmass_hybrid_solve_static(tmass_hybrid *h)
+{
+    int err;
+    if (!h) return TMASS_ERR_ARG;
+    err = tmass__hybrid_coupling(h);
+    if (err) return err;
+    tmass__hybrid_loads(h);
+    err = tmass_solve_static(h->dyn);
+    if (err) return err;
+    tmass__hybrid_finish(h);
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_hybrid_set_displacement(tmass_hybrid *h, int node, const tmass_real u[3])
+{
+    int k, q;
+    if (!h || !tmass__vec3_finite(u)) return TMASS_ERR_ARG;
+    if (node < 0 || node >= h->node_count) return TMASS_ERR_NODE_RANGE;
+    if (h->fixed[node]) return TMASS_ERR_NODE_PINNED;
+    if (h->dyn_of[node] >= 0) return tmass_set_displacement(h->dyn, h->dyn_of[node], u);
+    q = h->qs_of[node];
+    if (q < 0) return TMASS_ERR_NODE_INACTIVE;
+    if (h->qs->col_of_node[q] < 0) return TMASS_ERR_NOT_PRECOMPUTED;
+    for (k = 0; k < h->contact_count && h->contact_qs[k] != q; k++) {
+    }
+    if (k == h->contact_count) {
+        if (k == h->max_contacts) return TMASS_ERR_CONTACTS;
+        h->contact_qs[k] = q;
+        h->contact_count++;
+        h->contacts_dirty = 1;
+    }
+    memcpy(h->contact_u + 3 * k, u, 3 * sizeof(tmass_real));
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_hybrid_release_node(tmass_hybrid *h, int node)
+{
+    int k, q;
+    if (!h) return TMASS_ERR_ARG;
+    if (node < 0 || node >= h->node_count) return TMASS_ERR_NODE_RANGE;
+    if (h->fixed[node]) return TMASS_ERR_NODE_PINNED;
+    if (h->dyn_of[node] >= 0) return tmass_release_node(h->dyn, h->dyn_of[node]);
+    q = h->qs_of[node];
+    for (k = 0; k < h->contact_count; k++)
+        if (h->contact_qs[k] == q) {
+            int last = h->contact_count - 1;
+            h->contact_qs[k] = h->contact_qs[last];
+            memcpy(h->contact_u + 3 * k, h->contact_u + 3 * last, 3 * sizeof(tmass_real));
+            h->contact_count--;
+            h->contacts_dirty = 1;
+            break;
+        }
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_hybrid_contact_force(tmass_hybrid *h, int node, tmass_real f[3])
+{
+    int k, r;
+    if (!h || !f) return TMASS_ERR_ARG;
+    if (node < 0 || node >= h->node_count) return TMASS_ERR_NODE_RANGE;
+    f[0] = f[1] = f[2] = 0;
+    if (h->dyn_of[node] >= 0) {
+        int v = h->dyn_of[node];
+        if (h->dyn->node_state[v] == TMASS__PINNED) {
+            const tmass_real *fi = tmass_forces(h->dyn); /* includes the coupling stiffness */
+            for (r = 0; r < 3; r++)
+                f[r] = -(fi[3 * v + r] + h->dyn->ext[3 * v + r] + h->dyn->mass[v] * h->dyn->gravity[r]);
+        }
+        return TMASS_OK;
+    }
+    for (k = 0; k < h->contact_count; k++)
+        if (h->contact_qs[k] == h->qs_of[node])
+            for (r = 0; r < 3; r++) f[r] = (tmass_real)h->f_contact[3 * k + r];
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_hybrid_remove_tets(tmass_hybrid *h, const int *tets, int count, int *removed)
+{
+    int i, done = 0, total = 0, err = TMASS_OK;
+    if (removed) *removed = 0;
+    if (!h || count < 0 || (count > 0 && !tets)) return TMASS_ERR_ARG;
+    for (i = 0; i < count; i++) {
+        if (tets[i] < 0 || tets[i] >= h->tet_count) return TMASS_ERR_TET_RANGE;
+        if (!h->tet_dynamic[tets[i]]) return TMASS_ERR_PRECOMPUTED;
+    }
+    /* local indices through the dynamic part's tear list, in batches */
+    while (done < count && !err) {
+        int batch = count - done < h->dyn_tets ? count - done : h->dyn_tets, r = 0;
+        for (i = 0; i < batch; i++) h->dyn->tear_list[i] = h->tet_local[tets[done + i]];
+        err = tmass_remove_tets(h->dyn, h->dyn->tear_list, batch, &r);
+        total += r;
+        done += batch;
+    }
+    tmass__hybrid_drop_connections(h);
+    if (removed) *removed = total;
+    return err;
+}
+
+TMASSDEF int tmass_hybrid_tear(tmass_hybrid *h, const tmass_tear_criteria *c, int *removed)
+{
+    int err;
+    if (!h) return TMASS_ERR_ARG;
+    err = tmass_tear(h->dyn, c, removed);
+    tmass__hybrid_drop_connections(h);
+    return err;
+}
+
+TMASSDEF const tmass_real *tmass_hybrid_positions(const tmass_hybrid *h) { return h ? h->pos : NULL; }
+TMASSDEF tmass_model *tmass_hybrid_dynamic_part(tmass_hybrid *h) { return h ? h->dyn : NULL; }
+TMASSDEF const tmass_qs *tmass_hybrid_precomputed_part(const tmass_hybrid *h) { return h ? h->qs : NULL; }
+TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h) { return h ? h->conn_count : 0; }
+
+TMASSDEF const int *tmass_hybrid_boundary_triangles(tmass_hybrid *h, int *count)
+{
+    int f, n, k;
+    if (count) *count = 0;
+    if (!h) return NULL;
+    /* the precomputed part's own boundary, the interface faces a cut has exposed, and the
+       dynamic part's boundary without the faces it shares with the precomputed part */
+    memcpy(h->tri, h->qs_tri, sizeof(int) * 3 * (size_t)h->qs_tri_count);
+    n = h->qs_tri_count;
+    for (f = 0; f < h->iface_count; f++)
+        if (!h->dyn->tet_alive[h->iface_dyn_tet[f]]) memcpy(h->tri + 3 * n++, h->iface_tri + 3 * f, 3 * sizeof(int));
+    for (f = 0; f < h->dyn->tri_count; f++) {
+        if (h->dyn_face_iface[h->dyn->tri_owner[f]]) continue;
+        for (k = 0; k < 3; k++) h->tri[3 * n + k] = h->dyn_global[h->dyn->tri[3 * f + k]];
+        n++;
+    }
+    if (count) *count = n;
+    return h->tri;
 }
 
 #if defined(TMASS_STATIC) && defined(__GNUC__)
