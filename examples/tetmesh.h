@@ -112,6 +112,14 @@ TETMESHDEF int tetmesh_beam(tetmesh *out, double length, double width, double he
 TETMESHDEF int tetmesh_cylinder(tetmesh *out, double radius, double length, int rings,
                                 int segments, int layers);
 
+/* Ellipsoid (x/a)^2 + (y/b)^2 + (z/c)^2 <= 1 around the origin, radii = (a, b, c), carved
+   from a box mesh with `cells` cubic cells along its longest axis (5 tets each): the tets
+   whose centroid lies inside are kept, then the largest set of them connected through
+   faces (no piece hangs by an edge or a vertex), and the unused nodes dropped. The surface
+   is stair-stepped, like a voxel segmentation of an organ; the volume converges as
+   1/cells. */
+TETMESHDEF int tetmesh_ellipsoid(tetmesh *out, const double radii[3], int cells);
+
 /* Hexahedral grid of the box [lo, hi], nx * ny * nz cells; node numbering as tetmesh_box. */
 TETMESHDEF int hexmesh_grid(hexmesh *out, const double lo[3], const double hi[3], int nx, int ny,
                             int nz);
@@ -595,6 +603,118 @@ TETMESHDEF int tetmesh_boundary(const int *tets, int tet_count, int node_count, 
     }
     free(faces);
     *tri_count = out;
+    return TETMESH_OK;
+}
+
+/* Union-find root with path halving. */
+static int tetmesh__root(int *parent, int i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Keeps the largest set of tets connected through shared faces (a tet held by an edge or
+   a vertex only would be a mechanism). */
+static int tetmesh__keep_largest_component(tetmesh *m)
+{
+    static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    int n = 4 * m->tet_count, i, t, best = -1, best_size = 0, kept = 0, *parent, *size;
+    tetmesh__face *faces = (tetmesh__face *)malloc(sizeof *faces * (size_t)n);
+    parent = (int *)malloc(sizeof(int) * 2 * (size_t)m->tet_count);
+    if (!faces || !parent) {
+        free(faces);
+        free(parent);
+        return TETMESH_ERR_ALLOC;
+    }
+    size = parent + m->tet_count;
+    for (t = 0; t < m->tet_count; t++) {
+        int f;
+        parent[t] = t;
+        size[t] = 0;
+        for (f = 0; f < 4; f++) {
+            tetmesh__face *fc = faces + 4 * t + f;
+            int a = m->tets[4 * t + face[f][0]], b = m->tets[4 * t + face[f][1]],
+                c = m->tets[4 * t + face[f][2]], s;
+            if (a > b) { s = a; a = b; b = s; }
+            if (b > c) { s = b; b = c; c = s; }
+            if (a > b) { s = a; a = b; b = s; }
+            fc->key[0] = a;
+            fc->key[1] = b;
+            fc->key[2] = c;
+            fc->tri[0] = t; /* the owning tet */
+            fc->tri[1] = fc->tri[2] = 0;
+        }
+    }
+    qsort(faces, (size_t)n, sizeof *faces, tetmesh__face_cmp);
+    for (i = 0; i + 1 < n; i++)
+        if (memcmp(faces[i].key, faces[i + 1].key, sizeof faces[i].key) == 0) {
+            int ra = tetmesh__root(parent, faces[i].tri[0]), rb = tetmesh__root(parent, faces[i + 1].tri[0]);
+            if (ra != rb) parent[ra] = rb;
+        }
+    for (t = 0; t < m->tet_count; t++) size[tetmesh__root(parent, t)]++;
+    for (t = 0; t < m->tet_count; t++)
+        if (size[t] > best_size) {
+            best_size = size[t];
+            best = t;
+        }
+    for (t = 0; t < m->tet_count; t++)
+        if (tetmesh__root(parent, t) == best) memmove(m->tets + 4 * kept++, m->tets + 4 * t, 4 * sizeof(int));
+    m->tet_count = kept;
+    free(faces);
+    free(parent);
+    return TETMESH_OK;
+}
+
+TETMESHDEF int tetmesh_ellipsoid(tetmesh *out, const double radii[3], int cells)
+{
+    tetmesh box;
+    double lo[3], hi[3], rmax;
+    int n[3], k, t, kept = 0, nodes = 0, err, *map;
+    if (!out) return TETMESH_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!radii || cells < 1) return TETMESH_ERR_ARG;
+    for (k = 0; k < 3; k++)
+        if (!tetmesh__is_finite(radii[k]) || !(radii[k] > 0.0)) return TETMESH_ERR_ARG;
+    rmax = radii[0] > radii[1] ? radii[0] : radii[1];
+    rmax = rmax > radii[2] ? rmax : radii[2];
+    for (k = 0; k < 3; k++) {
+        n[k] = (int)ceil(cells * radii[k] / rmax - 1e-9);
+        if (n[k] < 1) n[k] = 1;
+        hi[k] = rmax * n[k] / cells; /* cubic cells */
+        lo[k] = -hi[k];
+    }
+    err = tetmesh_box(&box, lo, hi, n[0], n[1], n[2], TETMESH_SPLIT5);
+    if (err) return err;
+    for (t = 0; t < box.tet_count; t++) {
+        double c[3] = {0, 0, 0}, r2 = 0.0;
+        int j;
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 3; k++) c[k] += 0.25 * box.nodes[3 * box.tets[4 * t + j] + k];
+        for (k = 0; k < 3; k++) r2 += (c[k] / radii[k]) * (c[k] / radii[k]);
+        if (r2 <= 1.0) memmove(box.tets + 4 * kept++, box.tets + 4 * t, 4 * sizeof(int));
+    }
+    box.tet_count = kept;
+    err = kept ? tetmesh__keep_largest_component(&box) : TETMESH_ERR_ARG;
+    map = err ? NULL : (int *)malloc(sizeof(int) * (size_t)box.node_count);
+    if (!err && !map) err = TETMESH_ERR_ALLOC;
+    if (err) {
+        tetmesh_free(&box);
+        return err;
+    }
+    for (k = 0; k < box.node_count; k++) map[k] = -1;
+    for (t = 0; t < 4 * box.tet_count; t++) map[box.tets[t]] = 1;
+    for (k = 0; k < box.node_count; k++)
+        if (map[k] >= 0) {
+            memmove(box.nodes + 3 * nodes, box.nodes + 3 * k, 3 * sizeof(double));
+            map[k] = nodes++;
+        }
+    for (t = 0; t < 4 * box.tet_count; t++) box.tets[t] = map[box.tets[t]];
+    free(map);
+    box.node_count = nodes;
+    *out = box;
     return TETMESH_OK;
 }
 

@@ -451,6 +451,40 @@ static void test_cylinder_volume_convergence(void)
     }
 }
 
+/* The carved ellipsoid: positive tets, every node used, volume converging to 4/3 pi abc
+   (the stair-stepped surface errs by O(1 / cells)), and bad arguments refused. */
+static void test_ellipsoid(void)
+{
+    const double pi = 3.14159265358979323846, radii[3] = {0.15, 0.1, 0.06};
+    double exact = 4.0 / 3.0 * pi * radii[0] * radii[1] * radii[2], previous = 1.0, bad[3] = {1, 0, 1};
+    int cells, non_positive, i;
+    tetmesh m;
+    for (cells = 8; cells <= (TEST_IS_QUICK ? 16 : 32); cells *= 2) {
+        double error;
+        int *used, unused = 0;
+        REQUIRE(tetmesh_ellipsoid(&m, radii, cells) == TETMESH_OK);
+        error = fabs(mesh_volume(&m, &non_positive) - exact) / exact;
+        CHECK_INT(0, non_positive);
+        used = (int *)calloc((size_t)m.node_count, sizeof(int));
+        for (i = 0; i < 4 * m.tet_count; i++) used[m.tets[i]] = 1;
+        for (i = 0; i < m.node_count; i++) unused += !used[i];
+        CHECK_INT(0, unused);
+        for (i = 0; i < m.node_count; i++) /* nodes within a cell of the surface */
+            CHECK(pow(m.nodes[3 * i] / radii[0], 2) + pow(m.nodes[3 * i + 1] / radii[1], 2) +
+                      pow(m.nodes[3 * i + 2] / radii[2], 2) < pow(1.0 + 3.0 / cells * 0.15 / 0.06, 2));
+        printf("    %d cells: %d tets, volume error %.2f %%\n", cells, m.tet_count, 100 * error);
+        CHECK(error < previous);
+        CHECK(error < 0.6 / cells);
+        previous = error;
+        free(used);
+        tetmesh_free(&m);
+    }
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_ellipsoid(&m, bad, 8));
+    CHECK(mesh_is_empty(&m));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_ellipsoid(&m, radii, 0));
+    CHECK_INT(TETMESH_ERR_ARG, tetmesh_ellipsoid(NULL, radii, 8));
+}
+
 static void test_cylinder_bad_arguments(void)
 {
     tetmesh m;
@@ -1277,6 +1311,7 @@ static const test_case cases[] = {
     TEST(test_cylinder_conforming_positive),
     TEST(test_cylinder_volume_convergence),
     TEST(test_cylinder_bad_arguments),
+    TEST(test_ellipsoid),
     TEST(test_hexmesh_grid),
     TEST(test_tetgen_round_trip_zero_based),
     TEST(test_tetgen_round_trip_one_based),
