@@ -479,8 +479,10 @@ typedef struct tmass_qs_desc {
     int max_contacts;     /* most contact nodes in one update, default 16 */
     tmass_real cg_tolerance; /* relative residual of each solve, default 1e-10 (1e-6 float) */
     int cg_max_iterations;   /* default 20000 */
-    int (*progress)(int done, int total, void *user); /* called after each solve; return
-                                                         non-zero to cancel. May be NULL */
+    int (*progress)(int done, int total, void *user); /* solves done of total, called
+                                                         after the preload and after each
+                                                         block of 8 solves; return non-zero
+                                                         to cancel. May be NULL */
     void *progress_user;
     tmass_allocator allocator; /* NULL entries: TMASS_MALLOC / TMASS_FREE */
     unsigned int internal_cookie;
@@ -489,8 +491,10 @@ typedef struct tmass_qs_desc {
 /* Defaults as documented in the fields. */
 TMASSDEF tmass_qs_desc tmass_qs_default_desc(void);
 /* Precomputes the quasi-static model of the tensor-mass model m (its mesh, material, pinned
-   nodes, gravity and external forces at this moment). Costs 3 * |nodes| + 1 CG solves;
-   uses m's scratch memory but leaves its state unchanged. */
+   nodes, gravity and external forces at this moment). Costs 3 * |nodes| + 1 CG solves,
+   run 8 at a time so that each K product serves eight; uses m's scratch memory and a
+   temporary block of 6 x 8 vectors (freed before returning) and leaves m's state
+   unchanged. */
 TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out);
 TMASSDEF void tmass_qs_destroy(tmass_qs *qs);
 /* Imposes displacements (3 * count, m, from rest) on `count` precomputed nodes (the rest
@@ -2577,17 +2581,145 @@ TMASSDEF void tmass_qs_destroy(tmass_qs *qs)
     tmass__free(&a, qs->block, qs->block_bytes);
 }
 
+/* >>quasi-static-solver --------------------------------------------------------------- */
+
+/* The precomputation solves K x = b for many b. TMASS__RHS independent CG runs advance in
+   lock step and share each K product, so a tensor is read once for all of them; vectors
+   are interleaved ([degree of freedom][rhs]) so the work vectorises across the runs. */
+#define TMASS__RHS 8
+
+typedef struct tmass__block_ctx {
+    const tmass_model *m;
+    const tmass_real *p;
+    tmass_real *out;
+    int colour;
+} tmass__block_ctx;
+
+static void tmass__matvec_block_chunks(void *vctx, int begin, int end)
+{
+    const tmass__block_ctx *c = (const tmass__block_ctx *)vctx;
+    const tmass_model *m = c->m;
+    const tmass_real *p = c->p;
+    tmass_real *out = c->out;
+    int k;
+    enum { R = TMASS__RHS };
+    for (k = m->colour_start[c->colour] + begin; k < m->colour_start[c->colour] + end; k++) {
+        int s = m->chunk_start[k], s1 = s + m->chunk_live[k];
+        while (s < s1) {
+            int a = m->edge_a[s], r;
+            const tmass_real *pa = p + 3 * R * a;
+            tmass_real fa[3 * R];
+            for (r = 0; r < 3 * R; r++) fa[r] = 0;
+            do {
+                const tmass_real *K = m->edge_tensor + 9 * s, *pb = p + 3 * R * m->edge_b[s];
+                tmass_real *ob = out + 3 * R * m->edge_b[s];
+                for (r = 0; r < R; r++) {
+                    tmass_real d0 = pb[r] - pa[r], d1 = pb[R + r] - pa[R + r], d2 = pb[2 * R + r] - pa[2 * R + r];
+                    fa[r] += K[0] * d0 + K[1] * d1 + K[2] * d2;
+                    fa[R + r] += K[3] * d0 + K[4] * d1 + K[5] * d2;
+                    fa[2 * R + r] += K[6] * d0 + K[7] * d1 + K[8] * d2;
+                    ob[r] -= K[0] * d0 + K[3] * d1 + K[6] * d2;
+                    ob[R + r] -= K[1] * d0 + K[4] * d1 + K[7] * d2;
+                    ob[2 * R + r] -= K[2] * d0 + K[5] * d1 + K[8] * d2;
+                }
+                s++;
+            } while (s < s1 && m->edge_a[s] == a);
+            for (r = 0; r < 3 * R; r++) out[3 * R * a + r] += fa[r];
+        }
+    }
+}
+
+/* out = K p for TMASS__RHS interleaved vectors. */
+static void tmass__matvec_block(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    tmass__block_ctx c;
+    c.m = m;
+    c.p = p;
+    c.out = out;
+    memset(out, 0, sizeof(tmass_real) * 3 * TMASS__RHS * (size_t)m->node_count);
+    for (c.colour = 0; c.colour < m->colour_count; c.colour++)
+        tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
+                   tmass__matvec_block_chunks, &c);
+}
+
+/* Solves K X = B (interleaved, TMASS__RHS columns) on the free degrees of freedom by
+   Jacobi-preconditioned CG, each column to |r| <= tol |b|. w: four arrays like X.
+   Returns TMASS_OK or TMASS_ERR_NO_CONVERGENCE. */
+static int tmass__cg_block(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                           const tmass_real *pinv, double tol, int max_iterations)
+{
+    enum { R = TMASS__RHS };
+    tmass_real *res = w[0], *z = w[1], *p = w[2], *q = w[3];
+    double bb[R], rr[R], rz[R], pq[R], alpha[R], beta[R], tol2[R];
+    int n3 = 3 * m->node_count, i, r, it, done, active[R];
+    for (r = 0; r < R; r++) bb[r] = rr[r] = rz[r] = 0.0;
+    for (i = 0; i < n3; i++)
+        for (r = 0; r < R; r++) {
+            tmass_real b = B[i * R + r] * m->free_mask[i];
+            X[i * R + r] = 0;
+            res[i * R + r] = b;
+            z[i * R + r] = pinv[i] * b;
+            p[i * R + r] = z[i * R + r];
+            bb[r] += (double)b * b;
+            rz[r] += (double)b * z[i * R + r];
+        }
+    for (r = 0; r < R; r++) {
+        rr[r] = bb[r];
+        tol2[r] = tol * tol * bb[r];
+    }
+    for (it = 0; it < max_iterations; it++) {
+        for (r = 0, done = 1; r < R; r++) done &= rr[r] <= tol2[r];
+        if (done) break;
+        tmass__matvec_block(m, p, q);
+        for (r = 0; r < R; r++) pq[r] = 0.0;
+        for (i = 0; i < n3; i++)
+            for (r = 0; r < R; r++) {
+                q[i * R + r] *= m->free_mask[i];
+                pq[r] += (double)p[i * R + r] * q[i * R + r];
+            }
+        for (r = 0; r < R; r++) { /* a converged (or empty) column stops moving */
+            active[r] = rr[r] > tol2[r] && pq[r] > 0.0;
+            alpha[r] = active[r] ? rz[r] / pq[r] : 0.0;
+            beta[r] = rz[r];
+            rr[r] = rz[r] = 0.0;
+        }
+        for (i = 0; i < n3; i++)
+            for (r = 0; r < R; r++) {
+                int j = i * R + r;
+                X[j] += (tmass_real)alpha[r] * p[j];
+                res[j] -= (tmass_real)alpha[r] * q[j];
+                z[j] = pinv[i] * res[j];
+                rr[r] += (double)res[j] * res[j];
+                rz[r] += (double)res[j] * z[j];
+            }
+        for (r = 0; r < R; r++) beta[r] = active[r] && beta[r] > 0.0 ? rz[r] / beta[r] : 0.0;
+        for (i = 0; i < n3; i++)
+            for (r = 0; r < R; r++) p[i * R + r] = z[i * R + r] + (tmass_real)beta[r] * p[i * R + r];
+        m->stats.force_evaluations++;
+    }
+    m->stats.cg_iterations += it;
+    for (r = 0; r < R; r++)
+        if (!(rr[r] <= tol2[r])) return TMASS_ERR_NO_CONVERGENCE;
+    return TMASS_OK;
+}
+
 TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out)
 {
+    enum { R = TMASS__RHS };
     tmass_qs *q;
-    tmass_real *b, *x, *cg_scratch[5], saved_tol;
-    int err, i, j, saved_iter, total, n3, o3;
+    tmass_real *b, *x, *cg_scratch[5], *block, *w[4], *B, *X, *pinv, saved_tol;
+    size_t vec, block_bytes;
+    int err, i, j0, r, saved_iter, total, n3, o3, p3;
     if (!out) return TMASS_ERR_ARG;
     *out = NULL;
+    if (m && m->coupling_count) return TMASS_ERR_ARG; /* a hybrid's dynamic part */
     err = tmass__qs_prepare(m, d, &q);
     if (err) return err;
     n3 = 3 * m->node_count;
     o3 = 3 * q->out_count;
+    p3 = 3 * q->pre_count;
+    total = p3 + 1;
+    /* the preload: K g = f_ext + M g_vec on the free nodes (one CG) */
     b = m->scratch[0];
     x = m->scratch[1];
     for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[2 + i];
@@ -2595,33 +2727,50 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     saved_iter = m->cg_max_iterations;
     m->cg_tolerance = d->cg_tolerance;
     m->cg_max_iterations = d->cg_max_iterations;
-    total = 3 * q->pre_count + 1;
-    /* preload: K g = f_ext + M g_vec on the free nodes */
     for (i = 0; i < n3; i++) {
         b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3];
         x[i] = 0;
     }
     err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
-    memcpy(q->preload, x, sizeof(tmass_real) * (size_t)n3);
-    if (!err && d->progress && d->progress(1, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
-    /* one column of the compliance per precomputed degree of freedom */
-    for (j = 0; j < 3 * q->pre_count && !err; j++) {
-        tmass_real *col = q->compliance + (size_t)j * o3;
-        memset(b, 0, sizeof(tmass_real) * (size_t)n3);
-        memset(x, 0, sizeof(tmass_real) * (size_t)n3);
-        b[3 * q->pre_nodes[j / 3] + j % 3] = 1;
-        err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
-        if (err) break;
-        for (i = 0; i < q->out_count; i++) {
-            const tmass_real *u = x + 3 * q->out_nodes[i];
-            col[3 * i] = u[0];
-            col[3 * i + 1] = u[1];
-            col[3 * i + 2] = u[2];
-        }
-        if (d->progress && d->progress(j + 2, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
-    }
     m->cg_tolerance = saved_tol;
     m->cg_max_iterations = saved_iter;
+    memcpy(q->preload, x, sizeof(tmass_real) * (size_t)n3);
+    if (!err && d->progress && d->progress(1, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
+    /* the compliance columns, TMASS__RHS at a time (temporary block: six interleaved
+       vectors and the Jacobi preconditioner) */
+    vec = (size_t)n3 * R;
+    block_bytes = sizeof(tmass_real) * (6 * vec + (size_t)n3);
+    block = err ? NULL : (tmass_real *)tmass__alloc(&q->allocator, block_bytes);
+    if (!err && !block) err = TMASS_ERR_ALLOC;
+    if (!err) {
+        B = block;
+        X = B + vec;
+        for (i = 0; i < 4; i++) w[i] = X + vec * (1 + i);
+        pinv = X + 5 * vec;
+        for (i = 0; i < n3; i++) {
+            double dgl = (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)];
+            pinv[i] = (tmass_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
+        }
+        m->stats.cg_iterations = 0;
+        for (j0 = 0; j0 < p3 && !err; j0 += R) {
+            memset(B, 0, sizeof(tmass_real) * vec);
+            for (r = 0; r < R && j0 + r < p3; r++)
+                B[(size_t)(3 * q->pre_nodes[(j0 + r) / 3] + (j0 + r) % 3) * R + r] = 1;
+            err = tmass__cg_block(m, B, X, w, pinv, (double)d->cg_tolerance, d->cg_max_iterations);
+            for (r = 0; r < R && j0 + r < p3 && !err; r++) {
+                tmass_real *col = q->compliance + (size_t)(j0 + r) * o3;
+                for (i = 0; i < q->out_count; i++) {
+                    int v = q->out_nodes[i];
+                    col[3 * i] = X[(size_t)(3 * v) * R + r];
+                    col[3 * i + 1] = X[(size_t)(3 * v + 1) * R + r];
+                    col[3 * i + 2] = X[(size_t)(3 * v + 2) * R + r];
+                }
+            }
+            if (!err && d->progress && d->progress((j0 + R < p3 ? j0 + R : p3) + 1, total, d->progress_user))
+                err = TMASS_ERR_CANCELLED;
+        }
+        tmass__free(&q->allocator, block, block_bytes);
+    }
     if (err) {
         tmass_qs_destroy(q);
         return err;
@@ -3163,8 +3312,85 @@ static void tmass__sort3(const int *t, int *key)
     key[2] = c;
 }
 
+static int tmass__root(int *parent, int i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Adds fixed node v to a set of up to three non-collinear supports (indices in s[3]). */
+static void tmass__add_support(const tmass_real *x, int *s, int v)
+{
+    double e1[3], e2[3], c[3], l1 = 0.0, lc = 0.0;
+    int k;
+    if (s[0] < 0) {
+        s[0] = v;
+        return;
+    }
+    for (k = 0; k < 3; k++) e1[k] = (double)x[3 * v + k] - x[3 * s[0] + k];
+    for (k = 0; k < 3; k++) l1 += e1[k] * e1[k];
+    if (s[1] < 0) {
+        if (l1 > 0.0) s[1] = v;
+        return;
+    }
+    if (s[2] >= 0) return;
+    for (k = 0; k < 3; k++) {
+        e1[k] = (double)x[3 * s[1] + k] - x[3 * s[0] + k];
+        e2[k] = (double)x[3 * v + k] - x[3 * s[0] + k];
+    }
+    c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    for (k = 0, l1 = 0.0; k < 3; k++) {
+        lc += c[k] * c[k];
+        l1 += e1[k] * e1[k];
+    }
+    if (lc > 1e-12 * l1 * l1) s[2] = v;
+}
+
+/* A face-connected piece of the precomputed part that is not held by three non-collinear
+   fixed nodes has a singular stiffness (its precomputation cannot converge): such pieces
+   move to the dynamic part, where they hang on the connection nodes. work: 4T ints.
+   Returns the number of tetrahedra moved. */
+static int tmass__hybrid_support(const tmass_desc *m, unsigned char *dynamic, const unsigned char *fixed,
+                                 tmass__face_key *keys, int *work)
+{
+    int T = m->tet_count, t, f, i, k, n = 0, moved = 0, *parent = work, *support = work + T;
+    for (t = 0; t < T; t++) {
+        parent[t] = t;
+        support[3 * t] = support[3 * t + 1] = support[3 * t + 2] = -1;
+        if (dynamic[t]) continue;
+        for (f = 0; f < 4; f++, n++) {
+            for (k = 0; k < 3; k++) keys[n].tri[k] = m->tets[4 * t + tmass__face_local[f][k]];
+            tmass__sort3(keys[n].tri, keys[n].key);
+            keys[n].source = 0;
+            keys[n].owner = t;
+        }
+    }
+    qsort(keys, (size_t)n, sizeof *keys, tmass__face_key_cmp);
+    for (i = 0; i + 1 < n; i++)
+        if (memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) {
+            int a = tmass__root(parent, keys[i].owner), b = tmass__root(parent, keys[i + 1].owner);
+            if (a != b) parent[a] = b;
+        }
+    for (t = 0; t < T; t++)
+        if (!dynamic[t])
+            for (k = 0; k < 4; k++)
+                if (fixed[m->tets[4 * t + k]])
+                    tmass__add_support(m->rest_positions, support + 3 * tmass__root(parent, t), m->tets[4 * t + k]);
+    for (t = 0; t < T; t++)
+        if (!dynamic[t] && support[3 * tmass__root(parent, t) + 2] < 0) {
+            dynamic[t] = 1;
+            moved++;
+        }
+    return moved;
+}
+
 /* Sub-description of one part: its tets (and per-tet materials) with local node numbers. */
-static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, int part, const int *local_of,
+static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, const unsigned char *dynamic, int part, const int *local_of,
                                   int node_total, tmass_real *rest, int *tets, tmass_real *young,
                                   tmass_real *poisson, tmass_desc *sub)
 {
@@ -3173,7 +3399,7 @@ static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, int part, const in
     for (i = 0; i < d->model.node_count; i++)
         if (local_of[i] >= 0) memcpy(rest + 3 * local_of[i], d->model.rest_positions + 3 * i, 3 * sizeof(tmass_real));
     for (t = 0; t < d->model.tet_count; t++) {
-        if ((d->tet_dynamic[t] != 0) != (part == 1)) continue;
+        if ((dynamic[t] != 0) != (part == 1)) continue;
         for (j = 0; j < 4; j++) tets[4 * n + j] = local_of[d->model.tets[4 * t + j]];
         if (d->model.tet_young_modulus) young[n] = d->model.tet_young_modulus[t];
         if (d->model.tet_poisson_ratio) poisson[n] = d->model.tet_poisson_ratio[t];
@@ -3199,7 +3425,7 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
     tmass_allocator a;
     int err, i, t, N, T, n_dyn = 0, n_qs = 0, t_dyn = 0, c0 = 0, faces = 0, k;
     int *dyn_of = NULL, *qs_of = NULL, *itmp = NULL;
-    unsigned char *fixed = NULL;
+    unsigned char *fixed = NULL, *dynamic = NULL;
     tmass_real *rtmp = NULL;
     tmass__face_key *keys = NULL;
     size_t tmp_bytes;
@@ -3222,7 +3448,7 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
 
     /* temporary: two node maps, fixed flags, a rest copy, tets and per-tet materials of a
        part, face keys of both boundaries */
-    tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N +
+    tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N + (size_t)T +
                 sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
                 4 * TMASS__ALIGN;
     tmp_block = (char *)tmass__alloc(&a, tmp_bytes);
@@ -3235,12 +3461,21 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
     qs_of = dyn_of + N;
     itmp = qs_of + N;
     fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
+    dynamic = (unsigned char *)tmass__carve(&carver, (size_t)T);
     memset(fixed, 0, (size_t)N);
     for (i = 0; i < d->fixed_count; i++) fixed[d->fixed_nodes[i]] = 1;
+    for (t = 0; t < T; t++) dynamic[t] = d->tet_dynamic[t] != 0;
+    i = tmass__hybrid_support(&d->model, dynamic, fixed, keys, itmp);
+    if (i && d->model.log) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "%d tetrahedra of the precomputed part were not held by fixed nodes "
+                 "and were moved to the dynamic part", i);
+        d->model.log(TMASS_OK, msg, d->model.log_user);
+    }
     for (i = 0; i < N; i++) dyn_of[i] = qs_of[i] = -1;
     for (t = 0; t < T; t++) {
-        int *map = d->tet_dynamic[t] ? dyn_of : qs_of;
-        t_dyn += d->tet_dynamic[t] != 0;
+        int *map = dynamic[t] ? dyn_of : qs_of;
+        t_dyn += dynamic[t] != 0;
         for (k = 0; k < 4; k++) map[d->model.tets[4 * t + k]] = 1;
     }
     for (i = 0; i < N; i++) {
@@ -3250,14 +3485,14 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
     err = t_dyn == 0 || t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
     /* the dynamic part */
     if (!err) {
-        tmass__hybrid_subdesc(d, 1, dyn_of, n_dyn, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
+        tmass__hybrid_subdesc(d, dynamic, 1, dyn_of, n_dyn, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
         err = tmass_create(&sub, &dyn);
     }
     for (i = 0; i < N && !err; i++)
         if (fixed[i] && dyn_of[i] >= 0) err = tmass_fix_node(dyn, dyn_of[i]);
     /* the precomputed part */
     if (!err) {
-        tmass__hybrid_subdesc(d, 0, qs_of, n_qs, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
+        tmass__hybrid_subdesc(d, dynamic, 0, qs_of, n_qs, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
         err = tmass_create(&sub, &src);
     }
     for (i = 0; i < N && !err; i++)
@@ -3347,7 +3582,7 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
         {
             int nd = 0, nq = 0;
             for (t = 0; t < T; t++) {
-                h->tet_dynamic[t] = d->tet_dynamic[t] != 0;
+                h->tet_dynamic[t] = dynamic[t];
                 h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
             }
         }
