@@ -1,4 +1,4 @@
-/* tensormass.h - v0.1.0 - linear tensor-mass elasticity with cutting and tearing - MIT or public domain
+/* tensormass.h - v0.2.0 - linear tensor-mass elasticity with cutting, tearing, precomputed and hybrid models - MIT or public domain
 
    A drop-in soft-body model after Cotin, Delingette & Ayache, "Efficient linear elastic
    models of soft tissues for real-time surgery simulation" (INRIA RR-3510, 1998): linear
@@ -71,6 +71,14 @@
        5. Read tmass_positions / tmass_velocities / tmass_boundary_triangles to render.
        6. Topology: tmass_remove_tets (cutting), tmass_tear (tearing by criteria).
        7. tmass_destroy(m).
+       Precomputed quasi-static model (haptic rates, frozen topology): create a model as
+       above with its pinned nodes, then tmass_qs_create(m, &qd, &qs) (minutes on large
+       meshes; tmass_qs_save / tmass_qs_load keep the result), then per haptic frame
+       tmass_qs_update(qs, contact_nodes, displacements, count, forces) and read
+       tmass_qs_displacements. Hybrid model (cut one region, precompute the rest):
+       tmass_hybrid_desc hd = tmass_hybrid_default_desc(); hd.model = the whole mesh,
+       hd.tet_dynamic = which tets are dynamic, hd.fixed_nodes; tmass_hybrid_create, then
+       tmass_hybrid_step / tmass_hybrid_set_displacement / tmass_hybrid_remove_tets.
 
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, time s, forces
    N, mass_damping 1/s, stiffness_damping s, gravity m/s^2 (default 9.81 along -z).
@@ -150,6 +158,34 @@
    any enabled threshold of: relative volume change |V - V0| / V0, mean relative edge
    elongation, maximum relative edge elongation ((l - l0) / l0, positive in tension).
 
+   PRECOMPUTED QUASI-STATIC MODEL (sec. 4): with the pinned nodes as fixed boundary
+   conditions, one CG solve per precomputed node and direction gives the columns of the
+   compliance C = K^-1 (a unit force on that degree of freedom), restricted to the output
+   nodes (the precomputed nodes, or every node), plus the static preload g under gravity
+   and external forces. An update with imposed displacements u_I on a contact set I solves
+   the small dense system C_II f = u_I - g_I (Cholesky, 3|I| unknowns) for the forces f
+   that hold the contacts, then u = g + C_.I f on every output node: the constraints are
+   met exactly (superposition of elementary fields, valid because the model is linear).
+   Cost per update: 9 |I| |output| multiply-adds + (3|I|)^3 / 3; memory 9 |P| |output|
+   reals (tmass_qs_memory_bytes). Precomputation: 3 |P| + 1 solves, 8 at a time sharing
+   each pass over the tensors; it reports progress and can be cancelled. The file format
+   (tmass_qs_save) is a versioned header (magic, version, byte order, real size, counts,
+   a fingerprint of mesh, material, pins and loads), the payload and a checksum; loading
+   refuses a truncated, corrupted, other-version or other-model file with its own code.
+   Topology changes are refused (TMASS_ERR_PRECOMPUTED): the paper's limit.
+
+   HYBRID MODEL (sec. 6, fig. 5): the caller marks the dynamic tetrahedra; the rest is
+   precomputed on its boundary nodes. Connection nodes belong to both parts. Each step the
+   dynamic part's connection displacements are imposed on the precomputed part, which
+   returns the forces needed to hold them, applied to the dynamic part. Beyond the paper
+   the precomputed part's exact connection stiffness S = (C_cc)^-1 is included in the
+   dynamic part's implicit solve, so the coupling adds no time-step limit; at steady
+   state the hybrid equals a single tensor-mass model of the whole mesh (tested, also
+   after cuts). A face-connected piece of the precomputed part held by fewer than three
+   non-collinear fixed nodes would be singular: it is moved to the dynamic part (and
+   reported through desc.log). Cutting and tearing apply to the dynamic part; connection
+   nodes left without a dynamic tetrahedron stop coupling.
+
    PERFORMANCE: a force evaluation is one pass over the live edges. Per edge it reads two
    int node indices and one 3x3 tensor (8 + 72 = 80 bytes in double, 8 + 36 = 44 in
    float) and the displacements of both ends, and updates the forces of both ends; per
@@ -177,8 +213,14 @@
        - The explicit integrators are conditionally stable; tmass_step returns
          TMASS_ERR_NOT_FINITE rather than NaN when they blow up.
        - Inactive (cut-off) vertices keep their last position and do not move.
+       - Quasi-static and hybrid: the precomputed part is static (no inertia), linear, and
+         its topology is frozen; contacts on it enter the dynamic solve with a one-step
+         lag. Memory grows as |P| x |output| (about 19.5 MB for 531 precomputed nodes
+         with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       0.2.0 (2026-12-01) precomputed quasi-static model (save/load, progress) and the
+             hybrid model; compliance columns precomputed 8 per CG sweep.
        0.1.0 (2026-11-22) first release: tensor-mass and mass-spring models, four
              integrators, static solve, cutting, tearing.
 
@@ -189,7 +231,7 @@
 #include <stddef.h>
 
 #define TMASS_VERSION_MAJOR 0
-#define TMASS_VERSION_MINOR 1
+#define TMASS_VERSION_MINOR 2
 #define TMASS_VERSION_PATCH 0
 
 #ifndef TMASS_REAL
@@ -1202,7 +1244,7 @@ static void tmass__apply_tet(tmass_model *m, int t, double sign)
 
 /* >>creation -------------------------------------------------------------------------- */
 
-TMASSDEF const char *tmass_version(void) { return "0.1.0"; }
+TMASSDEF const char *tmass_version(void) { return "0.2.0"; }
 
 TMASSDEF const char *tmass_error_string(int code)
 {

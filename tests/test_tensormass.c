@@ -1226,7 +1226,11 @@ static void test_error_strings(void)
         for (k = 0; k > c; k--) CHECK(strcmp(tmass_error_string(c), tmass_error_string(k)) != 0);
     }
     CHECK(strcmp(tmass_error_string(TMASS_ERR_LAST_), "unknown error code") == 0);
-    CHECK(strcmp(tmass_version(), "0.1.0") == 0);
+    { /* the string agrees with the version macros */
+        char v[32];
+        snprintf(v, sizeof v, "%d.%d.%d", TMASS_VERSION_MAJOR, TMASS_VERSION_MINOR, TMASS_VERSION_PATCH);
+        CHECK(strcmp(tmass_version(), v) == 0);
+    }
 }
 
 static const test_case cases[] = {
