@@ -3,6 +3,9 @@
 #   make test      every test program in every configuration of the matrix below, then one
 #                  line "N passed, N failed" (test cases summed over the matrix)
 #   make examples  the example programs, into build/examples/
+#   make bench     the speed/accuracy trade, stability and kernel throughput, written to
+#                  bench/results/ (under 10 minutes on 2 cores)
+#   make bench-quick  the same at the smallest sizes (under a minute), to build/bench-quick/
 #   make clean     remove build/
 #
 # The matrix: gcc -std=c99, g++ (the same test sources compiled as C++) and clang -std=c99,
@@ -32,7 +35,7 @@ ENV_omp-double := OMP_NUM_THREADS=2
 TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 
-.PHONY: all test test-run examples clean
+.PHONY: all test test-run examples bench bench-quick clean
 # keep the test binaries between runs (they are intermediate files of the .result rules)
 .SECONDARY:
 all: test
@@ -64,6 +67,33 @@ examples: $(foreach e,$(EXAMPLES),build/examples/$(e))
 build/examples/%: examples/%.c $(HEADERS)
 	@mkdir -p build/examples
 	gcc -std=c99 -O2 $(WARN) -o $@ $< -lm
+
+# The bench: bench.c plus every adapter bench/model_*.c compiled twice (double, float).
+# Built for this machine; the flags and git revision go into every CSV row.
+BENCH_CFLAGS := -std=c99 -O3 -march=native -ffp-contract=fast -fopenmp
+BENCH_MODELS := $(basename $(notdir $(wildcard bench/model_*.c)))
+BENCH_OBJS := $(foreach m,$(BENCH_MODELS),build/bench/$(m)_double.o build/bench/$(m)_float.o)
+BENCH_GIT := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- 2>/dev/null || echo -dirty)
+BENCH_DEFS := -DBENCH_FLAGS='"$(BENCH_CFLAGS)"' -DBENCH_GIT='"$(BENCH_GIT)"'
+
+build/bench/%_double.o: bench/%.c bench/bench.h $(HEADERS)
+	@mkdir -p build/bench
+	gcc $(BENCH_CFLAGS) $(WARN) -c -o $@ $<
+
+build/bench/%_float.o: bench/%.c bench/bench.h $(HEADERS)
+	@mkdir -p build/bench
+	gcc $(BENCH_CFLAGS) $(WARN) -DBENCH_FLOAT -c -o $@ $<
+
+build/bench/bench: bench/bench.c bench/bench.h bench/svg.h $(BENCH_OBJS)
+	gcc $(BENCH_CFLAGS) $(WARN) $(BENCH_DEFS) -o $@ bench/bench.c $(BENCH_OBJS) -lm
+
+bench: build/bench/bench
+	@mkdir -p bench/results
+	build/bench/bench --out bench/results | tee bench/results/bench.txt
+
+bench-quick: build/bench/bench
+	@mkdir -p build/bench-quick
+	build/bench/bench --quick --out build/bench-quick
 
 clean:
 	rm -rf build

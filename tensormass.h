@@ -262,6 +262,16 @@ typedef TMASS_REAL tmass_real;
 #define TMASS_PARALLEL_MIN_EDGES 20000
 #endif
 
+/* The least memory traffic of one force evaluation (tmass_forces), for bandwidth bounds
+   (the bench divides it by a measured STREAM rate): per live edge the two node indices and
+   the data of the edge; per node its displacement read and its force written (springs
+   also read the rest position). Tensor-mass: the 3x3 edge tensor (80 bytes per edge in
+   double, 44 in float); springs: stiffness and rest length. */
+#define TMASS_FORCE_BYTES_PER_EDGE (2 * sizeof(int) + 9 * sizeof(tmass_real))
+#define TMASS_FORCE_BYTES_PER_NODE (6 * sizeof(tmass_real))
+#define TMASS_SPRING_BYTES_PER_EDGE (2 * sizeof(int) + 2 * sizeof(tmass_real))
+#define TMASS_SPRING_BYTES_PER_NODE (9 * sizeof(tmass_real))
+
 /* Error codes and their messages, one list so they cannot drift apart. */
 #define TMASS_ERROR_LIST(X) \
     X(TMASS_OK, 0, "ok") \

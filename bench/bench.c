@@ -1,0 +1,1171 @@
+/* bench.c - what each model costs and how accurate it is, on this machine.
+
+   make bench         the full run (under 10 minutes on 2 cores): bench/results/
+   make bench-quick   the smallest sizes (under a minute): build/bench-quick/
+
+   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,kernels]
+                     [--filter TEXT] [--repeats N] [--threads N]
+
+   1. trade: scenes with known answers (REFERENCES.md R1-R5 and a cutting scene), for every
+      model entry x resolution x integrator: DoF, seconds per step, seconds to the answer,
+      error. trade.csv, one SVG per scene (error against time, Pareto front), and the
+      cheapest configuration reaching 10 %, 1 % and 0.1 % error.
+   2. stability: largest stable time step by bisection, Poisson ratio towards 0.5, a
+      tetrahedron pushed through zero volume, a 180 degree twist, the scene 1e6 m from the
+      origin; each outcome classified. stability.csv.
+   3. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
+      the memory-bandwidth bound of the bytes each header says its kernel moves, with the
+      bandwidth measured in the same run by a STREAM triad. kernels.csv.
+
+   Every CSV row carries the date, compiler, flags, CPU and git revision. Timing uses the
+   monotonic clock, medians of repeated runs after a warm-up. Figures are printed, never
+   asserted. Adding a model: an entry in an adapter's table (bench/model_*.c) or one more
+   line in `registry` below. */
+#define _POSIX_C_SOURCE 199309L
+#include "bench.h"
+#include "svg.h"
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#ifndef BENCH_FLAGS
+#define BENCH_FLAGS "unknown"
+#endif
+#ifndef BENCH_GIT
+#define BENCH_GIT "unknown"
+#endif
+
+/* >>registry: one line per adapter table (each compiled in double and in float) */
+const bench_model *bench_models_tensormass_double(int *count);
+const bench_model *bench_models_tensormass_float(int *count);
+static const bench_models_fn registry[] = {
+    bench_models_tensormass_double,
+    bench_models_tensormass_float,
+};
+
+#define BIT(i) (1u << (i))
+#define PI 3.14159265358979323846
+static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", "semi-implicit-euler", "rk4",
+                                                              "implicit-euler", "static"};
+
+/* >>options and environment */
+typedef struct options {
+    int quick, repeats, threads;
+    const char *out, *filter;
+    int parts; /* bits: 1 trade, 2 stability, 4 kernels */
+    double budget; /* s: a configuration slower than this stops its refinement */
+} options;
+
+static char env_date[32], env_cpu[128], env_compiler[128];
+
+static void read_environment(void)
+{
+    time_t t = time(NULL);
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    char line[256];
+    strftime(env_date, sizeof env_date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&t));
+    strcpy(env_cpu, "unknown");
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "model name", 10) == 0) {
+            char *c = strchr(line, ':');
+            if (c) {
+                size_t n;
+                snprintf(env_cpu, sizeof env_cpu, "%s", c + 2);
+                n = strlen(env_cpu);
+                while (n && (env_cpu[n - 1] == '\n' || env_cpu[n - 1] == ' ')) env_cpu[--n] = 0;
+            }
+            break;
+        }
+    if (f) fclose(f);
+#if defined(__clang__)
+    snprintf(env_compiler, sizeof env_compiler, "clang %s", __clang_version__);
+#elif defined(__GNUC__)
+    snprintf(env_compiler, sizeof env_compiler, "gcc %s", __VERSION__);
+#else
+    strcpy(env_compiler, "unknown");
+#endif
+    for (t = 0; env_cpu[t]; t++)
+        if (env_cpu[t] == ',') env_cpu[t] = ' ';
+}
+
+static FILE *open_csv(const options *o, const char *name, const char *columns)
+{
+    char path[512];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s", o->out, name);
+    f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "bench: cannot write %s\n", path);
+        exit(1);
+    }
+    fprintf(f, "date,compiler,flags,cpu,git,%s\n", columns);
+    return f;
+}
+
+static void csv_prefix(FILE *f) { fprintf(f, "%s,%s,%s,%s,%s,", env_date, env_compiler, BENCH_FLAGS, env_cpu, BENCH_GIT); }
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void set_threads(int n)
+{
+#ifdef _OPENMP
+    omp_set_num_threads(n);
+#else
+    (void)n;
+#endif
+}
+
+static int selected(const options *o, const bench_model *m)
+{
+    char name[128];
+    if (!o->filter) return 1;
+    snprintf(name, sizeof name, "%s/%s/%s", m->model, m->variant, m->precision);
+    return strstr(name, o->filter) != NULL;
+}
+
+/* >>scene helpers */
+
+static bench_body make_body(double L, double W, double H, int nx, int ny, int nz, double young,
+                            double poisson, double density)
+{
+    bench_body b;
+    memset(&b, 0, sizeof b);
+    b.size[0] = L, b.size[1] = W, b.size[2] = H;
+    b.cells[0] = nx, b.cells[1] = ny, b.cells[2] = nz;
+    b.young = young, b.poisson = poisson, b.density = density;
+    b.gravity[2] = -9.81;
+    b.clamp = 1;
+    return b;
+}
+
+/* Mean displacement of the nodes whose rest coordinate `axis` (offset removed) is within
+   tol of value. Returns the number of such nodes. */
+static int face_mean(const bench_model *m, void *sim, const bench_body *b, int axis, double value,
+                     double tol, double u[3])
+{
+    int i, k, n = 0, count = m->node_count(sim);
+    double p0[3], p[3];
+    u[0] = u[1] = u[2] = 0;
+    for (i = 0; i < count; i++) {
+        m->rest(sim, i, p0);
+        if (fabs(p0[axis] - b->offset[axis] - value) > tol) continue;
+        m->position(sim, i, p);
+        for (k = 0; k < 3; k++) u[k] += p[k] - p0[k];
+        n++;
+    }
+    for (k = 0; n && k < 3; k++) u[k] /= n;
+    return n;
+}
+
+static double tip_deflection(const bench_model *m, void *sim, const bench_body *b)
+{
+    double u[3];
+    face_mean(m, sim, b, 0, b->size[0], 1e-6 * b->size[0], u);
+    return -u[2];
+}
+
+static int all_finite(const bench_model *m, void *sim)
+{
+    int i, k, n = m->node_count(sim);
+    double p[3];
+    for (i = 0; i < n; i++) {
+        m->position(sim, i, p);
+        for (k = 0; k < 3; k++)
+            if (!(fabs(p[k]) < HUGE_VAL)) return 0;
+    }
+    return 1;
+}
+
+/* Timoshenko tip deflection of a clamped cantilever of square section a x a under its own
+   weight (kappa = 10 (1 + nu) / (12 + 11 nu), rectangular section). */
+static double timoshenko_tip(double L, double a, double young, double nu, double density, double g)
+{
+    double A = a * a, I = a * a * a * a / 12.0, q = density * g * A, G = young / (2 * (1 + nu));
+    double kappa = 10 * (1 + nu) / (12 + 11 * nu);
+    return q * L * L * L * L / (8 * young * I) + q * L * L / (2 * kappa * G * A);
+}
+
+/* >>trade */
+
+typedef struct trade_row {
+    char scene[24], setting[32];
+    const bench_model *m;
+    int level, dof, status;
+    double elements, setup_s, step_s, answer_s, value, reference, error;
+} trade_row;
+
+static trade_row rows[4096];
+static int row_count;
+
+static trade_row *new_row(const char *scene, const bench_model *m, const char *setting, int level)
+{
+    trade_row *r;
+    if (row_count == (int)(sizeof rows / sizeof rows[0])) return NULL;
+    r = rows + row_count++;
+    memset(r, 0, sizeof *r);
+    snprintf(r->scene, sizeof r->scene, "%s", scene);
+    snprintf(r->setting, sizeof r->setting, "%s", setting);
+    r->m = m;
+    r->level = level;
+    r->error = r->value = r->reference = NAN;
+    return r;
+}
+
+static void print_row(const trade_row *r)
+{
+    printf("  %-6s %-10s %-12s %-6s %-22s L%-2d %8d dof  step %9.3g s  answer %9.3g s  value %11.5g  "
+           "error %9.3g%s",
+           r->scene, r->m->model, r->m->variant, r->m->precision, r->setting, r->level, r->dof, r->step_s,
+           r->answer_s, r->value, r->error, r->status ? "  failed:" : "");
+    printf(r->status ? " code %d\n" : "\n", r->status);
+    fflush(stdout);
+}
+
+/* Creates the body, runs the static solve `repeats` times on fresh models (only the solve
+   is timed) and leaves the last model in *sim for the caller to measure. */
+static int timed_static(const bench_model *m, const bench_body *b, int repeats, void **sim, trade_row *r)
+{
+    double t[8], t0;
+    int i, err = 0;
+    if (repeats > 8) repeats = 8;
+    for (i = 0; i < repeats; i++) {
+        if (i) m->destroy(*sim);
+        t0 = now();
+        err = m->create(b, sim);
+        r->setup_s = now() - t0;
+        if (err) return err;
+        r->dof = m->dof(*sim);
+        r->elements = m->elements(*sim);
+        t0 = now();
+        err = m->solve_static(*sim);
+        t[i] = now() - t0;
+        if (err) break;
+        if (t[i] > 0.3) { /* long solves are not repeated */
+            repeats = i + 1;
+            break;
+        }
+    }
+    r->step_s = r->answer_s = median(t, err ? i + 1 : repeats);
+    return err;
+}
+
+static double relative_error(double value, double reference) { return fabs(value - reference) / fabs(reference); }
+
+/* R1: the steel cantilever 16 x 0.5 x 0.5 m under its own weight, static. */
+static void trade_r1(const bench_model *m, const options *o)
+{
+    static const int levels[] = {1, 2, 3, 4, 6, 8};
+    int l, n = o->quick ? 2 : 6;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    for (l = 0; l < n; l++) {
+        int k = levels[l];
+        bench_body b = make_body(16, 0.5, 0.5, 32 * k, k, k, 200e9, 0.3, 7800);
+        void *sim = NULL;
+        trade_row *r = new_row("R1", m, "static", k);
+        if (!r) return;
+        r->reference = 0.15059; /* Timoshenko, REFERENCES.md R1 */
+        r->status = timed_static(m, &b, o->repeats, &sim, r);
+        if (!r->status) {
+            r->value = tip_deflection(m, sim, &b);
+            r->error = relative_error(r->value, r->reference);
+        }
+        if (sim) m->destroy(sim);
+        print_row(r);
+        if (r->status || r->answer_s > o->budget) break;
+    }
+}
+
+/* R2: the soft cantilever 16 x 1 x 1 m, 5 kg, E = 40 kPa: large deformation, no closed
+   form. Errors are filled in afterwards against each entry's finest level. */
+static void trade_r2(const bench_model *m, const options *o)
+{
+    static const int levels[] = {1, 2, 3, 4, 6};
+    int l, n = o->quick ? 2 : 5;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    for (l = 0; l < n; l++) {
+        int k = levels[l];
+        bench_body b = make_body(16, 1, 1, 16 * k, k, k, 40e3, 0.3, 5.0 / 16.0);
+        void *sim = NULL;
+        trade_row *r = new_row("R2", m, "static", k);
+        if (!r) return;
+        r->status = timed_static(m, &b, o->repeats, &sim, r);
+        if (!r->status) r->value = tip_deflection(m, sim, &b);
+        if (sim) m->destroy(sim);
+        print_row(r);
+        if (r->status || r->answer_s > o->budget) break;
+    }
+}
+
+/* Self-convergence of R2: each entry against its own finest converged level. */
+static void finish_r2(void)
+{
+    int i, j;
+    for (i = 0; i < row_count; i++) {
+        trade_row *best = NULL;
+        if (strcmp(rows[i].scene, "R2") || rows[i].status) continue;
+        for (j = 0; j < row_count; j++)
+            if (!strcmp(rows[j].scene, "R2") && rows[j].m == rows[i].m && !rows[j].status &&
+                (!best || rows[j].level > best->level))
+                best = rows + j;
+        rows[i].reference = best->value;
+        rows[i].error = best == rows + i ? NAN : relative_error(rows[i].value, best->value);
+    }
+}
+
+/* Zero crossings of a sampled signal: the mean period between the first and last
+   upward crossing (linear interpolation), or NAN with fewer than two. */
+static double period_of(const double *z, int n, double dt)
+{
+    double first = -1, last = -1;
+    int i, ups = 0;
+    for (i = 1; i < n; i++)
+        if (z[i - 1] < 0 && z[i] >= 0) {
+            double t = dt * (i - 1 + z[i - 1] / (z[i - 1] - z[i]));
+            if (first < 0) first = t;
+            last = t;
+            ups++;
+        }
+    return ups >= 2 ? (last - first) / (ups - 1) : NAN;
+}
+
+/* R3: first bending frequency of the clamped 1 x 0.1 x 0.1 m beam (E = 1 MPa), released
+   from its static deflection under a small load (tip about 1.5 mm), per integrator. */
+static void trade_r3(const bench_model *m, const options *o)
+{
+    static const int levels[] = {1, 2, 3, 4};
+    const double f_ref = 0.5069, T = 1.0 / f_ref; /* Timoshenko, REFERENCES.md R3 */
+    int l, it, n = o->quick ? 2 : 4;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    for (it = 0; it < BENCH_STATIC; it++) {
+        int variants = it == BENCH_IMPLICIT_EULER ? 2 : 1, v;
+        if (!(m->integrators & BIT(it))) continue;
+        for (v = 0; v < variants; v++)
+            for (l = 0; l < n; l++) {
+                int k = levels[l], steps, s, err = 0;
+                bench_body b = make_body(1, 0.1, 0.1, 10 * k, k, k, 1e6, 0.3, 1000);
+                double h = 0.1 / k, lambda = b.young * b.poisson / ((1 + b.poisson) * (1 - 2 * b.poisson)),
+                       mu = b.young / (2 * (1 + b.poisson)), cp = sqrt((lambda + 2 * mu) / b.density), dt, t0,
+                       *z, g0[3] = {0, 0, 0};
+                void *sim = NULL;
+                char setting[32];
+                trade_row *r;
+                /* explicit schemes: a fifth of the P-wave transit time of a cell (below
+                   their stability limit); implicit: 100 and 400 steps per period */
+                dt = it == BENCH_IMPLICIT_EULER ? T / (v ? 400 : 100) : 0.2 * h / cp;
+                snprintf(setting, sizeof setting, "%s dt=%.2g", integrator_name[it], dt);
+                r = new_row("R3", m, setting, k);
+                if (!r) return;
+                r->reference = f_ref;
+                b.gravity[2] = -0.01;
+                t0 = now();
+                err = m->create(&b, &sim);
+                r->setup_s = now() - t0;
+                if (!err) err = m->solve_static(sim);
+                if (!err) err = m->set_gravity(sim, g0);
+                steps = (int)ceil(2.3 * T / dt); /* three upward zero crossings */
+                z = (double *)malloc(sizeof(double) * (size_t)(steps + 1));
+                if (!err && z) {
+                    r->dof = m->dof(sim);
+                    r->elements = m->elements(sim);
+                    z[0] = -tip_deflection(m, sim, &b);
+                    t0 = now();
+                    for (s = 1; s <= steps && !err; s++) {
+                        err = m->step(sim, dt, it);
+                        z[s] = -tip_deflection(m, sim, &b); /* measured, not timed apart */
+                    }
+                    r->answer_s = now() - t0;
+                    r->step_s = r->answer_s / (s - 1);
+                    if (!err && !all_finite(m, sim)) err = -9999; /* silent non-finite */
+                    if (!err) {
+                        r->value = 1.0 / period_of(z, steps + 1, dt);
+                        r->error = relative_error(r->value, f_ref);
+                        if (!(r->error < HUGE_VAL)) r->error = 1.0; /* no oscillation left */
+                    }
+                }
+                free(z);
+                r->status = err;
+                if (sim) m->destroy(sim);
+                print_row(r);
+                if (err || r->answer_s > o->budget) break;
+            }
+    }
+}
+
+/* Lateral stretch t and P_zz of a uniaxial stretch s (REFERENCES.md R4, R5). */
+static void uniaxial_reference(int neo_hookean, double mu, double lambda, double s, double *t, double *pzz)
+{
+    if (!neo_hookean) { /* St Venant-Kirchhoff: S_xx = 0 gives t^2 */
+        *t = sqrt(1 - lambda * (s * s - 1) / (2 * (lambda + mu)));
+        *pzz = mu * (3 * lambda + 2 * mu) / (2 * (lambda + mu)) * (s * s * s - s);
+    } else { /* P_xx = mu (t - 1/t) + lambda ln(s t^2) / t = 0, scalar Newton from t = 1 */
+        double x = 1;
+        int i;
+        for (i = 0; i < 50; i++) {
+            double f = mu * (x - 1 / x) + lambda * log(s * x * x) / x;
+            double df = mu * (1 + 1 / (x * x)) + lambda * (2 - log(s * x * x)) / (x * x);
+            x -= f / df;
+        }
+        *t = x;
+        *pzz = mu * (s - 1 / s) + lambda * log(s * x * x) / s;
+    }
+}
+
+/* R4 / R5: a unit cube stretched along z to s, its end faces held at the uniaxial
+   solution (lateral stretch t of the closed form), its sides free; P_zz from the force
+   holding the top face, loaded in four increments. */
+static void trade_uniaxial(const bench_model *m, const options *o, int neo_hookean)
+{
+    static const int levels[] = {1, 2, 3, 4};
+    static const double stretches[] = {0.7, 1.3};
+    const char *scene = neo_hookean ? "R5" : "R4";
+    int l, q, n = o->quick ? 2 : 4;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    if (strcmp(m->law, neo_hookean ? "neo-hookean" : "svk") && strcmp(m->law, "linear") && strcmp(m->law, "springs"))
+        return;
+    for (q = 0; q < 2; q++)
+        for (l = 0; l < n; l++) {
+            int k = levels[l], inc, i, count, err;
+            bench_body b = make_body(1, 1, 1, k, k, k, 1e4, 0.3, 1000);
+            double mu = b.young / (2 * (1 + b.poisson)),
+                   lambda = b.young * b.poisson / ((1 + b.poisson) * (1 - 2 * b.poisson)), t, pzz, t0, *f;
+            void *sim = NULL;
+            char setting[32];
+            trade_row *r;
+            snprintf(setting, sizeof setting, "static s=%.1f", stretches[q]);
+            r = new_row(scene, m, setting, k);
+            if (!r) return;
+            b.clamp = 0;
+            b.gravity[2] = 0;
+            uniaxial_reference(neo_hookean, mu, lambda, stretches[q], &t, &pzz);
+            r->reference = pzz;
+            t0 = now();
+            err = m->create(&b, &sim);
+            r->setup_s = now() - t0;
+            if (err) {
+                r->status = err;
+                print_row(r);
+                break;
+            }
+            count = m->node_count(sim);
+            r->dof = m->dof(sim);
+            r->elements = m->elements(sim);
+            t0 = now();
+            for (inc = 1; inc <= 4 && !err; inc++) {
+                double si = 1 + (stretches[q] - 1) * inc / 4.0, ti, pi;
+                uniaxial_reference(neo_hookean, mu, lambda, si, &ti, &pi);
+                for (i = 0; i < count; i++) {
+                    double p[3], u[3];
+                    m->rest(sim, i, p);
+                    if (fabs(fabs(p[2]) - 0.5) > 1e-9) continue;
+                    u[0] = (ti - 1) * (p[0] - 0.5);
+                    u[1] = (ti - 1) * p[1];
+                    u[2] = (si - 1) * p[2];
+                    m->pin(sim, i, u, NULL);
+                }
+                err = m->solve_static(sim);
+            }
+            r->answer_s = now() - t0;
+            r->step_s = r->answer_s / 4;
+            f = (double *)malloc(sizeof(double) * 3 * (size_t)count);
+            if (!err && f && !(err = m->forces(sim, f))) {
+                double sum = 0;
+                for (i = 0; i < count; i++) {
+                    double p[3];
+                    m->rest(sim, i, p);
+                    if (p[2] > 0.5 - 1e-9) sum -= f[3 * i + 2];
+                }
+                r->value = sum; /* reference area 1 m^2 */
+                r->error = relative_error(r->value, pzz);
+            }
+            free(f);
+            r->status = err;
+            m->destroy(sim);
+            print_row(r);
+            if (err || r->answer_s > o->budget) break;
+        }
+}
+
+static void trade_r4(const bench_model *m, const options *o) { trade_uniaxial(m, o, 0); }
+static void trade_r5(const bench_model *m, const options *o) { trade_uniaxial(m, o, 1); }
+
+/* The cut region: a notch through the upper half at mid-length, one cell wide. */
+typedef struct notch {
+    double half_width;
+} notch;
+
+static int in_notch(const double c[3], void *user)
+{
+    const notch *n = (const notch *)user;
+    return fabs(c[0] - 0.5) < n->half_width && c[2] > 0;
+}
+
+/* Cutting: a 1 x 0.1 x 0.1 m cantilever (E = 100 MPa) notched at mid-length, then solved
+   statically. "cut" removes the notch from a live model (step = the cut); "rebuild"
+   creates the model without it. Reference: the double "rebuild" of the same variant. */
+static void trade_cut(const bench_model *m, const options *o)
+{
+    static const int levels[] = {1, 2, 3, 4, 6};
+    int l, n = o->quick ? 2 : 5, pass;
+    if (!m->cut || !(m->integrators & BIT(BENCH_STATIC))) return;
+    for (l = 0; l < n; l++) {
+        int k = levels[l];
+        notch region;
+        double reference = NAN, slow = 0;
+        region.half_width = 0.5 * 0.1 / k;
+        for (pass = 0; pass < 2; pass++) { /* 0: rebuild, 1: cut */
+            bench_body b = make_body(1, 0.1, 0.1, 10 * k, k, k, 1e8, 0.3, 1000);
+            void *sim = NULL;
+            trade_row *r = new_row("cut", m, pass ? "cut + static" : "rebuild + static", k);
+            double t0;
+            int err, removed = 0, j;
+            if (!r) return;
+            if (!pass) {
+                b.exclude = in_notch;
+                b.exclude_user = &region;
+            }
+            t0 = now();
+            err = m->create(&b, &sim);
+            r->setup_s = now() - t0;
+            if (!err) {
+                t0 = now();
+                if (pass) err = m->cut(sim, in_notch, &region, &removed);
+                r->step_s = now() - t0;
+                if (!err) err = m->solve_static(sim);
+                r->answer_s = now() - t0 + (pass ? 0 : r->setup_s);
+                if (!pass) r->step_s = r->setup_s;
+                r->dof = m->dof(sim);
+                r->elements = m->elements(sim);
+            }
+            if (!err) {
+                r->value = tip_deflection(m, sim, &b);
+                if (!pass) /* the reference: this variant in double, rebuilt */
+                    for (j = 0; j < row_count; j++)
+                        if (!strcmp(rows[j].scene, "cut") && rows[j].level == k && rows[j].m->model == m->model &&
+                            !strcmp(rows[j].m->variant, m->variant) && !strcmp(rows[j].m->precision, "double") &&
+                            !strncmp(rows[j].setting, "rebuild", 7))
+                            reference = rows[j].value;
+                r->reference = reference;
+                r->error = relative_error(r->value, reference);
+            }
+            r->status = err;
+            if (sim) m->destroy(sim);
+            print_row(r);
+            slow = slow > r->answer_s ? slow : r->answer_s;
+            if (err) return;
+        }
+        if (slow > o->budget) break;
+    }
+}
+
+typedef struct scene {
+    const char *name, *title;
+    void (*run)(const bench_model *m, const options *o);
+} scene;
+
+static const scene scenes[] = {
+    {"R1", "R1 steel cantilever, static tip deflection vs Timoshenko", trade_r1},
+    {"R2", "R2 soft cantilever (large deformation), self-convergence", trade_r2},
+    {"R3", "R3 first bending frequency vs Timoshenko", trade_r3},
+    {"R4", "R4 uniaxial stretch, St Venant-Kirchhoff P_zz", trade_r4},
+    {"R5", "R5 uniaxial stretch, Neo-Hookean P_zz", trade_r5},
+    {"cut", "cutting a notch vs rebuilding the mesh without it", trade_cut},
+};
+
+static void series_name(const trade_row *r, char *out, size_t size)
+{
+    const char *s = r->setting;
+    if (!strncmp(s, "static", 6) && s[6] == 0) s = "";
+    snprintf(out, size, "%s %s %s%s%s", r->m->model, r->m->variant, r->m->precision, *s ? " " : "", s);
+}
+
+/* One SVG per scene: error against seconds to the answer, one series per entry and
+   setting, and the Pareto front (no configuration both faster and more accurate). */
+static void plot_scene(const options *o, const scene *sc)
+{
+    enum { MAX_SERIES = 48 };
+    svg_series series[MAX_SERIES + 1];
+    char names[MAX_SERIES][96], path[512], title[160];
+    static double xs[MAX_SERIES + 1][64], ys[MAX_SERIES + 1][64];
+    int i, j, ns = 0, nf = 0;
+    for (i = 0; i < row_count; i++) {
+        char name[96];
+        const trade_row *r = rows + i;
+        if (strcmp(r->scene, sc->name) || r->status || !(r->error > 0)) continue;
+        series_name(r, name, sizeof name);
+        for (j = 0; j < ns && strcmp(names[j], name); j++) continue;
+        if (j == ns) {
+            if (ns == MAX_SERIES) continue;
+            snprintf(names[ns], sizeof names[ns], "%s", name);
+            series[ns].name = names[ns];
+            series[ns].count = 0;
+            series[ns].x = xs[ns];
+            series[ns].y = ys[ns];
+            series[ns].front = 0;
+            ns++;
+        }
+        if (series[j].count < 64) {
+            xs[j][series[j].count] = r->answer_s;
+            ys[j][series[j].count++] = r->error;
+        }
+    }
+    /* the front: sort every point by time, keep those more accurate than all faster ones */
+    {
+        static double pts[4096][2];
+        int np = 0;
+        double best = HUGE_VAL;
+        for (i = 0; i < ns; i++)
+            for (j = 0; j < series[i].count; j++) {
+                pts[np][0] = series[i].x[j];
+                pts[np++][1] = series[i].y[j];
+            }
+        qsort(pts, (size_t)np, sizeof pts[0], cmp_double); /* by time (first member) */
+        for (i = 0; i < np && nf < 64; i++)
+            if (pts[i][1] < best) {
+                best = pts[i][1];
+                xs[ns][nf] = pts[i][0];
+                ys[ns][nf++] = pts[i][1];
+            }
+    }
+    series[ns].name = "Pareto front";
+    series[ns].count = nf;
+    series[ns].x = xs[ns];
+    series[ns].y = ys[ns];
+    series[ns].front = 1;
+    snprintf(path, sizeof path, "%s/trade_%s.svg", o->out, sc->name);
+    snprintf(title, sizeof title, "%s", sc->title);
+    if (ns && svg_plot(path, title, "seconds to the answer", "relative error", series, ns + 1))
+        fprintf(stderr, "bench: cannot write %s\n", path);
+}
+
+/* For each scene, the cheapest configuration reaching 10 %, 1 % and 0.1 %. */
+static void print_cheapest(void)
+{
+    static const double goals[3] = {0.1, 0.01, 0.001};
+    int s, g, i;
+    printf("\ncheapest configuration reaching each error (seconds to the answer)\n");
+    printf("%-5s %-8s %s\n", "scene", "error", "configuration");
+    for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++)
+        for (g = 0; g < 3; g++) {
+            const trade_row *best = NULL;
+            char name[96];
+            for (i = 0; i < row_count; i++) {
+                const trade_row *r = rows + i;
+                if (strcmp(r->scene, scenes[s].name) || r->status || !(r->error <= goals[g])) continue;
+                if (!best || r->answer_s < best->answer_s) best = r;
+            }
+            if (!best) {
+                printf("%-5s %-8g none reached it\n", scenes[s].name, goals[g]);
+                continue;
+            }
+            series_name(best, name, sizeof name);
+            printf("%-5s %-8g %s, level %d (%d dof): %.3g s, error %.2g\n", scenes[s].name, goals[g], name,
+                   best->level, best->dof, best->answer_s, best->error);
+        }
+}
+
+static void run_trade(const options *o, const bench_model *const *models, int count)
+{
+    FILE *f;
+    int s, i;
+    printf("== 1. speed/accuracy trade ==\n");
+    for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) {
+        double t0 = now();
+        printf("%s\n", scenes[s].title);
+        for (i = 0; i < count; i++) scenes[s].run(models[i], o);
+        printf("  (%s: %.1f s)\n", scenes[s].name, now() - t0);
+    }
+    finish_r2();
+    f = open_csv(o, "trade.csv",
+                 "scene,model,variant,precision,setting,level,dof,elements,setup_s,step_s,answer_s,value,"
+                 "reference,error,status");
+    for (i = 0; i < row_count; i++) {
+        const trade_row *r = rows + i;
+        csv_prefix(f);
+        fprintf(f, "%s,%s,%s,%s,%s,%d,%d,%.0f,%.6g,%.6g,%.6g,%.9g,%.9g,%.6g,%d\n", r->scene, r->m->model,
+                r->m->variant, r->m->precision, r->setting, r->level, r->dof, r->elements, r->setup_s, r->step_s,
+                r->answer_s, r->value, r->reference, r->error, r->status);
+    }
+    fclose(f);
+    for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) plot_scene(o, scenes + s);
+    print_cheapest();
+}
+
+/* >>stability */
+
+typedef struct stability_row {
+    const char *test;
+    const bench_model *m;
+    char setting[40];
+    double parameter, value, error;
+    const char *outcome;
+    int code;
+} stability_row;
+
+static FILE *stability_csv;
+
+static void stability_out(const stability_row *r)
+{
+    printf("  %-12s %-10s %-12s %-6s %-28s %-16s value %10.4g  error %9.3g  code %d\n", r->test, r->m->model,
+           r->m->variant, r->m->precision, r->setting, r->outcome, r->value, r->error, r->code);
+    csv_prefix(stability_csv);
+    fprintf(stability_csv, "%s,%s,%s,%s,%s,%.6g,%.9g,%.6g,%s,%d\n", r->test, r->m->model, r->m->variant,
+            r->m->precision, r->setting, r->parameter, r->value, r->error, r->outcome, r->code);
+    fflush(stdout);
+}
+
+/* How a run ended: an error code the library reported, a non-finite state it did not
+   report, or a finite state judged by its error. */
+static const char *classify(int code, int finite, double error)
+{
+    if (code == BENCH_UNSUPPORTED) return "unsupported";
+    if (code) return finite ? "error-reported" : "non-finite-bug";
+    if (!finite) return "silent-nan";
+    return error > 0.1 ? "visibly-wrong" : "stable";
+}
+
+/* A 1 x 0.1 x 0.1 m cantilever released from rest under a load that would deflect it by
+   about 1 % of its length; stable when `steps` steps (1000, 300 when quick) stay finite,
+   raise no error and keep the tip within 10 deflections (an undamped unstable mode grows
+   past that). */
+static int stable_at(const bench_model *m, const bench_body *b, int integrator, double dt, int steps, int *code)
+{
+    void *sim = NULL;
+    int s, ok = 1;
+    double limit = 10 * 0.01;
+    *code = m->create(b, &sim);
+    if (*code) return 0;
+    for (s = 0; s < steps && ok; s++) {
+        *code = m->step(sim, dt, integrator);
+        if (*code) ok = 0;
+        else if (s % 50 == 49 || s == steps - 1) {
+            double d = tip_deflection(m, sim, b);
+            ok = fabs(d) < limit && all_finite(m, sim);
+        }
+    }
+    m->destroy(sim);
+    return ok;
+}
+
+static void stability_time_step(const bench_model *m, const options *o)
+{
+    int steps = o->quick ? 300 : 1000, halvings = o->quick ? 8 : 12;
+    static const double youngs[3] = {1e3, 1e5, 1e7};
+    int e, it;
+    for (it = 0; it < BENCH_STATIC; it++) {
+        if (!(m->integrators & BIT(it))) continue;
+        for (e = 0; e < 3; e++) {
+            bench_body b = make_body(1, 0.1, 0.1, 20, 2, 2, youngs[e], 0.3, 1000);
+            stability_row r;
+            double lo = 1e-7, hi = 1.0;
+            int i, code = 0, last = 0;
+            /* gravity scaled so the static tip deflection is about 1 cm */
+            b.gravity[2] = -0.01 / 1.5e5 * youngs[e];
+            memset(&r, 0, sizeof r);
+            r.test = "max-dt";
+            r.m = m;
+            snprintf(r.setting, sizeof r.setting, "%s E=%.0e", integrator_name[it], youngs[e]);
+            r.parameter = youngs[e];
+            if (stable_at(m, &b, it, hi, steps, &code)) {
+                r.value = hi;
+                r.outcome = "stable-at-1s";
+            } else if (!stable_at(m, &b, it, lo, steps, &last)) {
+                r.value = 0;
+                r.outcome = "unstable-at-1e-7s";
+                code = last;
+            } else {
+                for (i = 0; i < halvings; i++) { /* log bisection: 1e7^(2^-12), 0.4 % */
+                    double mid = sqrt(lo * hi);
+                    if (stable_at(m, &b, it, mid, steps, &last)) lo = mid;
+                    else hi = mid, code = last;
+                }
+                r.value = lo;
+                r.outcome = "bisected";
+            }
+            r.code = code;
+            r.error = NAN;
+            stability_out(&r);
+        }
+    }
+}
+
+/* Tip deflection of a 1 x 0.1 x 0.1 m cantilever (E = 1 MPa, load for about 1 cm) against
+   Timoshenko, at several Poisson ratios and optionally far from the origin. */
+static void beam_static(const bench_model *m, double nu, const double offset[3], int k, double *value,
+                        double *error, int *code, int *finite)
+{
+    bench_body b = make_body(1, 0.1, 0.1, 10 * k, k, k, 1e6, nu, 1000);
+    void *sim = NULL;
+    double ref;
+    memcpy(b.offset, offset, sizeof b.offset);
+    b.gravity[2] = -0.01 / 1.5e5 * b.young;
+    ref = timoshenko_tip(1, 0.1, b.young, nu, b.density, -b.gravity[2]);
+    *value = *error = NAN;
+    *finite = 1;
+    *code = m->create(&b, &sim);
+    if (!*code) *code = m->solve_static(sim);
+    if (sim) {
+        *finite = all_finite(m, sim);
+        if (!*code && *finite) {
+            *value = tip_deflection(m, sim, &b);
+            *error = relative_error(*value, ref);
+        }
+        m->destroy(sim);
+    }
+}
+
+static void stability_poisson(const bench_model *m)
+{
+    static const double nus[4] = {0.3, 0.45, 0.49, 0.499};
+    static const double zero[3] = {0, 0, 0};
+    int i, finite;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    for (i = 0; i < 4; i++) {
+        stability_row r;
+        memset(&r, 0, sizeof r);
+        r.test = "poisson";
+        r.m = m;
+        r.parameter = nus[i];
+        snprintf(r.setting, sizeof r.setting, "static nu=%g", nus[i]);
+        beam_static(m, nus[i], zero, 4, &r.value, &r.error, &r.code, &finite);
+        r.outcome = classify(r.code, finite, r.error);
+        stability_out(&r);
+    }
+}
+
+static void stability_far(const bench_model *m)
+{
+    static const double zero[3] = {0, 0, 0}, far[3] = {1e6, 1e6, 1e6};
+    stability_row r;
+    double near_value, near_error;
+    int finite;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    memset(&r, 0, sizeof r);
+    r.test = "far-origin";
+    r.m = m;
+    r.parameter = 1e6;
+    snprintf(r.setting, sizeof r.setting, "static offset=1e6 m");
+    beam_static(m, 0.3, zero, 2, &near_value, &near_error, &r.code, &finite);
+    beam_static(m, 0.3, far, 2, &r.value, &r.error, &r.code, &finite);
+    r.error = relative_error(r.value, near_value); /* against the same beam at the origin */
+    if (r.code == 0 && !(r.error < HUGE_VAL)) r.error = 1;
+    r.outcome = classify(r.code, finite, r.error);
+    stability_out(&r);
+}
+
+/* One cell, its far corner pushed through the opposite corner's side to invert the
+   tetrahedra that hold it, then released with damping: stable if it returns within 10 %
+   of the cell size after 2 s. */
+static void stability_squash(const bench_model *m)
+{
+    int it;
+    for (it = 0; it < BENCH_STATIC; it++) {
+        bench_body b = make_body(1, 1, 1, 1, 1, 1, 1e4, 0.3, 1000);
+        stability_row r;
+        void *sim = NULL;
+        int i, s, corner = -1, finite = 1, steps;
+        double u[3] = {-1.5, -1.5, -1.5}, dt, zero[3] = {0, 0, 0};
+        if (!(m->integrators & BIT(it))) continue;
+        memset(&r, 0, sizeof r);
+        r.test = "squash";
+        r.m = m;
+        b.clamp = 0;
+        b.gravity[2] = 0;
+        b.damping = 5;
+        /* explicit schemes at a tenth of the cell's P-wave transit time */
+        dt = it == BENCH_IMPLICIT_EULER ? 1e-2 : 0.1 / sqrt(1.35 * b.young / b.density);
+        steps = (int)(2.0 / dt);
+        snprintf(r.setting, sizeof r.setting, "%s dt=%.2g", integrator_name[it], dt);
+        r.code = m->create(&b, &sim);
+        if (!r.code) {
+            for (i = 0; i < m->node_count(sim); i++) {
+                double p[3];
+                m->rest(sim, i, p);
+                if (p[0] > 0.5 && p[1] > 0 && p[2] > 0) corner = i;
+                else m->pin(sim, i, zero, NULL);
+            }
+            r.code = m->pin(sim, corner, u, NULL);
+            if (!r.code) r.code = m->step(sim, dt, it); /* moves the pinned corner there */
+            if (!r.code) r.code = m->release(sim, corner);
+            for (s = 0; s < steps && !r.code; s++) r.code = m->step(sim, dt, it);
+            finite = all_finite(m, sim);
+            if (finite) {
+                double p0[3], p[3];
+                m->rest(sim, corner, p0);
+                m->position(sim, corner, p);
+                r.value = sqrt((p[0] - p0[0]) * (p[0] - p0[0]) + (p[1] - p0[1]) * (p[1] - p0[1]) +
+                               (p[2] - p0[2]) * (p[2] - p0[2]));
+                r.error = r.value; /* cell size 1 m */
+            }
+            m->destroy(sim);
+        }
+        r.outcome = classify(r.code, finite, r.error);
+        stability_out(&r);
+    }
+}
+
+/* A 1 x 0.1 x 0.1 m bar clamped at x = 0, its end face turned 180 degrees about the axis
+   in eight static increments; an exact model keeps the mid-length cross-section's
+   corner radius (to within the small Poynting-type change), a linear one collapses it. */
+static void stability_twist(const bench_model *m)
+{
+    bench_body b = make_body(1, 0.1, 0.1, 20, 4, 4, 1e5, 0.3, 1000);
+    stability_row r;
+    void *sim = NULL;
+    int i, inc, finite = 1;
+    if (!(m->integrators & BIT(BENCH_STATIC))) return;
+    memset(&r, 0, sizeof r);
+    r.test = "twist-180";
+    r.m = m;
+    r.parameter = 180;
+    snprintf(r.setting, sizeof r.setting, "static 8 increments");
+    b.gravity[2] = 0;
+    r.code = m->create(&b, &sim);
+    for (inc = 1; inc <= 8 && !r.code; inc++) {
+        double a = PI * inc / 8, c = cos(a), s = sin(a), R[9];
+        R[0] = 1, R[1] = 0, R[2] = 0, R[3] = 0, R[4] = c, R[5] = -s, R[6] = 0, R[7] = s, R[8] = c;
+        for (i = 0; i < m->node_count(sim); i++) {
+            double p[3], u[3];
+            m->rest(sim, i, p);
+            if (p[0] < 1 - 1e-9) continue;
+            u[0] = 0;
+            u[1] = c * p[1] - s * p[2] - p[1];
+            u[2] = s * p[1] + c * p[2] - p[2];
+            m->pin(sim, i, u, R);
+        }
+        r.code = m->solve_static(sim);
+    }
+    if (sim) {
+        finite = all_finite(m, sim);
+        if (!r.code && finite) {
+            double sum = 0, rest_r = sqrt(0.05 * 0.05 * 2);
+            int n = 0;
+            for (i = 0; i < m->node_count(sim); i++) {
+                double p0[3], p[3];
+                m->rest(sim, i, p0);
+                if (fabs(p0[0] - 0.5) > 1e-9 || fabs(fabs(p0[1]) - 0.05) > 1e-9 || fabs(fabs(p0[2]) - 0.05) > 1e-9)
+                    continue;
+                m->position(sim, i, p);
+                sum += sqrt(p[1] * p[1] + p[2] * p[2]);
+                n++;
+            }
+            r.value = n ? sum / n / rest_r : NAN; /* corner radius ratio at mid-length */
+            r.error = fabs(r.value - 1);
+        }
+        m->destroy(sim);
+    }
+    r.outcome = classify(r.code, finite, r.error);
+    stability_out(&r);
+}
+
+static void run_stability(const options *o, const bench_model *const *models, int count)
+{
+    int i;
+    printf("\n== 2. stability at the extremes ==\n");
+    stability_csv = open_csv(o, "stability.csv", "test,model,variant,precision,setting,parameter,value,error,outcome,code");
+    for (i = 0; i < count; i++) {
+        stability_time_step(models[i], o);
+        stability_poisson(models[i]);
+        stability_squash(models[i]);
+        stability_twist(models[i]);
+        stability_far(models[i]);
+    }
+    fclose(stability_csv);
+}
+
+/* >>kernels */
+
+/* STREAM triad a = b + s c over three arrays of n doubles: best of five, GB/s (24 bytes
+   per element, as STREAM counts). */
+static double stream_triad(size_t n, int threads)
+{
+    double *a = (double *)malloc(n * sizeof *a), *b = (double *)malloc(n * sizeof *b),
+           *c = (double *)malloc(n * sizeof *c), best = 0;
+    long i, len = (long)n;
+    int r;
+    if (!a || !b || !c) {
+        free(a), free(b), free(c);
+        return NAN;
+    }
+    set_threads(threads);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static)
+#endif
+    for (i = 0; i < len; i++) a[i] = 0, b[i] = 1, c[i] = 2;
+    for (r = 0; r < 5; r++) {
+        double t0 = now(), t;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static)
+#endif
+        for (i = 0; i < len; i++) a[i] = b[i] + 3.0 * c[i];
+        t = now() - t0;
+        if (24.0 * (double)n / t > best) best = 24.0 * (double)n / t;
+    }
+    if (a[len / 2] != 7.0) best = NAN; /* the loop really ran */
+    free(a), free(b), free(c);
+    return best / 1e9;
+}
+
+/* Seconds per kernel call: batches of calls until a batch lasts min_s, five batches,
+   the median. */
+static double time_kernel(const bench_model *m, void *sim, int kernel, double min_s, int *code)
+{
+    double t[5];
+    int r, calls = 1;
+    *code = m->kernel(sim, kernel); /* warm-up */
+    if (*code) return NAN;
+    for (;;) { /* find the batch size */
+        double t0 = now();
+        int c;
+        for (c = 0; c < calls; c++) m->kernel(sim, kernel);
+        if (now() - t0 >= min_s || calls > (1 << 24)) break;
+        calls *= 2;
+    }
+    for (r = 0; r < 5; r++) {
+        double t0 = now();
+        int c;
+        for (c = 0; c < calls; c++) m->kernel(sim, kernel);
+        t[r] = (now() - t0) / calls;
+    }
+    return median(t, 5);
+}
+
+static void run_kernels(const options *o, const bench_model *const *models, int count)
+{
+    static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v"};
+    double bandwidth[3];
+    int i, s, th, kern, sizes = o->quick ? 2 : 4, max_threads = o->threads;
+    FILE *f;
+    printf("\n== 3. kernel throughput ==\n");
+    for (th = 1; th <= max_threads; th++) {
+        bandwidth[th] = stream_triad(o->quick ? (size_t)1 << 22 : (size_t)1 << 25, th);
+        printf("STREAM triad, %d thread%s: %.1f GB/s\n", th, th > 1 ? "s" : "", bandwidth[th]);
+    }
+    f = open_csv(o, "kernels.csv",
+                 "model,variant,precision,kernel,threads,elements,element,ns_per_element,bytes_per_element,"
+                 "bound_ns_per_element,ratio_to_bound,stream_gbs");
+    printf("%-10s %-12s %-6s %-6s %-2s %9s %10s %10s %9s %7s\n", "model", "variant", "prec", "kernel", "th",
+           "elements", "ns/elem", "bytes/elem", "bound ns", "ratio");
+    for (i = 0; i < count; i++) {
+        const bench_model *m = models[i];
+        for (s = 0; s < sizes; s++) {
+            /* a cube of n^3 cells; adapters report the elements they built */
+            int n = (int)ceil(cbrt(targets[s] / 6.0)), code;
+            bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
+            void *sim = NULL;
+            if (m->create(&b, &sim)) continue;
+            /* one step under gravity, so the kernels see a generic deformed state */
+            m->step(sim, 1e-3, (m->integrators & BIT(BENCH_IMPLICIT_EULER)) ? BENCH_IMPLICIT_EULER
+                                                                            : BENCH_SEMI_IMPLICIT_EULER);
+            for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++)
+                for (th = 1; th <= max_threads; th++) {
+                    double sec, elems = m->elements(sim), bytes = m->kernel_bytes(sim, kern), bound, ns;
+                    set_threads(th);
+                    sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.05, &code);
+                    if (code) break;
+                    ns = 1e9 * sec / elems;
+                    bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
+                    printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
+                           m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
+                    csv_prefix(f);
+                    fprintf(f, "%s,%s,%s,%s,%d,%.0f,%s,%.4g,%.4g,%.4g,%.4g,%.4g\n", m->model, m->variant,
+                            m->precision, kernel_name[kern], th, elems, m->element, ns, bytes / elems, bound,
+                            ns / bound, bandwidth[th]);
+                }
+            m->destroy(sim);
+        }
+    }
+    /* haptic scenes: precomputed contact models */
+    for (i = 0; i < count; i++) {
+        double upd[3], pre = 0, mem = 0;
+        int surf = 0, c;
+        if (!models[i]->haptic) continue;
+        set_threads(1);
+        if (models[i]->haptic(o->quick, upd, &surf, &pre, &mem)) continue;
+        printf("haptic update %s %s %s: %d surface nodes, precomputed in %.1f s, %.1f MB:", models[i]->model,
+               models[i]->variant, models[i]->precision, surf, pre, mem / 1e6);
+        for (c = 0; c < 3; c++) {
+            printf("  %d contact%s %.2f us (%.0f Hz)", c + 1, c ? "s" : "", 1e6 * upd[c], 1 / upd[c]);
+            csv_prefix(f);
+            fprintf(f, "%s,%s,%s,qs-update-%d-contacts,1,%d,surface-node,%.4g,,,,%.4g\n", models[i]->model,
+                    models[i]->variant, models[i]->precision, c + 1, surf, 1e9 * upd[c] / surf, bandwidth[1]);
+        }
+        printf("\n");
+    }
+    fclose(f);
+}
+
+/* >>main */
+
+static void usage(void)
+{
+    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,kernels] [--filter TEXT] "
+                    "[--repeats N] [--threads N]\n");
+    exit(2);
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    static const bench_model *models[256];
+    int i, count = 0;
+    double t0 = now();
+    memset(&o, 0, sizeof o);
+    o.repeats = 3;
+    o.threads = 2;
+    o.out = "bench/results";
+    o.parts = 7;
+    o.budget = 5;
+    for (i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--quick")) o.quick = 1;
+        else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
+        else if (!strcmp(argv[i], "--filter") && i + 1 < argc) o.filter = argv[++i];
+        else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--parts") && i + 1 < argc) {
+            const char *p = argv[++i];
+            o.parts = (strstr(p, "trade") ? 1 : 0) | (strstr(p, "stability") ? 2 : 0) | (strstr(p, "kernels") ? 4 : 0);
+        } else usage();
+    }
+    if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
+    if (o.quick) o.budget = 2;
+    read_environment();
+    for (i = 0; i < (int)(sizeof registry / sizeof registry[0]); i++) {
+        int n, j;
+        const bench_model *table = registry[i](&n);
+        for (j = 0; j < n && count < 256; j++)
+            if (selected(&o, table + j)) models[count++] = table + j;
+    }
+    printf("bench: %d model entries, %s, %s, %s, git %s%s\n", count, env_cpu, env_compiler, BENCH_FLAGS, BENCH_GIT,
+           o.quick ? ", quick" : "");
+    set_threads(1);
+    if (o.parts & 1) run_trade(&o, models, count);
+    set_threads(1);
+    if (o.parts & 2) run_stability(&o, models, count);
+    if (o.parts & 4) run_kernels(&o, models, count);
+    printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
+    return 0;
+}

@@ -1,0 +1,307 @@
+/* model_tensormass.c - bench adapter of tensormass.h: the tensor-mass model and its
+   mass-spring baseline. Compiled twice by the Makefile, in double and with
+   -DBENCH_FLOAT; each build exports its own table. */
+#define _POSIX_C_SOURCE 199309L
+#ifdef BENCH_FLOAT
+#define TMASS_REAL float
+#define BENCH_TABLE bench_models_tensormass_float
+#define BENCH_PRECISION "float"
+#else
+#define BENCH_TABLE bench_models_tensormass_double
+#define BENCH_PRECISION "double"
+#endif
+#define TMASS_STATIC
+#define TENSORMASS_IMPLEMENTATION
+#include "../tensormass.h"
+#define TETMESH_STATIC
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "bench.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct tm_sim {
+    tmass_model *m;
+    int nodes, tets;
+    int *tet_nodes; /* 4 per tet, for cutting by centroid */
+    double *rest;   /* 3n, with the offset */
+    double offset[3];
+} tm_sim;
+
+static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
+{
+    tetmesh mesh;
+    tmass_desc d = tmass_default_desc();
+    tm_sim *s;
+    tmass_real *x;
+    int i, err;
+    *out = NULL;
+    if (tetmesh_beam(&mesh, b->size[0], b->size[1], b->size[2], b->cells[0], b->cells[1], b->cells[2],
+                     TETMESH_SPLIT5))
+        return TMASS_ERR_ALLOC;
+    x = (tmass_real *)malloc(sizeof(tmass_real) * 3 * (size_t)mesh.node_count);
+    s = (tm_sim *)calloc(1, sizeof *s);
+    if (!x || !s) {
+        free(x);
+        free(s);
+        tetmesh_free(&mesh);
+        return TMASS_ERR_ALLOC;
+    }
+    if (b->exclude) { /* keep the tets outside the excluded region */
+        int t, kept = 0, j, k;
+        for (t = 0; t < mesh.tet_count; t++) {
+            double c[3] = {0, 0, 0};
+            for (j = 0; j < 4; j++)
+                for (k = 0; k < 3; k++) c[k] += 0.25 * mesh.nodes[3 * mesh.tets[4 * t + j] + k];
+            if (!b->exclude(c, b->exclude_user)) memmove(mesh.tets + 4 * kept++, mesh.tets + 4 * t, 4 * sizeof(int));
+        }
+        mesh.tet_count = kept;
+    }
+    for (i = 0; i < 3 * mesh.node_count; i++) {
+        mesh.nodes[i] += b->offset[i % 3];
+        x[i] = (tmass_real)mesh.nodes[i];
+    }
+    d.rest_positions = x;
+    d.node_count = mesh.node_count;
+    d.tets = mesh.tets;
+    d.tet_count = mesh.tet_count;
+    d.kind = kind;
+    d.young_modulus = (tmass_real)b->young;
+    d.poisson_ratio = (tmass_real)b->poisson;
+    d.density = (tmass_real)b->density;
+    d.mass_damping = (tmass_real)b->damping;
+    for (i = 0; i < 3; i++) d.gravity[i] = (tmass_real)b->gravity[i];
+    /* static solves of stiff slender beams need tight tolerances and many iterations */
+    d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-9);
+    d.cg_max_iterations = 100000;
+    err = tmass_create(&d, &s->m);
+    free(x);
+    if (err) {
+        free(s);
+        tetmesh_free(&mesh);
+        return err;
+    }
+    s->nodes = mesh.node_count;
+    s->tets = mesh.tet_count;
+    s->tet_nodes = mesh.tets;
+    s->rest = mesh.nodes;
+    memcpy(s->offset, b->offset, sizeof s->offset);
+    if (b->clamp)
+        for (i = 0; i < s->nodes; i++)
+            if (s->rest[3 * i] - b->offset[0] <= 1e-9 * b->size[0]) tmass_fix_node(s->m, i);
+    *out = s;
+    return 0;
+}
+
+static int tm_create_tensor(const bench_body *b, void **out) { return tm_create(b, TMASS_TENSOR_MASS, out); }
+static int tm_create_springs(const bench_body *b, void **out) { return tm_create(b, TMASS_MASS_SPRING, out); }
+
+static void tm_destroy(void *v)
+{
+    tm_sim *s = (tm_sim *)v;
+    if (!s) return;
+    tmass_destroy(s->m);
+    free(s->tet_nodes);
+    free(s->rest);
+    free(s);
+}
+
+static int tm_dof(void *v) { return 3 * ((tm_sim *)v)->nodes; }
+static int tm_node_count(void *v) { return ((tm_sim *)v)->nodes; }
+
+static void tm_rest(void *v, int i, double p[3])
+{
+    tm_sim *s = (tm_sim *)v;
+    int k;
+    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
+}
+
+/* The model's position minus its rest plus the double rest, so a float model far from
+   the origin reports its displacement, not the rounding of its coordinates. */
+static void tm_position(void *v, int i, double p[3])
+{
+    tm_sim *s = (tm_sim *)v;
+    const tmass_real *x = tmass_positions(s->m), *x0 = tmass_rest_positions(s->m);
+    int k;
+    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k] + ((double)x[3 * i + k] - (double)x0[3 * i + k]);
+}
+
+static int tm_pin(void *v, int i, const double u[3], const double *rotation)
+{
+    tmass_real w[3];
+    int k;
+    (void)rotation;
+    for (k = 0; k < 3; k++) w[k] = (tmass_real)u[k];
+    return tmass_set_displacement(((tm_sim *)v)->m, i, w);
+}
+
+static int tm_release(void *v, int i) { return tmass_release_node(((tm_sim *)v)->m, i); }
+
+static int tm_set_gravity(void *v, const double g[3])
+{
+    tmass_real w[3];
+    int k;
+    for (k = 0; k < 3; k++) w[k] = (tmass_real)g[k];
+    return tmass_set_gravity(((tm_sim *)v)->m, w);
+}
+
+static int tm_solve_static(void *v) { return tmass_solve_static(((tm_sim *)v)->m); }
+
+static int tm_step(void *v, double dt, int integrator)
+{
+    static const tmass_integrator map[4] = {TMASS_EXPLICIT_EULER, TMASS_SEMI_IMPLICIT_EULER, TMASS_RK4,
+                                            TMASS_IMPLICIT_EULER};
+    if (integrator < 0 || integrator > 3) return BENCH_UNSUPPORTED;
+    return tmass_step_ex(((tm_sim *)v)->m, (tmass_real)dt, map[integrator]);
+}
+
+static int tm_forces(void *v, double *f)
+{
+    tm_sim *s = (tm_sim *)v;
+    const tmass_real *g = tmass_forces(s->m);
+    int i;
+    for (i = 0; i < 3 * s->nodes; i++) f[i] = g[i];
+    return 0;
+}
+
+static int tm_cut(void *v, int (*inside)(const double c[3], void *user), void *user, int *removed)
+{
+    tm_sim *s = (tm_sim *)v;
+    int t, j, k, n = 0, err, *list = (int *)malloc(sizeof(int) * (size_t)s->tets);
+    if (!list) return TMASS_ERR_ALLOC;
+    for (t = 0; t < s->tets; t++) {
+        double c[3] = {0, 0, 0};
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 3; k++) c[k] += 0.25 * (s->rest[3 * s->tet_nodes[4 * t + j] + k] - s->offset[k]);
+        if (inside(c, user)) list[n++] = t;
+    }
+    err = tmass_remove_tets(s->m, list, n, removed);
+    free(list);
+    return err;
+}
+
+static double tm_elements(void *v) { return (double)tmass_live_tet_count(((tm_sim *)v)->m); }
+
+static double tm_bytes_tensor(void *v, int kernel)
+{
+    tm_sim *s = (tm_sim *)v;
+    (void)kernel;
+    return (double)tmass_edge_count(s->m) * (double)TMASS_FORCE_BYTES_PER_EDGE +
+           (double)s->nodes * (double)TMASS_FORCE_BYTES_PER_NODE;
+}
+
+static double tm_bytes_springs(void *v, int kernel)
+{
+    tm_sim *s = (tm_sim *)v;
+    (void)kernel;
+    return (double)tmass_edge_count(s->m) * (double)TMASS_SPRING_BYTES_PER_EDGE +
+           (double)s->nodes * (double)TMASS_SPRING_BYTES_PER_NODE;
+}
+
+/* The tensor model is linear: its K * v is the force kernel itself (tmass_forces is
+   -K u), so both kernels time the same loop. Springs have no public K * v. */
+static int tm_kernel_tensor(void *v, int kernel)
+{
+    (void)kernel;
+    return tmass_forces(((tm_sim *)v)->m) ? 0 : TMASS_ERR_ARG;
+}
+
+static int tm_kernel_springs(void *v, int kernel)
+{
+    if (kernel != BENCH_KERNEL_FORCE) return BENCH_UNSUPPORTED;
+    return tmass_forces(((tm_sim *)v)->m) ? 0 : TMASS_ERR_ARG;
+}
+
+static double tm_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int tm_cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The haptic scene of the precomputed model: a 0.3 x 0.3 x 0.1 m block (30 x 30 x 3
+   cells, about 2,000 free surface nodes; 10 x 10 x 2 when quick) clamped on x = 0, a tool
+   pressing 1 to 3 nodes of its top face. */
+static int tm_haptic(int quick, double update_seconds[3], int *surface_nodes, double *precompute_seconds,
+                     double *memory_bytes)
+{
+    bench_body b;
+    void *v;
+    tm_sim *s;
+    tmass_qs *qs = NULL;
+    tmass_qs_desc qd = tmass_qs_default_desc();
+    int err, c, i, n, contacts[3], found = 0;
+    const int *pre;
+    double t0;
+    memset(&b, 0, sizeof b);
+    b.size[0] = b.size[1] = 0.3;
+    b.size[2] = quick ? 0.06 : 0.1;
+    b.cells[0] = b.cells[1] = quick ? 10 : 30;
+    b.cells[2] = quick ? 2 : 3;
+    b.young = 1e4, b.poisson = 0.45, b.density = 1000, b.clamp = 1;
+    b.gravity[2] = -9.81;
+    err = tm_create(&b, TMASS_TENSOR_MASS, &v);
+    if (err) return err;
+    s = (tm_sim *)v;
+    t0 = tm_now();
+    err = tmass_qs_create(s->m, &qd, &qs);
+    *precompute_seconds = tm_now() - t0;
+    if (err) {
+        tm_destroy(v);
+        return err;
+    }
+    pre = tmass_qs_nodes(qs, &n);
+    *surface_nodes = n;
+    *memory_bytes = (double)tmass_qs_memory_bytes(qs);
+    for (i = 0; i < n && found < 3; i++) { /* three top-face nodes near the middle */
+        const double *p = s->rest + 3 * pre[i];
+        if (p[2] > 0.5 * b.size[2] - 1e-9 && fabs(p[0] - 0.15) < 0.03 && fabs(p[1] - 0.02 * found) < 0.005)
+            contacts[found++] = pre[i];
+    }
+    for (c = 0; c < 3 && found == 3; c++) {
+        double t[9];
+        int r, rep, reps = quick ? 200 : 2000;
+        for (r = 0; r < 9; r++) {
+            t0 = tm_now();
+            for (rep = 0; rep < reps; rep++) {
+                tmass_real u[9], f[9];
+                for (i = 0; i < 3 * (c + 1); i++) u[i] = (tmass_real)(i % 3 == 2 ? -0.001 * (1 + rep % 7) : 0);
+                err |= tmass_qs_update(qs, contacts, u, c + 1, f);
+            }
+            t[r] = (tm_now() - t0) / reps;
+        }
+        qsort(t, 9, sizeof t[0], tm_cmp);
+        update_seconds[c] = t[4];
+    }
+    if (found < 3) err = TMASS_ERR_ARG;
+    tmass_qs_destroy(qs);
+    tm_destroy(v);
+    return err;
+}
+
+#define TM_ALL ((1u << BENCH_EXPLICIT_EULER) | (1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_RK4) | \
+                (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+
+static const bench_model tm_models[] = {
+    {"tensormass", "linear", "linear", BENCH_PRECISION, TM_ALL, 0, "tet", tm_create_tensor, tm_destroy, tm_dof,
+     tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
+     tm_cut, tm_elements, tm_bytes_tensor, tm_kernel_tensor, tm_haptic},
+    {"tensormass", "springs", "springs", BENCH_PRECISION, TM_ALL, 1, "tet", tm_create_springs, tm_destroy, tm_dof,
+     tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
+     tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL},
+};
+
+const bench_model *BENCH_TABLE(int *count);
+const bench_model *BENCH_TABLE(int *count)
+{
+    *count = (int)(sizeof tm_models / sizeof tm_models[0]);
+    return tm_models;
+}
