@@ -1,0 +1,4118 @@
+/* frames.h - v0.1.0 - 6-DoF frames and samples: meshless or mesh-based hyperelastic bodies - MIT or public domain
+
+   @@MANUAL@@
+
+   Licence at the end of the file. */
+#ifndef FRAMES_H
+#define FRAMES_H
+
+#include <stddef.h>
+
+#define FRM_VERSION_MAJOR 0
+#define FRM_VERSION_MINOR 1
+#define FRM_VERSION_PATCH 0
+
+#ifndef FRM_REAL
+#define FRM_REAL double
+#endif
+typedef FRM_REAL frm_real;
+
+#ifdef FRM_STATIC
+#define FRMDEF static
+#else
+#define FRMDEF extern
+#endif
+
+/* The per-sample and per-frame kernels (>>kernels) run on the host and, compiled by nvcc
+   in frames_cuda.cu, on the device. */
+#if defined(__CUDACC__)
+#define FRM_HOSTDEV __host__ __device__
+#else
+#define FRM_HOSTDEV
+#endif
+
+/* Float builds rename the entry points that take or make frm_real data, so that a float
+   and a double translation unit cannot be linked together by mistake. FRM_REAL must be
+   the single token float or double. */
+#define FRM__IS_float 1
+#define FRM__IS_double 0
+#define FRM__CAT2(a, b) a##b
+#define FRM__CAT(a, b) FRM__CAT2(a, b)
+#if FRM__CAT(FRM__IS_, FRM_REAL)
+#define frm_model_create frm_model_create_f32
+#define frm_model_default_desc frm_model_default_desc_f32
+#define frm_sampling_hexes frm_sampling_hexes_f32
+#define frm_sampling_tets frm_sampling_tets_f32
+#define frm_sampling_meshless frm_sampling_meshless_f32
+#define frm_sampling_box frm_sampling_box_f32
+#define frm_sampling_surface frm_sampling_surface_f32
+#define frm_shape_tet frm_shape_tet_f32
+#define frm_shape_hex frm_shape_hex_f32
+#define frm_shape_shepard frm_shape_shepard_f32
+#define frm_shape_mls frm_shape_mls_f32
+#endif
+
+/* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
+   memory, thesis sec. 4.4). */
+#define FRM_MAX_NEIGHBORS 16
+
+/* Pairs (sample, neighbour) below which loops run serially (starting threads costs more
+   than it saves on small models). */
+#ifndef FRM_PARALLEL_MIN_PAIRS
+#define FRM_PARALLEL_MIN_PAIRS 20000
+#endif
+
+/* Error codes and their messages, one list so they cannot drift apart. */
+#define FRM_ERROR_LIST(X) \
+    X(FRM_OK, 0, "ok") \
+    X(FRM_ERR_ARG, -1, "invalid argument (NULL pointer, bad count or non-finite value)") \
+    X(FRM_ERR_ALLOC, -2, "out of memory") \
+    X(FRM_ERR_DESC, -3, "description not initialised with its default function") \
+    X(FRM_ERR_FRAME_COUNT, -4, "frame count below 1 or too large") \
+    X(FRM_ERR_SAMPLE_COUNT, -5, "sample count below 1 or too large") \
+    X(FRM_ERR_FRAME_NOT_FINITE, -6, "frame position not finite") \
+    X(FRM_ERR_QUATERNION, -7, "orientation not a finite unit quaternion") \
+    X(FRM_ERR_SAMPLE_NOT_FINITE, -8, "sample position not finite") \
+    X(FRM_ERR_SAMPLE_VOLUME, -9, "sample volume not finite and > 0") \
+    X(FRM_ERR_NO_NEIGHBOR, -10, "a sample has no neighbouring frame") \
+    X(FRM_ERR_TOO_MANY_NEIGHBORS, -11, "a sample has more than FRM_MAX_NEIGHBORS (16) neighbouring frames") \
+    X(FRM_ERR_NEIGHBOR_TABLE, -12, "neighbour table malformed (start not 0 or decreasing, frame index out of range or repeated)") \
+    X(FRM_ERR_WEIGHT_NOT_FINITE, -13, "shape function weight or gradient not finite") \
+    X(FRM_ERR_WEIGHT_SUM, -14, "weights of a sample do not sum to one") \
+    X(FRM_ERR_GRADIENT_SUM, -15, "weight gradients of a sample do not sum to zero") \
+    X(FRM_ERR_FRAME_UNUSED, -16, "a frame carries no mass (no sample gives it a non-zero weight)") \
+    X(FRM_ERR_MATERIAL, -17, "unknown constitutive law or material index out of range") \
+    X(FRM_ERR_YOUNG_MODULUS, -18, "Young's modulus not finite and > 0") \
+    X(FRM_ERR_POISSON_RATIO, -19, "Poisson ratio outside (-1, 0.5)") \
+    X(FRM_ERR_DENSITY, -20, "density not finite and > 0") \
+    X(FRM_ERR_TIME_STEP, -21, "time step not finite and > 0") \
+    X(FRM_ERR_DAMPING, -22, "damping coefficient not finite and >= 0") \
+    X(FRM_ERR_SOLVER, -23, "solver settings invalid (tolerances > 0, iteration caps >= 1)") \
+    X(FRM_ERR_STIFFNESS_MODE, -24, "unknown stiffness mode, or assembled blocks requested from a matrix-free model") \
+    X(FRM_ERR_NOT_FINITE, -25, "result not finite; the last valid state was kept") \
+    X(FRM_ERR_NO_CONVERGENCE, -26, "solver did not converge; the last valid state was kept") \
+    X(FRM_ERR_INVERTED, -27, "a Neo-Hookean sample would invert (det F <= 0); the last valid state was kept") \
+    X(FRM_ERR_FRAME_RANGE, -28, "frame index out of range") \
+    X(FRM_ERR_NOT_NEIGHBORS, -29, "the two frames share no sample (no stiffness block between them)") \
+    X(FRM_ERR_SHAPE_DEGENERATE, -30, "shape function undefined: flat or inverted element, coincident or coplanar frames") \
+    X(FRM_ERR_INDEX_RANGE, -31, "element or triangle node index out of range") \
+    X(FRM_ERR_SAMPLING, -32, "sampling settings invalid (spacing, Gauss order, support) or too many points") \
+    X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume")
+
+enum {
+#define FRM__ENUM(name, value, text) name = value,
+    FRM_ERROR_LIST(FRM__ENUM)
+#undef FRM__ENUM
+    FRM_ERR_LAST_ = -34
+};
+
+/* Constitutive laws (per sample). Both are written in terms of the Green-Lagrange strain
+   E = (F^T F - I) / 2 and the second Piola-Kirchhoff stress S (total Lagrangian, eq. 3.37). */
+typedef enum frm_law {
+    FRM_LAW_SVK = 0,        /* St Venant-Kirchhoff, W = lambda/2 tr(E)^2 + mu E:E, S eq. 3.53 */
+    FRM_LAW_NEO_HOOKEAN = 1 /* compressible, W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2 */
+} frm_law;
+
+/* How K * v is evaluated inside CG (see PERFORMANCE). */
+typedef enum frm_stiffness_mode {
+    FRM_STIFFNESS_AUTO = 0,  /* choose per linearisation from the cost model (default) */
+    FRM_STIFFNESS_PAIRS = 1, /* matrix-free: per-pair data computed once per linearisation */
+    FRM_STIFFNESS_BLOCKS = 2 /* 6x6 blocks between neighbouring frames, assembled once */
+} frm_stiffness_mode;
+
+/* Meshless shape functions (sec. 4.1). */
+typedef enum frm_shape {
+    FRM_SHAPE_SHEPARD = 0, /* inverse distance, eqs. 4.8-4.9; any point layout, zero order */
+    FRM_SHAPE_MLS = 1      /* linear moving least squares: first order, needs 3D spread */
+} frm_shape;
+
+typedef enum frm_support {
+    FRM_SUPPORT_NEAREST = 0, /* the k nearest frames */
+    FRM_SUPPORT_RADIUS = 1   /* every frame closer than a radius */
+} frm_support;
+
+/* Custom allocator: alloc(size, align, user) returns memory aligned to `align` (a power
+   of two <= 64) or NULL; free(ptr, size, user) releases it. */
+typedef struct frm_allocator {
+    void *(*alloc)(size_t size, size_t align, void *user);
+    void (*free)(void *ptr, size_t size, void *user);
+    void *user;
+} frm_allocator;
+
+/* An engine's job system: run task(task_context, begin, end) over a partition of
+   [0, item_count) (any split, any threads) and return when every item is done. */
+typedef void (*frm_task_fn)(void *task_context, int begin, int end);
+typedef void (*frm_parallel_for_fn)(int item_count, frm_task_fn task, void *task_context, void *user);
+
+/* A material: law and parameters. */
+typedef struct frm_material {
+    frm_law law;            /* default FRM_LAW_SVK (the thesis's law) */
+    frm_real young_modulus; /* Pa, default 1e4 */
+    frm_real poisson_ratio; /* in (-1, 0.5), default 0.3 */
+    frm_real density;       /* kg/m^3, default 1000 */
+} frm_material;
+
+typedef struct frm_desc {
+    /* frames (read during frm_model_create only) */
+    const frm_real *frame_positions;    /* 3 * frame_count rest positions, m */
+    const frm_real *frame_orientations; /* 4 * frame_count rest orientations, unit quaternions
+                                           (x, y, z, w), or NULL for the identity */
+    int frame_count;                    /* >= 1 */
+
+    /* samples (integration points) */
+    const frm_real *sample_positions; /* 3 * sample_count rest positions, m */
+    const frm_real *sample_volumes;   /* sample_count volumes, m^3, > 0; they should add up
+                                         to the body's volume */
+    int sample_count;                 /* >= 1 */
+
+    /* neighbour table, compressed rows: sample s uses entries neighbor_start[s] to
+       neighbor_start[s + 1] - 1 (1 to FRM_MAX_NEIGHBORS of them). Fill it yourself or
+       with frm_sampling_* and frm_sampling_apply. */
+    const int *neighbor_start;          /* sample_count + 1 values, neighbor_start[0] = 0 */
+    const int *neighbor_frames;         /* frame index of each entry (distinct per sample) */
+    const frm_real *neighbor_weights;   /* w_i(p_s) of each entry; per sample they sum to 1 */
+    const frm_real *neighbor_gradients; /* 3 per entry, grad w_i(p_s), 1/m; sum to 0 */
+
+    /* materials */
+    frm_material material;         /* used by every sample when `materials` is NULL */
+    const frm_material *materials; /* optional table of material_count materials */
+    int material_count;
+    const int *sample_materials; /* optional sample_count indices into `materials` (NULL:
+                                    every sample uses materials[0]) */
+
+    /* dynamics */
+    frm_real gravity[3];        /* m/s^2, default (0, 0, -9.81) */
+    frm_real time_step;         /* s, default 1e-2, used by frm_model_step */
+    frm_real mass_damping;      /* Rayleigh alpha, 1/s, default 0 */
+    frm_real stiffness_damping; /* Rayleigh beta, s, default 0 */
+
+    /* solvers */
+    frm_real cg_tolerance;     /* relative residual of each CG solve, default 1e-6 (1e-4 float) */
+    int cg_max_iterations;     /* default 1000 */
+    int cg_fail_at_cap;        /* 1 (default): a CG solve stopped by cg_max_iterations above
+                                  the tolerance fails the implicit step (state kept); 0: the
+                                  step goes on with the iterate reached (fixed real-time cost,
+                                  as the thesis's 50 iterations per step) */
+    frm_real newton_tolerance; /* static solve: |residual| <= tol * |load|, default 1e-6
+                                  (1e-4 float) */
+    int newton_max_iterations; /* default 30 */
+    frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
+
+    /* environment */
+    frm_allocator allocator;          /* all NULL: FRM_MALLOC / FRM_FREE */
+    frm_parallel_for_fn parallel_for; /* NULL: OpenMP if compiled with it, else serial */
+    void *parallel_user;
+    void (*log)(int code, const char *message, void *user); /* validation details, or NULL */
+    void *log_user;
+
+    unsigned int internal_cookie; /* set by frm_model_default_desc; do not touch */
+} frm_desc;
+
+/* Statistics of the last step or static solve (frm_model_last_stats). */
+typedef struct frm_stats {
+    int newton_iterations;     /* static solve: Newton iterations; implicit step: 1 */
+    int cg_iterations;         /* CG iterations, summed over the Newton iterations */
+    int cg_iterations_last;    /* CG iterations of the last linear solve */
+    frm_real cg_residual;      /* relative residual |r| / |b| of the last linear solve */
+    frm_real residual;         /* static solve: final |f| over the free frames (N and N m) */
+    frm_real initial_residual; /* static solve: |f| before the first iteration */
+    int line_search_halvings;  /* static solve: step halvings, summed */
+    int stiffness_mode;        /* FRM_STIFFNESS_PAIRS or FRM_STIFFNESS_BLOCKS (last linearisation) */
+    int force_evaluations;     /* force passes in the step */
+    int stiffness_products;    /* K * v products in the step */
+} frm_stats;
+
+/* Energies of the current state (frm_model_energy), J. */
+typedef struct frm_energies {
+    double elastic;       /* sum over samples of v_s W(F_s) */
+    double kinetic;       /* 1/2 sum over frames of v^T M_i v (generalized mass, see MASS) */
+    double gravitational; /* -g . (moved mass moments), zero at rest */
+    double external;      /* -sum f_ext . (x - x_rest): potential of the external forces */
+} frm_energies;
+
+/* Meshless shape functions for frm_sampling_meshless / _box / _surface. */
+typedef struct frm_shape_desc {
+    frm_shape shape;     /* default FRM_SHAPE_SHEPARD */
+    frm_support support; /* default FRM_SUPPORT_NEAREST */
+    int nearest;         /* k for FRM_SUPPORT_NEAREST, 1..16 (MLS needs >= 4), default 8 */
+    frm_real radius;     /* m: the support radius for FRM_SUPPORT_RADIUS; ignored otherwise */
+    frm_real power;      /* Shepard exponent p of eq. 4.9, > 1, default 2 */
+} frm_shape_desc;
+
+/* Poisson-disk sampling of a domain (thesis sec. 4.1, "Domain sampling", after Bridson
+   2007): frames from a coarser distance than samples. */
+typedef struct frm_poisson_desc {
+    frm_real frame_spacing;  /* m, least distance between frames, > sample_spacing */
+    frm_real sample_spacing; /* m, least distance between samples */
+    unsigned int seed;       /* same seed, same points, on every platform; default 1 */
+    frm_real volume;         /* m^3 split evenly over the samples; <= 0 (default): the
+                                domain's own volume (needed for a flat or linear box) */
+    int max_points;          /* refuse (FRM_ERR_SAMPLING) to make more points, default 1e6 */
+} frm_poisson_desc;
+
+/* Frames, samples and their neighbour table, owning its arrays: what frm_sampling_*
+   make and frm_sampling_apply puts into a description. Free with frm_sampling_free. */
+typedef struct frm_sampling {
+    int frame_count, sample_count, pair_count;
+    frm_real *frame_positions;    /* 3 * frame_count, m */
+    frm_real *sample_positions;   /* 3 * sample_count, m */
+    frm_real *sample_volumes;     /* sample_count, m^3 */
+    int *neighbor_start;          /* sample_count + 1 */
+    int *neighbor_frames;         /* pair_count */
+    frm_real *neighbor_weights;   /* pair_count */
+    frm_real *neighbor_gradients; /* 3 * pair_count, 1/m */
+    frm_allocator allocator;      /* the one the arrays came from */
+} frm_sampling;
+
+typedef struct frm_model frm_model;
+
+/* Library version string "major.minor.patch". */
+FRMDEF const char *frm_version(void);
+/* Name of an error code (static string). */
+FRMDEF const char *frm_error_string(int code);
+
+/* ---- shape functions (sec. 4.1): pure functions, no allocation. Each gives weights that
+   sum to one and their exact gradients, which sum to zero. Computed in double. ---- */
+
+/* Tetrahedral barycentric (linear) functions of the 4 corners (12 coordinates, m, any
+   orientation) at point: weights[4], gradients[4 * 3] (1/m, constant in the element).
+   FRM_ERR_SHAPE_DEGENERATE for a flat tetrahedron. */
+FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], frm_real weights[4],
+                         frm_real gradients[12]);
+/* Hexahedral trilinear functions of the 8 corners (corner (a, b, c), a, b, c in {0, 1}, is
+   index a + 2 b + 4 c, as hexmesh_grid in examples/tetmesh.h) at the parametric point
+   xi in [0, 1]^3: the physical point (may be NULL), weights[8], gradients[8 * 3] (1/m)
+   and det(dx/dxi) (m^3, may be NULL). FRM_ERR_SHAPE_DEGENERATE if det <= 0 there. */
+FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_real point[3],
+                         frm_real weights[8], frm_real gradients[24], frm_real *jacobian_det);
+/* Shepard inverse-distance functions (eqs. 4.8-4.9) of `count` frames (3 * count
+   coordinates) at point, exponent power > 1. radius <= 0: w_i ~ 1/d_i^p (the thesis's
+   form); radius > 0: w_i ~ ((R - d_i)+ / (R d_i))^p (Franke-Little, zero at the support's
+   edge; frames beyond R get weight 0, at least one must be inside). A point on a frame
+   gets that frame's weight 1 and zero gradients (the limit for p > 1). Coplanar and
+   collinear frames are fine. FRM_ERR_SHAPE_DEGENERATE if two frames coincide. */
+FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real point[3], frm_real power,
+                             frm_real radius, frm_real *weights, frm_real *gradients);
+/* Linear moving least squares functions (eqs. 4.5-4.7 with p = [1 x y z]) of `count`
+   frames at point, Wendland C2 kernel of support radius > 0 (m). First-order
+   consistent: sum w_i x_i = point and sum x_i grad w_i^T = I. Weights may be negative.
+   FRM_ERR_SHAPE_DEGENERATE if the frames inside the radius are fewer than 4 or (nearly)
+   coplanar: the moment matrix is singular (table 4.1). */
+FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point[3], frm_real radius,
+                         frm_real *weights, frm_real *gradients);
+
+/* ---- sampling: frames, samples and neighbour tables (allocate; free with
+   frm_sampling_free). allocator may be NULL (FRM_MALLOC / FRM_FREE). On failure *out
+   is left empty. ---- */
+
+/* Mesh-based, hexahedra: a frame at every node (nodes: 3 * node_count, m; every node must
+   belong to a hexahedron) and gauss^3 samples per hexahedron at its Gauss-Legendre points
+   (gauss = 1 to 4 per axis), each with the volume of its quadrature weight times
+   det(dx/dxi), and the 8 trilinear neighbours (frm_shape_hex). Hex node order as in
+   frm_shape_hex; each must be positively oriented (det > 0 at every Gauss point). */
+FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node_count, const int *hexes,
+                              int hex_count, int gauss, const frm_allocator *allocator);
+/* Mesh-based, tetrahedra: a frame at every node and `points` samples per tetrahedron at
+   the barycentric coordinates `barycentric` (4 per point, summing to 1), or, when it is
+   NULL, at the symmetric Gauss points for points = 1 (centroid) or 4 (degree 2); the
+   element's volume is split evenly over its samples; 4 barycentric neighbours each. */
+FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_count, const int *tets,
+                             int tet_count, int points, const frm_real *barycentric,
+                             const frm_allocator *allocator);
+/* Meshless: the given frames and samples (3 coordinates each), total volume (m^3) split
+   evenly over the samples, neighbours and weights from the shape description (NULL: the
+   default one). */
+FRMDEF int frm_sampling_meshless(frm_sampling *out, const frm_real *frames, int frame_count,
+                                 const frm_real *samples, int sample_count, frm_real volume,
+                                 const frm_shape_desc *shape, const frm_allocator *allocator);
+/* Meshless, Poisson-disk points in the box [lo, hi] (an axis with lo = hi gives a flat or
+   linear domain; give its volume, e.g. area times thickness, in p->volume). */
+FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_real hi[3],
+                            const frm_poisson_desc *p, const frm_shape_desc *shape,
+                            const frm_allocator *allocator);
+/* Meshless, Poisson-disk points inside a closed, consistently oriented triangle surface
+   (3 * vertex_count coordinates, 3 * triangle_count zero-based indices). Inside means an
+   odd number of crossings of a ray along +z; the volume defaults to the enclosed one. */
+FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int vertex_count,
+                                const int *triangles, int triangle_count, const frm_poisson_desc *p,
+                                const frm_shape_desc *shape, const frm_allocator *allocator);
+/* Points the description's frame, sample and neighbour fields at the sampling's arrays
+   (which must outlive frm_model_create, not the model). */
+FRMDEF void frm_sampling_apply(const frm_sampling *s, frm_desc *d);
+/* Frees the arrays and empties the struct. */
+FRMDEF void frm_sampling_free(frm_sampling *s);
+/* Defaults as documented in the fields. */
+FRMDEF frm_shape_desc frm_shape_default_desc(void);
+FRMDEF frm_poisson_desc frm_poisson_default_desc(void);
+
+/* ---- model ---- */
+
+/* A description with the documented defaults; always start from it. */
+FRMDEF frm_desc frm_model_default_desc(void);
+/* Validates the description and creates a model in *out (NULL on failure). Allocates all
+   the model's memory (one block, plus temporary tables freed before returning); the
+   description's arrays may be freed afterwards. */
+FRMDEF int frm_model_create(const frm_desc *desc, frm_model **out);
+/* Frees the model and everything it owns. NULL is allowed. */
+FRMDEF void frm_model_destroy(frm_model *m);
+
+/* ---- boundary conditions and loads (no allocation) ---- */
+
+/* Holds frame i at its current pose (position and orientation). */
+FRMDEF int frm_model_fix_frame(frm_model *m, int i);
+/* Drives frame i to a prescribed pose (position m, unit quaternion (x, y, z, w)): the
+   next step moves it there (its velocity over the step follows), a static solve starts
+   with it there. The pose stays prescribed until frm_model_release_frame. */
+FRMDEF int frm_model_drive_frame(frm_model *m, int i, const frm_real position[3],
+                                 const frm_real orientation[4]);
+/* Frees a fixed or driven frame. */
+FRMDEF int frm_model_release_frame(frm_model *m, int i);
+/* 0 free, 1 fixed, 2 driven, < 0 error. */
+FRMDEF int frm_model_frame_state(const frm_model *m, int i);
+/* Constant external force (N) and torque (N m, about the frame's origin), world axes, on
+   frame i (replaces the previous ones). Either may be NULL for zero. */
+FRMDEF int frm_model_set_external(frm_model *m, int i, const frm_real force[3], const frm_real torque[3]);
+/* Sets every external force and torque to zero. */
+FRMDEF void frm_model_clear_external(frm_model *m);
+/* Gravity, m/s^2. */
+FRMDEF int frm_model_set_gravity(frm_model *m, const frm_real g[3]);
+/* CG tolerance (> 0) and cap (>= 1), Newton tolerance (> 0) and cap (>= 1). */
+FRMDEF int frm_model_set_solver(frm_model *m, frm_real cg_tolerance, int cg_max_iterations,
+                                frm_real newton_tolerance, int newton_max_iterations);
+/* Chooses how later linear solves evaluate K * v. FRM_STIFFNESS_BLOCKS and AUTO need the
+   block storage, reserved at creation unless the description asked for PAIRS. */
+FRMDEF int frm_model_set_stiffness_mode(frm_model *m, frm_stiffness_mode mode);
+
+/* ---- simulation ---- */
+
+/* One implicit Euler step (eq. 3.64, one linearisation) of the description's time step. */
+FRMDEF int frm_model_step(frm_model *m);
+/* One implicit Euler step of dt seconds:
+       (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
+   v += dv, x += dt v, q = exp(dt omega) q (renormalised). On failure (not finite, CG not
+   converged with cg_fail_at_cap, inverted sample) the state is unchanged. */
+FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
+/* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
+   the total potential energy, each solved by block-Jacobi CG; velocities are set to zero.
+   Driven frames are first put at their prescribed poses. On failure (newton cap reached,
+   not finite) the state is unchanged. */
+FRMDEF int frm_model_solve_static(frm_model *m);
+/* One Newton iteration of the static solve (for watching it converge). *residual (may be
+   NULL) receives |f| over the free frames after the iteration. Velocities set to zero. */
+FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual);
+
+/* ---- state access (pointers into the model, valid until frm_model_destroy) ---- */
+
+FRMDEF int frm_model_frame_count(const frm_model *m);
+FRMDEF int frm_model_sample_count(const frm_model *m);
+FRMDEF int frm_model_pair_count(const frm_model *m); /* (sample, neighbour) entries */
+FRMDEF const frm_real *frm_model_positions(const frm_model *m);    /* 3 per frame, m */
+FRMDEF const frm_real *frm_model_orientations(const frm_model *m); /* 4 per frame (x, y, z, w) */
+FRMDEF const frm_real *frm_model_velocities(const frm_model *m);   /* 6 per frame: m/s, rad/s (world) */
+/* Overwrites every frame's pose (3 + 4 values per frame; quaternions must be unit) or
+   velocities (6 per frame). Finite values only. */
+FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const frm_real *orientations);
+FRMDEF int frm_model_set_velocities(frm_model *m, const frm_real *velocities);
+/* Current sample positions (eq. 3.34), 3 per sample, m: computed into the model's array. */
+FRMDEF const frm_real *frm_model_sample_positions(frm_model *m);
+/* Current deformation gradients (eq. 3.40), 9 per sample, row-major: computed. */
+FRMDEF const frm_real *frm_model_deformation_gradients(frm_model *m);
+/* Internal elastic generalized forces (eq. 3.52), 6 per frame: force N, torque N m about
+   the frame origin, world axes (no gravity or external load). One force pass (see
+   PERFORMANCE). FRM_ERR_INVERTED / FRM_ERR_NOT_FINITE leave *out NULL. */
+FRMDEF int frm_model_forces(frm_model *m, const frm_real **out);
+/* Energies of the current state (one force pass). */
+FRMDEF int frm_model_energy(frm_model *m, frm_energies *out);
+/* Statistics of the last step or solve. */
+FRMDEF const frm_stats *frm_model_last_stats(const frm_model *m);
+/* The 6x6 generalized mass of frame i at its current orientation, row-major (kg, kg m,
+   kg m^2; see MASS). */
+FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36]);
+/* Bytes held by the model. */
+FRMDEF size_t frm_model_memory_bytes(const frm_model *m);
+
+/* ---- stiffness (K = -df/dq, 6 per frame: translation, then rotation about world axes:
+   a rotation dtheta moves R to exp([dtheta]x) R) ---- */
+
+/* Linearises at the current state: one force pass that also stores the per-pair data of
+   the chosen stiffness mode (or assembles the blocks). */
+FRMDEF int frm_model_prepare_stiffness(frm_model *m);
+/* out = K v (6 per frame each) at the last linearisation, every frame included (fixed or
+   not). symmetric = 0: the exact derivative of the force (the rotational diagonal blocks
+   carry an antisymmetric part 1/2 [tau]x from the torques, because rotations do not
+   commute); 1: its symmetric part, the Hessian of the energy in rotation-vector
+   coordinates, which the solvers use. Matrix-free or by blocks as prepared. */
+FRMDEF int frm_model_apply_stiffness(frm_model *m, const frm_real *v, frm_real *out, int symmetric);
+/* Assembles the 6x6 blocks (symmetric part) at the current state. Needs the block storage
+   (FRM_ERR_STIFFNESS_MODE otherwise). */
+FRMDEF int frm_model_assemble_stiffness(frm_model *m);
+/* The assembled block pattern: row i holds blocks row_start[i] .. row_start[i + 1] - 1
+   with frame columns cols[...] (sorted, the diagonal included); blocks (36 per block,
+   row-major, N/m, N/rad, N m/rad) valid after frm_model_assemble_stiffness or a solve in
+   block mode. NULL without block storage. */
+FRMDEF const frm_real *frm_model_stiffness_blocks(const frm_model *m, const int **row_start,
+                                                  const int **cols);
+/* Copies the block between frames i and j (after assembling). */
+FRMDEF int frm_model_stiffness_block(const frm_model *m, int i, int j, frm_real out[36]);
+
+#endif /* FRAMES_H */
+
+/* ======================================================================================
+   KERNELS: the per-frame, per-sample and per-pair math, FRM_HOSTDEV static inline so that
+   frames_cuda.cu (which defines FRAMES_KERNELS) runs the very code the CPU path runs.
+   Conventions: 3x3 matrices row-major (A[3 r + c]); symmetric tensors as 6 values in the
+   thesis's Voigt order (A.1) 00 11 22 12 02 01, tensor components (not doubled);
+   quaternions (x, y, z, w); a frame's generalized vector is (translation, rotation about
+   world axes).
+   ====================================================================================== */
+#if (defined(FRAMES_IMPLEMENTATION) || defined(FRAMES_KERNELS)) && !defined(FRAMES_KERNELS_ONCE)
+#define FRAMES_KERNELS_ONCE
+#include <math.h>
+
+/* Values per sample of a law's tangent data (frm_material_stress). */
+#define FRM_LAW_CACHE 7
+
+/* >>kernels ---------------------------------------------------------------------------- */
+
+FRM_HOSTDEV static inline void frm_cross(const frm_real a[3], const frm_real b[3], frm_real out[3])
+{
+    frm_real x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
+}
+
+/* Rotation matrix of a unit quaternion (x, y, z, w). */
+FRM_HOSTDEV static inline void frm_quat_to_matrix(const frm_real q[4], frm_real R[9])
+{
+    frm_real x = q[0], y = q[1], z = q[2], w = q[3];
+    R[0] = 1 - 2 * (y * y + z * z);
+    R[1] = 2 * (x * y - z * w);
+    R[2] = 2 * (x * z + y * w);
+    R[3] = 2 * (x * y + z * w);
+    R[4] = 1 - 2 * (x * x + z * z);
+    R[5] = 2 * (y * z - x * w);
+    R[6] = 2 * (x * z - y * w);
+    R[7] = 2 * (y * z + x * w);
+    R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* out = a b (Hamilton product: the rotation b, then a). out may alias a or b. */
+FRM_HOSTDEV static inline void frm_quat_multiply(const frm_real a[4], const frm_real b[4], frm_real out[4])
+{
+    frm_real x = a[3] * b[0] + b[3] * a[0] + a[1] * b[2] - a[2] * b[1];
+    frm_real y = a[3] * b[1] + b[3] * a[1] + a[2] * b[0] - a[0] * b[2];
+    frm_real z = a[3] * b[2] + b[3] * a[2] + a[0] * b[1] - a[1] * b[0];
+    frm_real w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
+    out[3] = w;
+}
+
+/* q <- exp(theta) q, renormalised: q followed by the rotation of vector theta (rad, world
+   axes). Renormalising after every update keeps |q| = 1 to round-off for ever. */
+FRM_HOSTDEV static inline void frm_quat_integrate(frm_real q[4], const frm_real theta[3])
+{
+    double t2 = (double)theta[0] * theta[0] + (double)theta[1] * theta[1] + (double)theta[2] * theta[2];
+    double t = sqrt(t2), s, c, n;
+    frm_real d[4];
+    if (t < 1e-4) { /* sin(t/2)/t and cos(t/2) by their series (error below t^4 / 4000) */
+        s = 0.5 - t2 / 48.0;
+        c = 1.0 - t2 / 8.0;
+    } else {
+        s = sin(0.5 * t) / t;
+        c = cos(0.5 * t);
+    }
+    d[0] = (frm_real)(s * theta[0]);
+    d[1] = (frm_real)(s * theta[1]);
+    d[2] = (frm_real)(s * theta[2]);
+    d[3] = (frm_real)c;
+    frm_quat_multiply(d, q, q);
+    n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+    q[0] = (frm_real)(q[0] / n);
+    q[1] = (frm_real)(q[1] / n);
+    q[2] = (frm_real)(q[2] / n);
+    q[3] = (frm_real)(q[3] / n);
+}
+
+/* Per frame: R from q and Q = R Rbar^T, the rotation since the rest pose (it maps the
+   rest axes to the current ones; the second term of eq. 3.40 uses it). */
+FRM_HOSTDEV static inline void frm_frame_rotations(const frm_real q[4], const frm_real rest_rotation[9],
+                                                   frm_real R[9], frm_real Q[9])
+{
+    int r, c;
+    frm_quat_to_matrix(q, R);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++)
+            Q[3 * r + c] = R[3 * r] * rest_rotation[3 * c] + R[3 * r + 1] * rest_rotation[3 * c + 1] +
+                           R[3 * r + 2] * rest_rotation[3 * c + 2];
+}
+
+/* Per sample, eqs. 3.34 and 3.40. Its n neighbours: frame indices, weights w_k, gradients
+   (3 n), rest local positions lbar_k = Rbar_k^T (pbar_s - xbar_k) (3 n, eq. 3.33). Frame
+   arrays: positions (3 per frame), R (9), Q = R Rbar^T (9). Out: the deformation gradient
+       F = sum_k d_k grad w_k^T + w_k Q_k,   d_k = x_k + R_k lbar_k,
+   the levers a_k = R_k lbar_k (3 n, may be NULL) and the position p = sum_k w_k d_k (may
+   be NULL). d_k is taken relative to d_0: the same F when the gradients sum to zero,
+   and no loss of precision far from the origin. */
+FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, const frm_real *weight,
+                                                      const frm_real *grad, const frm_real *local,
+                                                      const frm_real *frame_pos, const frm_real *frame_rot,
+                                                      const frm_real *frame_rel, frm_real F[9],
+                                                      frm_real *lever, frm_real *position)
+{
+    int k, r, c, i0 = frame[0];
+    frm_real a0[3], p[3] = {0, 0, 0};
+    const frm_real *R0 = frame_rot + 9 * i0, *l0 = local;
+    for (r = 0; r < 3; r++) a0[r] = R0[3 * r] * l0[0] + R0[3 * r + 1] * l0[1] + R0[3 * r + 2] * l0[2];
+    for (r = 0; r < 9; r++) F[r] = 0;
+    for (k = 0; k < n; k++) {
+        int i = frame[k];
+        const frm_real *R = frame_rot + 9 * i, *Q = frame_rel + 9 * i, *l = local + 3 * k, *g = grad + 3 * k;
+        frm_real a[3], e[3], w = weight[k];
+        for (r = 0; r < 3; r++) {
+            a[r] = R[3 * r] * l[0] + R[3 * r + 1] * l[1] + R[3 * r + 2] * l[2];
+            e[r] = (frame_pos[3 * i + r] - frame_pos[3 * i0 + r]) + (a[r] - a0[r]);
+            p[r] += w * e[r];
+        }
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) F[3 * r + c] += e[r] * g[c] + w * Q[3 * r + c];
+        if (lever)
+            for (r = 0; r < 3; r++) lever[3 * k + r] = a[r];
+    }
+    if (position)
+        for (r = 0; r < 3; r++) position[r] = frame_pos[3 * i0 + r] + a0[r] + p[r];
+}
+
+/* Symmetric tensor (6) to a full 3x3. */
+FRM_HOSTDEV static inline void frm_sym_to_matrix(const frm_real s[6], frm_real A[9])
+{
+    A[0] = s[0];
+    A[4] = s[1];
+    A[8] = s[2];
+    A[5] = A[7] = s[3];
+    A[2] = A[6] = s[4];
+    A[1] = A[3] = s[5];
+}
+
+/* P = F S (first Piola-Kirchhoff from the second). */
+FRM_HOSTDEV static inline void frm_first_piola(const frm_real F[9], const frm_real S[6], frm_real P[9])
+{
+    frm_real A[9];
+    int r, c;
+    frm_sym_to_matrix(S, A);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) P[3 * r + c] = F[3 * r] * A[c] + F[3 * r + 1] * A[3 + c] + F[3 * r + 2] * A[6 + c];
+}
+
+/* The law at F: second Piola-Kirchhoff stress S (6), energy density psi (J/m^3) and the
+   tangent data (FRM_LAW_CACHE values) frm_material_dstress needs.
+       SVK (eq. 3.53):  S = lambda tr(E) I + 2 mu E,  E = (C - I) / 2,  C = F^T F
+       Neo-Hookean:     S = mu (I - C^-1) + lambda ln J C^-1,  J = det F
+   Returns 0, or FRM_ERR_INVERTED for a Neo-Hookean sample with J <= 0 (the energy is
+   infinite there). Room for more laws: add a case here and in frm_material_dstress. */
+FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real lambda, const frm_real F[9],
+                                                  frm_real S[6], frm_real *psi, frm_real *cache)
+{
+    frm_real C[6];
+    C[0] = F[0] * F[0] + F[3] * F[3] + F[6] * F[6];
+    C[1] = F[1] * F[1] + F[4] * F[4] + F[7] * F[7];
+    C[2] = F[2] * F[2] + F[5] * F[5] + F[8] * F[8];
+    C[3] = F[1] * F[2] + F[4] * F[5] + F[7] * F[8];
+    C[4] = F[0] * F[2] + F[3] * F[5] + F[6] * F[8];
+    C[5] = F[0] * F[1] + F[3] * F[4] + F[6] * F[7];
+    if (law == FRM_LAW_NEO_HOOKEAN) {
+        frm_real J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                     F[2] * (F[3] * F[7] - F[4] * F[6]);
+        frm_real lnJ, inv_det, ci[6];
+        if (!(J > 0)) return FRM_ERR_INVERTED;
+        lnJ = (frm_real)log((double)J);
+        inv_det = 1 / (J * J); /* det C = J^2 */
+        ci[0] = (C[1] * C[2] - C[3] * C[3]) * inv_det;
+        ci[1] = (C[0] * C[2] - C[4] * C[4]) * inv_det;
+        ci[2] = (C[0] * C[1] - C[5] * C[5]) * inv_det;
+        ci[3] = (C[4] * C[5] - C[0] * C[3]) * inv_det;
+        ci[4] = (C[5] * C[3] - C[1] * C[4]) * inv_det;
+        ci[5] = (C[3] * C[4] - C[2] * C[5]) * inv_det;
+        S[0] = mu * (1 - ci[0]) + lambda * lnJ * ci[0];
+        S[1] = mu * (1 - ci[1]) + lambda * lnJ * ci[1];
+        S[2] = mu * (1 - ci[2]) + lambda * lnJ * ci[2];
+        S[3] = (lambda * lnJ - mu) * ci[3];
+        S[4] = (lambda * lnJ - mu) * ci[4];
+        S[5] = (lambda * lnJ - mu) * ci[5];
+        *psi = (frm_real)0.5 * mu * (C[0] + C[1] + C[2] - 3) - mu * lnJ + (frm_real)0.5 * lambda * lnJ * lnJ;
+        if (cache) {
+            int k;
+            for (k = 0; k < 6; k++) cache[k] = ci[k];
+            cache[6] = lnJ;
+        }
+        return 0;
+    } else {
+        frm_real E[6], tr;
+        int k;
+        E[0] = (frm_real)0.5 * (C[0] - 1);
+        E[1] = (frm_real)0.5 * (C[1] - 1);
+        E[2] = (frm_real)0.5 * (C[2] - 1);
+        E[3] = (frm_real)0.5 * C[3];
+        E[4] = (frm_real)0.5 * C[4];
+        E[5] = (frm_real)0.5 * C[5];
+        tr = E[0] + E[1] + E[2];
+        for (k = 0; k < 6; k++) S[k] = 2 * mu * E[k];
+        S[0] += lambda * tr;
+        S[1] += lambda * tr;
+        S[2] += lambda * tr;
+        *psi = (frm_real)0.5 * lambda * tr * tr +
+               mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
+        (void)cache;
+        return 0;
+    }
+}
+
+/* dS for a strain variation dE (6) at the state frm_material_stress cached (eq. 3.68):
+       SVK:          dS = lambda tr(dE) I + 2 mu dE
+       Neo-Hookean:  dS = lambda (C^-1 : dE) C^-1 + 2 (mu - lambda ln J) C^-1 dE C^-1 */
+FRM_HOSTDEV static inline void frm_material_dstress(int law, frm_real mu, frm_real lambda, const frm_real *cache,
+                                                    const frm_real dE[6], frm_real dS[6])
+{
+    if (law == FRM_LAW_NEO_HOOKEAN) {
+        frm_real c[9], d[9], t[9], x[9], a, b;
+        int r, k;
+        frm_sym_to_matrix(cache, c);
+        frm_sym_to_matrix(dE, d);
+        a = lambda * (cache[0] * dE[0] + cache[1] * dE[1] + cache[2] * dE[2] +
+                      2 * (cache[3] * dE[3] + cache[4] * dE[4] + cache[5] * dE[5]));
+        b = 2 * (mu - lambda * cache[6]);
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) t[3 * r + k] = d[3 * r] * c[k] + d[3 * r + 1] * c[3 + k] + d[3 * r + 2] * c[6 + k];
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) x[3 * r + k] = c[3 * r] * t[k] + c[3 * r + 1] * t[3 + k] + c[3 * r + 2] * t[6 + k];
+        dS[0] = a * cache[0] + b * x[0];
+        dS[1] = a * cache[1] + b * x[4];
+        dS[2] = a * cache[2] + b * x[8];
+        dS[3] = a * cache[3] + b * (frm_real)0.5 * (x[5] + x[7]);
+        dS[4] = a * cache[4] + b * (frm_real)0.5 * (x[2] + x[6]);
+        dS[5] = a * cache[5] + b * (frm_real)0.5 * (x[1] + x[3]);
+    } else {
+        frm_real tr = lambda * (dE[0] + dE[1] + dE[2]);
+        int k;
+        for (k = 0; k < 6; k++) dS[k] = 2 * mu * dE[k];
+        dS[0] += tr;
+        dS[1] += tr;
+        dS[2] += tr;
+        (void)cache;
+    }
+}
+
+/* sum_j a_j x b_j over the columns a_j of A and b_j of B (row-major 3x3). It is the
+   rotational row of B^T: for dF = [dtheta]x A, B : dF = dtheta . sum_j a_j x b_j. */
+FRM_HOSTDEV static inline void frm_column_cross_sum(const frm_real A[9], const frm_real B[9], frm_real out[3])
+{
+    out[0] = (A[3] * B[6] + A[4] * B[7] + A[5] * B[8]) - (A[6] * B[3] + A[7] * B[4] + A[8] * B[5]);
+    out[1] = (A[6] * B[0] + A[7] * B[1] + A[8] * B[2]) - (A[0] * B[6] + A[1] * B[7] + A[2] * B[8]);
+    out[2] = (A[0] * B[3] + A[1] * B[4] + A[2] * B[5]) - (A[3] * B[0] + A[4] * B[1] + A[5] * B[2]);
+}
+
+/* Pass 1 of the force: what one sample (volume v, first Piola stress P) puts on one of its
+   frames (eq. 3.52, f_i = -sum_s M^T S v_s, written as -v B^T vec(P) since
+   M^T {S} = B^T vec(F S)):
+       force  = -v P grad w
+       torque = -v sum_j g_j x p_j = -v (a x (P grad w) + w sum_j q_j x p_j),
+   g_j, p_j, q_j the columns of G = a grad w^T + w Q, P and Q; a the lever R lbar. */
+FRM_HOSTDEV static inline void frm_pair_force(frm_real volume, const frm_real P[9], const frm_real grad[3],
+                                              frm_real weight, const frm_real lever[3], const frm_real Q[9],
+                                              frm_real out[6])
+{
+    frm_real b[3], t[3], u[3];
+    int r;
+    for (r = 0; r < 3; r++) b[r] = P[3 * r] * grad[0] + P[3 * r + 1] * grad[1] + P[3 * r + 2] * grad[2];
+    frm_cross(lever, b, t);
+    frm_column_cross_sum(Q, P, u);
+    for (r = 0; r < 3; r++) {
+        out[r] = -volume * b[r];
+        out[3 + r] = -volume * (t[r] + weight * u[r]);
+    }
+}
+
+/* Per-pair data of the stiffness at the linearisation point:
+       G = a grad w^T + w Q, so that dF = dx grad w^T + [dtheta]x G  (eqs. 3.42-3.44),
+       H = v (G P^T - tr(G^T P) I), the derivative of B^T through the frame's own rotation
+           (eqs. 3.74-3.75, the K^R part of appendix B): (dB^T vec P) = H dtheta.
+   Hs receives the symmetric part of H (6); its antisymmetric part adds up, over a frame's
+   samples, to 1/2 [tau]x with tau the frame's internal torque. */
+FRM_HOSTDEV static inline void frm_pair_linearize(frm_real volume, const frm_real P[9], const frm_real grad[3],
+                                                  frm_real weight, const frm_real lever[3], const frm_real Q[9],
+                                                  frm_real G[9], frm_real Hs[6])
+{
+    frm_real h[9], tr = 0;
+    int r, c;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) G[3 * r + c] = lever[r] * grad[c] + weight * Q[3 * r + c];
+    for (r = 0; r < 3; r++) {
+        for (c = 0; c < 3; c++) h[3 * r + c] = G[3 * r] * P[3 * c] + G[3 * r + 1] * P[3 * c + 1] + G[3 * r + 2] * P[3 * c + 2];
+        tr += h[4 * r];
+    }
+    Hs[0] = volume * (h[0] - tr);
+    Hs[1] = volume * (h[4] - tr);
+    Hs[2] = volume * (h[8] - tr);
+    Hs[3] = volume * (frm_real)0.5 * (h[5] + h[7]);
+    Hs[4] = volume * (frm_real)0.5 * (h[2] + h[6]);
+    Hs[5] = volume * (frm_real)0.5 * (h[1] + h[3]);
+}
+
+/* dF += dx grad w^T + [dtheta]x G for one pair, dq = (dx, dtheta) (eq. 3.43). */
+FRM_HOSTDEV static inline void frm_pair_dF(const frm_real dq[6], const frm_real grad[3], const frm_real G[9],
+                                           frm_real dF[9])
+{
+    int c;
+    for (c = 0; c < 3; c++) {
+        frm_real g0 = G[c], g1 = G[3 + c], g2 = G[6 + c];
+        dF[c] += dq[0] * grad[c] + (dq[4] * g2 - dq[5] * g1);
+        dF[3 + c] += dq[1] * grad[c] + (dq[5] * g0 - dq[3] * g2);
+        dF[6 + c] += dq[2] * grad[c] + (dq[3] * g1 - dq[4] * g0);
+    }
+}
+
+/* Per sample: dP = dF S + F dS, dS = dS/dE : sym(F^T dF) (the material part, eqs.
+   3.67-3.69, and the geometric part dF S, eqs. 3.71-3.73, in one). */
+FRM_HOSTDEV static inline void frm_sample_dP(int law, frm_real mu, frm_real lambda, const frm_real *cache,
+                                             const frm_real F[9], const frm_real S[6], const frm_real dF[9],
+                                             frm_real dP[9])
+{
+    frm_real dE[6], dS[6], t[9];
+    int r, c;
+    for (r = 0; r < 3; r++) /* t = F^T dF */
+        for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
+    dE[0] = t[0];
+    dE[1] = t[4];
+    dE[2] = t[8];
+    dE[3] = (frm_real)0.5 * (t[5] + t[7]);
+    dE[4] = (frm_real)0.5 * (t[2] + t[6]);
+    dE[5] = (frm_real)0.5 * (t[1] + t[3]);
+    frm_material_dstress(law, mu, lambda, cache, dE, dS);
+    frm_first_piola(dF, S, dP);
+    frm_first_piola(F, dS, t);
+    for (r = 0; r < 9; r++) dP[r] += t[r];
+}
+
+/* Pass 1 of K v: what one pair gives its frame, v B^T vec(dP) + (0, Hs dtheta):
+       (v dP grad w,  v sum_j g_j x dp_j + Hs dtheta). */
+FRM_HOSTDEV static inline void frm_pair_apply(frm_real volume, const frm_real dP[9], const frm_real grad[3],
+                                              const frm_real G[9], const frm_real Hs[6], const frm_real dtheta[3],
+                                              frm_real out[6])
+{
+    frm_real t[3];
+    int r;
+    for (r = 0; r < 3; r++) out[r] = volume * (dP[3 * r] * grad[0] + dP[3 * r + 1] * grad[1] + dP[3 * r + 2] * grad[2]);
+    frm_column_cross_sum(G, dP, t);
+    out[3] = volume * t[0] + Hs[0] * dtheta[0] + Hs[5] * dtheta[1] + Hs[4] * dtheta[2];
+    out[4] = volume * t[1] + Hs[5] * dtheta[0] + Hs[1] * dtheta[1] + Hs[3] * dtheta[2];
+    out[5] = volume * t[2] + Hs[4] * dtheta[0] + Hs[3] * dtheta[1] + Hs[2] * dtheta[2];
+}
+
+/* Assembly: the 6 tangent columns cols[c] = A B e_c (9 each) of one pair, A = dP/dF. */
+FRM_HOSTDEV static inline void frm_pair_tangent_columns(int law, frm_real mu, frm_real lambda, const frm_real *cache,
+                                                        const frm_real F[9], const frm_real S[6],
+                                                        const frm_real grad[3], const frm_real G[9],
+                                                        frm_real cols[54])
+{
+    int c, k;
+    for (c = 0; c < 6; c++) {
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9];
+        for (k = 0; k < 9; k++) dF[k] = 0;
+        dq[c] = 1;
+        frm_pair_dF(dq, grad, G, dF);
+        frm_sample_dP(law, mu, lambda, cache, F, S, dF, cols + 9 * c);
+    }
+}
+
+/* Assembly: block K_ab += v B_a^T A B_b between slots a (rows, its tangent columns) and b
+   (grad w_b, G_b): row r is v B_b^T cols_a[r]. Row-major 6x6. */
+FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real cols_a[54], const frm_real grad_b[3],
+                                              const frm_real G_b[9], frm_real K[36])
+{
+    int r, c;
+    for (r = 0; r < 6; r++) {
+        const frm_real *Y = cols_a + 9 * r;
+        frm_real t[3];
+        for (c = 0; c < 3; c++) K[6 * r + c] += volume * (Y[3 * c] * grad_b[0] + Y[3 * c + 1] * grad_b[1] + Y[3 * c + 2] * grad_b[2]);
+        frm_column_cross_sum(G_b, Y, t);
+        for (c = 0; c < 3; c++) K[6 * r + 3 + c] += volume * t[c];
+    }
+}
+
+#endif /* FRAMES_KERNELS */
+
+/* ======================================================================================
+   IMPLEMENTATION
+   ====================================================================================== */
+#if defined(FRAMES_IMPLEMENTATION) && !defined(FRAMES_IMPLEMENTATION_ONCE)
+#define FRAMES_IMPLEMENTATION_ONCE
+
+/* With FRM_STATIC the functions a program does not call are unused statics. */
+#if defined(FRM_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#ifndef FRM_MALLOC
+#include <stdlib.h>
+#define FRM_MALLOC(size, user) ((void)(user), malloc(size))
+#define FRM_FREE(ptr, user) ((void)(user), free(ptr))
+#endif
+#ifndef FRM_ASSERT
+#include <assert.h>
+#define FRM_ASSERT(x) assert(x)
+#endif
+
+#define FRM__COOKIE 0x46524D53u /* "FRMS" */
+#define FRM__ALIGN 64
+#define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
+#define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
+#define FRM__VECS 10          /* 6n scratch vectors */
+#define FRM__IS_FLOAT (sizeof(frm_real) == sizeof(float))
+/* tolerance on sum w = 1 and sum grad w = 0 (relative to sum |grad w|): a few roundings
+   of 16 terms in frm_real */
+#define FRM__SUM_TOL (FRM__IS_FLOAT ? 1e-5 : 1e-9)
+/* tolerance on |q|^2 = 1 for given orientations (a normalised quaternion rounded to
+   float is within 3e-7) */
+#define FRM__UNIT_TOL 1e-5
+
+/* frame states */
+#define FRM__FREE 0
+#define FRM__FIXED 1
+#define FRM__DRIVEN 2
+
+/* scratch vector roles (6 per frame each) */
+#define FRM__V_R 0     /* CG residual */
+#define FRM__V_Z 1     /* CG preconditioned residual */
+#define FRM__V_P 2     /* CG direction */
+#define FRM__V_Q 3     /* CG A p */
+#define FRM__V_X 4     /* solution (Newton step, velocity change) */
+#define FRM__V_B 5     /* right-hand side */
+#define FRM__V_F 6     /* total generalized force */
+#define FRM__V_T 7     /* temporary */
+#define FRM__V_DV 8    /* previous velocity change (warm start) */
+#define FRM__V_DRIVE 9 /* driven frames' velocity change */
+
+struct frm_model {
+    int frame_count, sample_count, pair_count, block_count, sq_total;
+    int sample_chunks, frame_chunks, parallel, has_neo_hookean;
+    frm_allocator allocator;
+    frm_parallel_for_fn parallel_for;
+    void *parallel_user;
+    void *block;
+    size_t block_bytes;
+
+    /* settings */
+    frm_real gravity[3], time_step, mass_damping, stiffness_damping;
+    frm_real cg_tolerance, newton_tolerance;
+    int cg_max_iterations, newton_max_iterations, cg_fail_at_cap;
+    int stiffness_mode, has_blocks;
+
+    /* frames */
+    frm_real *pos, *quat, *vel;                /* 3, 4, 6 */
+    frm_real *rest_pos, *rest_quat, *rest_rot; /* 3, 4, 9 */
+    frm_real *rot, *rel;                       /* 9, 9: R and Q = R Rbar^T of the current pose */
+    double *mass_local;                        /* 10: m, cbar (3), Jbar (6), frame axes */
+    double *grav_local;                        /* 4: m_g, cbar_g (3), frame axes */
+    frm_real *mass_world;                      /* 10: m, c (3), J (6), world axes (mass_update) */
+    frm_real *ext;                             /* 6: external force, torque */
+    unsigned char *state;
+    frm_real *target;      /* 7: prescribed position, orientation */
+    frm_real *force;       /* 6: internal generalized force (last pass) */
+    frm_real *lin_torque;  /* 3: conservative torque at the linearisation */
+    frm_real *lin_gravity; /* 3: world gravity moment c_g at the linearisation */
+    frm_real *kdiag;       /* 36: K_ii (symmetric part) at the linearisation */
+    frm_real *precond;     /* 36: inverse of the block-Jacobi blocks */
+    int *rev_start, *rev_pair; /* frame -> pairs (the reverse table) */
+    int *blk_start, *blk_col;  /* block pattern (frame adjacency) */
+    frm_real *blocks;          /* 36 per block (assembled K, symmetric part) */
+    int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
+
+    /* samples */
+    frm_real *s_rest, *s_volume, *s_mu, *s_lambda;
+    unsigned char *s_law;
+    int *s_start;
+    frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
+    frm_real *s_pos, *s_F;               /* outputs: 3, 9 */
+
+    /* pairs */
+    int *p_frame, *p_sample;
+    frm_real *p_weight, *p_grad, *p_local; /* 1, 3, 3 */
+    frm_real *p_G, *p_H;                   /* 9, 6 at the linearisation */
+    frm_real *p_out;                       /* 6: pass-1 partial contributions */
+
+    /* per sample chunk: energy partial sums and errors of the last pass */
+    double *chunk_energy;
+    int *chunk_err;
+
+    /* scratch */
+    frm_real *vec[FRM__VECS];
+    frm_real *backup;      /* 13 per frame: position, orientation, velocity */
+    frm_real *start_state; /* 13 per frame: the state a static solve started from */
+
+    int lin_valid, lin_mode, lin_iterations;
+    frm_stats stats;
+};
+
+/* >>math ------------------------------------------------------------------------------- */
+
+static int frm__finite(double x) { return x == x && x - x == 0.0; }
+
+static int frm__all_finite(const frm_real *a, size_t count)
+{
+    size_t i;
+    int ok = 1;
+    for (i = 0; i < count; i++) ok &= frm__finite((double)a[i]);
+    return ok;
+}
+
+/* 6x6 symmetric positive definite inverse by Cholesky (double). Returns 0 if not PD. */
+static int frm__invert6(const double A[36], double inv[36])
+{
+    double L[36], y[6];
+    int i, j, k, c;
+    memset(L, 0, sizeof L);
+    for (j = 0; j < 6; j++) {
+        double d = A[6 * j + j];
+        for (k = 0; k < j; k++) d -= L[6 * j + k] * L[6 * j + k];
+        if (!(d > 1e-300) || !frm__finite(d)) return 0;
+        L[6 * j + j] = sqrt(d);
+        for (i = j + 1; i < 6; i++) {
+            double s = 0.5 * (A[6 * i + j] + A[6 * j + i]);
+            for (k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
+            L[6 * i + j] = s / L[6 * j + j];
+        }
+    }
+    for (c = 0; c < 6; c++) { /* column c of the inverse: L L^T x = e_c */
+        for (i = 0; i < 6; i++) {
+            double s = (i == c);
+            for (k = 0; k < i; k++) s -= L[6 * i + k] * y[k];
+            y[i] = s / L[6 * i + i];
+        }
+        for (i = 5; i >= 0; i--) {
+            double s = y[i];
+            for (k = i + 1; k < 6; k++) s -= L[6 * k + i] * inv[6 * k + c];
+            inv[6 * i + c] = s / L[6 * i + i];
+        }
+    }
+    return 1;
+}
+
+/* Rotation vector (rad) of the rotation taking quaternion a to quaternion b: b = exp(t) a. */
+static void frm__quat_delta(const frm_real a[4], const frm_real b[4], frm_real t[3])
+{
+    frm_real ai[4], d[4];
+    double s, angle, f;
+    ai[0] = -a[0];
+    ai[1] = -a[1];
+    ai[2] = -a[2];
+    ai[3] = a[3];
+    frm_quat_multiply(b, ai, d);
+    if (d[3] < 0) {
+        d[0] = -d[0];
+        d[1] = -d[1];
+        d[2] = -d[2];
+        d[3] = -d[3];
+    }
+    s = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
+    angle = 2.0 * atan2(s, (double)d[3]);
+    f = s > 1e-12 ? angle / s : 2.0;
+    t[0] = (frm_real)(f * d[0]);
+    t[1] = (frm_real)(f * d[1]);
+    t[2] = (frm_real)(f * d[2]);
+}
+
+static int frm__quat_valid(const frm_real *q)
+{
+    double n;
+    if (!frm__finite((double)q[0]) || !frm__finite((double)q[1]) || !frm__finite((double)q[2]) ||
+        !frm__finite((double)q[3]))
+        return 0;
+    n = (double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3];
+    return fabs(n - 1.0) <= FRM__UNIT_TOL;
+}
+
+static void frm__quat_normalized(const frm_real *q, frm_real *out)
+{
+    double n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+    int k;
+    for (k = 0; k < 4; k++) out[k] = (frm_real)(q[k] / n);
+}
+
+/* >>parallel --------------------------------------------------------------------------- */
+
+typedef void (*frm__range_fn)(void *ctx, int begin, int end);
+
+/* Runs fn over items [0, count) (chunks fixed by the caller, so the result does not depend
+   on how they are spread over threads). */
+static void frm__run(const frm_model *m, int count, frm__range_fn fn, void *ctx)
+{
+    if (count <= 0) return;
+    if (count == 1 || !m->parallel) {
+        fn(ctx, 0, count);
+        return;
+    }
+    if (m->parallel_for) {
+        m->parallel_for(count, fn, ctx, m->parallel_user);
+        return;
+    }
+#ifdef _OPENMP
+    {
+        int i;
+#pragma omp parallel for schedule(static)
+        for (i = 0; i < count; i++) fn(ctx, i, i + 1);
+    }
+#else
+    fn(ctx, 0, count);
+#endif
+}
+
+/* >>memory ----------------------------------------------------------------------------- */
+
+/* The allocator's alloc, or FRM_MALLOC with the block aligned to FRM__ALIGN by hand (the
+   pointer malloc returned is kept just before the aligned block). */
+static void *frm__alloc(const frm_allocator *a, size_t size)
+{
+    char *raw, *p;
+    if (a && a->alloc) return a->alloc(size, FRM__ALIGN, a->user);
+    raw = (char *)FRM_MALLOC(size + FRM__ALIGN + sizeof(void *), a ? a->user : NULL);
+    if (!raw) return NULL;
+    p = raw + sizeof(void *);
+    p += (FRM__ALIGN - (size_t)p % FRM__ALIGN) % FRM__ALIGN;
+    memcpy(p - sizeof(void *), &raw, sizeof(void *));
+    return p;
+}
+
+static void frm__free(const frm_allocator *a, void *ptr, size_t size)
+{
+    void *raw;
+    if (!ptr) return;
+    if (a && a->free) {
+        a->free(ptr, size, a->user);
+        return;
+    }
+    memcpy(&raw, (char *)ptr - sizeof(void *), sizeof(void *));
+    FRM_FREE(raw, a ? a->user : NULL);
+}
+
+/* Carves aligned arrays out of one block; with base NULL it only measures. */
+typedef struct frm__carver {
+    char *base;
+    size_t offset;
+} frm__carver;
+
+static void *frm__carve(frm__carver *c, size_t bytes)
+{
+    void *p;
+    c->offset = (c->offset + FRM__ALIGN - 1) & ~(size_t)(FRM__ALIGN - 1);
+    p = c->base ? (void *)(c->base + c->offset) : NULL;
+    c->offset += bytes ? bytes : 1;
+    return p;
+}
+
+#define FRM__CARVE(c, ptr, type, count) ((ptr) = (type *)frm__carve((c), sizeof(type) * (size_t)(count)))
+
+static void frm__layout(frm_model *m, frm__carver *c)
+{
+    size_t n = (size_t)m->frame_count, S = (size_t)m->sample_count, P = (size_t)m->pair_count;
+    size_t B = (size_t)m->block_count, sq = (size_t)m->sq_total;
+    int k;
+    FRM__CARVE(c, m->pos, frm_real, 3 * n);
+    FRM__CARVE(c, m->quat, frm_real, 4 * n);
+    FRM__CARVE(c, m->vel, frm_real, 6 * n);
+    FRM__CARVE(c, m->rest_pos, frm_real, 3 * n);
+    FRM__CARVE(c, m->rest_quat, frm_real, 4 * n);
+    FRM__CARVE(c, m->rest_rot, frm_real, 9 * n);
+    FRM__CARVE(c, m->rot, frm_real, 9 * n);
+    FRM__CARVE(c, m->rel, frm_real, 9 * n);
+    FRM__CARVE(c, m->mass_local, double, 10 * n);
+    FRM__CARVE(c, m->grav_local, double, 4 * n);
+    FRM__CARVE(c, m->mass_world, frm_real, 10 * n);
+    FRM__CARVE(c, m->ext, frm_real, 6 * n);
+    FRM__CARVE(c, m->state, unsigned char, n);
+    FRM__CARVE(c, m->target, frm_real, 7 * n);
+    FRM__CARVE(c, m->force, frm_real, 6 * n);
+    FRM__CARVE(c, m->lin_torque, frm_real, 3 * n);
+    FRM__CARVE(c, m->lin_gravity, frm_real, 3 * n);
+    FRM__CARVE(c, m->kdiag, frm_real, 36 * n);
+    FRM__CARVE(c, m->precond, frm_real, 36 * n);
+    FRM__CARVE(c, m->rev_start, int, n + 1);
+    FRM__CARVE(c, m->rev_pair, int, P);
+    if (m->has_blocks) {
+        FRM__CARVE(c, m->blk_start, int, n + 1);
+        FRM__CARVE(c, m->blk_col, int, B);
+        FRM__CARVE(c, m->blocks, frm_real, 36 * B);
+        FRM__CARVE(c, m->sq_start, int, S + 1);
+        FRM__CARVE(c, m->pair_blk, int, sq);
+    }
+    FRM__CARVE(c, m->s_rest, frm_real, 3 * S);
+    FRM__CARVE(c, m->s_volume, frm_real, S);
+    FRM__CARVE(c, m->s_mu, frm_real, S);
+    FRM__CARVE(c, m->s_lambda, frm_real, S);
+    FRM__CARVE(c, m->s_law, unsigned char, S);
+    FRM__CARVE(c, m->s_start, int, S + 1);
+    FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
+    FRM__CARVE(c, m->lin_S, frm_real, 6 * S);
+    FRM__CARVE(c, m->lin_cache, frm_real, FRM_LAW_CACHE * S);
+    FRM__CARVE(c, m->s_pos, frm_real, 3 * S);
+    FRM__CARVE(c, m->s_F, frm_real, 9 * S);
+    FRM__CARVE(c, m->p_frame, int, P);
+    FRM__CARVE(c, m->p_sample, int, P);
+    FRM__CARVE(c, m->p_weight, frm_real, P);
+    FRM__CARVE(c, m->p_grad, frm_real, 3 * P);
+    FRM__CARVE(c, m->p_local, frm_real, 3 * P);
+    FRM__CARVE(c, m->p_G, frm_real, 9 * P);
+    FRM__CARVE(c, m->p_H, frm_real, 6 * P);
+    FRM__CARVE(c, m->p_out, frm_real, 6 * P);
+    FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
+    FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
+    for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
+    FRM__CARVE(c, m->backup, frm_real, 13 * n);
+    FRM__CARVE(c, m->start_state, frm_real, 13 * n);
+}
+
+/* >>validation ------------------------------------------------------------------------- */
+
+static int frm__fail(const frm_desc *d, int code, const char *detail)
+{
+    if (d && d->log) d->log(code, detail, d->log_user);
+    return code;
+}
+
+static int frm__validate_material(const frm_material *mat, int index, char *msg, size_t size)
+{
+    if ((int)mat->law != FRM_LAW_SVK && (int)mat->law != FRM_LAW_NEO_HOOKEAN) {
+        snprintf(msg, size, "material %d: unknown law %d", index, (int)mat->law);
+        return FRM_ERR_MATERIAL;
+    }
+    if (!(frm__finite((double)mat->young_modulus) && mat->young_modulus > 0)) {
+        snprintf(msg, size, "material %d: Young's modulus %g", index, (double)mat->young_modulus);
+        return FRM_ERR_YOUNG_MODULUS;
+    }
+    if (!(frm__finite((double)mat->poisson_ratio) && mat->poisson_ratio > -1 && mat->poisson_ratio < 0.5)) {
+        snprintf(msg, size, "material %d: Poisson ratio %g", index, (double)mat->poisson_ratio);
+        return FRM_ERR_POISSON_RATIO;
+    }
+    if (!(frm__finite((double)mat->density) && mat->density > 0)) {
+        snprintf(msg, size, "material %d: density %g", index, (double)mat->density);
+        return FRM_ERR_DENSITY;
+    }
+    return FRM_OK;
+}
+
+static int frm__validate_settings(const frm_desc *d)
+{
+    int i;
+    for (i = 0; i < 3; i++)
+        if (!frm__finite((double)d->gravity[i])) return frm__fail(d, FRM_ERR_ARG, "gravity");
+    if (!(frm__finite((double)d->time_step) && d->time_step > 0))
+        return frm__fail(d, FRM_ERR_TIME_STEP, "time_step");
+    if (!(frm__finite((double)d->mass_damping) && d->mass_damping >= 0) ||
+        !(frm__finite((double)d->stiffness_damping) && d->stiffness_damping >= 0))
+        return frm__fail(d, FRM_ERR_DAMPING, "damping");
+    if (!(frm__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
+        !(frm__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_max_iterations < 1)
+        return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances and caps");
+    if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
+        return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return frm__fail(d, FRM_ERR_ARG, "allocator needs both alloc and free");
+    return FRM_OK;
+}
+
+static int frm__validate_neighbors(const frm_desc *d, int *marker)
+{
+    char msg[200];
+    int s, k;
+    if (d->neighbor_start[0] != 0) return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, "neighbor_start[0] must be 0");
+    for (s = 0; s < d->sample_count; s++) {
+        int b = d->neighbor_start[s], e = d->neighbor_start[s + 1];
+        double wsum = 0, gsum[3] = {0, 0, 0}, gabs = 0;
+        if (e < b) {
+            snprintf(msg, sizeof msg, "neighbor_start decreases at sample %d", s);
+            return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, msg);
+        }
+        if (e == b) {
+            snprintf(msg, sizeof msg, "sample %d has no neighbour", s);
+            return frm__fail(d, FRM_ERR_NO_NEIGHBOR, msg);
+        }
+        if (e - b > FRM_MAX_NEIGHBORS) {
+            snprintf(msg, sizeof msg, "sample %d has %d neighbours (at most %d)", s, e - b, FRM_MAX_NEIGHBORS);
+            return frm__fail(d, FRM_ERR_TOO_MANY_NEIGHBORS, msg);
+        }
+        for (k = b; k < e; k++) {
+            int f = d->neighbor_frames[k], c;
+            if (f < 0 || f >= d->frame_count || marker[f] == s) {
+                snprintf(msg, sizeof msg, "sample %d: neighbour frame %d out of range or repeated", s, f);
+                return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, msg);
+            }
+            marker[f] = s;
+            if (!frm__finite((double)d->neighbor_weights[k])) {
+                snprintf(msg, sizeof msg, "sample %d: weight not finite", s);
+                return frm__fail(d, FRM_ERR_WEIGHT_NOT_FINITE, msg);
+            }
+            wsum += d->neighbor_weights[k];
+            for (c = 0; c < 3; c++) {
+                double g = (double)d->neighbor_gradients[3 * k + c];
+                if (!frm__finite(g)) {
+                    snprintf(msg, sizeof msg, "sample %d: weight gradient not finite", s);
+                    return frm__fail(d, FRM_ERR_WEIGHT_NOT_FINITE, msg);
+                }
+                gsum[c] += g;
+                gabs += fabs(g);
+            }
+        }
+        if (!(fabs(wsum - 1.0) <= FRM__SUM_TOL)) {
+            snprintf(msg, sizeof msg, "sample %d: weights sum to %.17g", s, wsum);
+            return frm__fail(d, FRM_ERR_WEIGHT_SUM, msg);
+        }
+        if (!(fabs(gsum[0]) + fabs(gsum[1]) + fabs(gsum[2]) <= FRM__SUM_TOL * gabs)) {
+            snprintf(msg, sizeof msg, "sample %d: weight gradients sum to (%g, %g, %g)", s, gsum[0], gsum[1], gsum[2]);
+            return frm__fail(d, FRM_ERR_GRADIENT_SUM, msg);
+        }
+    }
+    return FRM_OK;
+}
+
+/* Everything but the frames' masses (checked once they are computed). marker: frame_count
+   ints of scratch. */
+static int frm__validate(const frm_desc *d, int *marker)
+{
+    char msg[200];
+    int i, s, err;
+    for (i = 0; i < d->frame_count; i++) marker[i] = -1;
+    for (i = 0; i < 3 * d->frame_count; i++)
+        if (!frm__finite((double)d->frame_positions[i])) {
+            snprintf(msg, sizeof msg, "position of frame %d is not finite", i / 3);
+            return frm__fail(d, FRM_ERR_FRAME_NOT_FINITE, msg);
+        }
+    if (d->frame_orientations)
+        for (i = 0; i < d->frame_count; i++)
+            if (!frm__quat_valid(d->frame_orientations + 4 * i)) {
+                snprintf(msg, sizeof msg, "orientation of frame %d is not a unit quaternion", i);
+                return frm__fail(d, FRM_ERR_QUATERNION, msg);
+            }
+    for (s = 0; s < 3 * d->sample_count; s++)
+        if (!frm__finite((double)d->sample_positions[s])) {
+            snprintf(msg, sizeof msg, "position of sample %d is not finite", s / 3);
+            return frm__fail(d, FRM_ERR_SAMPLE_NOT_FINITE, msg);
+        }
+    for (s = 0; s < d->sample_count; s++)
+        if (!(frm__finite((double)d->sample_volumes[s]) && d->sample_volumes[s] > 0)) {
+            snprintf(msg, sizeof msg, "volume %g of sample %d", (double)d->sample_volumes[s], s);
+            return frm__fail(d, FRM_ERR_SAMPLE_VOLUME, msg);
+        }
+    err = frm__validate_neighbors(d, marker);
+    if (err) return err;
+    if (!d->materials) {
+        err = frm__validate_material(&d->material, 0, msg, sizeof msg);
+        if (err) return frm__fail(d, err, msg);
+        if (d->sample_materials) return frm__fail(d, FRM_ERR_MATERIAL, "sample_materials needs a materials table");
+    } else {
+        if (d->material_count < 1) return frm__fail(d, FRM_ERR_MATERIAL, "material_count must be >= 1");
+        for (i = 0; i < d->material_count; i++) {
+            err = frm__validate_material(d->materials + i, i, msg, sizeof msg);
+            if (err) return frm__fail(d, err, msg);
+        }
+        if (d->sample_materials)
+            for (s = 0; s < d->sample_count; s++)
+                if (d->sample_materials[s] < 0 || d->sample_materials[s] >= d->material_count) {
+                    snprintf(msg, sizeof msg, "sample %d: material index %d", s, d->sample_materials[s]);
+                    return frm__fail(d, FRM_ERR_MATERIAL, msg);
+                }
+    }
+    return FRM_OK;
+}
+
+/* >>creation --------------------------------------------------------------------------- */
+
+FRMDEF const char *frm_version(void) { return "0.1.0"; }
+
+FRMDEF const char *frm_error_string(int code)
+{
+    switch (code) {
+#define FRM__CASE(name, value, text) \
+    case name: return text;
+        FRM_ERROR_LIST(FRM__CASE)
+#undef FRM__CASE
+    default: return "unknown error code";
+    }
+}
+
+static frm_material frm__default_material(void)
+{
+    frm_material mat;
+    mat.law = FRM_LAW_SVK;
+    mat.young_modulus = (frm_real)1e4;
+    mat.poisson_ratio = (frm_real)0.3;
+    mat.density = (frm_real)1000;
+    return mat;
+}
+
+FRMDEF frm_desc frm_model_default_desc(void)
+{
+    frm_desc d;
+    memset(&d, 0, sizeof d);
+    d.material = frm__default_material();
+    d.gravity[2] = (frm_real)-9.81;
+    d.time_step = (frm_real)1e-2;
+    d.cg_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
+    d.cg_max_iterations = 1000;
+    d.cg_fail_at_cap = 1;
+    d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
+    d.newton_max_iterations = 30;
+    d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    d.internal_cookie = FRM__COOKIE;
+    return d;
+}
+
+/* Sorts a short int array (a row of the block pattern). */
+static void frm__sort_ints(int *a, int n)
+{
+    int i, j;
+    for (i = 1; i < n; i++) {
+        int v = a[i];
+        for (j = i - 1; j >= 0 && a[j] > v; j--) a[j + 1] = a[j];
+        a[j + 1] = v;
+    }
+}
+
+/* Builds the reverse table (frame -> pairs in increasing pair order) in rev_start/rev_pair
+   and the pair -> sample map. */
+static void frm__build_reverse(int n, int S, const int *start, const int *frames, int *rev_start, int *rev_pair,
+                               int *pair_sample, int *cursor)
+{
+    int i, s, p;
+    memset(rev_start, 0, sizeof(int) * ((size_t)n + 1));
+    for (s = 0; s < S; s++)
+        for (p = start[s]; p < start[s + 1]; p++) {
+            rev_start[frames[p] + 1]++;
+            pair_sample[p] = s;
+        }
+    for (i = 0; i < n; i++) rev_start[i + 1] += rev_start[i];
+    for (i = 0; i < n; i++) cursor[i] = rev_start[i];
+    for (p = 0; p < start[S]; p++) rev_pair[cursor[frames[p]]++] = p;
+}
+
+/* Counts (cols == NULL) or fills the block pattern: row i holds every frame that shares a
+   sample with i, sorted. marker: n ints set to -1. Returns the block count. */
+static long long frm__block_pattern(int n, const int *start, const int *frames, const int *rev_start,
+                                    const int *rev_pair, const int *pair_sample, int *marker, int *row_start,
+                                    int *cols)
+{
+    long long total = 0;
+    int i, e, p;
+    for (i = 0; i < n; i++) {
+        int count = 0;
+        if (row_start) row_start[i] = (int)total;
+        for (e = rev_start[i]; e < rev_start[i + 1]; e++) {
+            int s = pair_sample[rev_pair[e]];
+            for (p = start[s]; p < start[s + 1]; p++) {
+                int j = frames[p];
+                if (marker[j] == i) continue;
+                marker[j] = i;
+                if (cols) cols[total + count] = j;
+                count++;
+            }
+        }
+        if (cols) frm__sort_ints(cols + total, count);
+        total += count;
+    }
+    if (row_start) row_start[n] = (int)total;
+    return total;
+}
+
+static int frm__find_block(const frm_model *m, int i, int j)
+{
+    int lo = m->blk_start[i], hi = m->blk_start[i + 1] - 1;
+    while (lo <= hi) {
+        int mid = (lo + hi) / 2;
+        if (m->blk_col[mid] == j) return mid;
+        if (m->blk_col[mid] < j) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+/* Generalized frame masses (see MASS in the manual) and the gravity moments, in double, in
+   pair order. Returns the first frame without mass, or -1. */
+static int frm__compute_masses(frm_model *m, const frm_desc *d)
+{
+    int s, p, k, r, c;
+    const double pi = 3.14159265358979323846;
+    memset(m->mass_local, 0, sizeof(double) * 10 * (size_t)m->frame_count);
+    memset(m->grav_local, 0, sizeof(double) * 4 * (size_t)m->frame_count);
+    for (s = 0; s < m->sample_count; s++) {
+        int b = m->s_start[s], e = m->s_start[s + 1];
+        int mi = d->materials ? (d->sample_materials ? d->sample_materials[s] : 0) : -1;
+        double rho = mi >= 0 ? (double)d->materials[mi].density : (double)d->material.density;
+        double v = (double)d->sample_volumes[s], ms = rho * v, wabs = 0;
+        double r2 = pow(3.0 * v / (4.0 * pi), 2.0 / 3.0); /* squared radius of a ball of volume v */
+        for (p = b; p < e; p++) wabs += fabs((double)m->p_weight[p]);
+        for (p = b; p < e; p++) {
+            double *ml = m->mass_local + 10 * (size_t)m->p_frame[p];
+            double *gl = m->grav_local + 4 * (size_t)m->p_frame[p];
+            double l[3], mu = ms * fabs((double)m->p_weight[p]) / wabs, wg = ms * (double)m->p_weight[p], ll;
+            for (k = 0; k < 3; k++) l[k] = (double)m->p_local[3 * p + k];
+            ll = l[0] * l[0] + l[1] * l[1] + l[2] * l[2];
+            ml[0] += mu;
+            gl[0] += wg;
+            for (k = 0; k < 3; k++) {
+                ml[1 + k] += mu * l[k];
+                gl[1 + k] += wg * l[k];
+            }
+            /* Jbar (6, Voigt 00 11 22 12 02 01) += mu (|l|^2 I - l l^T + 2/5 r^2 I) */
+            for (r = 0; r < 3; r++) ml[4 + r] += mu * (ll - l[r] * l[r] + 0.4 * r2);
+            ml[7] -= mu * l[1] * l[2];
+            ml[8] -= mu * l[0] * l[2];
+            ml[9] -= mu * l[0] * l[1];
+        }
+    }
+    for (c = 0; c < m->frame_count; c++)
+        if (!(m->mass_local[10 * (size_t)c] > 0)) return c;
+    return -1;
+}
+
+static void frm__update_frames(frm_model *m);
+
+FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
+{
+    frm_model tmp, *m;
+    frm__carver carver;
+    frm_allocator alloc;
+    int err, i, s, p, k, n, S, P, *marker, *rev_start, *rev_pair, *pair_sample, *cursor;
+    size_t tmp_bytes;
+    char *tmp_block;
+    char msg[120];
+
+    if (!out) return FRM_ERR_ARG;
+    *out = NULL;
+    if (!d) return FRM_ERR_ARG;
+    if (d->internal_cookie != FRM__COOKIE) return frm__fail(d, FRM_ERR_DESC, "start from frm_model_default_desc()");
+    if (d->frame_count < 1 || d->frame_count > 100000000 || !d->frame_positions)
+        return frm__fail(d, FRM_ERR_FRAME_COUNT, "frame_count must be >= 1 with positions");
+    if (d->sample_count < 1 || d->sample_count > 100000000 || !d->sample_positions || !d->sample_volumes)
+        return frm__fail(d, FRM_ERR_SAMPLE_COUNT, "sample_count must be >= 1 with positions and volumes");
+    if (!d->neighbor_start || !d->neighbor_frames || !d->neighbor_weights || !d->neighbor_gradients)
+        return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, "the four neighbour arrays are required");
+    err = frm__validate_settings(d);
+    if (err) return err;
+    n = d->frame_count;
+    S = d->sample_count;
+    alloc = d->allocator;
+
+    tmp_bytes = sizeof(int) * (size_t)n;
+    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
+    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    err = frm__validate(d, (int *)tmp_block);
+    frm__free(&alloc, tmp_block, tmp_bytes);
+    if (err) return err;
+
+    /* temporary tables: marker[n], cursor[n], rev_start[n+1], rev_pair[P], pair_sample[P] */
+    P = d->neighbor_start[S];
+    tmp_bytes = sizeof(int) * (3 * (size_t)n + 1 + 2 * (size_t)P);
+    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
+    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    marker = (int *)tmp_block;
+    cursor = marker + n;
+    rev_start = cursor + n;
+    rev_pair = rev_start + n + 1;
+    pair_sample = rev_pair + P;
+    frm__build_reverse(n, S, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample, cursor);
+
+    memset(&tmp, 0, sizeof tmp);
+    tmp.frame_count = n;
+    tmp.sample_count = S;
+    tmp.pair_count = P;
+    tmp.sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
+    tmp.frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
+    tmp.has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    if (tmp.has_blocks) {
+        long long blocks, sq = 0;
+        for (i = 0; i < n; i++) marker[i] = -1;
+        blocks = frm__block_pattern(n, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample,
+                                    marker, NULL, NULL);
+        for (s = 0; s < S; s++) {
+            long long c = d->neighbor_start[s + 1] - d->neighbor_start[s];
+            sq += c * c;
+        }
+        if (blocks > 200000000 || sq > 2000000000) {
+            frm__free(&alloc, tmp_block, tmp_bytes);
+            return frm__fail(d, FRM_ERR_ALLOC, "block pattern too large; use FRM_STIFFNESS_PAIRS");
+        }
+        tmp.block_count = (int)blocks;
+        tmp.sq_total = (int)sq;
+    }
+    carver.base = NULL;
+    carver.offset = sizeof(frm_model);
+    frm__layout(&tmp, &carver);
+    tmp.block_bytes = carver.offset;
+    tmp.block = frm__alloc(&alloc, tmp.block_bytes);
+    if (!tmp.block) {
+        frm__free(&alloc, tmp_block, tmp_bytes);
+        return frm__fail(d, FRM_ERR_ALLOC, "model block");
+    }
+    memset(tmp.block, 0, tmp.block_bytes);
+    carver.base = (char *)tmp.block;
+    carver.offset = sizeof(frm_model);
+    frm__layout(&tmp, &carver);
+    m = (frm_model *)tmp.block;
+    *m = tmp;
+
+    m->allocator = alloc;
+    m->parallel_for = d->parallel_for;
+    m->parallel_user = d->parallel_user;
+    m->parallel = P >= FRM_PARALLEL_MIN_PAIRS;
+    for (k = 0; k < 3; k++) m->gravity[k] = d->gravity[k];
+    m->time_step = d->time_step;
+    m->mass_damping = d->mass_damping;
+    m->stiffness_damping = d->stiffness_damping;
+    m->cg_tolerance = d->cg_tolerance;
+    m->cg_max_iterations = d->cg_max_iterations;
+    m->cg_fail_at_cap = d->cg_fail_at_cap;
+    m->newton_tolerance = d->newton_tolerance;
+    m->newton_max_iterations = d->newton_max_iterations;
+    m->stiffness_mode = d->stiffness_mode;
+
+    /* frames */
+    memcpy(m->rest_pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
+    memcpy(m->pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
+    for (i = 0; i < n; i++) {
+        frm_real *q = m->rest_quat + 4 * i;
+        if (d->frame_orientations) frm__quat_normalized(d->frame_orientations + 4 * i, q);
+        else q[0] = q[1] = q[2] = 0, q[3] = 1;
+        memcpy(m->quat + 4 * i, q, 4 * sizeof(frm_real));
+        frm_quat_to_matrix(q, m->rest_rot + 9 * i);
+        memcpy(m->target + 7 * i, m->rest_pos + 3 * i, 3 * sizeof(frm_real));
+        memcpy(m->target + 7 * i + 3, q, 4 * sizeof(frm_real));
+    }
+    memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
+    memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
+    memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
+
+    /* samples */
+    memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
+    memcpy(m->s_volume, d->sample_volumes, sizeof(frm_real) * (size_t)S);
+    memcpy(m->s_start, d->neighbor_start, sizeof(int) * ((size_t)S + 1));
+    for (s = 0; s < S; s++) {
+        const frm_material *mat =
+            d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
+        double E = (double)mat->young_modulus, nu = (double)mat->poisson_ratio;
+        m->s_mu[s] = (frm_real)(E / (2.0 * (1.0 + nu)));
+        m->s_lambda[s] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
+        m->s_law[s] = (unsigned char)mat->law;
+        if (mat->law == FRM_LAW_NEO_HOOKEAN) m->has_neo_hookean = 1;
+    }
+
+    /* pairs: lbar = Rbar^T (pbar_s - xbar_i) (eq. 3.33), in double */
+    memcpy(m->p_frame, d->neighbor_frames, sizeof(int) * (size_t)P);
+    memcpy(m->p_weight, d->neighbor_weights, sizeof(frm_real) * (size_t)P);
+    memcpy(m->p_grad, d->neighbor_gradients, sizeof(frm_real) * 3 * (size_t)P);
+    for (p = 0; p < P; p++) {
+        int f = m->p_frame[p], sm = m->p_sample[p], r;
+        const frm_real *Rb = m->rest_rot + 9 * f;
+        double dx[3];
+        for (r = 0; r < 3; r++) dx[r] = (double)m->s_rest[3 * sm + r] - (double)m->rest_pos[3 * f + r];
+        for (r = 0; r < 3; r++)
+            m->p_local[3 * p + r] = (frm_real)(Rb[r] * dx[0] + Rb[3 + r] * dx[1] + Rb[6 + r] * dx[2]);
+    }
+    i = frm__compute_masses(m, d);
+    if (i >= 0) {
+        frm__free(&alloc, tmp_block, tmp_bytes);
+        frm__free(&alloc, m->block, m->block_bytes);
+        snprintf(msg, sizeof msg, "frame %d carries no mass", i);
+        return frm__fail(d, FRM_ERR_FRAME_UNUSED, msg);
+    }
+
+    /* block pattern and the block index of every (pair, other slot of its sample) */
+    if (m->has_blocks) {
+        for (i = 0; i < n; i++) marker[i] = -1;
+        frm__block_pattern(n, m->s_start, m->p_frame, m->rev_start, m->rev_pair, m->p_sample, marker, m->blk_start,
+                           m->blk_col);
+        m->sq_start[0] = 0;
+        for (s = 0; s < S; s++) {
+            int b = m->s_start[s], c = m->s_start[s + 1] - b, a, q;
+            m->sq_start[s + 1] = m->sq_start[s] + c * c;
+            for (a = 0; a < c; a++)
+                for (q = 0; q < c; q++)
+                    m->pair_blk[m->sq_start[s] + a * c + q] = frm__find_block(m, m->p_frame[b + a], m->p_frame[b + q]);
+        }
+    }
+    frm__free(&alloc, tmp_block, tmp_bytes);
+    m->lin_iterations = -1;
+    frm__update_frames(m);
+    *out = m;
+    return FRM_OK;
+}
+
+FRMDEF void frm_model_destroy(frm_model *m)
+{
+    frm_allocator a;
+    if (!m) return;
+    a = m->allocator;
+    frm__free(&a, m->block, m->block_bytes);
+}
+
+/* >>forces ----------------------------------------------------------------------------- */
+
+/* R and Q = R Rbar^T of every frame from its quaternion. */
+static void frm__update_frames(frm_model *m)
+{
+    int i;
+    for (i = 0; i < m->frame_count; i++)
+        frm_frame_rotations(m->quat + 4 * i, m->rest_rot + 9 * i, m->rot + 9 * i, m->rel + 9 * i);
+}
+
+/* World gravity moment c_g = R cbar_g of frame i. */
+static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
+{
+    const frm_real *R = m->rot + 9 * i;
+    const double *g = m->grav_local + 4 * (size_t)i;
+    int r;
+    for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
+}
+
+typedef struct frm__force_ctx {
+    frm_model *m;
+    int linearize, outputs;
+} frm__force_ctx;
+
+/* Pass 1 of the force over sample chunks [begin, end): F, S, P per sample, the partial
+   force of every pair into p_out, the chunk's energy; with linearize, the per-pair G and
+   Hs and the per-sample F, S and tangent data too. Reads per pair 1 int and 7 reals
+   (weight, gradient, lbar), writes 6 (+ 15 when linearising); gathers the frames' x, R, Q. */
+static void frm__force_chunks(void *vctx, int begin, int end)
+{
+    frm__force_ctx *ctx = (frm__force_ctx *)vctx;
+    frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
+        double energy = 0;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e;
+            frm_real F[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
+            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_local + 3 * b, m->pos,
+                                   m->rot, m->rel, F, lever, ctx->outputs ? m->s_pos + 3 * s : NULL);
+            if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
+            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], F, S, &psi, cache);
+            if (e) {
+                err = e;
+                memset(m->p_out + 6 * (size_t)b, 0, sizeof(frm_real) * 6 * (size_t)n);
+                continue;
+            }
+            energy += (double)v * (double)psi;
+            frm_first_piola(F, S, P);
+            for (k = 0; k < n; k++)
+                frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
+                               m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
+            if (ctx->linearize) {
+                memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
+                memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
+                memcpy(m->lin_cache + FRM_LAW_CACHE * (size_t)s, cache, sizeof cache);
+                for (k = 0; k < n; k++)
+                    frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
+                                       m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k),
+                                       m->p_H + 6 * (size_t)(b + k));
+            }
+        }
+        m->chunk_energy[c] = energy;
+        m->chunk_err[c] = err;
+    }
+}
+
+typedef struct frm__gather_ctx {
+    const frm_model *m;
+    const frm_real *src;
+    frm_real *dst;
+} frm__gather_ctx;
+
+/* Pass 2 over frame chunks: each frame sums the partials of its pairs through the reverse
+   table, in pair order (the order never depends on threads). Reads 1 int and 6 reals per
+   pair, writes 6 reals per frame. */
+static void frm__gather_chunks(void *vctx, int begin, int end)
+{
+    frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
+    const frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
+        if (i1 > m->frame_count) i1 = m->frame_count;
+        for (i = i0; i < i1; i++) {
+            double sum[6] = {0, 0, 0, 0, 0, 0};
+            int e, k;
+            for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
+                const frm_real *src = ctx->src + 6 * (size_t)m->rev_pair[e];
+                for (k = 0; k < 6; k++) sum[k] += (double)src[k];
+            }
+            for (k = 0; k < 6; k++) ctx->dst[6 * i + k] = (frm_real)sum[k];
+        }
+    }
+}
+
+static void frm__gather(const frm_model *m, const frm_real *src, frm_real *dst)
+{
+    frm__gather_ctx g;
+    g.m = m;
+    g.src = src;
+    g.dst = dst;
+    frm__run(m, m->frame_chunks, frm__gather_chunks, &g);
+}
+
+/* Internal forces into m->force (both passes) and the elastic energy. With linearize, the
+   stiffness data of the state too (and lin_torque, lin_gravity). Returns FRM_OK,
+   FRM_ERR_INVERTED or FRM_ERR_NOT_FINITE. */
+static int frm__force_pass(frm_model *m, int linearize, int outputs, double *energy)
+{
+    frm__force_ctx ctx;
+    double W = 0;
+    int c, err = FRM_OK;
+    frm__update_frames(m);
+    ctx.m = m;
+    ctx.linearize = linearize;
+    ctx.outputs = outputs;
+    if (linearize) m->lin_valid = 0;
+    frm__run(m, m->sample_chunks, frm__force_chunks, &ctx);
+    m->stats.force_evaluations++;
+    for (c = 0; c < m->sample_chunks; c++) {
+        W += m->chunk_energy[c];
+        if (m->chunk_err[c] && !err) err = m->chunk_err[c];
+    }
+    if (energy) *energy = W;
+    if (err) return err;
+    frm__gather(m, m->p_out, m->force);
+    if (!frm__finite(W) || !frm__all_finite(m->force, 6 * (size_t)m->frame_count)) return FRM_ERR_NOT_FINITE;
+    if (linearize) {
+        int i, r;
+        for (i = 0; i < m->frame_count; i++) {
+            frm_real cg[3], tg[3];
+            frm__gravity_moment(m, i, cg);
+            frm_cross(cg, m->gravity, tg);
+            for (r = 0; r < 3; r++) {
+                m->lin_gravity[3 * i + r] = cg[r];
+                m->lin_torque[3 * i + r] = m->force[6 * i + 3 + r] + tg[r];
+            }
+        }
+        m->lin_valid = 1;
+    }
+    return FRM_OK;
+}
+
+/* Total generalized force on every frame: internal + gravity (m_g g, c_g x g) + external. */
+static void frm__total_force(const frm_model *m, frm_real *f)
+{
+    int i, r;
+    for (i = 0; i < m->frame_count; i++) {
+        frm_real cg[3], tg[3], mg = (frm_real)m->grav_local[4 * (size_t)i];
+        frm__gravity_moment(m, i, cg);
+        frm_cross(cg, m->gravity, tg);
+        for (r = 0; r < 3; r++) {
+            f[6 * i + r] = m->force[6 * i + r] + mg * m->gravity[r] + m->ext[6 * i + r];
+            f[6 * i + 3 + r] = m->force[6 * i + 3 + r] + tg[r] + m->ext[6 * i + 3 + r];
+        }
+    }
+}
+
+/* Euclidean norm over the free frames. */
+static double frm__norm_free(const frm_model *m, const frm_real *v)
+{
+    double s[4] = {0, 0, 0, 0};
+    int i, k;
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] == FRM__FREE)
+            for (k = 0; k < 6; k++) s[k & 3] += (double)v[6 * i + k] * v[6 * i + k];
+    return sqrt((s[0] + s[1]) + (s[2] + s[3]));
+}
+
+/* >>stiffness -------------------------------------------------------------------------- */
+
+typedef struct frm__apply_ctx {
+    const frm_model *m;
+    const frm_real *v;
+} frm__apply_ctx;
+
+/* Pass 1 of K v in pair mode over sample chunks: dF from the neighbours' dq, dP, then
+   each pair's contribution into p_out. Reads per pair 1 int and 3 + 9 + 6 reals (grad,
+   G, Hs), writes 6; per sample 9 + 6 (+ FRM_LAW_CACHE for Neo-Hookean) reals; gathers 6
+   per neighbour. */
+static void frm__apply_chunks(void *vctx, int begin, int end)
+{
+    frm__apply_ctx *ctx = (frm__apply_ctx *)vctx;
+    const frm_model *m = ctx->m;
+    const frm_real *v = ctx->v;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k;
+            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s];
+            for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
+            frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
+                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
+            for (k = b; k < b + n; k++)
+                frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_H + 6 * (size_t)k,
+                               v + 6 * m->p_frame[k] + 3, m->p_out + 6 * (size_t)k);
+        }
+    }
+}
+
+/* K v by assembled blocks over frame chunks: each row i, sum_j K_ij v_j. Reads 36 reals
+   and 1 int per block. */
+static void frm__block_chunks(void *vctx, int begin, int end)
+{
+    frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
+    const frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
+        if (i1 > m->frame_count) i1 = m->frame_count;
+        for (i = i0; i < i1; i++) {
+            double y[6] = {0, 0, 0, 0, 0, 0};
+            int e, r, k;
+            for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+                const frm_real *K = m->blocks + 36 * (size_t)e, *x = ctx->src + 6 * m->blk_col[e];
+                for (r = 0; r < 6; r++) {
+                    frm_real t = 0;
+                    for (k = 0; k < 6; k++) t += K[6 * r + k] * x[k];
+                    y[r] += (double)t;
+                }
+            }
+            for (r = 0; r < 6; r++) ctx->dst[6 * i + r] = (frm_real)y[r];
+        }
+    }
+}
+
+/* The gravity torque's stiffness at the linearisation, symmetric part:
+   K_g dtheta = -1/2 (c (g . dtheta) + g (c . dtheta)) + (c . g) dtheta, c = R cbar_g. */
+static void frm__gravity_stiffness(const frm_model *m, int i, double K[9])
+{
+    const frm_real *c = m->lin_gravity + 3 * i, *g = m->gravity;
+    double cg = (double)c[0] * g[0] + (double)c[1] * g[1] + (double)c[2] * g[2];
+    int r, k;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) K[3 * r + k] = -0.5 * ((double)c[r] * g[k] + (double)g[r] * c[k]) + (r == k ? cg : 0.0);
+}
+
+/* out = K v (all frames): pairs or blocks as linearised; the symmetric part, or with
+   exact = 1 the force derivative itself, which adds 1/2 tau x dtheta per frame (tau the
+   internal plus gravity torque at the linearisation). */
+static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *out, int exact)
+{
+    int i, r, k;
+    if (m->lin_mode == FRM_STIFFNESS_BLOCKS) {
+        frm__gather_ctx g;
+        g.m = m;
+        g.src = v;
+        g.dst = out;
+        frm__run(m, m->frame_chunks, frm__block_chunks, &g);
+    } else {
+        frm__apply_ctx a;
+        a.m = m;
+        a.v = v;
+        frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
+        frm__gather(m, m->p_out, out);
+        for (i = 0; i < m->frame_count; i++) {
+            double K[9];
+            frm__gravity_stiffness(m, i, K);
+            for (r = 0; r < 3; r++) {
+                double t = 0;
+                for (k = 0; k < 3; k++) t += K[3 * r + k] * v[6 * i + 3 + k];
+                out[6 * i + 3 + r] += (frm_real)t;
+            }
+        }
+    }
+    if (exact)
+        for (i = 0; i < m->frame_count; i++) {
+            frm_real t[3];
+            frm_cross(m->lin_torque + 3 * i, v + 6 * i + 3, t);
+            for (r = 0; r < 3; r++) out[6 * i + 3 + r] += (frm_real)0.5 * t[r];
+        }
+    m->stats.stiffness_products++;
+}
+
+/* Adds the symmetric Hs (6) to the rotational block of a 6x6 row-major block. */
+static void frm__add_rotational(const frm_real *H, frm_real *D)
+{
+    D[21] += H[0];
+    D[28] += H[1];
+    D[35] += H[2];
+    D[29] += H[3];
+    D[34] += H[3];
+    D[23] += H[4];
+    D[33] += H[4];
+    D[22] += H[5];
+    D[27] += H[5];
+}
+
+/* Per-frame diagonal block of the stiffness (symmetric part) from its pairs, computed in
+   the gather pass (pair mode; the block mode takes it from the assembled row). */
+static void frm__diag_chunks(void *vctx, int begin, int end)
+{
+    frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
+    frm_model *m = (frm_model *)ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
+        if (i1 > m->frame_count) i1 = m->frame_count;
+        for (i = i0; i < i1; i++) {
+            double acc[36], Kg[9];
+            int e, k, r;
+            memset(acc, 0, sizeof acc);
+            for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
+                int p = m->rev_pair[e], s = m->p_sample[p];
+                frm_real cols[54], K[36];
+                for (k = 0; k < 36; k++) K[k] = 0;
+                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
+                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
+                                         m->p_G + 9 * (size_t)p, cols);
+                frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
+                frm__add_rotational(m->p_H + 6 * (size_t)p, K);
+                for (k = 0; k < 36; k++) acc[k] += (double)K[k];
+            }
+            frm__gravity_stiffness(m, i, Kg);
+            for (r = 0; r < 3; r++)
+                for (k = 0; k < 3; k++) acc[6 * (3 + r) + 3 + k] += Kg[3 * r + k];
+            for (r = 0; r < 6; r++)
+                for (k = 0; k < 6; k++) m->kdiag[36 * (size_t)i + 6 * r + k] = (frm_real)(0.5 * (acc[6 * r + k] + acc[6 * k + r]));
+        }
+    }
+}
+
+/* Assembly over frame chunks: row i's blocks from the pairs of frame i (slot a of sample
+   s): K_{i, frame of slot b} += v B_a^T A B_b for every slot b, plus Hs on the diagonal
+   and the gravity stiffness. Rows are independent: no two tasks write the same block. */
+static void frm__assemble_chunks(void *vctx, int begin, int end)
+{
+    frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
+    frm_model *m = (frm_model *)ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
+        if (i1 > m->frame_count) i1 = m->frame_count;
+        for (i = i0; i < i1; i++) {
+            int e, k, r, diag = frm__find_block(m, i, i);
+            frm_real *D = m->blocks + 36 * (size_t)diag;
+            double Kg[9];
+            memset(m->blocks + 36 * (size_t)m->blk_start[i], 0,
+                   sizeof(frm_real) * 36 * (size_t)(m->blk_start[i + 1] - m->blk_start[i]));
+            for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
+                int p = m->rev_pair[e], s = m->p_sample[p], b = m->s_start[s], n = m->s_start[s + 1] - b, a = p - b, q;
+                frm_real cols[54];
+                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
+                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
+                                         m->p_G + 9 * (size_t)p, cols);
+                for (q = 0; q < n; q++)
+                    frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q),
+                                   m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q]);
+                frm__add_rotational(m->p_H + 6 * (size_t)p, D);
+            }
+            frm__gravity_stiffness(m, i, Kg);
+            for (r = 0; r < 3; r++)
+                for (k = 0; k < 3; k++) D[6 * (3 + r) + 3 + k] += (frm_real)Kg[3 * r + k];
+            for (r = 0; r < 6; r++)
+                for (k = 0; k < 6; k++) m->kdiag[36 * (size_t)i + 6 * r + k] = (frm_real)0.5 * (D[6 * r + k] + D[6 * k + r]);
+        }
+    }
+}
+
+/* Cost model of AUTO (see PERFORMANCE): estimated time of a linear solve of `iterations`
+   CG iterations in each mode, from per-item costs measured on one core (double, ns). */
+#define FRM__COST_PAIR_ITER 14.0    /* pair-mode K v, per pair per iteration */
+#define FRM__COST_PAIR_DIAG 60.0    /* pair-mode diagonal block, per pair */
+#define FRM__COST_BLOCK_ITER 4.0    /* block-mode K v, per block per iteration */
+#define FRM__COST_ASSEMBLE_COL 60.0 /* assembly: tangent columns, per pair */
+#define FRM__COST_ASSEMBLE_BLK 20.0 /* assembly: one slot-pair block, per (pair, slot) */
+
+static int frm__choose_mode(const frm_model *m)
+{
+    double it, pairs, blocks;
+    if (m->stiffness_mode == FRM_STIFFNESS_PAIRS || !m->has_blocks) return FRM_STIFFNESS_PAIRS;
+    if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS) return FRM_STIFFNESS_BLOCKS;
+    /* the last solve's iteration count predicts the next; before any, a typical 50 */
+    it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
+    pairs = FRM__COST_PAIR_DIAG * m->pair_count + it * FRM__COST_PAIR_ITER * m->pair_count;
+    blocks = FRM__COST_ASSEMBLE_COL * m->pair_count + FRM__COST_ASSEMBLE_BLK * m->sq_total +
+             it * FRM__COST_BLOCK_ITER * m->block_count;
+    return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
+}
+
+/* After a linearising force pass: the chosen mode's data (assembled blocks, or the
+   diagonal blocks for the preconditioner). */
+static void frm__prepare_mode(frm_model *m, int mode)
+{
+    frm__gather_ctx g;
+    g.m = m;
+    g.src = NULL;
+    g.dst = NULL;
+    m->lin_mode = mode;
+    m->stats.stiffness_mode = mode;
+    frm__run(m, m->frame_chunks, mode == FRM_STIFFNESS_BLOCKS ? frm__assemble_chunks : frm__diag_chunks, &g);
+}
+
+/* World mass data (m, c = R cbar, J = R Jbar R^T) of every frame at its current pose. */
+static void frm__mass_update(frm_model *m)
+{
+    int i, r, k, l;
+    for (i = 0; i < m->frame_count; i++) {
+        const double *ml = m->mass_local + 10 * (size_t)i;
+        const frm_real *R = m->rot + 9 * i;
+        frm_real *mw = m->mass_world + 10 * (size_t)i;
+        double J[9], RJ[9], W[9];
+        J[0] = ml[4];
+        J[4] = ml[5];
+        J[8] = ml[6];
+        J[5] = J[7] = ml[7];
+        J[2] = J[6] = ml[8];
+        J[1] = J[3] = ml[9];
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) {
+                double t = 0;
+                for (l = 0; l < 3; l++) t += (double)R[3 * r + l] * J[3 * l + k];
+                RJ[3 * r + k] = t;
+            }
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) {
+                double t = 0;
+                for (l = 0; l < 3; l++) t += RJ[3 * r + l] * (double)R[3 * k + l];
+                W[3 * r + k] = t;
+            }
+        mw[0] = (frm_real)ml[0];
+        for (r = 0; r < 3; r++) mw[1 + r] = (frm_real)(R[3 * r] * ml[1] + R[3 * r + 1] * ml[2] + R[3 * r + 2] * ml[3]);
+        mw[4] = (frm_real)W[0];
+        mw[5] = (frm_real)W[4];
+        mw[6] = (frm_real)W[8];
+        mw[7] = (frm_real)(0.5 * (W[5] + W[7]));
+        mw[8] = (frm_real)(0.5 * (W[2] + W[6]));
+        mw[9] = (frm_real)(0.5 * (W[1] + W[3]));
+    }
+}
+
+/* The 6x6 mass block of frame i from mass_world: [m I, -[c]x; [c]x, J]. */
+static void frm__mass_matrix(const frm_model *m, int i, double M[36])
+{
+    const frm_real *w = m->mass_world + 10 * (size_t)i;
+    double c0 = w[1], c1 = w[2], c2 = w[3];
+    int k;
+    memset(M, 0, 36 * sizeof(double));
+    for (k = 0; k < 3; k++) M[7 * k] = w[0];
+    M[4] = c2; /* -[c]x, top right */
+    M[5] = -c1;
+    M[9] = -c2;
+    M[11] = c0;
+    M[15] = c1;
+    M[16] = -c0;
+    M[19] = -c2; /* [c]x, bottom left */
+    M[20] = c1;
+    M[24] = c2;
+    M[26] = -c0;
+    M[30] = -c1;
+    M[31] = c0;
+    M[21] = w[4];
+    M[28] = w[5];
+    M[35] = w[6];
+    M[29] = M[34] = w[7];
+    M[23] = M[33] = w[8];
+    M[22] = M[27] = w[9];
+}
+
+/* out = M_i v for frame i (6 values): (m x + omega x c, c x x + J omega). */
+static void frm__mass_apply(const frm_model *m, int i, const frm_real *v, double out[6])
+{
+    const frm_real *w = m->mass_world + 10 * (size_t)i;
+    double x0 = v[0], x1 = v[1], x2 = v[2], o0 = v[3], o1 = v[4], o2 = v[5];
+    out[0] = (double)w[0] * x0 + (o1 * w[3] - o2 * w[2]);
+    out[1] = (double)w[0] * x1 + (o2 * w[1] - o0 * w[3]);
+    out[2] = (double)w[0] * x2 + (o0 * w[2] - o1 * w[1]);
+    out[3] = (w[2] * x2 - w[3] * x1) + w[4] * o0 + w[9] * o1 + w[8] * o2;
+    out[4] = (w[3] * x0 - w[1] * x2) + w[9] * o0 + w[5] * o1 + w[7] * o2;
+    out[5] = (w[1] * x1 - w[2] * x0) + w[8] * o0 + w[7] * o1 + w[6] * o2;
+}
+
+/* Block-Jacobi preconditioner: the inverse of a_mass M_i + a_stiff K_ii per free frame (a
+   Cholesky inverse; if that block is not positive definite, the inverse of its absolute
+   diagonal), zero for fixed and driven frames. */
+static void frm__build_precond(frm_model *m, double a_mass, double a_stiff)
+{
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        frm_real *P = m->precond + 36 * (size_t)i;
+        double A[36], M[36], inv[36];
+        if (m->state[i] != FRM__FREE) {
+            for (k = 0; k < 36; k++) P[k] = 0;
+            continue;
+        }
+        frm__mass_matrix(m, i, M);
+        for (k = 0; k < 36; k++) A[k] = a_mass * M[k] + a_stiff * (double)m->kdiag[36 * (size_t)i + k];
+        if (!frm__invert6(A, inv)) {
+            for (k = 0; k < 36; k++) inv[k] = 0;
+            for (k = 0; k < 6; k++) inv[7 * k] = fabs(A[7 * k]) > 0 ? 1.0 / fabs(A[7 * k]) : 0.0;
+        }
+        for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
+    }
+}
+
+/* >>solver ----------------------------------------------------------------------------- */
+
+/* out = (a_mass M + a_stiff K) v on the free frames, 0 on the others. */
+static void frm__system_product(frm_model *m, double a_mass, double a_stiff, const frm_real *v, frm_real *out)
+{
+    int i, k;
+    frm__stiffness_product(m, v, out, 0);
+    for (i = 0; i < m->frame_count; i++) {
+        double mv[6] = {0, 0, 0, 0, 0, 0};
+        if (m->state[i] != FRM__FREE) {
+            for (k = 0; k < 6; k++) out[6 * i + k] = 0;
+            continue;
+        }
+        if (a_mass != 0) frm__mass_apply(m, i, v + 6 * i, mv);
+        for (k = 0; k < 6; k++) out[6 * i + k] = (frm_real)(a_stiff * (double)out[6 * i + k] + a_mass * mv[k]);
+    }
+}
+
+/* z = P r per frame. */
+static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *z)
+{
+    int i, a, b;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *P = m->precond + 36 * (size_t)i, *x = r + 6 * i;
+        for (a = 0; a < 6; a++) {
+            frm_real t = 0;
+            for (b = 0; b < 6; b++) t += P[6 * a + b] * x[b];
+            z[6 * i + a] = t;
+        }
+    }
+}
+
+static double frm__dot(const frm_model *m, const frm_real *a, const frm_real *b)
+{
+    double s[4] = {0, 0, 0, 0};
+    int k, n6 = 6 * m->frame_count;
+    for (k = 0; k < n6; k++) s[k & 3] += (double)a[k] * (double)b[k];
+    return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
+#define FRM__CG_OK 0
+#define FRM__CG_CAP 1
+#define FRM__CG_NEGATIVE 2
+
+/* Block-Jacobi preconditioned CG on (a_mass M + a_stiff K) x = b over the free frames
+   (b and the initial x are masked here). Stops at |r| <= cg_tolerance |b|, at the cap, or
+   on a direction of non-positive curvature (x then holds the last iterate, or the
+   preconditioned residual if that happened at once). The vector work is serial, in a
+   fixed order. */
+static int frm__cg(frm_model *m, double a_mass, double a_stiff, frm_real *b, frm_real *x)
+{
+    frm_real *r = m->vec[FRM__V_R], *z = m->vec[FRM__V_Z], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
+    int i, k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
+    double bb, rr, rz, tol2;
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] != FRM__FREE)
+            for (k = 0; k < 6; k++) b[6 * i + k] = x[6 * i + k] = 0;
+    for (k = 0; k < n6; k++) nonzero |= x[k] != 0;
+    bb = frm__dot(m, b, b);
+    m->stats.cg_iterations_last = 0;
+    m->stats.cg_residual = 0;
+    if (bb == 0) {
+        memset(x, 0, sizeof(frm_real) * (size_t)n6);
+        return FRM__CG_OK;
+    }
+    tol2 = (double)m->cg_tolerance * (double)m->cg_tolerance * bb;
+    if (nonzero) {
+        frm__system_product(m, a_mass, a_stiff, x, q);
+        for (k = 0; k < n6; k++) r[k] = b[k] - q[k];
+    } else
+        memcpy(r, b, sizeof(frm_real) * (size_t)n6);
+    frm__precond_apply(m, r, z);
+    memcpy(p, z, sizeof(frm_real) * (size_t)n6);
+    rr = frm__dot(m, r, r);
+    rz = frm__dot(m, r, z);
+    for (it = 0; it < m->cg_max_iterations && rr > tol2; it++) {
+        double pq, alpha, beta, rz_new;
+        frm__system_product(m, a_mass, a_stiff, p, q);
+        pq = frm__dot(m, p, q);
+        if (!(pq > 0) || !(rz > 0)) {
+            status = FRM__CG_NEGATIVE;
+            if (it == 0) memcpy(x, z, sizeof(frm_real) * (size_t)n6);
+            break;
+        }
+        alpha = rz / pq;
+        for (k = 0; k < n6; k++) {
+            x[k] += (frm_real)alpha * p[k];
+            r[k] -= (frm_real)alpha * q[k];
+        }
+        frm__precond_apply(m, r, z);
+        rr = frm__dot(m, r, r);
+        rz_new = frm__dot(m, r, z);
+        beta = rz_new / rz;
+        rz = rz_new;
+        for (k = 0; k < n6; k++) p[k] = z[k] + (frm_real)beta * p[k];
+    }
+    if (status == FRM__CG_OK && !(rr <= tol2)) status = FRM__CG_CAP;
+    m->stats.cg_iterations_last = it;
+    m->stats.cg_iterations += it;
+    m->stats.cg_residual = (frm_real)sqrt(rr / bb);
+    m->lin_iterations = it;
+    return status;
+}
+
+static void frm__save_state(frm_model *m)
+{
+    int i;
+    for (i = 0; i < m->frame_count; i++) {
+        frm_real *b = m->backup + 13 * (size_t)i;
+        memcpy(b, m->pos + 3 * i, 3 * sizeof(frm_real));
+        memcpy(b + 3, m->quat + 4 * i, 4 * sizeof(frm_real));
+        memcpy(b + 7, m->vel + 6 * i, 6 * sizeof(frm_real));
+    }
+}
+
+static void frm__restore_state(frm_model *m)
+{
+    int i;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *b = m->backup + 13 * (size_t)i;
+        memcpy(m->pos + 3 * i, b, 3 * sizeof(frm_real));
+        memcpy(m->quat + 4 * i, b + 3, 4 * sizeof(frm_real));
+        memcpy(m->vel + 6 * i, b + 7, 6 * sizeof(frm_real));
+    }
+    frm__update_frames(m);
+    m->lin_valid = 0;
+}
+
+/* Puts the driven frames at their prescribed poses. */
+static void frm__apply_driven(frm_model *m)
+{
+    int i;
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] == FRM__DRIVEN) {
+            memcpy(m->pos + 3 * i, m->target + 7 * i, 3 * sizeof(frm_real));
+            memcpy(m->quat + 4 * i, m->target + 7 * i + 3, 4 * sizeof(frm_real));
+        }
+    frm__update_frames(m);
+    m->lin_valid = 0;
+}
+
+/* Free frames: x = x0 + alpha dx, q = exp(alpha dtheta) q0 (x0, q0 from the backup). */
+static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
+{
+    int i, r;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *b = m->backup + 13 * (size_t)i;
+        frm_real t[3];
+        if (m->state[i] != FRM__FREE) continue;
+        for (r = 0; r < 3; r++) {
+            m->pos[3 * i + r] = b[r] + (frm_real)alpha * step[6 * i + r];
+            t[r] = (frm_real)alpha * step[6 * i + 3 + r];
+        }
+        memcpy(m->quat + 4 * i, b + 3, 4 * sizeof(frm_real));
+        frm_quat_integrate(m->quat + 4 * i, t);
+    }
+}
+
+#define FRM__MAX_HALVINGS 12
+
+/* One Newton iteration (sec. 3.6): K dq = f by CG, then a backtracking (Armijo) line
+   search on the total potential along q(alpha) = q (+) alpha dq:
+       phi(alpha) - phi(0) = W(alpha) - W(0) + V_g(alpha) - V_g(0) - alpha f_ext . dq
+   (the constant external torques have no potential; their work along the path is exact).
+   *ref < 0 is set to the load's norm (or the first residual if larger); *converged tells
+   whether |f| <= newton_tolerance * ref held before the iteration, in which case nothing
+   moves. *res gets |f| after. */
+static int frm__newton_iteration(frm_model *m, double *ref, int *converged, double *res)
+{
+    frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X];
+    double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise;
+    int err, h, i, r, accepted = 0;
+    *converged = 0;
+    err = frm__force_pass(m, 1, 0, &W0);
+    if (err) return err;
+    frm__total_force(m, f);
+    norm = frm__norm_free(m, f);
+    *res = norm;
+    if (*ref < 0) {
+        frm_real *load = m->vec[FRM__V_T];
+        for (i = 0; i < m->frame_count; i++)
+            for (r = 0; r < 6; r++) load[6 * i + r] = f[6 * i + r] - m->force[6 * i + r];
+        *ref = frm__norm_free(m, load);
+        if (norm > *ref) *ref = norm;
+        m->stats.initial_residual = (frm_real)norm;
+    }
+    if (norm <= (double)m->newton_tolerance * *ref) {
+        *converged = 1;
+        return FRM_OK;
+    }
+    frm__prepare_mode(m, frm__choose_mode(m));
+    frm__build_precond(m, 0.0, 1.0);
+    memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    frm__cg(m, 0.0, 1.0, f, dq); /* a capped or truncated solve still gives a descent direction */
+    slope = frm__dot(m, f, dq);
+    if (!(slope > 0) || !frm__all_finite(dq, 6 * (size_t)m->frame_count)) { /* not a descent direction */
+        frm__precond_apply(m, f, dq);
+        slope = frm__dot(m, f, dq);
+        if (!(slope > 0)) return FRM_ERR_NO_CONVERGENCE;
+    }
+    frm__save_state(m);
+    noise = 64.0 * (FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON) * (fabs(W0) + slope);
+    for (h = 0; h <= FRM__MAX_HALVINGS && !accepted; h++) {
+        double alpha = ldexp(1.0, -h), W, dphi = 0;
+        frm__set_trial(m, dq, alpha);
+        err = frm__force_pass(m, 0, 0, &W);
+        m->stats.line_search_halvings += h > 0;
+        if (err) continue;
+        dphi = W - W0;
+        for (i = 0; i < m->frame_count; i++) {
+            frm_real cg_new[3];
+            const frm_real *b = m->backup + 13 * (size_t)i;
+            double mg = m->grav_local[4 * (size_t)i];
+            if (m->state[i] != FRM__FREE) continue;
+            frm__gravity_moment(m, i, cg_new);
+            for (r = 0; r < 3; r++) {
+                dphi -= (double)m->gravity[r] *
+                        (mg * ((double)m->pos[3 * i + r] - b[r]) + ((double)cg_new[r] - m->lin_gravity[3 * i + r]));
+                dphi -= alpha * ((double)m->ext[6 * i + r] * dq[6 * i + r] + (double)m->ext[6 * i + 3 + r] * dq[6 * i + 3 + r]);
+            }
+        }
+        if (dphi <= -1e-4 * alpha * slope + noise) accepted = 1;
+        else if (dphi < best) {
+            best = dphi;
+            best_alpha = alpha;
+        }
+    }
+    if (!accepted) { /* no decrease found: take the best trial, if any was valid */
+        if (best_alpha == 0) {
+            frm__restore_state(m);
+            return err ? err : FRM_ERR_NO_CONVERGENCE;
+        }
+        frm__set_trial(m, dq, best_alpha);
+        err = frm__force_pass(m, 0, 0, NULL);
+        if (err) {
+            frm__restore_state(m);
+            return err;
+        }
+    }
+    memset(m->vel, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    m->lin_valid = 0;
+    frm__total_force(m, f);
+    *res = frm__norm_free(m, f);
+    m->stats.newton_iterations++;
+    return FRM_OK;
+}
+
+static void frm__reset_stats(frm_model *m)
+{
+    int mode = m->stats.stiffness_mode;
+    memset(&m->stats, 0, sizeof m->stats);
+    m->stats.stiffness_mode = mode;
+}
+
+FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
+{
+    double ref = -1, res = 0;
+    int converged, err;
+    if (!m) return FRM_ERR_ARG;
+    frm__reset_stats(m);
+    frm__save_state(m);
+    memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+    frm__apply_driven(m);
+    err = frm__newton_iteration(m, &ref, &converged, &res);
+    if (err) {
+        memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+        frm__restore_state(m);
+        return err;
+    }
+    memset(m->vel, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    m->stats.residual = (frm_real)res;
+    if (residual) *residual = (frm_real)res;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_solve_static(frm_model *m)
+{
+    double ref = -1, res = 0;
+    int it, converged = 0, err = FRM_OK;
+    if (!m) return FRM_ERR_ARG;
+    frm__reset_stats(m);
+    frm__save_state(m);
+    memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+    frm__apply_driven(m);
+    for (it = 0;; it++) {
+        err = frm__newton_iteration(m, &ref, &converged, &res);
+        if (err || converged || it == m->newton_max_iterations) break;
+    }
+    if (!err && !converged) err = FRM_ERR_NO_CONVERGENCE;
+    m->stats.residual = (frm_real)res;
+    memset(m->vec[FRM__V_DV], 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    if (err) {
+        memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+        frm__restore_state(m);
+        return err;
+    }
+    memset(m->vel, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    return FRM_OK;
+}
+
+/* >>integrator ------------------------------------------------------------------------- */
+
+static int frm__linearize(frm_model *m, double *energy);
+
+/* The light check after a step of a model with Neo-Hookean samples: F of every such
+   sample has det F > 0 (else the new state has infinite energy). */
+static int frm__check_inversion(frm_model *m)
+{
+    int s;
+    frm__update_frames(m);
+    for (s = 0; s < m->sample_count; s++) {
+        int b = m->s_start[s];
+        frm_real F[9], J;
+        if (m->s_law[s] != FRM_LAW_NEO_HOOKEAN) continue;
+        frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
+                               m->p_local + 3 * b, m->pos, m->rot, m->rel, F, NULL, NULL);
+        J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+        if (!(J > 0)) return FRM_ERR_INVERTED;
+    }
+    return FRM_OK;
+}
+
+/* Implicit Euler, eq. 3.64 with our sign of K (K = -df/dq) and Rayleigh damping
+   D = alpha M + beta K:
+       (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
+   one linearisation at the start of the step (M and K at q_t). Driven frames move to
+   their targets, which enter the right-hand side through K. */
+static int frm__implicit_step(frm_model *m, double dt)
+{
+    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
+    frm_real *drive = m->vec[FRM__V_DRIVE];
+    double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
+    int err, i, k, cg, any_driven = 0;
+    frm__save_state(m);
+    err = frm__linearize(m, NULL);
+    if (err) return err;
+    frm__mass_update(m);
+    frm__total_force(m, f);
+    frm__build_precond(m, a_mass, a_stiff);
+    /* driven frames: the velocity that reaches the target in dt */
+    for (i = 0; i < m->frame_count; i++) {
+        for (k = 0; k < 6; k++) drive[6 * i + k] = 0;
+        if (m->state[i] == FRM__DRIVEN) {
+            frm_real w[3];
+            frm__quat_delta(m->quat + 4 * i, m->target + 7 * i + 3, w);
+            for (k = 0; k < 3; k++) {
+                drive[6 * i + k] = (frm_real)(((double)m->target[7 * i + k] - m->pos[3 * i + k]) / dt) - m->vel[6 * i + k];
+                drive[6 * i + 3 + k] = (frm_real)(w[k] / dt) - m->vel[6 * i + 3 + k];
+            }
+            any_driven = 1;
+        }
+    }
+    /* b = dt (f - (dt + beta) K v - alpha M v) - a_stiff K dv_driven */
+    frm__stiffness_product(m, m->vel, t, 0);
+    for (i = 0; i < m->frame_count; i++) {
+        double mv[6];
+        frm__mass_apply(m, i, m->vel + 6 * i, mv);
+        for (k = 0; k < 6; k++)
+            b[6 * i + k] = (frm_real)(dt * ((double)f[6 * i + k] - (dt + (double)m->stiffness_damping) * t[6 * i + k] -
+                                            (double)m->mass_damping * mv[k]));
+    }
+    if (any_driven) {
+        frm__stiffness_product(m, drive, t, 0);
+        for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
+    }
+    memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
+    cg = frm__cg(m, a_mass, a_stiff, b, dv);
+    if ((cg == FRM__CG_CAP && m->cg_fail_at_cap) || cg == FRM__CG_NEGATIVE) {
+        frm__restore_state(m);
+        return FRM_ERR_NO_CONVERGENCE;
+    }
+    for (i = 0; i < m->frame_count; i++) {
+        frm_real *v = m->vel + 6 * i, th[3];
+        if (m->state[i] == FRM__FIXED) {
+            for (k = 0; k < 6; k++) v[k] = 0;
+            continue;
+        }
+        for (k = 0; k < 6; k++) v[k] += m->state[i] == FRM__DRIVEN ? drive[6 * i + k] : dv[6 * i + k];
+        if (m->state[i] == FRM__DRIVEN) {
+            memcpy(m->pos + 3 * i, m->target + 7 * i, 3 * sizeof(frm_real));
+            memcpy(m->quat + 4 * i, m->target + 7 * i + 3, 4 * sizeof(frm_real));
+            continue;
+        }
+        for (k = 0; k < 3; k++) {
+            m->pos[3 * i + k] += (frm_real)dt * v[k];
+            th[k] = (frm_real)dt * v[3 + k];
+        }
+        frm_quat_integrate(m->quat + 4 * i, th);
+    }
+    if (!frm__all_finite(m->pos, 3 * (size_t)m->frame_count) || !frm__all_finite(m->quat, 4 * (size_t)m->frame_count) ||
+        !frm__all_finite(m->vel, 6 * (size_t)m->frame_count)) {
+        frm__restore_state(m);
+        return FRM_ERR_NOT_FINITE;
+    }
+    if (m->has_neo_hookean && frm__check_inversion(m)) {
+        frm__restore_state(m);
+        return FRM_ERR_INVERTED;
+    }
+    memcpy(m->vec[FRM__V_DV], dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    frm__update_frames(m);
+    m->lin_valid = 0;
+    m->stats.newton_iterations = 1;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_step(frm_model *m)
+{
+    if (!m) return FRM_ERR_ARG;
+    return frm_model_step_ex(m, m->time_step);
+}
+
+FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt)
+{
+    if (!m) return FRM_ERR_ARG;
+    if (!(frm__finite((double)dt) && dt > 0)) return FRM_ERR_TIME_STEP;
+    frm__reset_stats(m);
+    return frm__implicit_step(m, (double)dt);
+}
+
+/* Linearises at the current state (force pass with the stiffness data), chooses the mode
+   and prepares it. */
+static int frm__linearize(frm_model *m, double *energy)
+{
+    int err = frm__force_pass(m, 1, 0, energy);
+    if (err) return err;
+    frm__prepare_mode(m, frm__choose_mode(m));
+    return FRM_OK;
+}
+
+/* >>boundary-conditions ---------------------------------------------------------------- */
+
+static int frm__check_frame(const frm_model *m, int i)
+{
+    if (!m) return FRM_ERR_ARG;
+    if (i < 0 || i >= m->frame_count) return FRM_ERR_FRAME_RANGE;
+    return FRM_OK;
+}
+
+static int frm__vec3_finite(const frm_real *v)
+{
+    return frm__finite((double)v[0]) && frm__finite((double)v[1]) && frm__finite((double)v[2]);
+}
+
+FRMDEF int frm_model_fix_frame(frm_model *m, int i)
+{
+    int err = frm__check_frame(m, i);
+    if (err) return err;
+    m->state[i] = FRM__FIXED;
+    memset(m->vel + 6 * i, 0, 6 * sizeof(frm_real));
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_drive_frame(frm_model *m, int i, const frm_real position[3], const frm_real orientation[4])
+{
+    int err = frm__check_frame(m, i);
+    if (err) return err;
+    if (!position || !orientation || !frm__vec3_finite(position)) return FRM_ERR_ARG;
+    if (!frm__quat_valid(orientation)) return FRM_ERR_QUATERNION;
+    m->state[i] = FRM__DRIVEN;
+    memcpy(m->target + 7 * i, position, 3 * sizeof(frm_real));
+    frm__quat_normalized(orientation, m->target + 7 * i + 3);
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_release_frame(frm_model *m, int i)
+{
+    int err = frm__check_frame(m, i);
+    if (err) return err;
+    m->state[i] = FRM__FREE;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_frame_state(const frm_model *m, int i)
+{
+    int err = frm__check_frame(m, i);
+    return err ? err : (int)m->state[i];
+}
+
+FRMDEF int frm_model_set_external(frm_model *m, int i, const frm_real force[3], const frm_real torque[3])
+{
+    int err = frm__check_frame(m, i), k;
+    if (err) return err;
+    if ((force && !frm__vec3_finite(force)) || (torque && !frm__vec3_finite(torque))) return FRM_ERR_ARG;
+    for (k = 0; k < 3; k++) {
+        m->ext[6 * i + k] = force ? force[k] : 0;
+        m->ext[6 * i + 3 + k] = torque ? torque[k] : 0;
+    }
+    return FRM_OK;
+}
+
+FRMDEF void frm_model_clear_external(frm_model *m)
+{
+    if (m) memset(m->ext, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+}
+
+FRMDEF int frm_model_set_gravity(frm_model *m, const frm_real g[3])
+{
+    if (!m || !g || !frm__vec3_finite(g)) return FRM_ERR_ARG;
+    memcpy(m->gravity, g, 3 * sizeof(frm_real));
+    m->lin_valid = 0;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_set_solver(frm_model *m, frm_real cg_tolerance, int cg_max_iterations, frm_real newton_tolerance,
+                                int newton_max_iterations)
+{
+    if (!m) return FRM_ERR_ARG;
+    if (!(frm__finite((double)cg_tolerance) && cg_tolerance > 0) || cg_max_iterations < 1 ||
+        !(frm__finite((double)newton_tolerance) && newton_tolerance > 0) || newton_max_iterations < 1)
+        return FRM_ERR_SOLVER;
+    m->cg_tolerance = cg_tolerance;
+    m->cg_max_iterations = cg_max_iterations;
+    m->newton_tolerance = newton_tolerance;
+    m->newton_max_iterations = newton_max_iterations;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_set_stiffness_mode(frm_model *m, frm_stiffness_mode mode)
+{
+    if (!m) return FRM_ERR_ARG;
+    if ((int)mode < 0 || (int)mode > 2 || (mode != FRM_STIFFNESS_PAIRS && !m->has_blocks)) return FRM_ERR_STIFFNESS_MODE;
+    m->stiffness_mode = mode;
+    m->lin_valid = 0;
+    return FRM_OK;
+}
+
+/* >>state ------------------------------------------------------------------------------ */
+
+FRMDEF int frm_model_frame_count(const frm_model *m) { return m ? m->frame_count : 0; }
+FRMDEF int frm_model_sample_count(const frm_model *m) { return m ? m->sample_count : 0; }
+FRMDEF int frm_model_pair_count(const frm_model *m) { return m ? m->pair_count : 0; }
+FRMDEF const frm_real *frm_model_positions(const frm_model *m) { return m ? m->pos : NULL; }
+FRMDEF const frm_real *frm_model_orientations(const frm_model *m) { return m ? m->quat : NULL; }
+FRMDEF const frm_real *frm_model_velocities(const frm_model *m) { return m ? m->vel : NULL; }
+FRMDEF const frm_stats *frm_model_last_stats(const frm_model *m) { return m ? &m->stats : NULL; }
+
+FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const frm_real *orientations)
+{
+    int i;
+    if (!m || !positions || !orientations) return FRM_ERR_ARG;
+    if (!frm__all_finite(positions, 3 * (size_t)m->frame_count)) return FRM_ERR_ARG;
+    for (i = 0; i < m->frame_count; i++)
+        if (!frm__quat_valid(orientations + 4 * i)) return FRM_ERR_QUATERNION;
+    memcpy(m->pos, positions, sizeof(frm_real) * 3 * (size_t)m->frame_count);
+    for (i = 0; i < m->frame_count; i++) frm__quat_normalized(orientations + 4 * i, m->quat + 4 * i);
+    frm__update_frames(m);
+    m->lin_valid = 0;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_set_velocities(frm_model *m, const frm_real *velocities)
+{
+    if (!m || !velocities || !frm__all_finite(velocities, 6 * (size_t)m->frame_count)) return FRM_ERR_ARG;
+    memcpy(m->vel, velocities, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    return FRM_OK;
+}
+
+/* The per-sample outputs (positions, deformation gradients) without the force passes. */
+static void frm__outputs_chunks(void *vctx, int begin, int end)
+{
+    frm_model *m = ((frm__force_ctx *)vctx)->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            int b = m->s_start[s];
+            frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
+                                   m->p_local + 3 * b, m->pos, m->rot, m->rel, m->s_F + 9 * (size_t)s, NULL,
+                                   m->s_pos + 3 * (size_t)s);
+        }
+    }
+}
+
+static void frm__outputs(frm_model *m)
+{
+    frm__force_ctx ctx;
+    ctx.m = m;
+    ctx.linearize = 0;
+    ctx.outputs = 1;
+    frm__update_frames(m);
+    frm__run(m, m->sample_chunks, frm__outputs_chunks, &ctx);
+}
+
+FRMDEF const frm_real *frm_model_sample_positions(frm_model *m)
+{
+    if (!m) return NULL;
+    frm__outputs(m);
+    return m->s_pos;
+}
+
+FRMDEF const frm_real *frm_model_deformation_gradients(frm_model *m)
+{
+    if (!m) return NULL;
+    frm__outputs(m);
+    return m->s_F;
+}
+
+FRMDEF int frm_model_forces(frm_model *m, const frm_real **out)
+{
+    int err;
+    if (out) *out = NULL;
+    if (!m || !out) return FRM_ERR_ARG;
+    err = frm__force_pass(m, 0, 0, NULL);
+    if (err) return err;
+    *out = m->force;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_energy(frm_model *m, frm_energies *out)
+{
+    double W, kin = 0, grav = 0, ext = 0;
+    int err, i, r;
+    if (!m || !out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    err = frm__force_pass(m, 0, 0, &W);
+    if (err) return err;
+    frm__mass_update(m);
+    for (i = 0; i < m->frame_count; i++) {
+        double mv[6];
+        const double *gl = m->grav_local + 4 * (size_t)i;
+        const frm_real *Rb = m->rest_rot + 9 * i;
+        frm_real cg[3];
+        frm__mass_apply(m, i, m->vel + 6 * i, mv);
+        frm__gravity_moment(m, i, cg);
+        for (r = 0; r < 6; r++) kin += 0.5 * (double)m->vel[6 * i + r] * mv[r];
+        for (r = 0; r < 3; r++) {
+            double du = (double)m->pos[3 * i + r] - m->rest_pos[3 * i + r];
+            double c0 = Rb[3 * r] * gl[1] + Rb[3 * r + 1] * gl[2] + Rb[3 * r + 2] * gl[3];
+            grav -= (double)m->gravity[r] * (gl[0] * du + ((double)cg[r] - c0));
+            ext -= (double)m->ext[6 * i + r] * du;
+        }
+    }
+    out->elastic = W;
+    out->kinetic = kin;
+    out->gravitational = grav;
+    out->external = ext;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36])
+{
+    double M[36];
+    int err = frm__check_frame(m, i), k;
+    if (err) return err;
+    if (!out) return FRM_ERR_ARG;
+    frm__mass_update((frm_model *)m);
+    frm__mass_matrix(m, i, M);
+    for (k = 0; k < 36; k++) out[k] = (frm_real)M[k];
+    return FRM_OK;
+}
+
+FRMDEF size_t frm_model_memory_bytes(const frm_model *m) { return m ? m->block_bytes : 0; }
+
+/* >>stiffness-api ---------------------------------------------------------------------- */
+
+FRMDEF int frm_model_prepare_stiffness(frm_model *m)
+{
+    if (!m) return FRM_ERR_ARG;
+    return frm__linearize(m, NULL);
+}
+
+FRMDEF int frm_model_apply_stiffness(frm_model *m, const frm_real *v, frm_real *out, int symmetric)
+{
+    if (!m || !v || !out) return FRM_ERR_ARG;
+    if (!m->lin_valid) {
+        int err = frm__linearize(m, NULL);
+        if (err) return err;
+    }
+    frm__stiffness_product(m, v, out, !symmetric);
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_assemble_stiffness(frm_model *m)
+{
+    int err;
+    if (!m) return FRM_ERR_ARG;
+    if (!m->has_blocks) return FRM_ERR_STIFFNESS_MODE;
+    err = frm__force_pass(m, 1, 0, NULL);
+    if (err) return err;
+    frm__prepare_mode(m, FRM_STIFFNESS_BLOCKS);
+    return FRM_OK;
+}
+
+FRMDEF const frm_real *frm_model_stiffness_blocks(const frm_model *m, const int **row_start, const int **cols)
+{
+    if (row_start) *row_start = m && m->has_blocks ? m->blk_start : NULL;
+    if (cols) *cols = m && m->has_blocks ? m->blk_col : NULL;
+    return m && m->has_blocks ? m->blocks : NULL;
+}
+
+FRMDEF int frm_model_stiffness_block(const frm_model *m, int i, int j, frm_real out[36])
+{
+    int err = frm__check_frame(m, i), e;
+    if (err) return err;
+    err = frm__check_frame(m, j);
+    if (err) return err;
+    if (!out) return FRM_ERR_ARG;
+    if (!m->has_blocks) return FRM_ERR_STIFFNESS_MODE;
+    e = frm__find_block(m, i, j);
+    if (e < 0) return FRM_ERR_NOT_NEIGHBORS;
+    memcpy(out, m->blocks + 36 * (size_t)e, 36 * sizeof(frm_real));
+    return FRM_OK;
+}
+
+/* >>shape-functions -------------------------------------------------------------------- */
+
+static double frm__dot3d(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void frm__cross3d(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Tet barycentric functions in double: weights w[4] and constant gradients g[4][3].
+   Returns 0 for a flat tetrahedron. */
+static int frm__tet_functions(double X[4][3], const double p[3], double w[4], double g[4][3])
+{
+    double e[3][3], c[3][3], det, longest = 0, d[3];
+    int k, r, a, b;
+    for (k = 0; k < 3; k++)
+        for (r = 0; r < 3; r++) e[k][r] = X[k + 1][r] - X[0][r];
+    for (a = 0; a < 4; a++)
+        for (b = a + 1; b < 4; b++) {
+            double l2 = 0;
+            for (r = 0; r < 3; r++) l2 += (X[a][r] - X[b][r]) * (X[a][r] - X[b][r]);
+            if (l2 > longest) longest = l2;
+        }
+    frm__cross3d(e[1], e[2], c[0]);
+    frm__cross3d(e[2], e[0], c[1]);
+    frm__cross3d(e[0], e[1], c[2]);
+    det = frm__dot3d(e[0], c[0]);
+    /* a regular tetrahedron has |det| = l^3 / sqrt(2); refuse ones 1e10 times flatter */
+    if (!(fabs(det) > 1e-10 * longest * sqrt(longest))) return 0;
+    for (r = 0; r < 3; r++) d[r] = p[r] - X[0][r];
+    w[0] = 1;
+    for (r = 0; r < 3; r++) g[0][r] = 0;
+    for (k = 0; k < 3; k++) {
+        for (r = 0; r < 3; r++) {
+            g[k + 1][r] = c[k][r] / det;
+            g[0][r] -= g[k + 1][r];
+        }
+        w[k + 1] = frm__dot3d(g[k + 1], d);
+        w[0] -= w[k + 1];
+    }
+    return 1;
+}
+
+FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], frm_real weights[4], frm_real gradients[12])
+{
+    double X[4][3], p[3], w[4], g[4][3];
+    int k, r;
+    if (!corners || !point || !weights || !gradients) return FRM_ERR_ARG;
+    for (k = 0; k < 4; k++)
+        for (r = 0; r < 3; r++) X[k][r] = (double)corners[3 * k + r];
+    for (r = 0; r < 3; r++) p[r] = (double)point[r];
+    if (!frm__tet_functions(X, p, w, g)) return FRM_ERR_SHAPE_DEGENERATE;
+    for (k = 0; k < 4; k++) {
+        weights[k] = (frm_real)w[k];
+        for (r = 0; r < 3; r++) gradients[3 * k + r] = (frm_real)g[k][r];
+    }
+    return FRM_OK;
+}
+
+/* Trilinear functions of a hexahedron in double at xi in [0, 1]^3. Returns det(dx/dxi). */
+static double frm__hex_functions(double X[8][3], const double xi[3], double p[3], double w[8], double g[8][3])
+{
+    double dn[8][3], J[9], inv[9], det;
+    int a, r, k;
+    for (a = 0; a < 8; a++) {
+        double f[3], df[3];
+        for (k = 0; k < 3; k++) {
+            int bit = (a >> k) & 1;
+            f[k] = bit ? xi[k] : 1 - xi[k];
+            df[k] = bit ? 1 : -1;
+        }
+        w[a] = f[0] * f[1] * f[2];
+        dn[a][0] = df[0] * f[1] * f[2];
+        dn[a][1] = f[0] * df[1] * f[2];
+        dn[a][2] = f[0] * f[1] * df[2];
+    }
+    for (r = 0; r < 9; r++) J[r] = 0;
+    for (r = 0; r < 3; r++) p[r] = 0;
+    for (a = 0; a < 8; a++)
+        for (r = 0; r < 3; r++) {
+            p[r] += w[a] * X[a][r];
+            for (k = 0; k < 3; k++) J[3 * r + k] += X[a][r] * dn[a][k];
+        }
+    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    if (!(det > 0)) return det;
+    inv[0] = (J[4] * J[8] - J[5] * J[7]) / det;
+    inv[1] = (J[2] * J[7] - J[1] * J[8]) / det;
+    inv[2] = (J[1] * J[5] - J[2] * J[4]) / det;
+    inv[3] = (J[5] * J[6] - J[3] * J[8]) / det;
+    inv[4] = (J[0] * J[8] - J[2] * J[6]) / det;
+    inv[5] = (J[2] * J[3] - J[0] * J[5]) / det;
+    inv[6] = (J[3] * J[7] - J[4] * J[6]) / det;
+    inv[7] = (J[1] * J[6] - J[0] * J[7]) / det;
+    inv[8] = (J[0] * J[4] - J[1] * J[3]) / det;
+    /* grad_x N = J^-T grad_xi N: component c is sum_k inv[k][c] dN/dxi_k */
+    for (a = 0; a < 8; a++)
+        for (r = 0; r < 3; r++) g[a][r] = inv[r] * dn[a][0] + inv[3 + r] * dn[a][1] + inv[6 + r] * dn[a][2];
+    return det;
+}
+
+FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_real point[3], frm_real weights[8],
+                         frm_real gradients[24], frm_real *jacobian_det)
+{
+    double X[8][3], x[3], p[3], w[8], g[8][3], det;
+    int a, r;
+    if (!corners || !xi || !weights || !gradients) return FRM_ERR_ARG;
+    for (a = 0; a < 8; a++)
+        for (r = 0; r < 3; r++) X[a][r] = (double)corners[3 * a + r];
+    for (r = 0; r < 3; r++) x[r] = (double)xi[r];
+    det = frm__hex_functions(X, x, p, w, g);
+    if (jacobian_det) *jacobian_det = (frm_real)det;
+    if (!(det > 0)) return FRM_ERR_SHAPE_DEGENERATE;
+    for (a = 0; a < 8; a++) {
+        weights[a] = (frm_real)w[a];
+        for (r = 0; r < 3; r++) gradients[3 * a + r] = (frm_real)g[a][r];
+    }
+    if (point)
+        for (r = 0; r < 3; r++) point[r] = (frm_real)p[r];
+    return FRM_OK;
+}
+
+/* Shepard functions in double (see frm_shape_shepard). X: 3 * count. */
+static int frm__shepard_functions(const double *X, int count, const double p[3], double power, double radius,
+                                  double *w, double *g)
+{
+    double d[FRM_MAX_NEIGHBORS > 64 ? FRM_MAX_NEIGHBORS : 64], scale = 0, umax = 0, sum = 0, gsum[3] = {0, 0, 0};
+    int i, j, r, hit = -1;
+    if (count < 1 || count > 64 || !(power > 0)) return FRM_ERR_ARG;
+    for (i = 0; i < count; i++) {
+        double s = 0;
+        for (r = 0; r < 3; r++) s += (p[r] - X[3 * i + r]) * (p[r] - X[3 * i + r]);
+        d[i] = sqrt(s);
+        if (d[i] > scale) scale = d[i];
+    }
+    for (i = 0; i < count; i++)
+        for (j = i + 1; j < count; j++) {
+            double s = 0;
+            for (r = 0; r < 3; r++) s += (X[3 * i + r] - X[3 * j + r]) * (X[3 * i + r] - X[3 * j + r]);
+            if (!(sqrt(s) > 1e-12 * scale)) return FRM_ERR_SHAPE_DEGENERATE; /* coincident frames */
+        }
+    for (i = 0; i < count; i++)
+        if (!(d[i] > 1e-12 * scale)) hit = i;
+    if (hit >= 0) { /* on a frame: the limit for p > 1 */
+        if (!(power > 1)) return FRM_ERR_SHAPE_DEGENERATE;
+        for (i = 0; i < count; i++) {
+            w[i] = i == hit;
+            for (r = 0; r < 3; r++) g[3 * i + r] = 0;
+        }
+        return FRM_OK;
+    }
+    /* phi_i = (u_i / u_max)^p with u = 1/d (or 1/d - 1/R), scaled to avoid overflow */
+    for (i = 0; i < count; i++) {
+        double u = 1.0 / d[i] - (radius > 0 ? 1.0 / radius : 0.0);
+        if (u > umax) umax = u;
+    }
+    if (!(umax > 0)) return FRM_ERR_SHAPE_DEGENERATE; /* no frame inside the radius */
+    for (i = 0; i < count; i++) {
+        double u = 1.0 / d[i] - (radius > 0 ? 1.0 / radius : 0.0), phi = 0, dphi = 0;
+        if (u > 0) {
+            phi = pow(u / umax, power);
+            /* d phi / dx = p (u/umax)^(p-1) / umax * du/dx, du/dx = -(x - X_i) / d^3 */
+            dphi = -power * pow(u / umax, power - 1) / umax / (d[i] * d[i] * d[i]);
+        }
+        w[i] = phi;
+        for (r = 0; r < 3; r++) {
+            g[3 * i + r] = dphi * (p[r] - X[3 * i + r]);
+            gsum[r] += g[3 * i + r];
+        }
+        sum += phi;
+    }
+    for (i = 0; i < count; i++) {
+        w[i] /= sum;
+        for (r = 0; r < 3; r++) g[3 * i + r] = (g[3 * i + r] - w[i] * gsum[r]) / sum;
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real point[3], frm_real power, frm_real radius,
+                             frm_real *weights, frm_real *gradients)
+{
+    double X[3 * 64], p[3], w[64], g[3 * 64];
+    int i, err;
+    if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
+    for (i = 0; i < 3; i++) p[i] = (double)point[i];
+    err = frm__shepard_functions(X, count, p, (double)power, (double)radius, w, g);
+    if (err) return err;
+    for (i = 0; i < count; i++) weights[i] = (frm_real)w[i];
+    for (i = 0; i < 3 * count; i++) gradients[i] = (frm_real)g[i];
+    return FRM_OK;
+}
+
+/* Cholesky inverse of a symmetric 4x4; 0 if a pivot falls below 1e-10 of the largest
+   diagonal entry (a singular or nearly singular moment matrix). */
+static int frm__invert4(const double A[16], double inv[16])
+{
+    double L[16], y[4], dmax = 0;
+    int i, j, k, c;
+    memset(L, 0, sizeof L);
+    for (i = 0; i < 4; i++)
+        if (A[5 * i] > dmax) dmax = A[5 * i];
+    for (j = 0; j < 4; j++) {
+        double d = A[5 * j];
+        for (k = 0; k < j; k++) d -= L[4 * j + k] * L[4 * j + k];
+        if (!(d > 1e-10 * dmax)) return 0;
+        L[5 * j] = sqrt(d);
+        for (i = j + 1; i < 4; i++) {
+            double s = A[4 * i + j];
+            for (k = 0; k < j; k++) s -= L[4 * i + k] * L[4 * j + k];
+            L[4 * i + j] = s / L[5 * j];
+        }
+    }
+    for (c = 0; c < 4; c++) {
+        for (i = 0; i < 4; i++) {
+            double s = (i == c);
+            for (k = 0; k < i; k++) s -= L[4 * i + k] * y[k];
+            y[i] = s / L[5 * i];
+        }
+        for (i = 3; i >= 0; i--) {
+            double s = y[i];
+            for (k = i + 1; k < 4; k++) s -= L[4 * k + i] * inv[4 * k + c];
+            inv[4 * i + c] = s / L[5 * i];
+        }
+    }
+    return 1;
+}
+
+/* Linear MLS functions in double (see frm_shape_mls). Basis p(y) = [1, (y - x)/R] centred
+   at the evaluation point x, kernel phi(r) = (1 - r)^4 (4 r + 1) (Wendland C2), r = d/R:
+       N_i = phi_i alpha . p_i,  M alpha = e_0,  M = sum phi_j p_j p_j^T
+       dN_i/dx_k = phi_i (beta_k - gamma_k) . p_i + dphi_i/dx_k alpha . p_i,
+       beta_k = M^-1 e_{k+1} / R,  gamma_k = M^-1 (dM/dx_k) alpha,
+   the derivative taken with the centre fixed (then evaluated at x). */
+static int frm__mls_functions(const double *X, int count, const double x[3], double radius, double *w, double *g)
+{
+    double P[64][4], phi[64], dphi[64][3], M[16], Mi[16], alpha[4], beta[3][4], gamma[3][4];
+    int i, a, b, k, inside = 0;
+    if (count < 1 || count > 64 || !(radius > 0)) return FRM_ERR_ARG;
+    memset(M, 0, sizeof M);
+    for (i = 0; i < count; i++) {
+        double d2 = 0, d, r;
+        for (k = 0; k < 3; k++) {
+            P[i][1 + k] = (X[3 * i + k] - x[k]) / radius;
+            d2 += P[i][1 + k] * P[i][1 + k];
+        }
+        P[i][0] = 1;
+        r = sqrt(d2);
+        d = r * radius;
+        (void)d;
+        if (r < 1) {
+            double o = 1 - r;
+            phi[i] = o * o * o * o * (4 * r + 1);
+            /* dphi/dx = dphi/dr dr/dx = -20 r o^3 * (x - X_i) / (d R) = 20 o^3 P_i / R */
+            for (k = 0; k < 3; k++) dphi[i][k] = 20 * o * o * o * P[i][1 + k] / radius;
+            inside++;
+        } else {
+            phi[i] = 0;
+            for (k = 0; k < 3; k++) dphi[i][k] = 0;
+        }
+        for (a = 0; a < 4; a++)
+            for (b = 0; b < 4; b++) M[4 * a + b] += phi[i] * P[i][a] * P[i][b];
+    }
+    if (inside < 4 || !frm__invert4(M, Mi)) return FRM_ERR_SHAPE_DEGENERATE;
+    for (a = 0; a < 4; a++) alpha[a] = Mi[4 * a];
+    for (k = 0; k < 3; k++) {
+        double Ma[4] = {0, 0, 0, 0};
+        for (i = 0; i < count; i++) {
+            double pa = 0;
+            if (phi[i] == 0) continue;
+            for (a = 0; a < 4; a++) pa += P[i][a] * alpha[a];
+            for (a = 0; a < 4; a++) Ma[a] += dphi[i][k] * P[i][a] * pa;
+        }
+        for (a = 0; a < 4; a++) {
+            beta[k][a] = Mi[4 * a + 1 + k] / radius;
+            gamma[k][a] = 0;
+            for (b = 0; b < 4; b++) gamma[k][a] += Mi[4 * a + b] * Ma[b];
+        }
+    }
+    for (i = 0; i < count; i++) {
+        double ap = 0;
+        for (a = 0; a < 4; a++) ap += alpha[a] * P[i][a];
+        w[i] = phi[i] * ap;
+        for (k = 0; k < 3; k++) {
+            double t = 0;
+            for (a = 0; a < 4; a++) t += (beta[k][a] - gamma[k][a]) * P[i][a];
+            g[3 * i + k] = phi[i] * t + dphi[i][k] * ap;
+        }
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point[3], frm_real radius, frm_real *weights,
+                         frm_real *gradients)
+{
+    double X[3 * 64], p[3], w[64], g[3 * 64];
+    int i, err;
+    if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
+    for (i = 0; i < 3; i++) p[i] = (double)point[i];
+    err = frm__mls_functions(X, count, p, (double)radius, w, g);
+    if (err) return err;
+    for (i = 0; i < count; i++) weights[i] = (frm_real)w[i];
+    for (i = 0; i < 3 * count; i++) gradients[i] = (frm_real)g[i];
+    return FRM_OK;
+}
+
+/* >>sampling --------------------------------------------------------------------------- */
+
+FRMDEF frm_shape_desc frm_shape_default_desc(void)
+{
+    frm_shape_desc s;
+    memset(&s, 0, sizeof s);
+    s.shape = FRM_SHAPE_SHEPARD;
+    s.support = FRM_SUPPORT_NEAREST;
+    s.nearest = 8;
+    s.radius = 0;
+    s.power = 2;
+    return s;
+}
+
+FRMDEF frm_poisson_desc frm_poisson_default_desc(void)
+{
+    frm_poisson_desc p;
+    memset(&p, 0, sizeof p);
+    p.frame_spacing = (frm_real)0.2;
+    p.sample_spacing = (frm_real)0.1;
+    p.seed = 1;
+    p.volume = 0;
+    p.max_points = 1000000;
+    return p;
+}
+
+static void frm__sampling_layout(frm_sampling *s, frm__carver *c)
+{
+    size_t F = (size_t)s->frame_count, S = (size_t)s->sample_count, P = (size_t)s->pair_count;
+    FRM__CARVE(c, s->frame_positions, frm_real, 3 * F);
+    FRM__CARVE(c, s->sample_positions, frm_real, 3 * S);
+    FRM__CARVE(c, s->sample_volumes, frm_real, S);
+    FRM__CARVE(c, s->neighbor_start, int, S + 1);
+    FRM__CARVE(c, s->neighbor_frames, int, P);
+    FRM__CARVE(c, s->neighbor_weights, frm_real, P);
+    FRM__CARVE(c, s->neighbor_gradients, frm_real, 3 * P);
+}
+
+static size_t frm__sampling_bytes(const frm_sampling *s)
+{
+    frm_sampling t = *s;
+    frm__carver c;
+    c.base = NULL;
+    c.offset = 0;
+    frm__sampling_layout(&t, &c);
+    return c.offset;
+}
+
+/* One block for every array of the sampling (the first array is the block's start). */
+static int frm__sampling_alloc(frm_sampling *s, int frames, int samples, int pairs, const frm_allocator *a)
+{
+    frm__carver c;
+    void *block;
+    memset(s, 0, sizeof *s);
+    if (a) s->allocator = *a;
+    s->frame_count = frames;
+    s->sample_count = samples;
+    s->pair_count = pairs;
+    block = frm__alloc(&s->allocator, frm__sampling_bytes(s));
+    if (!block) {
+        memset(s, 0, sizeof *s);
+        return FRM_ERR_ALLOC;
+    }
+    c.base = (char *)block;
+    c.offset = 0;
+    frm__sampling_layout(s, &c);
+    return FRM_OK;
+}
+
+FRMDEF void frm_sampling_free(frm_sampling *s)
+{
+    if (!s) return;
+    if (s->frame_positions) {
+        frm_allocator a = s->allocator;
+        frm__free(&a, s->frame_positions, frm__sampling_bytes(s));
+    }
+    memset(s, 0, sizeof *s);
+}
+
+FRMDEF void frm_sampling_apply(const frm_sampling *s, frm_desc *d)
+{
+    if (!s || !d) return;
+    d->frame_positions = s->frame_positions;
+    d->frame_orientations = NULL;
+    d->frame_count = s->frame_count;
+    d->sample_positions = s->sample_positions;
+    d->sample_volumes = s->sample_volumes;
+    d->sample_count = s->sample_count;
+    d->neighbor_start = s->neighbor_start;
+    d->neighbor_frames = s->neighbor_frames;
+    d->neighbor_weights = s->neighbor_weights;
+    d->neighbor_gradients = s->neighbor_gradients;
+}
+
+static int frm__check_mesh(const frm_real *nodes, int node_count, const int *cells, int cell_count, int per_cell)
+{
+    int i;
+    if (!nodes || !cells || node_count < 1 || cell_count < 1 || node_count > 100000000 || cell_count > 100000000)
+        return FRM_ERR_ARG;
+    if (!frm__all_finite(nodes, 3 * (size_t)node_count)) return FRM_ERR_FRAME_NOT_FINITE;
+    for (i = 0; i < per_cell * cell_count; i++)
+        if (cells[i] < 0 || cells[i] >= node_count) return FRM_ERR_INDEX_RANGE;
+    return FRM_OK;
+}
+
+/* Gauss-Legendre points and weights on [0, 1], n = 1..4. */
+static void frm__gauss(int n, double *x, double *w)
+{
+    static const double p[4][4] = {{0.0, 0, 0, 0},
+                                   {-0.57735026918962576, 0.57735026918962576, 0, 0},
+                                   {-0.77459666924148338, 0.0, 0.77459666924148338, 0},
+                                   {-0.86113631159405258, -0.33998104358485626, 0.33998104358485626, 0.86113631159405258}};
+    static const double q[4][4] = {{2.0, 0, 0, 0},
+                                   {1.0, 1.0, 0, 0},
+                                   {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0, 0},
+                                   {0.34785484513745386, 0.65214515486254614, 0.65214515486254614, 0.34785484513745386}};
+    int i;
+    for (i = 0; i < n; i++) {
+        x[i] = 0.5 * (1.0 + p[n - 1][i]);
+        w[i] = 0.5 * q[n - 1][i];
+    }
+}
+
+FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node_count, const int *hexes, int hex_count,
+                              int gauss, const frm_allocator *allocator)
+{
+    double gx[4], gw[4];
+    int err, h, a, b, i, j, k, r, s = 0, g3;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    err = frm__check_mesh(nodes, node_count, hexes, hex_count, 8);
+    if (err) return err;
+    if (gauss < 1 || gauss > 4) return FRM_ERR_SAMPLING;
+    g3 = gauss * gauss * gauss;
+    if ((long long)hex_count * g3 * 8 > 2000000000LL) return FRM_ERR_SAMPLING;
+    for (h = 0; h < hex_count; h++)
+        for (a = 0; a < 8; a++)
+            for (b = 0; b < a; b++)
+                if (hexes[8 * h + a] == hexes[8 * h + b]) return FRM_ERR_SHAPE_DEGENERATE;
+    err = frm__sampling_alloc(out, node_count, hex_count * g3, hex_count * g3 * 8, allocator);
+    if (err) return err;
+    memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
+    frm__gauss(gauss, gx, gw);
+    for (h = 0; h < hex_count; h++) {
+        double X[8][3];
+        for (a = 0; a < 8; a++)
+            for (r = 0; r < 3; r++) X[a][r] = (double)nodes[3 * hexes[8 * h + a] + r];
+        for (k = 0; k < gauss; k++)
+            for (j = 0; j < gauss; j++)
+                for (i = 0; i < gauss; i++, s++) {
+                    double xi[3], p[3], w[8], g[8][3], det;
+                    xi[0] = gx[i];
+                    xi[1] = gx[j];
+                    xi[2] = gx[k];
+                    det = frm__hex_functions(X, xi, p, w, g);
+                    if (!(det > 0)) {
+                        frm_sampling_free(out);
+                        return FRM_ERR_SHAPE_DEGENERATE;
+                    }
+                    out->neighbor_start[s] = 8 * s;
+                    for (r = 0; r < 3; r++) out->sample_positions[3 * s + r] = (frm_real)p[r];
+                    out->sample_volumes[s] = (frm_real)(det * gw[i] * gw[j] * gw[k]);
+                    for (a = 0; a < 8; a++) {
+                        out->neighbor_frames[8 * s + a] = hexes[8 * h + a];
+                        out->neighbor_weights[8 * s + a] = (frm_real)w[a];
+                        for (r = 0; r < 3; r++) out->neighbor_gradients[3 * (8 * s + a) + r] = (frm_real)g[a][r];
+                    }
+                }
+    }
+    out->neighbor_start[s] = 8 * s;
+    return FRM_OK;
+}
+
+FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_count, const int *tets, int tet_count,
+                             int points, const frm_real *barycentric, const frm_allocator *allocator)
+{
+    static const double gauss4a = 0.58541019662496845, gauss4b = 0.13819660112501052;
+    double bary[4 * 64];
+    int err, t, k, a, r, s = 0;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    err = frm__check_mesh(nodes, node_count, tets, tet_count, 4);
+    if (err) return err;
+    if (points < 1 || points > 64 || (long long)tet_count * points * 4 > 2000000000LL) return FRM_ERR_SAMPLING;
+    if (!barycentric) {
+        if (points == 1)
+            for (k = 0; k < 4; k++) bary[k] = 0.25;
+        else if (points == 4)
+            for (k = 0; k < 4; k++)
+                for (a = 0; a < 4; a++) bary[4 * k + a] = a == k ? gauss4a : gauss4b;
+        else
+            return FRM_ERR_SAMPLING;
+    } else
+        for (k = 0; k < points; k++) {
+            double sum = 0;
+            for (a = 0; a < 4; a++) {
+                bary[4 * k + a] = (double)barycentric[4 * k + a];
+                if (!frm__finite(bary[4 * k + a])) return FRM_ERR_SAMPLING;
+                sum += bary[4 * k + a];
+            }
+            if (!(fabs(sum - 1.0) <= 1e-6)) return FRM_ERR_SAMPLING;
+            for (a = 0; a < 4; a++) bary[4 * k + a] /= sum;
+        }
+    for (t = 0; t < tet_count; t++)
+        for (a = 0; a < 4; a++)
+            for (k = 0; k < a; k++)
+                if (tets[4 * t + a] == tets[4 * t + k]) return FRM_ERR_SHAPE_DEGENERATE;
+    err = frm__sampling_alloc(out, node_count, tet_count * points, tet_count * points * 4, allocator);
+    if (err) return err;
+    memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
+    for (t = 0; t < tet_count; t++) {
+        double X[4][3], w[4], g[4][3], vol, e[3][3], c[3];
+        for (a = 0; a < 4; a++)
+            for (r = 0; r < 3; r++) X[a][r] = (double)nodes[3 * tets[4 * t + a] + r];
+        if (!frm__tet_functions(X, X[0], w, g)) {
+            frm_sampling_free(out);
+            return FRM_ERR_SHAPE_DEGENERATE;
+        }
+        for (a = 0; a < 3; a++)
+            for (r = 0; r < 3; r++) e[a][r] = X[a + 1][r] - X[0][r];
+        frm__cross3d(e[1], e[2], c);
+        vol = fabs(frm__dot3d(e[0], c)) / 6.0;
+        for (k = 0; k < points; k++, s++) {
+            out->neighbor_start[s] = 4 * s;
+            for (r = 0; r < 3; r++) {
+                double p = 0;
+                for (a = 0; a < 4; a++) p += bary[4 * k + a] * X[a][r];
+                out->sample_positions[3 * s + r] = (frm_real)p;
+            }
+            out->sample_volumes[s] = (frm_real)(vol / points);
+            for (a = 0; a < 4; a++) {
+                out->neighbor_frames[4 * s + a] = tets[4 * t + a];
+                out->neighbor_weights[4 * s + a] = (frm_real)bary[4 * k + a];
+                for (r = 0; r < 3; r++) out->neighbor_gradients[3 * (4 * s + a) + r] = (frm_real)g[a][r];
+            }
+        }
+    }
+    out->neighbor_start[s] = 4 * s;
+    return FRM_OK;
+}
+
+/* A uniform grid over points (the frames), for neighbour queries. */
+typedef struct frm__grid {
+    double lo[3], h[3], hmin;
+    int n[3];
+    int *start, *items; /* cell -> point indices, in increasing index */
+    size_t bytes;
+} frm__grid;
+
+static int frm__grid_cell(const frm__grid *g, const double *p, int axis)
+{
+    double t = (p[axis] - g->lo[axis]) / g->h[axis];
+    int c = t < 0 ? 0 : (t >= g->n[axis] ? g->n[axis] - 1 : (int)t);
+    return c;
+}
+
+/* Builds the grid with cells of about `cell` metres (cell <= 0: about one point per cell). */
+static int frm__grid_build(frm__grid *g, const double *X, int count, double cell, const frm_allocator *a)
+{
+    double hi[3], ext[3], vol = 1;
+    int i, k, dims = 0, cells;
+    for (k = 0; k < 3; k++) {
+        g->lo[k] = hi[k] = X[k];
+        for (i = 1; i < count; i++) {
+            if (X[3 * i + k] < g->lo[k]) g->lo[k] = X[3 * i + k];
+            if (X[3 * i + k] > hi[k]) hi[k] = X[3 * i + k];
+        }
+        ext[k] = hi[k] - g->lo[k];
+    }
+    if (!(cell > 0)) {
+        double emax = ext[0] > ext[1] ? (ext[0] > ext[2] ? ext[0] : ext[2]) : (ext[1] > ext[2] ? ext[1] : ext[2]);
+        for (k = 0; k < 3; k++)
+            if (ext[k] > 1e-9 * emax) {
+                vol *= ext[k];
+                dims++;
+            }
+        cell = dims ? pow(vol / count, 1.0 / dims) : 1.0;
+        if (!(cell > 0)) cell = 1.0;
+    }
+    cells = 1;
+    g->hmin = HUGE_VAL;
+    for (k = 0; k < 3; k++) {
+        double nk = ceil(ext[k] / cell);
+        g->n[k] = nk < 1 ? 1 : (nk > 512 ? 512 : (int)nk);
+        g->h[k] = ext[k] > 0 ? ext[k] / g->n[k] : cell;
+        if (g->h[k] <= 0) g->h[k] = cell;
+        if (g->n[k] > 1 && g->h[k] < g->hmin) g->hmin = g->h[k];
+        cells *= g->n[k];
+    }
+    if (g->hmin == HUGE_VAL) g->hmin = cell;
+    g->bytes = sizeof(int) * ((size_t)cells + 1 + (size_t)count);
+    g->start = (int *)frm__alloc(a, g->bytes);
+    if (!g->start) return FRM_ERR_ALLOC;
+    g->items = g->start + cells + 1;
+    memset(g->start, 0, sizeof(int) * ((size_t)cells + 1));
+    for (i = 0; i < count; i++) {
+        int c = frm__grid_cell(g, X + 3 * i, 0) + g->n[0] * (frm__grid_cell(g, X + 3 * i, 1) + g->n[1] * frm__grid_cell(g, X + 3 * i, 2));
+        g->start[c + 1]++;
+    }
+    for (i = 0; i < cells; i++) g->start[i + 1] += g->start[i];
+    for (i = 0; i < count; i++) { /* fill in index order, shifting start back after */
+        int c = frm__grid_cell(g, X + 3 * i, 0) + g->n[0] * (frm__grid_cell(g, X + 3 * i, 1) + g->n[1] * frm__grid_cell(g, X + 3 * i, 2));
+        g->items[g->start[c]++] = i;
+    }
+    for (i = cells; i > 0; i--) g->start[i] = g->start[i - 1];
+    g->start[0] = 0;
+    return FRM_OK;
+}
+
+/* Inserts (d, index) into the sorted list of the k best (smallest d, then index). */
+static void frm__keep_nearest(double *bd, int *bi, int *count, int k, double d, int index)
+{
+    int j;
+    if (*count == k && (d > bd[k - 1] || (d == bd[k - 1] && index > bi[k - 1]))) return;
+    j = *count < k ? (*count)++ : k - 1;
+    while (j > 0 && (bd[j - 1] > d || (bd[j - 1] == d && bi[j - 1] > index))) {
+        bd[j] = bd[j - 1];
+        bi[j] = bi[j - 1];
+        j--;
+    }
+    bd[j] = d;
+    bi[j] = index;
+}
+
+/* The neighbours of point p: the k nearest (radius <= 0) or all within radius (at most
+   `cap`, else returns cap + 1), sorted by distance then index. */
+static int frm__grid_query(const frm__grid *g, const double *X, const double *p, int k, double radius, int cap,
+                           int *out, double *dist)
+{
+    int c[3], lo[3], hi[3], ring, count = 0, a;
+    for (a = 0; a < 3; a++) c[a] = frm__grid_cell(g, p, a);
+    for (ring = 0;; ring++) {
+        int x, y, z, done = 1;
+        if (radius > 0 && ring > 0) break;
+        for (a = 0; a < 3; a++) {
+            int span = radius > 0 ? (int)ceil(radius / g->h[a]) : ring;
+            lo[a] = c[a] - span;
+            hi[a] = c[a] + span;
+            if (lo[a] > 0 || hi[a] < g->n[a] - 1) done = 0;
+            if (lo[a] < 0) lo[a] = 0;
+            if (hi[a] > g->n[a] - 1) hi[a] = g->n[a] - 1;
+        }
+        for (z = lo[2]; z <= hi[2]; z++)
+            for (y = lo[1]; y <= hi[1]; y++)
+                for (x = lo[0]; x <= hi[0]; x++) {
+                    int cell = x + g->n[0] * (y + g->n[1] * z), e;
+                    /* in nearest mode, only the shell of this ring is new */
+                    if (radius <= 0 && ring > 0 && abs(x - c[0]) < ring && abs(y - c[1]) < ring && abs(z - c[2]) < ring)
+                        continue;
+                    for (e = g->start[cell]; e < g->start[cell + 1]; e++) {
+                        int i = g->items[e];
+                        double d = sqrt((p[0] - X[3 * i]) * (p[0] - X[3 * i]) + (p[1] - X[3 * i + 1]) * (p[1] - X[3 * i + 1]) +
+                                        (p[2] - X[3 * i + 2]) * (p[2] - X[3 * i + 2]));
+                        if (radius > 0) {
+                            if (d < radius) {
+                                if (count == cap) return cap + 1;
+                                frm__keep_nearest(dist, out, &count, cap, d, i);
+                            }
+                        } else
+                            frm__keep_nearest(dist, out, &count, k, d, i);
+                    }
+                }
+        if (radius > 0) break;
+        /* every point not yet seen lies at least ring * hmin away */
+        if (done || (count == k && dist[k - 1] <= ring * g->hmin)) break;
+    }
+    return count;
+}
+
+static int frm__check_shape(const frm_shape_desc *sh)
+{
+    if ((int)sh->shape != FRM_SHAPE_SHEPARD && (int)sh->shape != FRM_SHAPE_MLS) return FRM_ERR_SAMPLING;
+    if (sh->support == FRM_SUPPORT_NEAREST) {
+        if (sh->nearest < 1 || sh->nearest > FRM_MAX_NEIGHBORS) return FRM_ERR_SAMPLING;
+        if (sh->shape == FRM_SHAPE_MLS && sh->nearest < 4) return FRM_ERR_SAMPLING;
+    } else if (sh->support == FRM_SUPPORT_RADIUS) {
+        if (!(frm__finite((double)sh->radius) && sh->radius > 0)) return FRM_ERR_SAMPLING;
+    } else
+        return FRM_ERR_SAMPLING;
+    if (sh->shape == FRM_SHAPE_SHEPARD && !(frm__finite((double)sh->power) && sh->power > 0)) return FRM_ERR_SAMPLING;
+    return FRM_OK;
+}
+
+FRMDEF int frm_sampling_meshless(frm_sampling *out, const frm_real *frames, int frame_count, const frm_real *samples,
+                                 int sample_count, frm_real volume, const frm_shape_desc *shape,
+                                 const frm_allocator *allocator)
+{
+    frm_shape_desc sh = shape ? *shape : frm_shape_default_desc();
+    frm_allocator alloc;
+    frm__grid grid;
+    double *X = NULL, dist[FRM_MAX_NEIGHBORS + 1];
+    int err, s, i, r, k, pass, pairs = 0, idx[FRM_MAX_NEIGHBORS + 1];
+    size_t xbytes;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    memset(&alloc, 0, sizeof alloc);
+    if (allocator) alloc = *allocator;
+    if (!frames || !samples || frame_count < 1 || sample_count < 1 || frame_count > 100000000 || sample_count > 100000000)
+        return FRM_ERR_ARG;
+    if (!frm__all_finite(frames, 3 * (size_t)frame_count)) return FRM_ERR_FRAME_NOT_FINITE;
+    if (!frm__all_finite(samples, 3 * (size_t)sample_count)) return FRM_ERR_SAMPLE_NOT_FINITE;
+    if (!(frm__finite((double)volume) && volume > 0)) return FRM_ERR_SAMPLE_VOLUME;
+    err = frm__check_shape(&sh);
+    if (err) return err;
+    k = sh.support == FRM_SUPPORT_NEAREST ? (sh.nearest < frame_count ? sh.nearest : frame_count) : 0;
+    if (sh.shape == FRM_SHAPE_MLS && k > 0 && k < 4) return FRM_ERR_SHAPE_DEGENERATE;
+    xbytes = sizeof(double) * 3 * (size_t)frame_count;
+    X = (double *)frm__alloc(&alloc, xbytes);
+    if (!X) return FRM_ERR_ALLOC;
+    for (i = 0; i < 3 * frame_count; i++) X[i] = (double)frames[i];
+    err = frm__grid_build(&grid, X, frame_count, sh.support == FRM_SUPPORT_RADIUS ? (double)sh.radius : 0.0, &alloc);
+    if (err) {
+        frm__free(&alloc, X, xbytes);
+        return err;
+    }
+    /* pass 0 counts the neighbours, pass 1 fills the table */
+    for (pass = 0; pass < 2 && !err; pass++) {
+        if (pass == 1) {
+            err = frm__sampling_alloc(out, frame_count, sample_count, pairs, &alloc);
+            if (err) break;
+            memcpy(out->frame_positions, frames, sizeof(frm_real) * 3 * (size_t)frame_count);
+            memcpy(out->sample_positions, samples, sizeof(frm_real) * 3 * (size_t)sample_count);
+            pairs = 0;
+        }
+        for (s = 0; s < sample_count && !err; s++) {
+            double p[3], Xn[3 * FRM_MAX_NEIGHBORS], w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS], R;
+            int n;
+            for (r = 0; r < 3; r++) p[r] = (double)samples[3 * s + r];
+            n = frm__grid_query(&grid, X, p, k, sh.support == FRM_SUPPORT_RADIUS ? (double)sh.radius : 0.0,
+                                FRM_MAX_NEIGHBORS, idx, dist);
+            if (n == 0) err = FRM_ERR_NO_NEIGHBOR;
+            else if (n > FRM_MAX_NEIGHBORS) err = FRM_ERR_TOO_MANY_NEIGHBORS;
+            if (err) break;
+            if (pass == 0) {
+                pairs += n;
+                continue;
+            }
+            for (i = 0; i < n; i++)
+                for (r = 0; r < 3; r++) Xn[3 * i + r] = X[3 * idx[i] + r];
+            if (sh.shape == FRM_SHAPE_MLS) {
+                /* nearest support: a kernel reaching 1.5 times the k-th distance */
+                R = sh.support == FRM_SUPPORT_RADIUS ? (double)sh.radius : 1.5 * dist[n - 1];
+                err = frm__mls_functions(Xn, n, p, R, w, g);
+            } else
+                err = frm__shepard_functions(Xn, n, p, (double)sh.power,
+                                             sh.support == FRM_SUPPORT_RADIUS ? (double)sh.radius : 0.0, w, g);
+            if (err) break;
+            out->neighbor_start[s] = pairs;
+            out->sample_volumes[s] = (frm_real)((double)volume / sample_count);
+            for (i = 0; i < n; i++, pairs++) {
+                out->neighbor_frames[pairs] = idx[i];
+                out->neighbor_weights[pairs] = (frm_real)w[i];
+                for (r = 0; r < 3; r++) out->neighbor_gradients[3 * pairs + r] = (frm_real)g[3 * i + r];
+            }
+        }
+        if (pass == 1 && !err) out->neighbor_start[sample_count] = pairs;
+    }
+    frm__free(&alloc, grid.start, grid.bytes);
+    frm__free(&alloc, X, xbytes);
+    if (err) frm_sampling_free(out);
+    return err;
+}
+
+/* >>poisson ---------------------------------------------------------------------------- */
+
+/* splitmix64: the same stream on every platform for a seed. */
+static double frm__random(unsigned long long *state)
+{
+    unsigned long long z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* A closed triangle surface for inside tests: triangles binned by their xy bounding box. */
+typedef struct frm__surface {
+    const frm_real *v;
+    const int *t;
+    int tri_count, nb[2];
+    double lo[3], hi[3], cell[2];
+    int *start, *items;
+    size_t bytes;
+} frm__surface;
+
+/* The 2D edge function of (a, b) at p, computed from the lexicographically smaller end so
+   that the two triangles sharing an edge get exactly opposite values. */
+static double frm__edge_function(const frm_real *a, const frm_real *b, double px, double py)
+{
+    int swap = (a[0] > b[0]) || (a[0] == b[0] && a[1] > b[1]);
+    const frm_real *u = swap ? b : a, *w = swap ? a : b;
+    double e = ((double)w[0] - u[0]) * (py - u[1]) - ((double)w[1] - u[1]) * (px - u[0]);
+    return swap ? -e : e;
+}
+
+/* 1 if the +z ray from p crosses triangle t (xy projection containing (px, py) by the
+   top-left rule, so a point on a shared edge belongs to exactly one side; above p). */
+static int frm__ray_crosses(const frm__surface *S, int t, const double *p)
+{
+    const frm_real *a = S->v + 3 * S->t[3 * t], *b = S->v + 3 * S->t[3 * t + 1], *c = S->v + 3 * S->t[3 * t + 2];
+    const frm_real *q[3];
+    double area, e[3], z;
+    int k;
+    area = ((double)b[0] - a[0]) * ((double)c[1] - a[1]) - ((double)b[1] - a[1]) * ((double)c[0] - a[0]);
+    if (area == 0) return 0;
+    q[0] = a;
+    q[1] = area > 0 ? b : c;
+    q[2] = area > 0 ? c : b;
+    for (k = 0; k < 3; k++) {
+        const frm_real *u = q[k], *w = q[(k + 1) % 3];
+        double dx = (double)w[0] - u[0], dy = (double)w[1] - u[1];
+        e[k] = frm__edge_function(u, w, p[0], p[1]);
+        if (e[k] < 0) return 0;
+        if (e[k] == 0 && !(dy < 0 || (dy == 0 && dx < 0))) return 0;
+    }
+    /* e[k] is twice the area opposite vertex q[k + 2] */
+    z = (e[0] * q[2][2] + e[1] * q[0][2] + e[2] * q[1][2]) / (e[0] + e[1] + e[2]);
+    return z > p[2];
+}
+
+static int frm__inside(const frm__surface *S, const double *p)
+{
+    int bx, by, e, crossings = 0;
+    if (p[0] < S->lo[0] || p[0] > S->hi[0] || p[1] < S->lo[1] || p[1] > S->hi[1] || p[2] < S->lo[2] || p[2] > S->hi[2])
+        return 0;
+    bx = (int)((p[0] - S->lo[0]) / S->cell[0]);
+    by = (int)((p[1] - S->lo[1]) / S->cell[1]);
+    if (bx >= S->nb[0]) bx = S->nb[0] - 1;
+    if (by >= S->nb[1]) by = S->nb[1] - 1;
+    for (e = S->start[bx + S->nb[0] * by]; e < S->start[bx + S->nb[0] * by + 1]; e++)
+        crossings += frm__ray_crosses(S, S->items[e], p);
+    return crossings & 1;
+}
+
+static int frm__edge_compare(const void *pa, const void *pb)
+{
+    const int *a = (const int *)pa, *b = (const int *)pb;
+    if (a[0] != b[0]) return a[0] < b[0] ? -1 : 1;
+    if (a[1] != b[1]) return a[1] < b[1] ? -1 : 1;
+    return a[2] < b[2] ? -1 : (a[2] > b[2]);
+}
+
+/* Validates the surface (indices, every edge used once in each direction, positive
+   volume), sets *volume and builds the bins. */
+static int frm__surface_build(frm__surface *S, const frm_real *v, int vc, const int *t, int tc, double *volume,
+                              const frm_allocator *a)
+{
+    int *edges, i, k, bx, by, pass;
+    size_t ebytes = sizeof(int) * 3 * 3 * (size_t)tc;
+    double vol = 0;
+    memset(S, 0, sizeof *S);
+    if (!v || !t || vc < 4 || tc < 4 || tc > 50000000) return FRM_ERR_SURFACE;
+    if (!frm__all_finite(v, 3 * (size_t)vc)) return FRM_ERR_SAMPLE_NOT_FINITE;
+    for (i = 0; i < 3 * tc; i++)
+        if (t[i] < 0 || t[i] >= vc) return FRM_ERR_INDEX_RANGE;
+    edges = (int *)frm__alloc(a, ebytes);
+    if (!edges) return FRM_ERR_ALLOC;
+    for (i = 0; i < tc; i++)
+        for (k = 0; k < 3; k++) { /* directed edge (u, w) stored as (min, max, direction) */
+            int u = t[3 * i + k], w = t[3 * i + (k + 1) % 3];
+            int *e = edges + 3 * (3 * i + k);
+            e[0] = u < w ? u : w;
+            e[1] = u < w ? w : u;
+            e[2] = u < w;
+        }
+    qsort(edges, 3 * (size_t)tc, 3 * sizeof(int), frm__edge_compare);
+    for (i = 0; i < 3 * tc; i += 2) /* closed and consistently oriented: pairs (u,w,0)(u,w,1) */
+        if (i + 1 >= 3 * tc || edges[3 * i] != edges[3 * i + 3] || edges[3 * i + 1] != edges[3 * i + 4] ||
+            edges[3 * i + 2] != 0 || edges[3 * i + 5] != 1 || edges[3 * i] == edges[3 * i + 1] ||
+            (i + 2 < 3 * tc && edges[3 * i + 6] == edges[3 * i] && edges[3 * i + 7] == edges[3 * i + 1])) {
+            frm__free(a, edges, ebytes);
+            return FRM_ERR_SURFACE;
+        }
+    frm__free(a, edges, ebytes);
+    for (i = 0; i < tc; i++) { /* divergence theorem */
+        const frm_real *p = v + 3 * t[3 * i], *q = v + 3 * t[3 * i + 1], *r = v + 3 * t[3 * i + 2];
+        vol += ((double)p[0] * ((double)q[1] * r[2] - (double)q[2] * r[1]) - (double)p[1] * ((double)q[0] * r[2] - (double)q[2] * r[0]) +
+                (double)p[2] * ((double)q[0] * r[1] - (double)q[1] * r[0])) / 6.0;
+    }
+    if (!(fabs(vol) > 0)) return FRM_ERR_SURFACE;
+    *volume = fabs(vol);
+    S->v = v;
+    S->t = t;
+    S->tri_count = tc;
+    for (k = 0; k < 3; k++) {
+        S->lo[k] = S->hi[k] = v[k];
+        for (i = 1; i < vc; i++) {
+            if (v[3 * i + k] < S->lo[k]) S->lo[k] = v[3 * i + k];
+            if (v[3 * i + k] > S->hi[k]) S->hi[k] = v[3 * i + k];
+        }
+    }
+    S->nb[0] = S->nb[1] = (int)sqrt((double)tc) + 1;
+    if (S->nb[0] > 1024) S->nb[0] = S->nb[1] = 1024;
+    for (k = 0; k < 2; k++) {
+        S->cell[k] = (S->hi[k] - S->lo[k]) / S->nb[k];
+        if (!(S->cell[k] > 0)) return FRM_ERR_SURFACE;
+    }
+    /* two passes over the triangles' xy boxes: count, then fill */
+    for (pass = 0; pass < 2; pass++) {
+        int cells = S->nb[0] * S->nb[1];
+        if (pass == 0) {
+            S->start = NULL;
+            S->bytes = sizeof(int) * ((size_t)cells + 1);
+            S->start = (int *)frm__alloc(a, S->bytes);
+            if (!S->start) return FRM_ERR_ALLOC;
+            memset(S->start, 0, S->bytes);
+        }
+        for (i = 0; i < tc; i++) {
+            double lo[2], hi[2];
+            int b0[2], b1[2];
+            for (k = 0; k < 2; k++) {
+                lo[k] = hi[k] = v[3 * t[3 * i] + k];
+                if (v[3 * t[3 * i + 1] + k] < lo[k]) lo[k] = v[3 * t[3 * i + 1] + k];
+                if (v[3 * t[3 * i + 1] + k] > hi[k]) hi[k] = v[3 * t[3 * i + 1] + k];
+                if (v[3 * t[3 * i + 2] + k] < lo[k]) lo[k] = v[3 * t[3 * i + 2] + k];
+                if (v[3 * t[3 * i + 2] + k] > hi[k]) hi[k] = v[3 * t[3 * i + 2] + k];
+                b0[k] = (int)((lo[k] - S->lo[k]) / S->cell[k]);
+                b1[k] = (int)((hi[k] - S->lo[k]) / S->cell[k]);
+                if (b1[k] >= S->nb[k]) b1[k] = S->nb[k] - 1;
+                if (b0[k] >= S->nb[k]) b0[k] = S->nb[k] - 1;
+            }
+            for (by = b0[1]; by <= b1[1]; by++)
+                for (bx = b0[0]; bx <= b1[0]; bx++) {
+                    if (pass == 0) S->start[bx + S->nb[0] * by + 1]++;
+                    else S->items[S->start[bx + S->nb[0] * by]++] = i;
+                }
+        }
+        if (pass == 0) { /* prefix sums, then the item array after them */
+            size_t total, old = S->bytes;
+            int *grown;
+            for (i = 0; i < cells; i++) S->start[i + 1] += S->start[i];
+            total = (size_t)S->start[cells];
+            S->bytes = sizeof(int) * ((size_t)cells + 1 + total);
+            grown = (int *)frm__alloc(a, S->bytes);
+            if (!grown) {
+                frm__free(a, S->start, old);
+                S->start = NULL;
+                return FRM_ERR_ALLOC;
+            }
+            memcpy(grown, S->start, sizeof(int) * ((size_t)cells + 1));
+            frm__free(a, S->start, old);
+            S->start = grown;
+            S->items = grown + cells + 1;
+        } else {
+            for (i = cells; i > 0; i--) S->start[i] = S->start[i - 1];
+            S->start[0] = 0;
+        }
+    }
+    return FRM_OK;
+}
+
+/* Growable point list (3 doubles per point). */
+typedef struct frm__points {
+    double *p;
+    int count, capacity, max;
+    const frm_allocator *a;
+} frm__points;
+
+static int frm__points_push(frm__points *L, const double *x)
+{
+    if (L->count == L->max) return FRM_ERR_SAMPLING;
+    if (L->count == L->capacity) {
+        int cap = L->capacity ? 2 * L->capacity : 256;
+        double *q = (double *)frm__alloc(L->a, sizeof(double) * 3 * (size_t)cap);
+        if (!q) return FRM_ERR_ALLOC;
+        if (L->p) {
+            memcpy(q, L->p, sizeof(double) * 3 * (size_t)L->count);
+            frm__free(L->a, L->p, sizeof(double) * 3 * (size_t)L->capacity);
+        }
+        L->p = q;
+        L->capacity = cap;
+    }
+    memcpy(L->p + 3 * (size_t)L->count, x, 3 * sizeof(double));
+    L->count++;
+    return FRM_OK;
+}
+
+/* Poisson-disk points at least r apart in the box [lo, hi] (and inside S when given),
+   Bridson's algorithm (30 candidates in the annulus [r, 2r] around each active point),
+   then a fill pass that seeds every still-empty grid cell, so separate pieces and thin
+   parts get points too. Axes with lo = hi stay flat. Deterministic for a seed. */
+static int frm__poisson(const double lo[3], const double hi[3], const frm__surface *S, double r, unsigned int seed,
+                        frm__points *L)
+{
+    unsigned long long state = 0x853C49E6748FEA9Bull ^ ((unsigned long long)seed * 0x9E3779B97F4A7C15ull);
+    double cs, ext[3], emax = 0;
+    int dims = 0, axis[3], n[3] = {1, 1, 1}, *grid, *active, active_count = 0, k, cell, err = FRM_OK, a;
+    size_t cells, gbytes, abytes;
+    for (k = 0; k < 3; k++) {
+        ext[k] = hi[k] - lo[k];
+        if (ext[k] > emax) emax = ext[k];
+    }
+    for (k = 0; k < 3; k++) axis[k] = ext[k] > 1e-12 * emax;
+    for (k = 0; k < 3; k++) dims += axis[k];
+    if (!dims || !(r > 0) || !(emax / r < 1e6)) return FRM_ERR_SAMPLING;
+    cs = r / sqrt((double)dims);
+    cells = 1;
+    for (k = 0; k < 3; k++) {
+        if (axis[k]) n[k] = (int)ceil(ext[k] / cs);
+        if (n[k] < 1) n[k] = 1;
+        cells *= (size_t)n[k];
+    }
+    if (cells > 100000000) return FRM_ERR_SAMPLING;
+    gbytes = sizeof(int) * cells;
+    grid = (int *)frm__alloc(L->a, gbytes);
+    if (!grid) return FRM_ERR_ALLOC;
+    for (cell = 0; cell < (int)cells; cell++) grid[cell] = -1;
+    abytes = sizeof(int) * (size_t)(L->max + 1);
+    active = (int *)frm__alloc(L->a, abytes);
+    if (!active) {
+        frm__free(L->a, grid, gbytes);
+        return FRM_ERR_ALLOC;
+    }
+#define FRM__CELL_OF(x, c) \
+    do { \
+        for (a = 0; a < 3; a++) { \
+            int t_ = axis[a] ? (int)(((x)[a] - lo[a]) / cs) : 0; \
+            (c)[a] = t_ < 0 ? 0 : (t_ >= n[a] ? n[a] - 1 : t_); \
+        } \
+    } while (0)
+    for (cell = 0; cell < (int)cells && !err; cell++) {
+        int tries;
+        if (grid[cell] >= 0) continue;
+        /* seed this empty cell (the first one seeds the whole domain) */
+        for (tries = 0; tries < 8 && grid[cell] < 0 && !err; tries++) {
+            int ci[3], c3[3], ok = 1, x, y, z;
+            double p[3];
+            ci[0] = cell % n[0];
+            ci[1] = (cell / n[0]) % n[1];
+            ci[2] = cell / (n[0] * n[1]);
+            for (a = 0; a < 3; a++) p[a] = axis[a] ? lo[a] + (ci[a] + frm__random(&state)) * cs : lo[a];
+            for (a = 0; a < 3; a++)
+                if (p[a] > hi[a]) ok = 0;
+            if (!ok || (S && !frm__inside(S, p))) continue;
+            FRM__CELL_OF(p, c3);
+            for (z = c3[2] - 2; z <= c3[2] + 2 && ok; z++)
+                for (y = c3[1] - 2; y <= c3[1] + 2 && ok; y++)
+                    for (x = c3[0] - 2; x <= c3[0] + 2 && ok; x++) {
+                        int q;
+                        if (x < 0 || y < 0 || z < 0 || x >= n[0] || y >= n[1] || z >= n[2]) continue;
+                        q = grid[x + n[0] * (y + n[1] * z)];
+                        if (q >= 0) {
+                            const double *o = L->p + 3 * (size_t)q;
+                            if ((o[0] - p[0]) * (o[0] - p[0]) + (o[1] - p[1]) * (o[1] - p[1]) + (o[2] - p[2]) * (o[2] - p[2]) < r * r)
+                                ok = 0;
+                        }
+                    }
+            if (!ok) continue;
+            err = frm__points_push(L, p);
+            if (err) break;
+            grid[c3[0] + n[0] * (c3[1] + n[1] * c3[2])] = L->count - 1;
+            active[active_count++] = L->count - 1;
+            while (active_count > 0 && !err) { /* Bridson growth */
+                int pick = (int)(frm__random(&state) * active_count), j, found = 0;
+                double base[3];
+                if (pick >= active_count) pick = active_count - 1;
+                memcpy(base, L->p + 3 * (size_t)active[pick], sizeof base);
+                for (j = 0; j < 30 && !found; j++) {
+                    double dir[3], len = 0, rad = r * (1.0 + frm__random(&state)), q[3];
+                    int ok2 = 1;
+                    do { /* a direction in the active axes */
+                        len = 0;
+                        for (a = 0; a < 3; a++) {
+                            dir[a] = axis[a] ? 2.0 * frm__random(&state) - 1.0 : 0.0;
+                            len += dir[a] * dir[a];
+                        }
+                    } while (len > 1.0 || len < 1e-6);
+                    len = sqrt(len);
+                    for (a = 0; a < 3; a++) {
+                        q[a] = base[a] + rad * dir[a] / len;
+                        if (axis[a] && (q[a] < lo[a] || q[a] > hi[a])) ok2 = 0;
+                        if (!axis[a]) q[a] = lo[a];
+                    }
+                    if (!ok2 || (S && !frm__inside(S, q))) continue;
+                    FRM__CELL_OF(q, c3);
+                    for (z = c3[2] - 2; z <= c3[2] + 2 && ok2; z++)
+                        for (y = c3[1] - 2; y <= c3[1] + 2 && ok2; y++)
+                            for (x = c3[0] - 2; x <= c3[0] + 2 && ok2; x++) {
+                                int o;
+                                if (x < 0 || y < 0 || z < 0 || x >= n[0] || y >= n[1] || z >= n[2]) continue;
+                                o = grid[x + n[0] * (y + n[1] * z)];
+                                if (o >= 0) {
+                                    const double *w = L->p + 3 * (size_t)o;
+                                    if ((w[0] - q[0]) * (w[0] - q[0]) + (w[1] - q[1]) * (w[1] - q[1]) + (w[2] - q[2]) * (w[2] - q[2]) <
+                                        r * r)
+                                        ok2 = 0;
+                                }
+                            }
+                    if (!ok2) continue;
+                    err = frm__points_push(L, q);
+                    if (err) break;
+                    grid[c3[0] + n[0] * (c3[1] + n[1] * c3[2])] = L->count - 1;
+                    active[active_count++] = L->count - 1;
+                    found = 1;
+                }
+                if (!found) active[pick] = active[--active_count];
+            }
+        }
+    }
+#undef FRM__CELL_OF
+    frm__free(L->a, active, abytes);
+    frm__free(L->a, grid, gbytes);
+    return err;
+}
+
+static int frm__check_poisson(const frm_poisson_desc *p)
+{
+    if (!p) return FRM_ERR_ARG;
+    if (!(frm__finite((double)p->frame_spacing) && p->frame_spacing > 0) ||
+        !(frm__finite((double)p->sample_spacing) && p->sample_spacing > 0) || !frm__finite((double)p->volume) ||
+        p->max_points < 1)
+        return FRM_ERR_SAMPLING;
+    return FRM_OK;
+}
+
+/* Poisson points for frames (seed) and samples (seed + 1), then the meshless tables. */
+static int frm__sampling_poisson(frm_sampling *out, const double lo[3], const double hi[3], const frm__surface *S,
+                                 double volume, const frm_poisson_desc *p, const frm_shape_desc *shape,
+                                 const frm_allocator *alloc)
+{
+    frm__points F, P;
+    frm_real *fr = NULL, *sr = NULL;
+    size_t fbytes = 0, sbytes = 0;
+    int err, i;
+    memset(&F, 0, sizeof F);
+    memset(&P, 0, sizeof P);
+    F.a = P.a = alloc;
+    F.max = P.max = p->max_points;
+    err = frm__poisson(lo, hi, S, (double)p->frame_spacing, p->seed, &F);
+    if (!err) err = frm__poisson(lo, hi, S, (double)p->sample_spacing, p->seed + 1u, &P);
+    if (!err && (F.count < 1 || P.count < 1)) err = FRM_ERR_SAMPLING;
+    if (!err) {
+        fbytes = sizeof(frm_real) * 3 * (size_t)F.count;
+        sbytes = sizeof(frm_real) * 3 * (size_t)P.count;
+        fr = (frm_real *)frm__alloc(alloc, fbytes);
+        sr = (frm_real *)frm__alloc(alloc, sbytes);
+        if (!fr || !sr) err = FRM_ERR_ALLOC;
+    }
+    if (!err) {
+        for (i = 0; i < 3 * F.count; i++) fr[i] = (frm_real)F.p[i];
+        for (i = 0; i < 3 * P.count; i++) sr[i] = (frm_real)P.p[i];
+        err = frm_sampling_meshless(out, fr, F.count, sr, P.count, (frm_real)volume, shape, alloc);
+    }
+    frm__free(alloc, fr, fbytes);
+    frm__free(alloc, sr, sbytes);
+    if (F.p) frm__free(alloc, F.p, sizeof(double) * 3 * (size_t)F.capacity);
+    if (P.p) frm__free(alloc, P.p, sizeof(double) * 3 * (size_t)P.capacity);
+    return err;
+}
+
+FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_real hi[3], const frm_poisson_desc *p,
+                            const frm_shape_desc *shape, const frm_allocator *allocator)
+{
+    frm_allocator alloc;
+    double l[3], h[3], vol = 1;
+    int err, k;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!lo || !hi || !frm__vec3_finite(lo) || !frm__vec3_finite(hi)) return FRM_ERR_ARG;
+    err = frm__check_poisson(p);
+    if (err) return err;
+    memset(&alloc, 0, sizeof alloc);
+    if (allocator) alloc = *allocator;
+    for (k = 0; k < 3; k++) {
+        l[k] = (double)lo[k];
+        h[k] = (double)hi[k];
+        if (h[k] < l[k]) return FRM_ERR_ARG;
+        vol *= h[k] - l[k];
+    }
+    if (p->volume > 0) vol = (double)p->volume;
+    if (!(vol > 0)) return FRM_ERR_SAMPLING; /* a flat box needs its volume */
+    return frm__sampling_poisson(out, l, h, NULL, vol, p, shape, &alloc);
+}
+
+FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int vertex_count, const int *triangles,
+                                int triangle_count, const frm_poisson_desc *p, const frm_shape_desc *shape,
+                                const frm_allocator *allocator)
+{
+    frm_allocator alloc;
+    frm__surface S;
+    double vol = 0;
+    int err;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    err = frm__check_poisson(p);
+    if (err) return err;
+    memset(&alloc, 0, sizeof alloc);
+    if (allocator) alloc = *allocator;
+    err = frm__surface_build(&S, vertices, vertex_count, triangles, triangle_count, &vol, &alloc);
+    if (!err) err = frm__sampling_poisson(out, S.lo, S.hi, &S, p->volume > 0 ? (double)p->volume : vol, p, shape, &alloc);
+    if (S.start) frm__free(&alloc, S.start, S.bytes);
+    return err;
+}
+
+#if defined(FRM_STATIC) && defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+#endif /* FRAMES_IMPLEMENTATION */
+
+/*
+------------------------------------------------------------------------------
+This software is available under 2 licenses -- choose whichever you prefer.
+------------------------------------------------------------------------------
+ALTERNATIVE A - MIT License
+Copyright (c) 2026 The soft-body library authors
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+of the Software, and to permit persons to whom the Software is furnished to do
+so, subject to the following conditions:
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+------------------------------------------------------------------------------
+ALTERNATIVE B - Public Domain (www.unlicense.org)
+This is free and unencumbered software released into the public domain.
+Anyone is free to copy, modify, publish, use, compile, sell, or distribute this
+software, either in source code form or as a compiled binary, for any purpose,
+commercial or non-commercial, and by any means.
+In jurisdictions that recognize copyright laws, the author or authors of this
+software dedicate any and all copyright interest in the software to the public
+domain. We make this dedication for the benefit of the public at large and to
+the detriment of our heirs and successors. We intend this dedication to be an
+overt act of relinquishment in perpetuity of all present and future rights to
+this software under copyright law.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER LIABILITY, WHETHER IN AN
+ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM, OUT OF OR IN CONNECTION
+WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE SOFTWARE.
+------------------------------------------------------------------------------
+*/
