@@ -421,6 +421,10 @@ FRMDEF const frm_real *frm_model_deformation_gradients(frm_model *m);
    the frame origin, world axes (no gravity or external load). One force pass (see
    PERFORMANCE). FRM_ERR_INVERTED / FRM_ERR_NOT_FINITE leave *out NULL. */
 FRMDEF int frm_model_forces(frm_model *m, const frm_real **out);
+/* The total generalized force, 6 per frame: internal + gravity (the samples' weight, which
+   also has a torque about the frame's origin) + external. The static solve drives it to
+   zero on the free frames. One force pass; same errors as frm_model_forces. */
+FRMDEF int frm_model_total_forces(frm_model *m, const frm_real **out);
 /* Energies of the current state (one force pass). */
 FRMDEF int frm_model_energy(frm_model *m, frm_energies *out);
 /* Statistics of the last step or solve. */
@@ -2769,6 +2773,18 @@ FRMDEF int frm_model_forces(frm_model *m, const frm_real **out)
     err = frm__force_pass(m, 0, 0, NULL);
     if (err) return err;
     *out = m->force;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_total_forces(frm_model *m, const frm_real **out)
+{
+    int err;
+    if (out) *out = NULL;
+    if (!m || !out) return FRM_ERR_ARG;
+    err = frm__force_pass(m, 0, 0, NULL);
+    if (err) return err;
+    frm__total_force(m, m->vec[FRM__V_F]);
+    *out = m->vec[FRM__V_F];
     return FRM_OK;
 }
 

@@ -1,0 +1,749 @@
+/* Tests of frames.h: shape functions (partition of unity, exact gradients, linear
+   reproduction), frame indifference (R6), forces against an independent energy, stiffness
+   against finite differences of the forces, the generalized mass, Poisson-disk sampling,
+   the steel cantilever (R1), the soft cantilever's convergence (R2), the beam frequency
+   (R3), a 180 degree torsion and a coplanar Shepard sheet, determinism, allocation
+   discipline and every validation error. */
+#define FRAMES_IMPLEMENTATION
+#include "../frames.h"
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "test.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define IS_FLOAT (sizeof(frm_real) == sizeof(float))
+/* Round-off of the model's real type. */
+#define EPS ((double)(IS_FLOAT ? 1.2e-7 : 2.3e-16))
+
+/* ---- helpers ------------------------------------------------------------------------ */
+
+static frm_real *alloc_reals(int count)
+{
+    return (frm_real *)calloc(count > 0 ? (size_t)count : 1, sizeof(frm_real));
+}
+
+/* Deterministic pseudo-random numbers in [-1, 1]. */
+static double rnd(unsigned *state)
+{
+    *state = *state * 1664525u + 1013904223u;
+    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
+}
+
+/* Independent quaternion helpers in double (x, y, z, w). */
+static void q_mul(const double *a, const double *b, double *o)
+{
+    double x = a[3] * b[0] + b[3] * a[0] + a[1] * b[2] - a[2] * b[1];
+    double y = a[3] * b[1] + b[3] * a[1] + a[2] * b[0] - a[0] * b[2];
+    double z = a[3] * b[2] + b[3] * a[2] + a[0] * b[1] - a[1] * b[0];
+    double w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    o[0] = x;
+    o[1] = y;
+    o[2] = z;
+    o[3] = w;
+}
+
+static void q_exp(const double *t, double *q)
+{
+    double a = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), s = a > 0 ? sin(0.5 * a) / a : 0.5;
+    q[0] = s * t[0];
+    q[1] = s * t[1];
+    q[2] = s * t[2];
+    q[3] = cos(0.5 * a);
+}
+
+/* Rotation matrix by Rodrigues from the quaternion's axis and angle (a different route
+   than the library's polynomial form). */
+static void q_matrix(const double *q, double *R)
+{
+    double s = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]), angle = 2 * atan2(s, q[3]), k[3] = {0, 0, 0}, c, sn;
+    int r, j;
+    if (s > 0)
+        for (r = 0; r < 3; r++) k[r] = q[r] / s;
+    c = cos(angle);
+    sn = sin(angle);
+    for (r = 0; r < 3; r++)
+        for (j = 0; j < 3; j++) R[3 * r + j] = (r == j ? c : 0) + (1 - c) * k[r] * k[j];
+    R[1] -= sn * k[2];
+    R[2] += sn * k[1];
+    R[3] += sn * k[2];
+    R[5] -= sn * k[0];
+    R[6] -= sn * k[1];
+    R[7] += sn * k[0];
+}
+
+/* Rotates the pose of every frame: q <- exp(t) q. */
+static void rotate_quat(frm_real *q, const double *t)
+{
+    double a[4], d[4], o[4];
+    int k;
+    for (k = 0; k < 4; k++) a[k] = q[k];
+    q_exp(t, d);
+    q_mul(d, a, o);
+    for (k = 0; k < 4; k++) q[k] = (frm_real)o[k];
+}
+
+/* A test scene: the sampling (kept for the independent energy), the description and the
+   model. */
+typedef struct scene {
+    frm_sampling s;
+    frm_desc d;
+    frm_model *m;
+} scene;
+
+static void scene_free(scene *sc)
+{
+    frm_model_destroy(sc->m);
+    frm_sampling_free(&sc->s);
+    memset(sc, 0, sizeof *sc);
+}
+
+static int scene_create(scene *sc, frm_law law, double E, double nu, double rho, frm_stiffness_mode mode)
+{
+    int err;
+    sc->d = frm_model_default_desc();
+    frm_sampling_apply(&sc->s, &sc->d);
+    sc->d.material.law = law;
+    sc->d.material.young_modulus = (frm_real)E;
+    sc->d.material.poisson_ratio = (frm_real)nu;
+    sc->d.material.density = (frm_real)rho;
+    sc->d.stiffness_mode = mode;
+    err = frm_model_create(&sc->d, &sc->m);
+    if (err) fprintf(stderr, "frm_model_create: %s\n", frm_error_string(err));
+    return err;
+}
+
+/* A hexahedral grid [lo, hi] of nx ny nz cells with gauss^3 samples per cell. */
+static int scene_hex(scene *sc, const double lo[3], const double hi[3], int nx, int ny, int nz, int gauss, frm_law law,
+                     double E, double nu, double rho, frm_stiffness_mode mode)
+{
+    hexmesh h;
+    frm_real *x;
+    int i, err;
+    memset(sc, 0, sizeof *sc);
+    if (hexmesh_grid(&h, lo, hi, nx, ny, nz) != TETMESH_OK) return -1;
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    err = frm_sampling_hexes(&sc->s, x, h.node_count, h.hexes, h.hex_count, gauss, NULL);
+    free(x);
+    hexmesh_free(&h);
+    if (err) {
+        fprintf(stderr, "frm_sampling_hexes: %s\n", frm_error_string(err));
+        return err;
+    }
+    return scene_create(sc, law, E, nu, rho, mode);
+}
+
+/* A box of tetrahedra with `points` samples per tetrahedron. */
+static int scene_tet(scene *sc, int nx, int ny, int nz, double sx, double sy, double sz, int points, frm_law law,
+                     double E, double nu)
+{
+    tetmesh t;
+    double lo[3] = {0, 0, 0}, hi[3];
+    frm_real *x;
+    int i, err;
+    memset(sc, 0, sizeof *sc);
+    hi[0] = sx;
+    hi[1] = sy;
+    hi[2] = sz;
+    if (tetmesh_box(&t, lo, hi, nx, ny, nz, TETMESH_SPLIT6) != TETMESH_OK) return -1;
+    x = alloc_reals(3 * t.node_count);
+    for (i = 0; i < 3 * t.node_count; i++) x[i] = (frm_real)t.nodes[i];
+    err = frm_sampling_tets(&sc->s, x, t.node_count, t.tets, t.tet_count, points, NULL, NULL);
+    free(x);
+    tetmesh_free(&t);
+    if (err) return err;
+    return scene_create(sc, law, E, nu, 1000, FRM_STIFFNESS_AUTO);
+}
+
+/* Meshless: Poisson points in a box. */
+static int scene_box(scene *sc, const double lo[3], const double hi[3], double frame_spacing, double sample_spacing,
+                     frm_shape shape, int nearest, frm_law law, double E, double nu)
+{
+    frm_poisson_desc p = frm_poisson_default_desc();
+    frm_shape_desc sh = frm_shape_default_desc();
+    frm_real l[3], h[3];
+    int k, err;
+    memset(sc, 0, sizeof *sc);
+    for (k = 0; k < 3; k++) {
+        l[k] = (frm_real)lo[k];
+        h[k] = (frm_real)hi[k];
+    }
+    p.frame_spacing = (frm_real)frame_spacing;
+    p.sample_spacing = (frm_real)sample_spacing;
+    sh.shape = shape;
+    sh.nearest = nearest;
+    err = frm_sampling_box(&sc->s, l, h, &p, &sh, NULL);
+    if (err) {
+        fprintf(stderr, "frm_sampling_box: %s\n", frm_error_string(err));
+        return err;
+    }
+    return scene_create(sc, law, E, nu, 1000, FRM_STIFFNESS_AUTO);
+}
+
+/* The energy of the current poses computed independently of the library: eq. 3.34/3.40
+   with Rodrigues rotations, then the law's energy density in double. */
+static double independent_energy(const scene *sc)
+{
+    const frm_sampling *s = &sc->s;
+    const frm_real *x = frm_model_positions(sc->m), *q = frm_model_orientations(sc->m);
+    double mu = (double)sc->d.material.young_modulus / (2 * (1 + (double)sc->d.material.poisson_ratio));
+    double nu = (double)sc->d.material.poisson_ratio;
+    double lambda = (double)sc->d.material.young_modulus * nu / ((1 + nu) * (1 - 2 * nu)), W = 0;
+    int smp, e, r, c, k;
+    for (smp = 0; smp < s->sample_count; smp++) {
+        double F[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, C[9], J, psi;
+        for (e = s->neighbor_start[smp]; e < s->neighbor_start[smp + 1]; e++) {
+            int i = s->neighbor_frames[e];
+            double qq[4], R[9], l[3], d[3];
+            const frm_real *g = s->neighbor_gradients + 3 * e;
+            double w = s->neighbor_weights[e];
+            for (k = 0; k < 4; k++) qq[k] = q[4 * i + k];
+            q_matrix(qq, R);
+            /* rest frames of the samplings are axis-aligned: lbar = pbar - xbar */
+            for (k = 0; k < 3; k++) l[k] = (double)s->sample_positions[3 * smp + k] - s->frame_positions[3 * i + k];
+            for (r = 0; r < 3; r++) d[r] = (double)x[3 * i + r] + R[3 * r] * l[0] + R[3 * r + 1] * l[1] + R[3 * r + 2] * l[2];
+            for (r = 0; r < 3; r++)
+                for (c = 0; c < 3; c++) F[3 * r + c] += d[r] * g[c] + w * R[3 * r + c];
+        }
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) C[3 * r + c] = F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c];
+        J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+        if (sc->d.material.law == FRM_LAW_SVK) {
+            double tr = 0.5 * (C[0] + C[4] + C[8] - 3), ee = 0;
+            for (k = 0; k < 9; k++) {
+                double E = 0.5 * (C[k] - (k % 4 == 0));
+                ee += E * E;
+            }
+            psi = 0.5 * lambda * tr * tr + mu * ee;
+        } else
+            psi = 0.5 * mu * (C[0] + C[4] + C[8] - 3) - mu * log(J) + 0.5 * lambda * log(J) * log(J);
+        W += (double)s->sample_volumes[smp] * psi;
+    }
+    return W;
+}
+
+/* Positions and orientations copied out of a model (the caller frees). */
+static void get_poses(const frm_model *m, frm_real **x, frm_real **q)
+{
+    int n = frm_model_frame_count(m);
+    *x = alloc_reals(3 * n);
+    *q = alloc_reals(4 * n);
+    memcpy(*x, frm_model_positions(m), sizeof(frm_real) * 3 * (size_t)n);
+    memcpy(*q, frm_model_orientations(m), sizeof(frm_real) * 4 * (size_t)n);
+}
+
+/* Random deformation: positions moved by amp * size, orientations turned by up to rot rad. */
+static void perturb(frm_model *m, double amp, double rot, unsigned seed)
+{
+    frm_real *x, *q;
+    int i, k, n = frm_model_frame_count(m);
+    get_poses(m, &x, &q);
+    for (i = 0; i < n; i++) {
+        double t[3];
+        for (k = 0; k < 3; k++) {
+            x[3 * i + k] += (frm_real)(amp * rnd(&seed));
+            t[k] = rot * rnd(&seed);
+        }
+        rotate_quat(q + 4 * i, t);
+    }
+    frm_model_set_poses(m, x, q);
+    free(x);
+    free(q);
+}
+
+/* ---- shape functions ---------------------------------------------------------------- */
+
+/* Checks sum w = 1, sum grad = 0, gradients against central differences of the weights
+   (evaluated by `eval` at moved points) and, when linear, sum w x_i = p and
+   sum x_i grad^T = I. */
+typedef int (*shape_eval)(const void *ctx, const double p[3], frm_real *w, frm_real *g);
+
+static void check_shape(const char *name, shape_eval eval, const void *ctx, const double *frames, int count,
+                        const double p[3], int linear, double h)
+{
+    frm_real w[64], g[192], wp[64], gp[192], wm[64], gm[192];
+    double sw = 0, sg[3] = {0, 0, 0}, gscale = 0, xr[3] = {0, 0, 0}, J[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, worst = 0;
+    int i, k, j;
+    /* float: weights and gradients are stored in float; the FD step h is chosen by the
+       caller so that the truncation error (h^2) and the rounding (eps / h) both stay below
+       1e-3 of the gradient scale */
+    double tol_sum = IS_FLOAT ? 1e-6 : 1e-13, tol_fd = IS_FLOAT ? 2e-3 : 1e-6;
+    REQUIRE(eval(ctx, p, w, g) == FRM_OK);
+    for (i = 0; i < count; i++) {
+        sw += w[i];
+        for (k = 0; k < 3; k++) {
+            sg[k] += g[3 * i + k];
+            gscale += fabs(g[3 * i + k]);
+            xr[k] += w[i] * frames[3 * i + k];
+            for (j = 0; j < 3; j++) J[3 * k + j] += frames[3 * i + k] * g[3 * i + j];
+        }
+    }
+    CHECK_NEAR(1.0, sw, tol_sum * count);
+    for (k = 0; k < 3; k++) CHECK_NEAR(0.0, sg[k], tol_sum * gscale);
+    for (k = 0; k < 3; k++) { /* gradients against central differences */
+        double pp[3], pm[3];
+        for (j = 0; j < 3; j++) pp[j] = pm[j] = p[j];
+        pp[k] += h;
+        pm[k] -= h;
+        REQUIRE(eval(ctx, pp, wp, gp) == FRM_OK);
+        REQUIRE(eval(ctx, pm, wm, gm) == FRM_OK);
+        for (i = 0; i < count; i++) {
+            double fd = ((double)wp[i] - wm[i]) / (2 * h), e = fabs(fd - g[3 * i + k]);
+            if (e > worst) worst = e;
+        }
+    }
+    if (worst > tol_fd * gscale) printf("    %s: FD gradient error %.3g of scale %.3g\n", name, worst, gscale);
+    CHECK(worst <= tol_fd * gscale);
+    if (linear) {
+        double scale = fabs(p[0]) + fabs(p[1]) + fabs(p[2]) + 1;
+        for (k = 0; k < 3; k++) CHECK_NEAR(p[k], xr[k], (IS_FLOAT ? 1e-5 : 1e-12) * scale * count);
+        for (k = 0; k < 9; k++) CHECK_NEAR(k % 4 == 0 ? 1.0 : 0.0, J[k], (IS_FLOAT ? 1e-4 : 1e-11) * count);
+    }
+}
+
+typedef struct shape_ctx {
+    frm_real frames[3 * 64];
+    int count;
+    double power, radius;
+} shape_ctx;
+
+static int eval_tet(const void *c, const double p[3], frm_real *w, frm_real *g)
+{
+    frm_real pt[3] = {(frm_real)p[0], (frm_real)p[1], (frm_real)p[2]};
+    return frm_shape_tet(((const shape_ctx *)c)->frames, pt, w, g);
+}
+
+static int eval_shepard(const void *c, const double p[3], frm_real *w, frm_real *g)
+{
+    const shape_ctx *s = (const shape_ctx *)c;
+    frm_real pt[3] = {(frm_real)p[0], (frm_real)p[1], (frm_real)p[2]};
+    return frm_shape_shepard(s->frames, s->count, pt, (frm_real)s->power, (frm_real)s->radius, w, g);
+}
+
+static int eval_mls(const void *c, const double p[3], frm_real *w, frm_real *g)
+{
+    const shape_ctx *s = (const shape_ctx *)c;
+    frm_real pt[3] = {(frm_real)p[0], (frm_real)p[1], (frm_real)p[2]};
+    return frm_shape_mls(s->frames, s->count, pt, (frm_real)s->radius, w, g);
+}
+
+static void test_shape_tet(void)
+{
+    shape_ctx c;
+    double X[12] = {0.1, 0.2, -0.1, 1.3, 0.1, 0.2, 0.2, 1.1, 0.0, 0.3, 0.4, 0.9}, p[3] = {0.45, 0.4, 0.3};
+    int i;
+    frm_real w[4], g[12], flat[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    for (i = 0; i < 12; i++) c.frames[i] = (frm_real)X[i];
+    c.count = 4;
+    check_shape("tet", eval_tet, &c, X, 4, p, 1, IS_FLOAT ? 1e-2 : 1e-5);
+    { /* the weights at a corner are the Kronecker delta */
+        frm_real pt[3] = {c.frames[6], c.frames[7], c.frames[8]};
+        REQUIRE(frm_shape_tet(c.frames, pt, w, g) == FRM_OK);
+        CHECK_NEAR(1.0, w[2], 1e-5);
+        CHECK_NEAR(0.0, w[0], 1e-5);
+    }
+    CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_shape_tet(flat, c.frames, w, g));
+}
+
+static void test_shape_hex(void)
+{
+    /* a distorted hexahedron; the gradients w.r.t. x are checked through xi by the chain
+       rule, dN/dxi_k = grad N . dx/dxi_k, both sides by central differences in xi */
+    frm_real C[24], w[8], g[24], wp[8], gp[24], wm[8], gm[24], pt[3], pp[3], pm[3], det, xi[3] = {0.3f, 0.6f, 0.45f};
+    double h = IS_FLOAT ? 1e-2 : 1e-5, worst = 0, gs = 0, sw = 0, rep[3] = {0, 0, 0}, J[9] = {0};
+    unsigned seed = 7;
+    int a, k, j;
+    for (a = 0; a < 8; a++)
+        for (k = 0; k < 3; k++) C[3 * a + k] = (frm_real)(((a >> k) & 1) * (k == 0 ? 2.0 : 1.0) + 0.15 * rnd(&seed));
+    REQUIRE(frm_shape_hex(C, xi, pt, w, g, &det) == FRM_OK);
+    CHECK(det > 0);
+    for (a = 0; a < 8; a++) {
+        sw += w[a];
+        for (k = 0; k < 3; k++) {
+            gs += fabs(g[3 * a + k]);
+            rep[k] += w[a] * C[3 * a + k];
+            for (j = 0; j < 3; j++) J[3 * k + j] += C[3 * a + k] * g[3 * a + j];
+        }
+    }
+    CHECK_NEAR(1.0, sw, 10 * EPS);
+    for (k = 0; k < 3; k++) CHECK_NEAR(pt[k], rep[k], 100 * EPS);
+    for (k = 0; k < 9; k++) CHECK_NEAR(k % 4 == 0 ? 1.0 : 0.0, J[k], 1000 * EPS);
+    for (k = 0; k < 3; k++) {
+        frm_real xp[3], xm[3];
+        for (j = 0; j < 3; j++) xp[j] = xm[j] = xi[j];
+        xp[k] += (frm_real)h;
+        xm[k] -= (frm_real)h;
+        REQUIRE(frm_shape_hex(C, xp, pp, wp, gp, &det) == FRM_OK);
+        REQUIRE(frm_shape_hex(C, xm, pm, wm, gm, &det) == FRM_OK);
+        for (a = 0; a < 8; a++) {
+            double dn = ((double)wp[a] - wm[a]) / (2 * h), chain = 0;
+            for (j = 0; j < 3; j++) chain += g[3 * a + j] * ((double)pp[j] - pm[j]) / (2 * h);
+            if (fabs(dn - chain) > worst) worst = fabs(dn - chain);
+        }
+    }
+    /* float: h = 1e-2 leaves h^2 truncation (the functions are quadratic along a line
+       through a distorted cell) and eps/h rounding, both near 1e-4 of the scale */
+    CHECK(worst <= (IS_FLOAT ? 2e-3 : 1e-8) * gs);
+    { /* an inverted hexahedron is refused */
+        frm_real B[24];
+        for (a = 0; a < 24; a++) B[a] = C[a];
+        for (a = 0; a < 8; a++) B[3 * a] = -B[3 * a];
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_shape_hex(B, xi, pt, w, g, &det));
+    }
+}
+
+/* Shepard (both supports) and MLS on a cloud of 10 frames around a point. */
+static void test_shape_meshless(void)
+{
+    shape_ctx c;
+    double X[30], p[3] = {0.05, -0.1, 0.12};
+    frm_real w[16], g[48], flat[30];
+    unsigned seed = 11;
+    int i, k;
+    for (i = 0; i < 10; i++)
+        for (k = 0; k < 3; k++) {
+            X[3 * i + k] = 0.6 * rnd(&seed);
+            c.frames[3 * i + k] = (frm_real)X[3 * i + k];
+        }
+    c.count = 10;
+    c.power = 2;
+    c.radius = 0;
+    check_shape("shepard 1/d^2", eval_shepard, &c, X, 10, p, 0, IS_FLOAT ? 1e-3 : 1e-6);
+    c.power = 3;
+    c.radius = 1.2;
+    check_shape("shepard radius", eval_shepard, &c, X, 10, p, 0, IS_FLOAT ? 1e-3 : 1e-6);
+    c.radius = 1.3;
+    check_shape("mls", eval_mls, &c, X, 10, p, 1, IS_FLOAT ? 1e-3 : 1e-6);
+    /* Shepard is zero order only: it does not reproduce x (the reason the test above
+       asks MLS alone for linear reproduction) */
+    {
+        double xr = 0;
+        c.power = 2;
+        c.radius = 0;
+        REQUIRE(eval_shepard(&c, p, w, g) == FRM_OK);
+        for (i = 0; i < 10; i++) xr += w[i] * X[3 * i];
+        CHECK(fabs(xr - p[0]) > 1e-3);
+    }
+    /* on a frame: weight 1 there */
+    REQUIRE(frm_shape_shepard(c.frames, 10, c.frames + 9, 2, 0, w, g) == FRM_OK);
+    CHECK_NEAR(1.0, w[3], 0);
+    CHECK_NEAR(0.0, g[9], 0);
+    /* coplanar frames: Shepard works, MLS is refused (singular moment matrix) */
+    for (i = 0; i < 30; i++) flat[i] = i % 3 == 2 ? 0 : c.frames[i];
+    {
+        frm_real pt[3] = {0.05f, -0.1f, 0};
+        CHECK_INT(FRM_OK, frm_shape_shepard(flat, 10, pt, 2, 0, w, g));
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_shape_mls(flat, 10, pt, (frm_real)1.3, w, g));
+    }
+    /* coincident frames, no frame in the radius */
+    {
+        frm_real two[6] = {0, 0, 0, 0, 0, 0}, pt[3] = {1, 0, 0};
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_shape_shepard(two, 2, pt, 2, 0, w, g));
+        two[3] = 0.5f;
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_shape_shepard(two, 2, pt, 2, (frm_real)0.2, w, g));
+    }
+}
+
+/* ---- forces and stiffness ----------------------------------------------------------- */
+
+/* Largest |component| of a 6n vector, forces and torques separately (units differ). */
+static void max_abs(const frm_real *f, int n, double *fmax, double *tmax)
+{
+    int i, k;
+    *fmax = *tmax = 0;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) {
+            if (fabs(f[6 * i + k]) > *fmax) *fmax = fabs(f[6 * i + k]);
+            if (fabs(f[6 * i + 3 + k]) > *tmax) *tmax = fabs(f[6 * i + 3 + k]);
+        }
+}
+
+/* Moves every frame by the generalized step t * v (x += t v_x, q = exp(t v_theta) q). */
+static void move_poses(frm_model *m, const frm_real *x0, const frm_real *q0, const double *v, double t)
+{
+    int n = frm_model_frame_count(m), i, k;
+    frm_real *x = alloc_reals(3 * n), *q = alloc_reals(4 * n);
+    memcpy(q, q0, sizeof(frm_real) * 4 * (size_t)n);
+    for (i = 0; i < n; i++) {
+        double th[3];
+        for (k = 0; k < 3; k++) {
+            x[3 * i + k] = (frm_real)((double)x0[3 * i + k] + t * v[6 * i + k]);
+            th[k] = t * v[6 * i + 3 + k];
+        }
+        rotate_quat(q + 4 * i, th);
+    }
+    frm_model_set_poses(m, x, q);
+    free(x);
+    free(q);
+}
+
+/* R6: a rigid motion (90 degrees about a skew axis, then (1e3, -2e3, 5e2) m) leaves every
+   F a rotation and every force zero, relative to the forces of a 1 % stretch. h: the
+   scene's frame spacing (the float tolerance is the rounding of the far positions over it). */
+static void check_rigid(scene *sc, double h, const char *name)
+{
+    frm_model *m = sc->m;
+    int n = frm_model_frame_count(m), S = frm_model_sample_count(m), i, k, s;
+    frm_real *x0, *q0, *x, *q;
+    const frm_real *f, *F;
+    double axis[3] = {1, 2, -2}, t[3] = {1e3, -2e3, 5e2}, Q[9], qr[4], ref_f, ref_t, fm, tm, worst_rot = 0;
+    double tol;
+    get_poses(m, &x0, &q0);
+    x = alloc_reals(3 * n);
+    q = alloc_reals(4 * n);
+    /* reference: 1 % stretch about the origin */
+    for (i = 0; i < 3 * n; i++) x[i] = (frm_real)(1.01 * x0[i]);
+    REQUIRE(frm_model_set_poses(m, x, q0) == FRM_OK);
+    REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+    max_abs(f, n, &ref_f, &ref_t);
+    REQUIRE(ref_f > 0);
+    ref_t = ref_f * h; /* a symmetric stretch has (nearly) no torques: use force x spacing */
+    for (k = 0; k < 3; k++) axis[k] *= (3.14159265358979323846 / 2) / 3.0; /* |axis| = 3 */
+    q_exp(axis, qr);
+    q_matrix(qr, Q);
+    for (i = 0; i < n; i++) {
+        for (k = 0; k < 3; k++)
+            x[3 * i + k] = (frm_real)(Q[3 * k] * x0[3 * i] + Q[3 * k + 1] * x0[3 * i + 1] + Q[3 * k + 2] * x0[3 * i + 2] + t[k]);
+        memcpy(q + 4 * i, q0 + 4 * i, 4 * sizeof(frm_real));
+        rotate_quat(q + 4 * i, axis);
+    }
+    REQUIRE(frm_model_set_poses(m, x, q) == FRM_OK);
+    F = frm_model_deformation_gradients(m);
+    for (s = 0; s < S; s++) { /* F^T F = I */
+        const frm_real *A = F + 9 * s;
+        int r, c;
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) {
+                double e = A[r] * A[c] + A[3 + r] * A[3 + c] + A[6 + r] * A[6 + c] - (r == c);
+                if (fabs(e) > worst_rot) worst_rot = fabs(e);
+            }
+    }
+    REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+    max_abs(f, n, &fm, &tm);
+    /* the round-off of positions 2e3 m from the origin (2.3e3 eps) over the spacing h is
+       the strain error, compared with the 1e-2 strain of the reference; a factor 2 covers
+       the sums. It is what float can store (0.3 of the reference force) and 6e-10 in
+       double. */
+    tol = 2 * EPS * 3e3 / h;
+    printf("    %s: |F^T F - I| %.2g, rigid force / 1%% stretch force %.2g, torque %.2g (tol %.2g)\n", name,
+           worst_rot, fm / ref_f, tm / ref_t, tol / 1e-2);
+    CHECK(worst_rot <= tol);
+    CHECK(fm <= tol / 1e-2 * ref_f);
+    CHECK(tm <= tol / 1e-2 * ref_t);
+    frm_model_set_poses(m, x0, q0);
+    free(x0);
+    free(q0);
+    free(x);
+    free(q);
+}
+
+static void test_rigid_motion_r6(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5}, blo[3] = {0, 0, 0}, bhi[3] = {1, 0.6, 0.4};
+    scene sc;
+    int law;
+    for (law = 0; law < 2; law++) {
+        REQUIRE(scene_hex(&sc, lo, hi, 4, 2, 2, 2, (frm_law)law, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+        check_rigid(&sc, 0.25, law ? "hex, Neo-Hookean" : "hex, SVK");
+        scene_free(&sc);
+    }
+    REQUIRE(scene_tet(&sc, 3, 2, 2, 1, 0.6, 0.6, 4, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3) == FRM_OK);
+    check_rigid(&sc, 0.3, "tets, Neo-Hookean");
+    scene_free(&sc);
+    REQUIRE(scene_box(&sc, blo, bhi, 0.25, 0.12, FRM_SHAPE_SHEPARD, 6, FRM_LAW_SVK, 1e5, 0.3) == FRM_OK);
+    check_rigid(&sc, 0.25, "meshless Shepard");
+    scene_free(&sc);
+    REQUIRE(scene_box(&sc, blo, bhi, 0.25, 0.12, FRM_SHAPE_MLS, 10, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3) == FRM_OK);
+    check_rigid(&sc, 0.25, "meshless MLS");
+    scene_free(&sc);
+}
+
+/* Forces equal minus the central-difference gradient of an independent energy, for every
+   degree of freedom of a few frames, translations and rotations, in a deformed state. */
+static void check_force_gradient(scene *sc, const char *name)
+{
+    frm_model *m = sc->m;
+    int n = frm_model_frame_count(m), i, k, checked = 0;
+    frm_real *x0, *q0, *f;
+    const frm_real *fp;
+    double *v, fscale = 0, tscale = 0, worst_f = 0, worst_t = 0, h;
+    frm_energies en;
+    REQUIRE(frm_model_energy(m, &en) == FRM_OK);
+    CHECK_REL(independent_energy(sc), en.elastic, IS_FLOAT ? 1e-4 : 1e-10);
+    get_poses(m, &x0, &q0);
+    REQUIRE(frm_model_forces(m, &fp) == FRM_OK);
+    f = alloc_reals(6 * n);
+    memcpy(f, fp, sizeof(frm_real) * 6 * (size_t)n);
+    max_abs(f, n, &fscale, &tscale);
+    v = (double *)calloc((size_t)6 * n, sizeof(double));
+    /* h: central differences err by h^2 (curvature of the energy) and by eps W / h */
+    h = IS_FLOAT ? 1e-3 : 1e-6;
+    for (i = 0; i < n; i += (n > 8 ? n / 7 : 1))
+        for (k = 0; k < 6; k++) {
+            double Wp, Wm, fd;
+            v[6 * i + k] = 1;
+            move_poses(m, x0, q0, v, h);
+            Wp = independent_energy(sc);
+            move_poses(m, x0, q0, v, -h);
+            Wm = independent_energy(sc);
+            v[6 * i + k] = 0;
+            fd = -(Wp - Wm) / (2 * h);
+            if (k < 3 && fabs(fd - f[6 * i + k]) > worst_f) worst_f = fabs(fd - f[6 * i + k]);
+            if (k >= 3 && fabs(fd - f[6 * i + k]) > worst_t) worst_t = fabs(fd - f[6 * i + k]);
+            checked++;
+        }
+    printf("    %s: %d dof, force error %.2g of %.2g, torque error %.2g of %.2g\n", name, checked, worst_f, fscale, worst_t,
+           tscale);
+    /* float: the moved poses are stored in float, so the energy differences carry rounding
+       of about eps W / h; 2e-2 of the largest component covers it */
+    CHECK(worst_f <= (IS_FLOAT ? 2e-2 : 1e-6) * fscale);
+    CHECK(worst_t <= (IS_FLOAT ? 2e-2 : 1e-6) * tscale);
+    frm_model_set_poses(m, x0, q0);
+    free(x0);
+    free(q0);
+    free(f);
+    free(v);
+}
+
+static void test_force_is_minus_energy_gradient(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5}, blo[3] = {0, 0, 0}, bhi[3] = {1, 0.6, 0.4};
+    scene sc;
+    int law;
+    for (law = 0; law < 2; law++) {
+        REQUIRE(scene_hex(&sc, lo, hi, 2, 2, 1, 2, (frm_law)law, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+        perturb(sc.m, 0.04, 0.15, 3 + law);
+        check_force_gradient(&sc, law ? "hex NH" : "hex SVK");
+        scene_free(&sc);
+    }
+    REQUIRE(scene_tet(&sc, 2, 1, 1, 1, 0.5, 0.5, 4, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3) == FRM_OK);
+    perturb(sc.m, 0.03, 0.2, 5);
+    check_force_gradient(&sc, "tet NH");
+    scene_free(&sc);
+    REQUIRE(scene_box(&sc, blo, bhi, 0.3, 0.15, FRM_SHAPE_MLS, 10, FRM_LAW_SVK, 1e5, 0.3) == FRM_OK);
+    perturb(sc.m, 0.02, 0.1, 9);
+    check_force_gradient(&sc, "MLS SVK");
+    scene_free(&sc);
+}
+
+/* K v (exact) against central differences of the force along v, and the symmetric part
+   against the energy's second difference along v and against symmetry u.Kv = v.Ku. The
+   gravity term is included: the total force and the total potential. */
+static void check_stiffness(scene *sc, const char *name, unsigned seed)
+{
+    frm_model *m = sc->m;
+    int n = frm_model_frame_count(m), i, trial;
+    frm_real *x0, *q0, *fp, *fm, *Kv, *Ku, *vr, *ur;
+    const frm_real *f;
+    double *v, h = IS_FLOAT ? 3e-3 : 1e-6, worst = 0, scale = 0, worst_q = 0, worst_sym = 0, qscale = 0;
+    get_poses(m, &x0, &q0);
+    v = (double *)calloc((size_t)6 * n, sizeof(double));
+    vr = alloc_reals(6 * n);
+    ur = alloc_reals(6 * n);
+    Kv = alloc_reals(6 * n);
+    Ku = alloc_reals(6 * n);
+    fp = alloc_reals(6 * n);
+    fm = alloc_reals(6 * n);
+    for (trial = 0; trial < 3; trial++) {
+        double E0, Ep, Em, q2, vKu, uKv;
+        frm_energies en;
+        /* trial 0: translations only, 1: rotations only, 2: both */
+        for (i = 0; i < 6 * n; i++) {
+            int rot = i % 6 >= 3;
+            v[i] = (trial == 0 && rot) || (trial == 1 && !rot) ? 0 : rnd(&seed);
+            vr[i] = (frm_real)v[i];
+            ur[i] = (frm_real)rnd(&seed);
+        }
+        frm_model_set_poses(m, x0, q0);
+        REQUIRE(frm_model_prepare_stiffness(m) == FRM_OK);
+        REQUIRE(frm_model_apply_stiffness(m, vr, Kv, 0) == FRM_OK);
+        move_poses(m, x0, q0, v, h);
+        REQUIRE(frm_model_total_forces(m, &f) == FRM_OK);
+        memcpy(fp, f, sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(frm_model_energy(m, &en) == FRM_OK);
+        Ep = en.elastic + en.gravitational;
+        move_poses(m, x0, q0, v, -h);
+        REQUIRE(frm_model_total_forces(m, &f) == FRM_OK);
+        memcpy(fm, f, sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(frm_model_energy(m, &en) == FRM_OK);
+        Em = en.elastic + en.gravitational;
+        frm_model_set_poses(m, x0, q0);
+        REQUIRE(frm_model_energy(m, &en) == FRM_OK);
+        E0 = en.elastic + en.gravitational;
+        for (i = 0; i < 6 * n; i++) {
+            double fd = -((double)fp[i] - fm[i]) / (2 * h);
+            if (fabs(fd - Kv[i]) > worst) worst = fabs(fd - Kv[i]);
+            if (fabs(Kv[i]) > scale) scale = fabs(Kv[i]);
+        }
+        /* the symmetric part: v.K_sym v = second difference of the energy */
+        REQUIRE(frm_model_prepare_stiffness(m) == FRM_OK);
+        REQUIRE(frm_model_apply_stiffness(m, vr, Kv, 1) == FRM_OK);
+        REQUIRE(frm_model_apply_stiffness(m, ur, Ku, 1) == FRM_OK);
+        q2 = 0;
+        vKu = uKv = 0;
+        for (i = 0; i < 6 * n; i++) {
+            q2 += v[i] * Kv[i];
+            vKu += vr[i] * Ku[i];
+            uKv += ur[i] * Kv[i];
+        }
+        if (fabs((Ep - 2 * E0 + Em) / (h * h) - q2) > worst_q) worst_q = fabs((Ep - 2 * E0 + Em) / (h * h) - q2);
+        if (fabs(q2) > qscale) qscale = fabs(q2);
+        if (fabs(vKu - uKv) > worst_sym) worst_sym = fabs(vKu - uKv);
+    }
+    printf("    %s: K v vs FD %.2g of %.2g; v.Kv vs energy %.2g of %.2g; asymmetry %.2g\n", name, worst, scale, worst_q,
+           qscale, worst_sym);
+    /* double: central differences (h^2 times the third derivative, eps f / h); float: the
+       poses and forces are float, so the quotient loses about eps f / h */
+    CHECK(worst <= (IS_FLOAT ? 3e-2 : 1e-5) * scale);
+    /* the energy's second difference loses eps E / h^2: only in double is it sharp */
+    CHECK(worst_q <= (IS_FLOAT ? 0.5 : 1e-4) * qscale);
+    CHECK(worst_sym <= (IS_FLOAT ? 1e-3 : 1e-9) * qscale);
+    frm_model_set_poses(m, x0, q0);
+    free(x0);
+    free(q0);
+    free(v);
+    free(vr);
+    free(ur);
+    free(Kv);
+    free(Ku);
+    free(fp);
+    free(fm);
+}
+
+static void test_stiffness_is_minus_force_derivative(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5}, blo[3] = {0, 0, 0}, bhi[3] = {1, 0.6, 0.4};
+    scene sc;
+    int law, mode;
+    for (law = 0; law < 2; law++)
+        for (mode = 1; mode <= 2; mode++) {
+            char name[64];
+            REQUIRE(scene_hex(&sc, lo, hi, 2, 2, 1, 2, (frm_law)law, 1e5, 0.3, 1000, (frm_stiffness_mode)mode) == FRM_OK);
+            /* at rest: only the material part (S = 0) and gravity's torque */
+            snprintf(name, sizeof name, "%s %s at rest", law ? "NH" : "SVK", mode == 1 ? "pairs" : "blocks");
+            check_stiffness(&sc, name, 21);
+            /* deformed, stressed: material and geometric parts */
+            perturb(sc.m, 0.05, 0.2, 4 + law);
+            snprintf(name, sizeof name, "%s %s deformed", law ? "NH" : "SVK", mode == 1 ? "pairs" : "blocks");
+            check_stiffness(&sc, name, 22);
+            scene_free(&sc);
+        }
+    REQUIRE(scene_box(&sc, blo, bhi, 0.3, 0.15, FRM_SHAPE_SHEPARD, 5, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3) == FRM_OK);
+    perturb(sc.m, 0.03, 0.2, 8);
+    check_stiffness(&sc, "Shepard NH deformed", 23);
+    scene_free(&sc);
+}
+
+static const test_case cases[] = {
+    TEST(test_shape_tet),
+    TEST(test_shape_hex),
+    TEST(test_shape_meshless),
+    TEST(test_rigid_motion_r6),
+    TEST(test_force_is_minus_energy_gradient),
+    TEST(test_stiffness_is_minus_force_derivative),
+};
+
+int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
