@@ -126,6 +126,13 @@ typedef enum frm_shape {
     FRM_SHAPE_MLS = 1      /* linear moving least squares: first order, needs 3D spread */
 } frm_shape;
 
+/* Where mesh-based samples sit in each hexahedron (frm_sampling_hexes). */
+typedef enum frm_quadrature {
+    FRM_QUADRATURE_SUBCELL = 0, /* n^3 sub-cell centres, the cell's volume split over them
+                                   (sec. 4.1: the thesis's choice; less locking, see LIMITS) */
+    FRM_QUADRATURE_GAUSS = 1    /* n^3 Gauss-Legendre points with their weights */
+} frm_quadrature;
+
 typedef enum frm_support {
     FRM_SUPPORT_NEAREST = 0, /* the k nearest frames */
     FRM_SUPPORT_RADIUS = 1   /* every frame closer than a radius */
@@ -196,6 +203,11 @@ typedef struct frm_desc {
     frm_real newton_tolerance; /* static solve: |residual| <= tol * |load|, default 1e-6
                                   (1e-4 float) */
     int newton_max_iterations; /* default 30 */
+    frm_real static_regularization; /* static solves add this times |K_ii| to each frame's
+                                       rotational diagonal inside CG (not to the forces: the
+                                       equilibrium is unchanged), default 1e-6. It fixes the
+                                       orientations the energy leaves free (see LIMITS:
+                                       invisible rotations); 0 gives the plain Newton step */
     frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
 
     /* environment */
@@ -306,12 +318,14 @@ FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point
    is left empty. ---- */
 
 /* Mesh-based, hexahedra: a frame at every node (nodes: 3 * node_count, m; every node must
-   belong to a hexahedron) and gauss^3 samples per hexahedron at its Gauss-Legendre points
-   (gauss = 1 to 4 per axis), each with the volume of its quadrature weight times
-   det(dx/dxi), and the 8 trilinear neighbours (frm_shape_hex). Hex node order as in
-   frm_shape_hex; each must be positively oriented (det > 0 at every Gauss point). */
+   belong to a hexahedron) and points^3 samples per hexahedron (points = 1 to 4 per axis)
+   with the 8 trilinear neighbours (frm_shape_hex): at the centres of points^3 equal
+   sub-cells of the parameter cube, each with the volume of its sub-cell (rule
+   FRM_QUADRATURE_SUBCELL), or at the Gauss-Legendre points with their quadrature weights
+   (FRM_QUADRATURE_GAUSS); volumes are weight * det(dx/dxi). Hex node order as in
+   frm_shape_hex; each must be positively oriented (det > 0 at every sample). */
 FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node_count, const int *hexes,
-                              int hex_count, int gauss, const frm_allocator *allocator);
+                              int hex_count, int points, frm_quadrature rule, const frm_allocator *allocator);
 /* Mesh-based, tetrahedra: a frame at every node and `points` samples per tetrahedron at
    the barycentric coordinates `barycentric` (4 per point, summing to 1), or, when it is
    NULL, at the symmetric Gauss points for points = 1 (centroid) or 4 (degree 2); the
@@ -921,6 +935,8 @@ struct frm_model {
     frm_real cg_tolerance, newton_tolerance;
     int cg_max_iterations, newton_max_iterations, cg_fail_at_cap;
     int stiffness_mode, has_blocks;
+    double regularization, solve_regularization; /* static solves: eps added to K's rotational diagonal */
+    double newton_previous;                      /* |f| at the previous Newton iteration */
 
     /* frames */
     frm_real *pos, *quat, *vel;                /* 3, 4, 6 */
@@ -1225,8 +1241,9 @@ static int frm__validate_settings(const frm_desc *d)
         !(frm__finite((double)d->stiffness_damping) && d->stiffness_damping >= 0))
         return frm__fail(d, FRM_ERR_DAMPING, "damping");
     if (!(frm__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
-        !(frm__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_max_iterations < 1)
-        return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances and caps");
+        !(frm__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_max_iterations < 1 ||
+        !(frm__finite((double)d->static_regularization) && d->static_regularization >= 0))
+        return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -1375,6 +1392,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.cg_fail_at_cap = 1;
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
+    d.static_regularization = (frm_real)1e-6;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.internal_cookie = FRM__COOKIE;
     return d;
@@ -1587,6 +1605,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->newton_tolerance = d->newton_tolerance;
     m->newton_max_iterations = d->newton_max_iterations;
     m->stiffness_mode = d->stiffness_mode;
+    m->regularization = (double)d->static_regularization;
 
     /* frames */
     memcpy(m->rest_pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
@@ -1883,17 +1902,26 @@ static void frm__block_chunks(void *vctx, int begin, int end)
         int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
         if (i1 > m->frame_count) i1 = m->frame_count;
         for (i = i0; i < i1; i++) {
-            double y[6] = {0, 0, 0, 0, 0, 0};
-            int e, r, k;
+            frm_real y0 = 0, y1 = 0, y2 = 0, y3 = 0, y4 = 0, y5 = 0; /* six independent chains */
+            int e, k;
             for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
                 const frm_real *K = m->blocks + 36 * (size_t)e, *x = ctx->src + 6 * m->blk_col[e];
-                for (r = 0; r < 6; r++) {
-                    frm_real t = 0;
-                    for (k = 0; k < 6; k++) t += K[6 * r + k] * x[k];
-                    y[r] += (double)t;
+                for (k = 0; k < 6; k++) {
+                    frm_real xk = x[k];
+                    y0 += K[k] * xk;
+                    y1 += K[6 + k] * xk;
+                    y2 += K[12 + k] * xk;
+                    y3 += K[18 + k] * xk;
+                    y4 += K[24 + k] * xk;
+                    y5 += K[30 + k] * xk;
                 }
             }
-            for (r = 0; r < 6; r++) ctx->dst[6 * i + r] = (frm_real)y[r];
+            ctx->dst[6 * i] = y0;
+            ctx->dst[6 * i + 1] = y1;
+            ctx->dst[6 * i + 2] = y2;
+            ctx->dst[6 * i + 3] = y3;
+            ctx->dst[6 * i + 4] = y4;
+            ctx->dst[6 * i + 5] = y5;
         }
     }
 }
@@ -2159,6 +2187,7 @@ static void frm__build_precond(frm_model *m, double a_mass, double a_stiff)
         }
         frm__mass_matrix(m, i, M);
         for (k = 0; k < 36; k++) A[k] = a_mass * M[k] + a_stiff * (double)m->kdiag[36 * (size_t)i + k];
+        for (k = 3; k < 6; k++) A[7 * k] += a_stiff * m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]);
         if (!frm__invert6(A, inv)) {
             for (k = 0; k < 36; k++) inv[k] = 0;
             for (k = 0; k < 6; k++) inv[7 * k] = fabs(A[7 * k]) > 0 ? 1.0 / fabs(A[7 * k]) : 0.0;
@@ -2180,8 +2209,11 @@ static void frm__system_product(frm_model *m, double a_mass, double a_stiff, con
             for (k = 0; k < 6; k++) out[6 * i + k] = 0;
             continue;
         }
+        double reg[6] = {0, 0, 0, 0, 0, 0};
         if (a_mass != 0) frm__mass_apply(m, i, v + 6 * i, mv);
-        for (k = 0; k < 6; k++) out[6 * i + k] = (frm_real)(a_stiff * (double)out[6 * i + k] + a_mass * mv[k]);
+        if (m->solve_regularization != 0)
+            for (k = 3; k < 6; k++) reg[k] = m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]) * v[6 * i + k];
+        for (k = 0; k < 6; k++) out[6 * i + k] = (frm_real)(a_stiff * ((double)out[6 * i + k] + reg[k]) + a_mass * mv[k]);
     }
 }
 
@@ -2216,7 +2248,7 @@ static double frm__dot(const frm_model *m, const frm_real *a, const frm_real *b)
    on a direction of non-positive curvature (x then holds the last iterate, or the
    preconditioned residual if that happened at once). The vector work is serial, in a
    fixed order. */
-static int frm__cg(frm_model *m, double a_mass, double a_stiff, frm_real *b, frm_real *x)
+static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
     frm_real *r = m->vec[FRM__V_R], *z = m->vec[FRM__V_Z], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
     int i, k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
@@ -2232,7 +2264,7 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, frm_real *b, frm
         memset(x, 0, sizeof(frm_real) * (size_t)n6);
         return FRM__CG_OK;
     }
-    tol2 = (double)m->cg_tolerance * (double)m->cg_tolerance * bb;
+    tol2 = tolerance * tolerance * bb;
     if (nonzero) {
         frm__system_product(m, a_mass, a_stiff, x, q);
         for (k = 0; k < n6; k++) r[k] = b[k] - q[k];
@@ -2337,8 +2369,8 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
 static int frm__newton_iteration(frm_model *m, double *ref, int *converged, double *res)
 {
     frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X];
-    double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise;
-    int err, h, i, r, accepted = 0;
+    double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta;
+    int err, h, i, r, accepted = 0, first = *ref < 0;
     *converged = 0;
     err = frm__force_pass(m, 1, 0, &W0);
     if (err) return err;
@@ -2358,9 +2390,17 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
         return FRM_OK;
     }
     frm__prepare_mode(m, frm__choose_mode(m));
+    m->solve_regularization = m->regularization;
     frm__build_precond(m, 0.0, 1.0);
     memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
-    frm__cg(m, 0.0, 1.0, f, dq); /* a capped or truncated solve still gives a descent direction */
+    /* inexact Newton (Eisenstat-Walker): solve as accurately as the step can use */
+    eta = first ? 1e-3 : (norm / m->newton_previous) * (norm / m->newton_previous);
+    if (eta > 1e-3) eta = 1e-3;
+    if (eta < 0.1 * (double)m->newton_tolerance * *ref / norm) eta = 0.1 * (double)m->newton_tolerance * *ref / norm;
+    if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
+    m->newton_previous = norm;
+    frm__cg(m, 0.0, 1.0, eta, f, dq); /* a capped or truncated solve still gives a descent direction */
+    m->solve_regularization = 0;
     slope = frm__dot(m, f, dq);
     if (!(slope > 0) || !frm__all_finite(dq, 6 * (size_t)m->frame_count)) { /* not a descent direction */
         frm__precond_apply(m, f, dq);
@@ -2533,7 +2573,7 @@ static int frm__implicit_step(frm_model *m, double dt)
         for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
     }
     memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
-    cg = frm__cg(m, a_mass, a_stiff, b, dv);
+    cg = frm__cg(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
     if ((cg == FRM__CG_CAP && m->cg_fail_at_cap) || cg == FRM__CG_NEGATIVE) {
         frm__restore_state(m);
         return FRM_ERR_NO_CONVERGENCE;
@@ -3316,7 +3356,7 @@ static void frm__gauss(int n, double *x, double *w)
 }
 
 FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node_count, const int *hexes, int hex_count,
-                              int gauss, const frm_allocator *allocator)
+                              int gauss, frm_quadrature rule, const frm_allocator *allocator)
 {
     double gx[4], gw[4];
     int err, h, a, b, i, j, k, r, s = 0, g3;
@@ -3324,7 +3364,8 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
     memset(out, 0, sizeof *out);
     err = frm__check_mesh(nodes, node_count, hexes, hex_count, 8);
     if (err) return err;
-    if (gauss < 1 || gauss > 4) return FRM_ERR_SAMPLING;
+    if (gauss < 1 || gauss > 4 || ((int)rule != FRM_QUADRATURE_SUBCELL && (int)rule != FRM_QUADRATURE_GAUSS))
+        return FRM_ERR_SAMPLING;
     g3 = gauss * gauss * gauss;
     if ((long long)hex_count * g3 * 8 > 2000000000LL) return FRM_ERR_SAMPLING;
     for (h = 0; h < hex_count; h++)
@@ -3334,7 +3375,12 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
     err = frm__sampling_alloc(out, node_count, hex_count * g3, hex_count * g3 * 8, allocator);
     if (err) return err;
     memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
-    frm__gauss(gauss, gx, gw);
+    if (rule == FRM_QUADRATURE_GAUSS) frm__gauss(gauss, gx, gw);
+    else
+        for (i = 0; i < gauss; i++) {
+            gx[i] = (i + 0.5) / gauss;
+            gw[i] = 1.0 / gauss;
+        }
     for (h = 0; h < hex_count; h++) {
         double X[8][3];
         for (a = 0; a < 8; a++)

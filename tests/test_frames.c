@@ -126,7 +126,7 @@ static int scene_hex(scene *sc, const double lo[3], const double hi[3], int nx, 
     if (hexmesh_grid(&h, lo, hi, nx, ny, nz) != TETMESH_OK) return -1;
     x = alloc_reals(3 * h.node_count);
     for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
-    err = frm_sampling_hexes(&sc->s, x, h.node_count, h.hexes, h.hex_count, gauss, NULL);
+    err = frm_sampling_hexes(&sc->s, x, h.node_count, h.hexes, h.hex_count, gauss, FRM_QUADRATURE_GAUSS, NULL);
     free(x);
     hexmesh_free(&h);
     if (err) {
