@@ -183,7 +183,7 @@
                              step: the fastest, and the paper's. Conditionally stable:
                              dt below about h / c with c = sqrt((lambda + 2 mu) / rho) and
                              h the smallest tetrahedron altitude (heml_stable_time_step
-                             estimates it). Use it for soft tissue with small steps
+                             returns half of that). Use it for soft tissue with small steps
                              (haptics at 1 kHz), or when the step is small anyway.
        HEML_IMPLICIT_EULER   backward Euler by Newton (desc.newton_iterations, default 1:
                              the linearly implicit step), each iteration solving
@@ -491,7 +491,7 @@ HEMLDEF heml_desc heml_default_desc(void);
 /* A material of the given law whose small-strain response is that of Young's modulus E
    (Pa) and Poisson ratio nu: SVK and eq. 26 take mu, lambda; the incompressible forms
    c1 = mu/2 (Neo-Hookean) or c1 = c2 = mu/4 and kappa = K - 4 (c1 + 4 c2) / 3 (which
-   needs nu > 1/3 for Mooney-Rivlin); the split Mooney-Rivlin c1 = c2 = mu/4, kappa = K;
+   needs nu > 1/4 for Mooney-Rivlin); the split Mooney-Rivlin c1 = c2 = mu/4, kappa = K;
    springs E. Density 1000 kg/m^3, no Prony terms. Invalid E or nu give constants that
    heml_create refuses. */
 HEMLDEF heml_material heml_material_from_young(heml_law law, double young_modulus,
@@ -521,6 +521,8 @@ HEMLDEF int heml_set_external_force(heml_model *m, int i, const heml_real f[3]);
 HEMLDEF void heml_clear_external_forces(heml_model *m);
 /* Gravity, m/s^2. */
 HEMLDEF int heml_set_gravity(heml_model *m, const heml_real g[3]);
+/* Mass damping coefficient (1/s, >= 0): damping force -alpha m v. */
+HEMLDEF int heml_set_mass_damping(heml_model *m, heml_real alpha);
 /* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves. */
 HEMLDEF int heml_set_solver(heml_model *m, heml_real tolerance, int max_iterations);
 /* Newton iterations per implicit step (>= 1). */
@@ -538,9 +540,11 @@ HEMLDEF int heml_step(heml_model *m);
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator);
 /* Moves the free degrees of freedom to the static equilibrium under gravity, external
    forces and the pinned axes (Newton with MINRES and a backtracking line search on the
-   residual, the fully relaxed Prony response), sets velocities to zero and the viscous
-   state to its relaxed value. On failure (HEML_ERR_NO_CONVERGENCE within
-   static_max_iterations, HEML_ERR_NOT_FINITE) the state is unchanged. */
+   residual, with adaptive load stepping when a full step fails; the fully relaxed Prony
+   response), sets velocities to zero and the viscous state to its relaxed value. On
+   failure (HEML_ERR_NO_CONVERGENCE: static_max_iterations Newton iterations per load
+   step were not enough even with steps of 1/1024 of the load; HEML_ERR_NOT_FINITE) the
+   state is unchanged. */
 HEMLDEF int heml_solve_static(heml_model *m);
 
 /* ---- kernels (for benchmarks and custom solvers) ---- */
@@ -586,9 +590,10 @@ HEMLDEF int heml_tet_volume_ratios(const heml_model *m, heml_real *out);
 HEMLDEF int heml_tet_stresses(heml_model *m, heml_stress_kind kind, heml_real *out);
 /* The same for one tetrahedron (costs a block of 16). */
 HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_real out[9]);
-/* Estimate of the largest stable semi-explicit time step, s: the smallest over the
+/* Estimate of the largest stable semi-explicit time step, s: half the smallest over the
    tetrahedra of altitude / sqrt((lambda + 2 mu) / rho) with small-strain moduli. A CFL
-   heuristic, not a guarantee (large deformations stiffen most laws). */
+   heuristic with a safety factor of about 2 (on box meshes the scheme blew up at 1.7 to
+   2.8 times it), not a guarantee: large deformations stiffen most laws. */
 HEMLDEF double heml_stable_time_step(const heml_model *m);
 /* Bytes held by the model. */
 HEMLDEF size_t heml_memory_bytes(const heml_model *m);
@@ -714,6 +719,7 @@ struct heml_model {
     heml_real *rest, *pos, *vel, *force, *ext, *target, *mass, *inv_mass;
     heml_real *free_mask, *pin_mask; /* per degree of freedom: 1 free / 1 pinned */
     heml_real *diag;                 /* per degree of freedom: small-strain stiffness diagonal */
+    double force_floor;              /* round-off level of |f|, N (see heml__static_newton) */
     unsigned char *axes;             /* pinned axes per node */
 
     /* tetrahedra, in blocks of HEML__W slots (structure of arrays inside a block) */
@@ -2132,8 +2138,9 @@ static void heml__set_masks(heml_model *m, int i)
 static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc, double *diag_acc)
 {
     int s, blk, k, j, r, l;
+    double *scale_acc = diag_acc + 3 * (size_t)m->node_count, floor2 = 0.0;
     memset(mass_acc, 0, sizeof(double) * (size_t)m->node_count);
-    memset(diag_acc, 0, sizeof(double) * 3 * (size_t)m->node_count);
+    memset(diag_acc, 0, sizeof(double) * 4 * (size_t)m->node_count);
     for (s = 0; s < m->slot_count; s++) {
         int t = m->slot_tet[s], *idx;
         heml_real *R;
@@ -2166,6 +2173,9 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             for (j = 0; j < 4; j++) {
                 double gg = g[j][0] * g[j][0] + g[j][1] * g[j][1] + g[j][2] * g[j][2];
                 mass_acc[q[j]] += mt->density * vol / 4.0;
+                /* the size of each of the terms of this tetrahedron's force on node j (they
+                   cancel at rest): Vol (lambda + 2 mu) |grad N_j| */
+                scale_acc[q[j]] += vol * (mt->small_lambda + 2.0 * mt->small_mu) * sqrt(gg);
                 for (r = 0; r < 3; r++)
                     diag_acc[3 * q[j] + r] +=
                         vol * ((mt->small_lambda + mt->small_mu) * g[j][r] * g[j][r] + mt->small_mu * gg);
@@ -2187,6 +2197,8 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             m->blk_valid[blk] = k + 1;
         }
     }
+    for (s = 0; s < m->node_count; s++) floor2 += scale_acc[s] * scale_acc[s];
+    m->force_floor = (HEML__FLOAT ? 6e-8 : 1.1e-16) * sqrt(floor2);
     for (s = 0; s < m->node_count; s++) {
         m->mass[s] = (heml_real)mass_acc[s];
         m->inv_mass[s] = mass_acc[s] > 0 ? (heml_real)(1.0 / mass_acc[s]) : (heml_real)0;
@@ -2283,12 +2295,12 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
     /* temporary: per-material counters, node stamps, chunk colours and reorder space,
        mass and diagonal accumulators */
-    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+    tmp_bytes = sizeof(double) * 5 * (size_t)n + sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
     tmp_block = heml__alloc(&alloc, tmp_bytes);
     if (!tmp_block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
     mass_acc = (double *)tmp_block;
     diag_acc = mass_acc + n;
-    counts = (int *)(diag_acc + 3 * (size_t)n);
+    counts = (int *)(diag_acc + 4 * (size_t)n);
     fill = counts + M;
     bstart = fill + M;
     stamp = bstart + M;
@@ -2686,89 +2698,108 @@ HEMLDEF int heml_step(heml_model *m)
 
 /* >>static ---------------------------------------------------------------------------- */
 
-/* R = mask (f + f_ext + M g); returns |R|. */
-static double heml__static_residual(heml_model *m, const heml_real *f, heml_real *R)
+/* R = mask (f + lambda (f_ext + M g)); returns |R|. */
+static double heml__static_residual(heml_model *m, const heml_real *f, double lambda, heml_real *R)
 {
     int i, r, n = m->node_count;
+    heml_real l = (heml_real)lambda;
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
-            R[j] = (f[j] + m->ext[j] + m->mass[i] * m->gravity[r]) * m->free_mask[j];
+            R[j] = (f[j] + l * (m->ext[j] + m->mass[i] * m->gravity[r])) * m->free_mask[j];
         }
     return sqrt(heml__dot(R, R, 3 * n));
 }
 
-/* Newton on R(x) = 0 with K delta = R (K = -df/dx) by MINRES and backtracking on |R|
-   (the exact Newton direction is a descent direction of |R|^2 even where K is
-   indefinite). The
-   reference scale of |R| is the largest of the first residual, the internal forces at
-   the start (pinned axes included: the reactions) and the applied loads. */
+/* Newton at load factor lambda from x (pinned axes already placed): K delta = R
+   (K = -df/dx) by MINRES, backtracking on |R| (the exact Newton direction is a descent
+   direction of |R|^2 even where K is indefinite). Converged when |R| is below
+   static_tolerance times the largest of the first residual, the internal forces at the
+   start (pinned axes included: the reactions) and the applied loads, or below 4 times the
+   round-off level of the forces: each tetrahedron's force is the difference of terms of
+   size Vol (lambda + 2 mu) |grad N| that cancel at rest, so |f| carries about EPS times
+   their norm whatever the deformation (in float, 1e-3 of a gravity load on stiff tissue).
+   Scratch 1..14; x is updated in place. */
+static int heml__static_newton(heml_model *m, double lambda, heml_real *x)
+{
+    heml_real *f = m->scratch[1], *R = m->scratch[2], *delta = m->scratch[3], *xt = m->scratch[4];
+    heml_real *ft = m->scratch[5], *Rt = m->scratch[6], *krylov[8];
+    int i, r, it, n3 = 3 * m->node_count;
+    double res, scale, load = 0.0;
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[7 + i];
+    heml__forces(m, x, f, 1);
+    res = heml__static_residual(m, f, lambda, R);
+    scale = sqrt(heml__dot(f, f, n3));
+    for (i = 0; i < m->node_count; i++)
+        for (r = 0; r < 3; r++) {
+            double l = lambda * ((double)m->ext[3 * i + r] + (double)m->mass[i] * m->gravity[r]) *
+                       m->free_mask[3 * i + r];
+            load += l * l;
+        }
+    if (res > scale) scale = res;
+    if (sqrt(load) > scale) scale = sqrt(load);
+    for (it = 0;; it++) {
+        double step = 1.0, res_t = 0.0;
+        int ls;
+        m->stats.static_residual = (heml_real)(scale > 0 ? res / scale : 0.0);
+        if (!heml__finite(res)) return HEML_ERR_NOT_FINITE;
+        if (res <= (double)m->static_tolerance * scale || res <= 4.0 * m->force_floor) return HEML_OK;
+        if (it == m->static_max_iterations) return HEML_ERR_NO_CONVERGENCE;
+        (void)heml__minres(m, x, R, delta, krylov);
+        m->stats.newton_iterations++;
+        for (ls = 0; ls < 12; ls++, step *= 0.5) {
+            for (i = 0; i < n3; i++) xt[i] = x[i] + (heml_real)step * delta[i];
+            heml__forces(m, xt, ft, 1);
+            res_t = heml__static_residual(m, ft, lambda, Rt);
+            if (res_t < res) break;
+        }
+        if (!(res_t < res)) /* no descent along the Newton direction */
+            return heml__finite(res_t) ? HEML_ERR_NO_CONVERGENCE : HEML_ERR_NOT_FINITE;
+        memcpy(x, xt, sizeof(heml_real) * (size_t)n3);
+        memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
+        res = res_t;
+    }
+}
+
+/* Equilibrium by load stepping: loads (gravity, external forces) and the pinned axes'
+   moves to their targets are applied with a factor lambda from 0 to 1, first in one
+   step; when Newton fails at a factor, the increment is halved from the last converged
+   one (down to 1/1024) and doubled again after a success. */
 HEMLDEF int heml_solve_static(heml_model *m)
 {
-    heml_real *x, *f, *R, *delta, *xt, *ft, *Rt, *krylov[8];
-    int i, it, n3, err = HEML_OK, converged = 0;
-    double res, scale;
+    heml_real *x, *saved;
+    int i, n3, err = HEML_OK;
+    double lambda = 0.0, increment = 1.0;
     if (!m) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * m->node_count;
     x = m->scratch[0];
-    f = m->scratch[1];
-    R = m->scratch[2];
-    delta = m->scratch[3];
-    xt = m->scratch[4];
-    ft = m->scratch[5];
-    Rt = m->scratch[6];
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[7 + i];
+    saved = m->scratch[15];
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, -1.0);
-    for (i = 0; i < n3; i++) x[i] = m->pos[i] + m->pin_mask[i] * (m->target[i] - m->pos[i]);
-    heml__forces(m, x, f, 1);
-    res = heml__static_residual(m, f, R);
-    scale = res > sqrt(heml__dot(f, f, n3)) ? res : sqrt(heml__dot(f, f, n3));
-    {
-        double load = 0.0;
-        int r;
-        for (i = 0; i < m->node_count; i++)
-            for (r = 0; r < 3; r++) {
-                double l = ((double)m->ext[3 * i + r] + (double)m->mass[i] * m->gravity[r]) * m->free_mask[3 * i + r];
-                load += l * l;
-            }
-        if (sqrt(load) > scale) scale = sqrt(load);
+    memcpy(x, m->pos, sizeof(heml_real) * (size_t)n3);
+    while (lambda < 1.0) {
+        double trial = lambda + increment > 1.0 ? 1.0 : lambda + increment;
+        heml_real t = (heml_real)trial;
+        memcpy(saved, x, sizeof(heml_real) * (size_t)n3);
+        for (i = 0; i < n3; i++)
+            if (m->pin_mask[i] > 0) x[i] = m->pos[i] + t * (m->target[i] - m->pos[i]);
+        err = heml__static_newton(m, trial, x);
+        if (err == HEML_OK) {
+            lambda = trial;
+            increment *= 2.0;
+        } else {
+            memcpy(x, saved, sizeof(heml_real) * (size_t)n3);
+            increment *= 0.5;
+            if (increment < 1.0 / 1024) break;
+        }
     }
-    for (it = 0; it <= m->static_max_iterations; it++) {
-        double step = 1.0, res_t = 0.0;
-        int ls;
-        if (!heml__finite(res)) {
-            err = HEML_ERR_NOT_FINITE;
-            break;
-        }
-        if (res <= (double)m->static_tolerance * scale) {
-            converged = 1;
-            break;
-        }
-        if (it == m->static_max_iterations) break;
-        (void)heml__minres(m, x, R, delta, krylov);
-        m->stats.newton_iterations = it + 1;
-        for (ls = 0; ls < 12; ls++, step *= 0.5) {
-            for (i = 0; i < n3; i++) xt[i] = x[i] + (heml_real)step * delta[i];
-            heml__forces(m, xt, ft, 1);
-            res_t = heml__static_residual(m, ft, Rt);
-            if (res_t < res) break;
-        }
-        if (!(res_t < res)) { /* no descent along the Newton direction: give up */
-            err = heml__finite(res_t) ? HEML_ERR_NO_CONVERGENCE : HEML_ERR_NOT_FINITE;
-            break;
-        }
-        memcpy(x, xt, sizeof(heml_real) * (size_t)n3);
-        memcpy(f, ft, sizeof(heml_real) * (size_t)n3);
-        memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
-        res = res_t;
-    }
-    m->stats.static_residual = (heml_real)(scale > 0 ? res / scale : 0.0);
-    if (err) return err;
-    if (!converged) return HEML_ERR_NO_CONVERGENCE;
+    if (lambda < 1.0) return err;
     if (!heml__all_finite(x, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-    heml__commit(m, x, NULL); /* the last force pass was at x: its Prony state is the relaxed one */
+    if (m->has_prony) { /* the Prony state of the last pass at x: make sure it is at x */
+        heml__forces(m, x, m->scratch[1], 1);
+    }
+    heml__commit(m, x, NULL);
     memset(m->dv_prev, 0, sizeof(heml_real) * (size_t)n3);
     return HEML_OK;
 }
@@ -2844,6 +2875,14 @@ HEMLDEF int heml_set_gravity(heml_model *m, const heml_real g[3])
     int r;
     if (!m || !heml__vec3_finite(g)) return HEML_ERR_ARG;
     for (r = 0; r < 3; r++) m->gravity[r] = g[r];
+    return HEML_OK;
+}
+
+HEMLDEF int heml_set_mass_damping(heml_model *m, heml_real alpha)
+{
+    if (!m) return HEML_ERR_ARG;
+    if (!(heml__finite((double)alpha) && alpha >= 0)) return HEML_ERR_DAMPING;
+    m->mass_damping = alpha;
     return HEML_OK;
 }
 
@@ -3035,7 +3074,7 @@ HEMLDEF double heml_stable_time_step(const heml_model *m)
                 double gmax = g00 > g11 ? g00 : g11, g0 = g00 + g11 + g22 + 2 * (g01 + g02 + g12), h;
                 if (g22 > gmax) gmax = g22;
                 if (g0 > gmax) gmax = g0;
-                h = 1.0 / sqrt(gmax);
+                h = 0.5 / sqrt(gmax);
                 if (speed > 0 && h / speed < best) best = h / speed;
             }
         }
