@@ -6,6 +6,9 @@
 #define TENSORMASS_IMPLEMENTATION
 #include "../tensormass.h"
 #include "../tensormass.h"
+#define HEML_IMPLEMENTATION
+#include "../heml.h"
+#include "../heml.h"
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "../examples/tetmesh.h"
@@ -37,8 +40,36 @@ static void test_tensormass_smoke(void)
     tetmesh_free(&mesh);
 }
 
+static void test_heml_smoke(void)
+{
+    tetmesh mesh;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    heml_real *x;
+    heml_desc d = heml_default_desc();
+    heml_model *m;
+    int i;
+    REQUIRE(tetmesh_box(&mesh, lo, hi, 2, 2, 2, TETMESH_SPLIT6) == TETMESH_OK);
+    x = (heml_real *)calloc((size_t)3 * 27, sizeof(heml_real));
+    for (i = 0; i < 3 * mesh.node_count; i++) x[i] = (heml_real)mesh.nodes[i];
+    d.rest_positions = x;
+    d.node_count = mesh.node_count;
+    d.tets = mesh.tets;
+    d.tet_count = mesh.tet_count;
+    CHECK_INT(HEML_OK, heml_create(&d, &m));
+    if (m) {
+        heml_fix_node(m, 0);
+        CHECK_INT(HEML_OK, heml_step(m));
+        CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)1e-2, HEML_IMPLICIT_EULER));
+        CHECK(heml_positions(m)[3 * 26 + 2] < (heml_real)1.0);
+        heml_destroy(m);
+    }
+    free(x);
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_tensormass_smoke),
+    TEST(test_heml_smoke),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
