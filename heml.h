@@ -198,6 +198,13 @@
                              dynamic accuracy. The exact differential is not positive
                              definite under strong compression; CG stops at a direction of
                              negative curvature and the stats say so.
+   STATIC SOLVE (heml_solve_static): Newton on f(x) + f_ext + M g = 0 over the free axes,
+       each step by MINRES (the tangent may be indefinite far from equilibrium, where CG
+       would stop) with a backtracking line search on the residual, and adaptive load
+       stepping (loads and pinned moves scaled by a factor raised from 0 to 1, the increment
+       halved on failure) when a full step fails. It converges to any equilibrium it is
+       started near, stable or not (e.g. St Venant-Kirchhoff compressed beyond the
+       softening point): drive large motions in increments from the last solution.
 
    PERFORMANCE: the force kernel streams, per tetrahedron, 4 int node indices and the 8
    rest constants (HEML_KERNEL_BYTES_PER_TET: 80 bytes in double, 48 in float; springs
@@ -230,14 +237,22 @@
          or inversion it may stop early (stats.negative_curvature) and the step is then
          less implicit.
        - St Venant-Kirchhoff softens in compression (the stress falls to zero as a
-         tetrahedron flattens, sec. 4.2); the J0 guard keeps it from settling inverted but
-         compressions beyond s = 0.58 are unstable in the law itself.
+         tetrahedron flattens, sec. 4.2); the J0 guard keeps it from settling inverted, but
+         a homogeneous uniaxial compression is unstable in the law itself beyond about
+         s = 0.67 at nu = 0.3 (the cube of examples/heml_compression.c shears sideways
+         there), and P_zz has its extremum at s = 1/sqrt(3).
+       - Eq. 26 with lambda < 0 (nu below about -0.5): the tangent continuation below J0 is
+         no longer restoring (its slope lambda (1 - ln J0) + mu turns negative).
        - Mass-spring networks: central forces only (Poisson ratio pinned near 1/4, shear
          stiffness set by the mesh), not inversion-safe.
-       - Float builds: positions far from the origin lose digits in the links (an offset of
-         1e3 m leaves about 1e-4 m resolution); use double there, or simulate near the
-         origin. Energies in float lose relative accuracy at small strains (cancellation
-         in I1 - 3).
+       - Float builds: a tetrahedron's force is the difference of terms of size
+         Vol (lambda + 2 mu) |grad N| that cancel at rest, so forces carry an absolute
+         round-off of about 1e-7 of that whatever the deformation: for stiff tissue under
+         gravity alone this is 1e-4 to 1e-3 of the load (the static solve stops at that
+         floor). Positions far from the origin lose digits in the links (an offset of 1e3 m
+         leaves about 1e-4 m resolution: 2 % of the forces of a 1 % strain on 0.5 m
+         elements). Energies lose relative accuracy at small strains (cancellation in
+         I1 - 3). Use double for these cases.
 
    HISTORY
        0.1.0 (2026-12-01) first release: St Venant-Kirchhoff, Neo-Hookean and Mooney-Rivlin
@@ -459,15 +474,16 @@ typedef struct heml_desc {
 
 /* Statistics of the last step, solve or force evaluation (read with heml_last_stats). */
 typedef struct heml_stats {
-    int cg_iterations;         /* summed over Newton iterations */
-    heml_real cg_residual;     /* final relative residual |r| / |b| of the last CG solve */
+    int cg_iterations;         /* CG (implicit step) or MINRES (static solve) iterations,
+                                  summed over Newton iterations */
+    heml_real cg_residual;     /* final relative residual |r| / |b| of the last Krylov solve */
     int newton_iterations;     /* Newton iterations done */
     int force_evaluations;     /* force passes */
     int stiffness_products;    /* force-differential passes */
     int negative_curvature;    /* CG solves stopped at a direction of negative curvature */
     int below_threshold;       /* tetrahedra with J < J0 at the last force evaluation */
     int inverted;              /* tetrahedra with J <= 0 at the last force evaluation */
-    heml_real static_residual; /* heml_solve_static: final |r| over its reference scale */
+    heml_real static_residual; /* heml_solve_static: last |r| over its reference scale */
 } heml_stats;
 
 /* Energies of the current state (heml_energy). */
@@ -1299,7 +1315,7 @@ static void heml__forces_nh(const heml__mat *mt, heml_real J0, const heml_real *
                             heml__blk *b)
 {
     const heml_real c1 = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
-    int k, r;
+    int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
         heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
@@ -1329,12 +1345,79 @@ static void heml__forces_nh(const heml__mat *mt, heml_real J0, const heml_real *
         s02 = s * R[4 * HEML__W + k];
         s12 = s * R[5 * HEML__W + k];
         b->J[k] = J;
-        for (r = 0; r < 3; r++) {
-            heml_real va = b->e[r][k], vb = b->e[3 + r][k], vd = b->e[6 + r][k];
-            b->f[r][k] = -(s00 * va + s01 * vb + s02 * vd + g * c[r]);
-            b->f[3 + r][k] = -(s01 * va + s11 * vb + s12 * vd + g * c[3 + r]);
-            b->f[6 + r][k] = -(s02 * va + s12 * vb + s22 * vd + g * c[6 + r]);
-        }
+        /* f_k = -(sum_j Sigma_jk v_j + gamma c_k), written out (an inner loop would keep
+           gcc -O2 from vectorising the lane loop) */
+        b->f[0][k] = -(s00 * a0 + s01 * b0 + s02 * d0 + g * c[0]);
+        b->f[1][k] = -(s00 * a1 + s01 * b1 + s02 * d1 + g * c[1]);
+        b->f[2][k] = -(s00 * a2 + s01 * b2 + s02 * d2 + g * c[2]);
+        b->f[3][k] = -(s01 * a0 + s11 * b0 + s12 * d0 + g * c[3]);
+        b->f[4][k] = -(s01 * a1 + s11 * b1 + s12 * d1 + g * c[4]);
+        b->f[5][k] = -(s01 * a2 + s11 * b2 + s12 * d2 + g * c[5]);
+        b->f[6][k] = -(s02 * a0 + s12 * b0 + s22 * d0 + g * c[6]);
+        b->f[7][k] = -(s02 * a1 + s12 * b1 + s22 * d1 + g * c[7]);
+        b->f[8][k] = -(s02 * a2 + s12 * b2 + s22 * d2 + g * c[8]);
+    }
+}
+
+/* The Neo-Hookean force differential in one loop (see heml__block_diff for the
+   formulas; here dSigma = 0 and dgamma = U''(J) dJ / 6). */
+static void heml__diff_nh(const heml__mat *mt, heml_real J0, const heml_real *HEML__RESTRICT R, heml__blk *b)
+{
+    const heml_real c1 = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
+        heml_real c[9], dc[9], J, Jc, d, L, iJ, hh, g, dg, s, dJ;
+        heml_real s00, s11, s22, s01, s02, s12;
+        c[0] = b1 * d2 - b2 * d1;
+        c[1] = b2 * d0 - b0 * d2;
+        c[2] = b0 * d1 - b1 * d0;
+        c[3] = d1 * a2 - d2 * a1;
+        c[4] = d2 * a0 - d0 * a2;
+        c[5] = d0 * a1 - d1 * a0;
+        c[6] = a1 * b2 - a2 * b1;
+        c[7] = a2 * b0 - a0 * b2;
+        c[8] = a0 * b1 - a1 * b0;
+        dc[0] = y1 * d2 - y2 * d1 + b1 * z2 - b2 * z1;
+        dc[1] = y2 * d0 - y0 * d2 + b2 * z0 - b0 * z2;
+        dc[2] = y0 * d1 - y1 * d0 + b0 * z1 - b1 * z0;
+        dc[3] = z1 * a2 - z2 * a1 + d1 * x2 - d2 * x1;
+        dc[4] = z2 * a0 - z0 * a2 + d2 * x0 - d0 * x2;
+        dc[5] = z0 * a1 - z1 * a0 + d0 * x1 - d1 * x0;
+        dc[6] = x1 * b2 - x2 * b1 + a1 * y2 - a2 * y1;
+        dc[7] = x2 * b0 - x0 * b2 + a2 * y0 - a0 * y2;
+        dc[8] = x0 * b1 - x1 * b0 + a0 * y1 - a1 * y0;
+        J = (a0 * c[0] + a1 * c[1] + a2 * c[2]) * R[7 * HEML__W + k];
+        dJ = (x0 * c[0] + x1 * c[1] + x2 * c[2] + y0 * c[3] + y1 * c[4] + y2 * c[5] + z0 * c[6] + z1 * c[7] +
+              z2 * c[8]) * R[7 * HEML__W + k];
+        Jc = heml__max(J, J0);
+        d = J - Jc;
+        L = heml__log(Jc);
+        iJ = 1 / Jc;
+        hh = (kappa * (1 - L) + p0) * iJ * iJ;
+        g = ((kappa * L - p0) * iJ + hh * d) * HEML__SIXTH;
+        dg = hh * dJ * HEML__SIXTH;
+        s = c1 * R[6 * HEML__W + k];
+        s00 = s * R[k];
+        s11 = s * R[HEML__W + k];
+        s22 = s * R[2 * HEML__W + k];
+        s01 = s * R[3 * HEML__W + k];
+        s02 = s * R[4 * HEML__W + k];
+        s12 = s * R[5 * HEML__W + k];
+        b->f[0][k] = -(s00 * x0 + s01 * y0 + s02 * z0 + dg * c[0] + g * dc[0]);
+        b->f[1][k] = -(s00 * x1 + s01 * y1 + s02 * z1 + dg * c[1] + g * dc[1]);
+        b->f[2][k] = -(s00 * x2 + s01 * y2 + s02 * z2 + dg * c[2] + g * dc[2]);
+        b->f[3][k] = -(s01 * x0 + s11 * y0 + s12 * z0 + dg * c[3] + g * dc[3]);
+        b->f[4][k] = -(s01 * x1 + s11 * y1 + s12 * z1 + dg * c[4] + g * dc[4]);
+        b->f[5][k] = -(s01 * x2 + s11 * y2 + s12 * z2 + dg * c[5] + g * dc[5]);
+        b->f[6][k] = -(s02 * x0 + s12 * y0 + s22 * z0 + dg * c[6] + g * dc[6]);
+        b->f[7][k] = -(s02 * x1 + s12 * y1 + s22 * z1 + dg * c[7] + g * dc[7]);
+        b->f[8][k] = -(s02 * x2 + s12 * y2 + s22 * z2 + dg * c[8] + g * dc[8]);
     }
 }
 
@@ -1388,6 +1471,10 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     int k, r, general;
     heml__gather(idx, x, b->e);
     heml__gather(idx, dx, b->de);
+    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
+        heml__diff_nh(mt, m->J0, R, b);
+        return;
+    }
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml__spring_tensions(S, b, 0);
