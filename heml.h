@@ -1141,7 +1141,12 @@ static void heml__invariants(const heml_real *HEML__RESTRICT R, heml__blk *b, in
                    2 * (R[3 * HEML__W + k] * D01 + R[4 * HEML__W + k] * D02 + R[5 * HEML__W + k] * D12);
         b->I2[k] = 0;
     }
-    if (!uses_i2) return;
+    if (!uses_i2) { /* zeros, so that the differential needs no branch */
+        int r;
+        for (r = 0; r < 6; r++)
+            for (k = 0; k < HEML__W; k++) b->GDG[r][k] = 0;
+        return;
+    }
     for (k = 0; k < HEML__W; k++) {
         heml_real g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
         heml_real g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
@@ -1426,7 +1431,7 @@ static void heml__block_forces(const heml_model *m, const heml__mat *mt, int blk
                                heml__blk *b, int prony_write)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml__gather(idx, x, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
@@ -1454,6 +1459,82 @@ static void heml__block_forces(const heml_model *m, const heml__mat *mt, int blk
     heml__link_forces(b);
 }
 
+/* The differential's last stage, one loop for dJ, dD, dI1, dI2, G dD G, dw, dSigma,
+   dgamma, dc and df (see heml__block_diff), written out so that it vectorises (also at
+   gcc -O2; restrict parameters: the workspace escapes to user callbacks). */
+static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
+        heml_real g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
+        heml_real g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
+        heml_real v2 = 2 * R[6 * HEML__W + k], w2 = b->w2[k], I1 = b->I1[k];
+        heml_real dJ = (b->c[0][k] * x0 + b->c[1][k] * x1 + b->c[2][k] * x2 + b->c[3][k] * y0 + b->c[4][k] * y1 +
+                        b->c[5][k] * y2 + b->c[6][k] * z0 + b->c[7][k] * z1 + b->c[8][k] * z2) * R[7 * HEML__W + k];
+        /* dD (symmetric) */
+        heml_real q00 = 2 * (a0 * x0 + a1 * x1 + a2 * x2), q11 = 2 * (b0 * y0 + b1 * y1 + b2 * y2);
+        heml_real q22 = 2 * (d0 * z0 + d1 * z1 + d2 * z2);
+        heml_real q01 = a0 * y0 + a1 * y1 + a2 * y2 + x0 * b0 + x1 * b1 + x2 * b2;
+        heml_real q02 = a0 * z0 + a1 * z1 + a2 * z2 + x0 * d0 + x1 * d1 + x2 * d2;
+        heml_real q12 = b0 * z0 + b1 * z1 + b2 * z2 + y0 * d0 + y1 * d1 + y2 * d2;
+        heml_real dI1 = g00 * q00 + g11 * q11 + g22 * q22 + 2 * (g01 * q01 + g02 * q02 + g12 * q12);
+        /* G dD (full) and G dD G (symmetric); without I2, w_2 = 0 and G D G = 0 make these
+           terms vanish */
+        heml_real n00 = g00 * q00 + g01 * q01 + g02 * q02, n01 = g00 * q01 + g01 * q11 + g02 * q12;
+        heml_real n02 = g00 * q02 + g01 * q12 + g02 * q22, n10 = g01 * q00 + g11 * q01 + g12 * q02;
+        heml_real n11 = g01 * q01 + g11 * q11 + g12 * q12, n12 = g01 * q02 + g11 * q12 + g12 * q22;
+        heml_real n20 = g02 * q00 + g12 * q01 + g22 * q02, n21 = g02 * q01 + g12 * q11 + g22 * q12;
+        heml_real n22 = g02 * q02 + g12 * q12 + g22 * q22;
+        heml_real dI2 = I1 * dI1 - (b->GDG[0][k] * q00 + b->GDG[1][k] * q11 + b->GDG[2][k] * q22 +
+                                    2 * (b->GDG[3][k] * q01 + b->GDG[4][k] * q02 + b->GDG[5][k] * q12));
+        heml_real p0 = n00 * g00 + n01 * g01 + n02 * g02, p1 = n10 * g01 + n11 * g11 + n12 * g12;
+        heml_real p2 = n20 * g02 + n21 * g12 + n22 * g22, p3 = n00 * g01 + n01 * g11 + n02 * g12;
+        heml_real p4 = n00 * g02 + n01 * g12 + n02 * g22, p5 = n10 * g02 + n11 * g12 + n12 * g22;
+        heml_real dw1, dw2, dwJ, ds, dt, dg, t00, t11, t22, t01, t02, t12, w;
+        heml_real s00 = b->sig[0][k], s11 = b->sig[1][k], s22 = b->sig[2][k];
+        heml_real s01 = b->sig[3][k], s02 = b->sig[4][k], s12 = b->sig[5][k], g = b->sig[6][k];
+        heml_real dc0, dc1, dc2, dc3, dc4, dc5, dc6, dc7, dc8;
+        dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
+        dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
+        dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
+        ds = sp * v2 * (dw1 + dI1 * w2 + I1 * dw2);
+        dt = sp * v2 * dw2;
+        w = sp * v2 * w2;
+        t00 = ds * g00 - (dt * b->GDG[0][k] + w * p0);
+        t11 = ds * g11 - (dt * b->GDG[1][k] + w * p1);
+        t22 = ds * g22 - (dt * b->GDG[2][k] + w * p2);
+        t01 = ds * g01 - (dt * b->GDG[3][k] + w * p3);
+        t02 = ds * g02 - (dt * b->GDG[4][k] + w * p4);
+        t12 = ds * g12 - (dt * b->GDG[5][k] + w * p5);
+        dg = sp * dwJ * HEML__SIXTH;
+        /* dc_1 = dv2 x v3 + v2 x dv3, dc_2 = dv3 x v1 + v3 x dv1, dc_3 = dv1 x v2 + v1 x dv2 */
+        dc0 = y1 * d2 - y2 * d1 + b1 * z2 - b2 * z1;
+        dc1 = y2 * d0 - y0 * d2 + b2 * z0 - b0 * z2;
+        dc2 = y0 * d1 - y1 * d0 + b0 * z1 - b1 * z0;
+        dc3 = z1 * a2 - z2 * a1 + d1 * x2 - d2 * x1;
+        dc4 = z2 * a0 - z0 * a2 + d2 * x0 - d0 * x2;
+        dc5 = z0 * a1 - z1 * a0 + d0 * x1 - d1 * x0;
+        dc6 = x1 * b2 - x2 * b1 + a1 * y2 - a2 * y1;
+        dc7 = x2 * b0 - x0 * b2 + a2 * y0 - a0 * y2;
+        dc8 = x0 * b1 - x1 * b0 + a0 * y1 - a1 * y0;
+        b->f[0][k] = -(s00 * x0 + s01 * y0 + s02 * z0 + t00 * a0 + t01 * b0 + t02 * d0 + dg * b->c[0][k] + g * dc0);
+        b->f[1][k] = -(s00 * x1 + s01 * y1 + s02 * z1 + t00 * a1 + t01 * b1 + t02 * d1 + dg * b->c[1][k] + g * dc1);
+        b->f[2][k] = -(s00 * x2 + s01 * y2 + s02 * z2 + t00 * a2 + t01 * b2 + t02 * d2 + dg * b->c[2][k] + g * dc2);
+        b->f[3][k] = -(s01 * x0 + s11 * y0 + s12 * z0 + t01 * a0 + t11 * b0 + t12 * d0 + dg * b->c[3][k] + g * dc3);
+        b->f[4][k] = -(s01 * x1 + s11 * y1 + s12 * z1 + t01 * a1 + t11 * b1 + t12 * d1 + dg * b->c[4][k] + g * dc4);
+        b->f[5][k] = -(s01 * x2 + s11 * y2 + s12 * z2 + t01 * a2 + t11 * b2 + t12 * d2 + dg * b->c[5][k] + g * dc5);
+        b->f[6][k] = -(s02 * x0 + s12 * y0 + s22 * z0 + t02 * a0 + t12 * b0 + t22 * d0 + dg * b->c[6][k] + g * dc6);
+        b->f[7][k] = -(s02 * x1 + s12 * y1 + s22 * z1 + t02 * a1 + t12 * b1 + t22 * d1 + dg * b->c[7][k] + g * dc7);
+        b->f[8][k] = -(s02 * x2 + s12 * y2 + s22 * z2 + t02 * a2 + t12 * b2 + t22 * d2 + dg * b->c[8][k] + g * dc8);
+    }
+}
+
 /* The force differential of one block at x in direction dx into b->f:
        df_k = -( sum_j (Sigma_jk dv_j + dSigma_jk v_j) + dgamma c_k + gamma dc_k )
    with dD = dv^T v + v^T dv, dI1 = G : dD, dI2 = I1 dI1 - G D G : dD,
@@ -1466,9 +1547,10 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
                              const heml_real *dx, heml__blk *b)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     const heml_real sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
-    int k, r, general;
+    const int i2 = mt->uses_i2;
+    int k, r;
     heml__gather(idx, x, b->e);
     heml__gather(idx, dx, b->de);
     if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
@@ -1509,111 +1591,13 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     }
     heml__cofactors(R, b);
     heml__clamp_J(m->J0, b);
-    general = !(mt->kind == HEML__K_RAW && !mt->uses_i2);
-    if (!general) {
-        heml__law_raw(mt, b, HEML__WANT_SECOND);
-        heml__sigma_nh(mt, R, b);
-    } else {
-        heml__invariants(R, b, mt->uses_i2);
-        heml__law(mt, b, m->blk_valid[blk], HEML__WANT_SECOND);
-        heml__sigma(R, b, mt->uses_i2);
-    }
+    /* (raw laws without I2 reach here only with Prony: the general path covers them, with
+       zero I-derivatives) */
+    heml__invariants(R, b, i2);
+    heml__law(mt, b, m->blk_valid[blk], HEML__WANT_SECOND);
+    heml__sigma(R, b, i2);
     if (mt->prony_count) heml__prony(m, mt, blk, b, 7, 0);
-    for (k = 0; k < HEML__W; k++) {
-        heml_real dJ = 0;
-        for (r = 0; r < 9; r++) dJ += b->c[r][k] * b->de[r][k];
-        b->J[k] = dJ * R[7 * HEML__W + k]; /* J is free now: it holds dJ */
-    }
-    if (!general) {
-        for (k = 0; k < HEML__W; k++) {
-            for (r = 0; r < 6; r++) b->dsig[r][k] = 0;
-            b->dsig[6][k] = sp * b->h[5][k] * b->J[k] * HEML__SIXTH;
-        }
-    } else {
-        for (k = 0; k < HEML__W; k++) {
-            heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
-            heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
-            heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
-            heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
-            heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
-            heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
-            heml_real g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
-            heml_real g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
-            heml_real v2 = 2 * R[6 * HEML__W + k];
-            /* dD (symmetric) */
-            heml_real q00 = 2 * (a0 * x0 + a1 * x1 + a2 * x2), q11 = 2 * (b0 * y0 + b1 * y1 + b2 * y2);
-            heml_real q22 = 2 * (d0 * z0 + d1 * z1 + d2 * z2);
-            heml_real q01 = a0 * y0 + a1 * y1 + a2 * y2 + x0 * b0 + x1 * b1 + x2 * b2;
-            heml_real q02 = a0 * z0 + a1 * z1 + a2 * z2 + x0 * d0 + x1 * d1 + x2 * d2;
-            heml_real q12 = b0 * z0 + b1 * z1 + b2 * z2 + y0 * d0 + y1 * d1 + y2 * d2;
-            heml_real dI1 = g00 * q00 + g11 * q11 + g22 * q22 + 2 * (g01 * q01 + g02 * q02 + g12 * q12);
-            heml_real dI2 = 0, dJ = b->J[k], w2 = b->w2[k], I1 = b->I1[k];
-            heml_real dw1, dw2, dwJ, ds, dt;
-            heml_real p[6] = {0, 0, 0, 0, 0, 0}; /* G dD G */
-            if (mt->uses_i2) {
-                heml_real n00 = g00 * q00 + g01 * q01 + g02 * q02, n01 = g00 * q01 + g01 * q11 + g02 * q12;
-                heml_real n02 = g00 * q02 + g01 * q12 + g02 * q22, n10 = g01 * q00 + g11 * q01 + g12 * q02;
-                heml_real n11 = g01 * q01 + g11 * q11 + g12 * q12, n12 = g01 * q02 + g11 * q12 + g12 * q22;
-                heml_real n20 = g02 * q00 + g12 * q01 + g22 * q02, n21 = g02 * q01 + g12 * q11 + g22 * q12;
-                heml_real n22 = g02 * q02 + g12 * q12 + g22 * q22;
-                dI2 = I1 * dI1 - (b->GDG[0][k] * q00 + b->GDG[1][k] * q11 + b->GDG[2][k] * q22 +
-                                  2 * (b->GDG[3][k] * q01 + b->GDG[4][k] * q02 + b->GDG[5][k] * q12));
-                p[0] = n00 * g00 + n01 * g01 + n02 * g02;
-                p[1] = n10 * g01 + n11 * g11 + n12 * g12;
-                p[2] = n20 * g02 + n21 * g12 + n22 * g22;
-                p[3] = n00 * g01 + n01 * g11 + n02 * g12;
-                p[4] = n00 * g02 + n01 * g12 + n02 * g22;
-                p[5] = n10 * g02 + n11 * g12 + n12 * g22;
-            }
-            dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
-            dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
-            dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
-            ds = sp * v2 * (dw1 + dI1 * w2 + I1 * dw2);
-            dt = sp * v2 * dw2;
-            b->dsig[0][k] = ds * g00;
-            b->dsig[1][k] = ds * g11;
-            b->dsig[2][k] = ds * g22;
-            b->dsig[3][k] = ds * g01;
-            b->dsig[4][k] = ds * g02;
-            b->dsig[5][k] = ds * g12;
-            if (mt->uses_i2)
-                for (r = 0; r < 6; r++) b->dsig[r][k] -= dt * b->GDG[r][k] + sp * v2 * w2 * p[r];
-            b->dsig[6][k] = sp * dwJ * HEML__SIXTH;
-        }
-    }
-    for (k = 0; k < HEML__W; k++) {
-        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
-        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
-        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
-        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
-        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
-        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
-        heml_real dc[9];
-        heml_real s00 = b->sig[0][k], s11 = b->sig[1][k], s22 = b->sig[2][k];
-        heml_real s01 = b->sig[3][k], s02 = b->sig[4][k], s12 = b->sig[5][k], g = b->sig[6][k];
-        heml_real t00 = b->dsig[0][k], t11 = b->dsig[1][k], t22 = b->dsig[2][k];
-        heml_real t01 = b->dsig[3][k], t02 = b->dsig[4][k], t12 = b->dsig[5][k], dg = b->dsig[6][k];
-        /* dc_1 = dv2 x v3 + v2 x dv3, dc_2 = dv3 x v1 + v3 x dv1, dc_3 = dv1 x v2 + v1 x dv2 */
-        dc[0] = y1 * d2 - y2 * d1 + b1 * z2 - b2 * z1;
-        dc[1] = y2 * d0 - y0 * d2 + b2 * z0 - b0 * z2;
-        dc[2] = y0 * d1 - y1 * d0 + b0 * z1 - b1 * z0;
-        dc[3] = z1 * a2 - z2 * a1 + d1 * x2 - d2 * x1;
-        dc[4] = z2 * a0 - z0 * a2 + d2 * x0 - d0 * x2;
-        dc[5] = z0 * a1 - z1 * a0 + d0 * x1 - d1 * x0;
-        dc[6] = x1 * b2 - x2 * b1 + a1 * y2 - a2 * y1;
-        dc[7] = x2 * b0 - x0 * b2 + a2 * y0 - a0 * y2;
-        dc[8] = x0 * b1 - x1 * b0 + a0 * y1 - a1 * y0;
-        for (r = 0; r < 3; r++) {
-            heml_real va = b->e[r][k], vb = b->e[3 + r][k], vd = b->e[6 + r][k];
-            heml_real ua = b->de[r][k], ub = b->de[3 + r][k], ud = b->de[6 + r][k];
-            b->f[r][k] = -(s00 * ua + s01 * ub + s02 * ud + t00 * va + t01 * vb + t02 * vd +
-                           dg * b->c[r][k] + g * dc[r]);
-            b->f[3 + r][k] = -(s01 * ua + s11 * ub + s12 * ud + t01 * va + t11 * vb + t12 * vd +
-                               dg * b->c[3 + r][k] + g * dc[3 + r]);
-            b->f[6 + r][k] = -(s02 * ua + s12 * ub + s22 * ud + t02 * va + t12 * vb + t22 * vd +
-                               dg * b->c[6 + r][k] + g * dc[6 + r]);
-        }
-    }
+    heml__diff_general(sp, R, b);
 }
 
 /* Elastic energy of one block's valid lanes, J (sum Vol w, in double). */
@@ -1621,7 +1605,7 @@ static double heml__block_energy(const heml_model *m, const heml__mat *mt, int b
                                  heml__blk *b)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     int k, valid = m->blk_valid[blk];
     double sum = 0.0;
     heml__gather(idx, x, b->e);
