@@ -1078,8 +1078,8 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
             void *sim = NULL;
             if (m->create(&b, &sim)) continue;
             /* one step under gravity, so the kernels see a generic deformed state */
-            m->step(sim, 1e-3, (m->integrators & BIT(BENCH_IMPLICIT_EULER)) ? BENCH_IMPLICIT_EULER
-                                                                            : BENCH_SEMI_IMPLICIT_EULER);
+            m->step(sim, 1e-5, (m->integrators & BIT(BENCH_SEMI_IMPLICIT_EULER)) ? BENCH_SEMI_IMPLICIT_EULER
+                                                                                 : BENCH_IMPLICIT_EULER);
             for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++)
                 for (th = 1; th <= max_threads; th++) {
                     double sec, elems = m->elements(sim), bytes = m->kernel_bytes(sim, kern), bound, ns;
@@ -1090,6 +1090,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                     bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
                     printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
                            m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
+                    fflush(stdout);
                     csv_prefix(f);
                     fprintf(f, "%s,%s,%s,%s,%d,%.0f,%s,%.4g,%.4g,%.4g,%.4g,%.4g\n", m->model, m->variant,
                             m->precision, kernel_name[kern], th, elems, m->element, ns, bytes / elems, bound,
