@@ -187,6 +187,12 @@ typedef struct frm_desc {
     const int *sample_materials; /* optional sample_count indices into `materials` (NULL:
                                     every sample uses materials[0]) */
 
+    frm_real frame_coupling; /* dimensionless, default 1e-2: weight of the coupling term that
+                                ties each frame's own prediction of a sample to the blended
+                                position (see MODEL); it stiffens the rotations a trilinear
+                                grid cannot see and is of higher order for smooth fields.
+                                0 gives the thesis's model exactly */
+
     /* dynamics */
     frm_real gravity[3];        /* m/s^2, default (0, 0, -9.81) */
     frm_real time_step;         /* s, default 1e-2, used by frm_model_step */
@@ -571,14 +577,15 @@ FRM_HOSTDEV static inline void frm_frame_rotations(const frm_real q[4], const fr
    (3 n), rest local positions lbar_k = Rbar_k^T (pbar_s - xbar_k) (3 n, eq. 3.33). Frame
    arrays: positions (3 per frame), R (9), Q = R Rbar^T (9). Out: the deformation gradient
        F = sum_k d_k grad w_k^T + w_k Q_k,   d_k = x_k + R_k lbar_k,
-   the levers a_k = R_k lbar_k (3 n, may be NULL) and the position p = sum_k w_k d_k (may
-   be NULL). d_k is taken relative to d_0: the same F when the gradients sum to zero,
-   and no loss of precision far from the origin. */
+   the levers a_k = R_k lbar_k (3 n, may be NULL), the offsets d_k - p of each frame's own
+   prediction from the blended position (3 n, may be NULL; see the coupling term) and the
+   position p = sum_k w_k d_k (may be NULL). d_k is taken relative to d_0: the same F when
+   the gradients sum to zero, and no loss of precision far from the origin. */
 FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, const frm_real *weight,
                                                       const frm_real *grad, const frm_real *local,
                                                       const frm_real *frame_pos, const frm_real *frame_rot,
                                                       const frm_real *frame_rel, frm_real F[9],
-                                                      frm_real *lever, frm_real *position)
+                                                      frm_real *lever, frm_real *offset, frm_real *position)
 {
     int k, r, c, i0 = frame[0];
     frm_real a0[3], p[3] = {0, 0, 0};
@@ -598,7 +605,12 @@ FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, c
             for (c = 0; c < 3; c++) F[3 * r + c] += e[r] * g[c] + w * Q[3 * r + c];
         if (lever)
             for (r = 0; r < 3; r++) lever[3 * k + r] = a[r];
+        if (offset)
+            for (r = 0; r < 3; r++) offset[3 * k + r] = e[r];
     }
+    if (offset)
+        for (k = 0; k < n; k++)
+            for (r = 0; r < 3; r++) offset[3 * k + r] -= p[r];
     if (position)
         for (r = 0; r < 3; r++) position[r] = frame_pos[3 * i0 + r] + a0[r] + p[r];
 }
@@ -828,6 +840,112 @@ FRM_HOSTDEV static inline void frm_pair_apply(frm_real volume, const frm_real dP
     out[5] = volume * t[2] + Hs[4] * dtheta[0] + Hs[3] * dtheta[1] + Hs[2] * dtheta[2];
 }
 
+/* The coupling term (see MODEL): E_c = 1/2 sum_k c |w_k| |d_k - p|^2 per sample, c =
+   frame_coupling * mu v / h^2. It vanishes under rigid motion and pins the rotations the
+   interpolation cannot see. Adds its generalized forces (-g_k, -a_k x g_k),
+   g_k = dE_c/dd_k = c |w_k| e_k - w_k sum_j c |w_j| e_j, to out (6 per slot); stores g
+   (3 per slot) when gout is not NULL; returns E_c. */
+FRM_HOSTDEV static inline frm_real frm_sample_coupling_force(int n, const frm_real *weight, const frm_real *lever,
+                                                             const frm_real *offset, frm_real c, frm_real *out,
+                                                             frm_real *gout)
+{
+    frm_real ebar[3] = {0, 0, 0}, energy = 0;
+    int k, r;
+    for (k = 0; k < n; k++) {
+        frm_real a = c * (weight[k] < 0 ? -weight[k] : weight[k]);
+        const frm_real *e = offset + 3 * k;
+        for (r = 0; r < 3; r++) ebar[r] += a * e[r];
+        energy += (frm_real)0.5 * a * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    }
+    for (k = 0; k < n; k++) {
+        frm_real a = c * (weight[k] < 0 ? -weight[k] : weight[k]), g[3], t[3];
+        for (r = 0; r < 3; r++) g[r] = a * offset[3 * k + r] - weight[k] * ebar[r];
+        frm_cross(lever + 3 * k, g, t);
+        for (r = 0; r < 3; r++) {
+            out[6 * k + r] -= g[r];
+            out[6 * k + 3 + r] -= t[r];
+        }
+        if (gout)
+            for (r = 0; r < 3; r++) gout[3 * k + r] = g[r];
+    }
+    return energy;
+}
+
+/* Its stiffness applied to v (6 per frame, gathered through frame[]), added to out (6 per
+   slot): the Gauss-Newton part, y_k = c |w_k| (dd_k - dp) - w_k sum_j c |w_j| (dd_j - dp)
+   with dd = dx + dtheta x a and dp = sum w dd, mapped as (y, a x y), plus the rotation's
+   second-order part M dtheta, M = (g a^T + a g^T)/2 - (g . a) I. */
+FRM_HOSTDEV static inline void frm_sample_coupling_apply(int n, const int *frame, const frm_real *weight,
+                                                         const frm_real *lever, const frm_real *g, frm_real c,
+                                                         const frm_real *v, frm_real *out)
+{
+    frm_real dd[3 * FRM_MAX_NEIGHBORS], dp[3] = {0, 0, 0}, rbar[3] = {0, 0, 0};
+    int k, r;
+    for (k = 0; k < n; k++) {
+        const frm_real *q = v + 6 * frame[k];
+        frm_real t[3];
+        frm_cross(q + 3, lever + 3 * k, t);
+        for (r = 0; r < 3; r++) {
+            dd[3 * k + r] = q[r] + t[r];
+            dp[r] += weight[k] * dd[3 * k + r];
+        }
+    }
+    for (k = 0; k < n; k++) {
+        frm_real a = c * (weight[k] < 0 ? -weight[k] : weight[k]);
+        for (r = 0; r < 3; r++) {
+            dd[3 * k + r] = a * (dd[3 * k + r] - dp[r]);
+            rbar[r] += dd[3 * k + r];
+        }
+    }
+    for (k = 0; k < n; k++) {
+        const frm_real *th = v + 6 * frame[k] + 3, *a = lever + 3 * k, *gk = g + 3 * k;
+        frm_real y[3], t[3], at = a[0] * th[0] + a[1] * th[1] + a[2] * th[2];
+        frm_real gt = gk[0] * th[0] + gk[1] * th[1] + gk[2] * th[2], ga = gk[0] * a[0] + gk[1] * a[1] + gk[2] * a[2];
+        for (r = 0; r < 3; r++) y[r] = dd[3 * k + r] - weight[k] * rbar[r];
+        frm_cross(a, y, t);
+        for (r = 0; r < 3; r++) {
+            out[6 * k + r] += y[r];
+            out[6 * k + 3 + r] += t[r] + (frm_real)0.5 * (gk[r] * at + a[r] * gt) - ga * th[r];
+        }
+    }
+}
+
+/* Assembly of the coupling: K_ab += coef J_a^T J_b, J_k = [I, -[a_k]x] (dd_k = J_k dq_k),
+   coef = c (|w_a| delta_ab - |w_a| w_b - w_a |w_b| + sum|w| w_a w_b); the caller adds M on
+   the diagonal. J_a^T J_b = [I, -[b]x; [a]x, (a . b) I - b a^T]. */
+FRM_HOSTDEV static inline void frm_pair_coupling_block(frm_real coef, const frm_real la[3], const frm_real lb[3],
+                                                       frm_real K[36])
+{
+    frm_real ab = la[0] * lb[0] + la[1] * lb[1] + la[2] * lb[2];
+    int r, c;
+    for (r = 0; r < 3; r++) K[7 * r] += coef;
+    /* -[b]x top right, [a]x bottom left */
+    K[4] += coef * lb[2];
+    K[5] -= coef * lb[1];
+    K[9] -= coef * lb[2];
+    K[11] += coef * lb[0];
+    K[15] += coef * lb[1];
+    K[16] -= coef * lb[0];
+    K[19] -= coef * la[2];
+    K[20] += coef * la[1];
+    K[24] += coef * la[2];
+    K[26] -= coef * la[0];
+    K[30] -= coef * la[1];
+    K[31] += coef * la[0];
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) K[6 * (3 + r) + 3 + c] += coef * ((r == c ? ab : 0) - lb[r] * la[c]);
+}
+
+/* The coupling's second-order rotational part M = (g a^T + a g^T)/2 - (g . a) I, added to
+   the rotational block of a 6x6. */
+FRM_HOSTDEV static inline void frm_pair_coupling_rotation(const frm_real g[3], const frm_real a[3], frm_real K[36])
+{
+    frm_real ga = g[0] * a[0] + g[1] * a[1] + g[2] * a[2];
+    int r, c;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) K[6 * (3 + r) + 3 + c] += (frm_real)0.5 * (g[r] * a[c] + a[r] * g[c]) - (r == c ? ga : 0);
+}
+
 /* Assembly: the 6 tangent columns cols[c] = A B e_c (9 each) of one pair, A = dP/dF. */
 FRM_HOSTDEV static inline void frm_pair_tangent_columns(int law, frm_real mu, frm_real lambda, const frm_real *cache,
                                                         const frm_real F[9], const frm_real S[6],
@@ -959,7 +1077,7 @@ struct frm_model {
     int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
 
     /* samples */
-    frm_real *s_rest, *s_volume, *s_mu, *s_lambda;
+    frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
     unsigned char *s_law;
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
@@ -968,7 +1086,7 @@ struct frm_model {
     /* pairs */
     int *p_frame, *p_sample;
     frm_real *p_weight, *p_grad, *p_local; /* 1, 3, 3 */
-    frm_real *p_G, *p_H;                   /* 9, 6 at the linearisation */
+    frm_real *p_G, *p_H, *p_A, *p_C;       /* 9, 6, 3 (lever), 3 (coupling g) at the linearisation */
     frm_real *p_out;                       /* 6: pass-1 partial contributions */
 
     /* per sample chunk: energy partial sums and errors of the last pass */
@@ -1179,6 +1297,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_volume, frm_real, S);
     FRM__CARVE(c, m->s_mu, frm_real, S);
     FRM__CARVE(c, m->s_lambda, frm_real, S);
+    FRM__CARVE(c, m->s_couple, frm_real, S);
     FRM__CARVE(c, m->s_law, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
     FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
@@ -1193,6 +1312,8 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_local, frm_real, 3 * P);
     FRM__CARVE(c, m->p_G, frm_real, 9 * P);
     FRM__CARVE(c, m->p_H, frm_real, 6 * P);
+    FRM__CARVE(c, m->p_A, frm_real, 3 * P);
+    FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
@@ -1244,6 +1365,8 @@ static int frm__validate_settings(const frm_desc *d)
         !(frm__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_max_iterations < 1 ||
         !(frm__finite((double)d->static_regularization) && d->static_regularization >= 0))
         return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
+    if (!(frm__finite((double)d->frame_coupling) && d->frame_coupling >= 0))
+        return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -1393,6 +1516,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
     d.static_regularization = (frm_real)1e-6;
+    d.frame_coupling = 0;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.internal_cookie = FRM__COOKIE;
     return d;
@@ -1649,6 +1773,17 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         for (r = 0; r < 3; r++)
             m->p_local[3 * p + r] = (frm_real)(Rb[r] * dx[0] + Rb[3 + r] * dx[1] + Rb[6 + r] * dx[2]);
     }
+    for (s = 0; s < S; s++) { /* c = eps mu v / h^2, h^2 the mean squared lever */
+        double h2 = 0, wsum = 0;
+        for (p = m->s_start[s]; p < m->s_start[s + 1]; p++) {
+            double w = fabs((double)m->p_weight[p]);
+            const frm_real *l = m->p_local + 3 * p;
+            h2 += w * ((double)l[0] * l[0] + (double)l[1] * l[1] + (double)l[2] * l[2]);
+            wsum += w;
+        }
+        h2 = wsum > 0 ? h2 / wsum : 0;
+        m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
+    }
     i = frm__compute_masses(m, d);
     if (i >= 0) {
         frm__free(&alloc, tmp_block, tmp_bytes);
@@ -1726,8 +1861,9 @@ static void frm__force_chunks(void *vctx, int begin, int end)
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e;
             frm_real F[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
+            frm_real offset[3 * FRM_MAX_NEIGHBORS];
             frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_local + 3 * b, m->pos,
-                                   m->rot, m->rel, F, lever, ctx->outputs ? m->s_pos + 3 * s : NULL);
+                                   m->rot, m->rel, F, lever, offset, ctx->outputs ? m->s_pos + 3 * s : NULL);
             if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
             e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], F, S, &psi, cache);
             if (e) {
@@ -1740,7 +1876,12 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             for (k = 0; k < n; k++)
                 frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
+            if (m->s_couple[s] != 0)
+                energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
+                                                            m->p_out + 6 * (size_t)b,
+                                                            ctx->linearize ? m->p_C + 3 * (size_t)b : NULL);
             if (ctx->linearize) {
+                memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
                 memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
                 memcpy(m->lin_cache + FRM_LAW_CACHE * (size_t)s, cache, sizeof cache);
@@ -1887,6 +2028,9 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             for (k = b; k < b + n; k++)
                 frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_H + 6 * (size_t)k,
                                v + 6 * m->p_frame[k] + 3, m->p_out + 6 * (size_t)k);
+            if (m->s_couple[s] != 0)
+                frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->p_C + 3 * (size_t)b,
+                                          m->s_couple[s], v, m->p_out + 6 * (size_t)b);
         }
     }
 }
@@ -1988,6 +2132,16 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
     D[27] += H[5];
 }
 
+/* The coupling's Gauss-Newton coefficient between slots a and b of sample s. */
+static frm_real frm__coupling_coef(const frm_model *m, int s, int a, int b)
+{
+    const frm_real *w = m->p_weight + m->s_start[s];
+    double wa = (double)w[a], wb = (double)w[b], sum = 0;
+    int k;
+    for (k = 0; k < m->s_start[s + 1] - m->s_start[s]; k++) sum += fabs((double)w[k]);
+    return (frm_real)((double)m->s_couple[s] * ((a == b ? fabs(wa) : 0.0) - fabs(wa) * wb - wa * fabs(wb) + sum * wa * wb));
+}
+
 /* Per-frame diagonal block of the stiffness (symmetric part) from its pairs, computed in
    the gather pass (pair mode; the block mode takes it from the assembled row). */
 static void frm__diag_chunks(void *vctx, int begin, int end)
@@ -2011,6 +2165,11 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                                          m->p_G + 9 * (size_t)p, cols);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
                 frm__add_rotational(m->p_H + 6 * (size_t)p, K);
+                if (m->s_couple[s] != 0) {
+                    frm_pair_coupling_block(frm__coupling_coef(m, s, p - m->s_start[s], p - m->s_start[s]), m->p_A + 3 * (size_t)p,
+                                            m->p_A + 3 * (size_t)p, K);
+                    frm_pair_coupling_rotation(m->p_C + 3 * (size_t)p, m->p_A + 3 * (size_t)p, K);
+                }
                 for (k = 0; k < 36; k++) acc[k] += (double)K[k];
             }
             frm__gravity_stiffness(m, i, Kg);
@@ -2045,10 +2204,14 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
                 frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
                                          m->p_G + 9 * (size_t)p, cols);
-                for (q = 0; q < n; q++)
-                    frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q),
-                                   m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q]);
+                for (q = 0; q < n; q++) {
+                    frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
+                    frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q), K);
+                    if (m->s_couple[s] != 0)
+                        frm_pair_coupling_block(frm__coupling_coef(m, s, a, q), m->p_A + 3 * (size_t)p, m->p_A + 3 * (size_t)(b + q), K);
+                }
                 frm__add_rotational(m->p_H + 6 * (size_t)p, D);
+                if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)p, m->p_A + 3 * (size_t)p, D);
             }
             frm__gravity_stiffness(m, i, Kg);
             for (r = 0; r < 3; r++)
@@ -2522,7 +2685,7 @@ static int frm__check_inversion(frm_model *m)
         frm_real F[9], J;
         if (m->s_law[s] != FRM_LAW_NEO_HOOKEAN) continue;
         frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
-                               m->p_local + 3 * b, m->pos, m->rot, m->rel, F, NULL, NULL);
+                               m->p_local + 3 * b, m->pos, m->rot, m->rel, F, NULL, NULL, NULL);
         J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
         if (!(J > 0)) return FRM_ERR_INVERTED;
     }
@@ -2776,7 +2939,7 @@ static void frm__outputs_chunks(void *vctx, int begin, int end)
             int b = m->s_start[s];
             frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
                                    m->p_local + 3 * b, m->pos, m->rot, m->rel, m->s_F + 9 * (size_t)s, NULL,
-                                   m->s_pos + 3 * (size_t)s);
+                                   NULL, m->s_pos + 3 * (size_t)s);
         }
     }
 }
