@@ -1005,6 +1005,878 @@ static void test_soft_cantilever_r2(void)
     }
 }
 
+/* ---- large rotations, flat and linear meshless bodies ---------------------------------- */
+
+/* Thesis fig. 4.11: a bar of 10 frames and 50 samples on a line (collinear: Shepard, 4
+   nearest), E = 10 kPa, no gravity, the first frame fixed, the last driven about the
+   axis to 180 degrees in 12 steps of 15, a static solve each. Every solve converges and
+   the twist spreads along the bar: frame i turns 180 x_i degrees to within 5 (measured
+   within 3.5; the end frames' samples see one side only). */
+static void test_torsion_180(void)
+{
+    frm_real F[30], S[150];
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_shape_desc sh = frm_shape_default_desc();
+    frm_model *m;
+    int i, k, steps = TEST_IS_QUICK ? 4 : 12, ok = 1;
+    double pi = 3.14159265358979323846, worst = 0;
+    for (i = 0; i < 10; i++) {
+        F[3 * i] = (frm_real)(i / 9.0);
+        F[3 * i + 1] = F[3 * i + 2] = 0;
+    }
+    for (i = 0; i < 50; i++) {
+        S[3 * i] = (frm_real)((i + 0.5) / 50);
+        S[3 * i + 1] = S[3 * i + 2] = 0;
+    }
+    sh.nearest = 4;
+    REQUIRE(frm_sampling_meshless(&s, F, 10, S, 50, (frm_real)0.01, &sh, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    d.material.young_modulus = 1e4;
+    d.gravity[2] = 0;
+    d.newton_max_iterations = 60;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    frm_model_fix_frame(m, 0);
+    for (k = 1; k <= steps && ok; k++) {
+        double a = pi * k / steps;
+        frm_real q[4];
+        q[0] = (frm_real)sin(a / 2);
+        q[1] = q[2] = 0;
+        q[3] = (frm_real)cos(a / 2);
+        REQUIRE(frm_model_drive_frame(m, 9, F + 27, q) == FRM_OK);
+        ok = frm_model_solve_static(m) == FRM_OK;
+        CHECK(ok);
+    }
+    REQUIRE(ok);
+    CHECK(frm__all_finite(frm_model_positions(m), 30) && frm__all_finite(frm_model_orientations(m), 40));
+    printf("    twist along the bar (degrees):");
+    for (i = 0; i < 10; i++) {
+        const frm_real *q = frm_model_orientations(m) + 4 * i;
+        double angle = 2 * atan2((double)q[0], (double)q[3]) * 180 / pi, e = fabs(angle - 20.0 * i);
+        printf(" %.1f", angle);
+        if (e > worst) worst = e;
+        CHECK(fabs((double)frm_model_positions(m)[3 * i] - F[3 * i]) < 0.05); /* the bar stays a bar */
+    }
+    printf("; worst %.2f from linear\n", worst);
+    CHECK(worst < 5);
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+}
+
+/* Thesis fig. 4.10: a flat sheet 2 x 1 m (5 cm thick for the volume), Poisson-disk frames
+   0.15 m apart and samples 0.06 m apart in the plane z = 0 (coplanar: Shepard, 6 nearest),
+   E = 25 kPa, both short sides fixed, 300 N down on the frames of the central 0.6 x 0.6 m
+   in 6 load steps, a static solve each. Every solve converges, the sheet sags, left and
+   right halves agree (the sampling is not symmetric: 5 %), and it stiffens like a membrane:
+   6 times the load, less than 3 times the sag (measured 1.93; a membrane gives 6^(1/3)). */
+static void test_shepard_sheet(void)
+{
+    frm_real lo[3] = {0, 0, 0}, hi[3] = {2, 1, 0};
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_shape_desc sh = frm_shape_default_desc();
+    frm_poisson_desc p = frm_poisson_default_desc();
+    frm_model *m;
+    int i, k, loaded = 0, steps = TEST_IS_QUICK ? 3 : 6;
+    double first = 0, last = 0, zl = 0, zr = 0;
+    sh.nearest = 6;
+    p.frame_spacing = (frm_real)0.15;
+    p.sample_spacing = (frm_real)0.06;
+    p.volume = (frm_real)(2 * 1 * 0.05);
+    REQUIRE(frm_sampling_box(&s, lo, hi, &p, &sh, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    d.material.young_modulus = 25e3;
+    d.gravity[2] = 0;
+    d.newton_max_iterations = 60;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    for (i = 0; i < s.frame_count; i++) {
+        double x = s.frame_positions[3 * i], y = s.frame_positions[3 * i + 1];
+        if (x < 0.15 || x > 1.85) frm_model_fix_frame(m, i);
+        else if (fabs(x - 1) < 0.3 && fabs(y - 0.5) < 0.3) loaded++;
+    }
+    REQUIRE(loaded > 0);
+    for (k = 1; k <= steps; k++) {
+        double zc = 0;
+        int count = 0, nl = 0, nr = 0;
+        for (i = 0; i < s.frame_count; i++) {
+            double x = s.frame_positions[3 * i], y = s.frame_positions[3 * i + 1];
+            if (frm_model_frame_state(m, i) == 0 && fabs(x - 1) < 0.3 && fabs(y - 0.5) < 0.3) {
+                frm_real f[3];
+                f[0] = f[1] = 0;
+                f[2] = (frm_real)(-300.0 * k / steps / loaded);
+                frm_model_set_external(m, i, f, NULL);
+            }
+        }
+        CHECK_INT(FRM_OK, frm_model_solve_static(m));
+        zl = zr = 0;
+        for (i = 0; i < s.frame_count; i++) {
+            double x = s.frame_positions[3 * i], y = s.frame_positions[3 * i + 1], z = frm_model_positions(m)[3 * i + 2];
+            if (fabs(x - 1) < 0.3 && fabs(y - 0.5) < 0.3) {
+                zc += z;
+                count++;
+            }
+            if (fabs(x - 0.6) < 0.2 && fabs(y - 0.5) < 0.3) {
+                zl += z;
+                nl++;
+            }
+            if (fabs(x - 1.4) < 0.2 && fabs(y - 0.5) < 0.3) {
+                zr += z;
+                nr++;
+            }
+        }
+        zc /= count;
+        zl /= nl;
+        zr /= nr;
+        if (k == 1) first = zc;
+        CHECK(zc < zl && zc < zr && zl < 0 && zr < 0);
+        CHECK(zc < last); /* more load, more sag */
+        last = zc;
+    }
+    printf("    sheet %d frames, %d samples: centre %.4f m at 300 N (x%.2f from the first step), sides %.4f / %.4f\n",
+           s.frame_count, s.sample_count, last, last / first, zl, zr);
+    CHECK(fabs(zl - zr) < 0.05 * fabs(zl));
+    CHECK(last / first < 0.5 * steps && last / first > 1);
+    CHECK(frm__all_finite(frm_model_positions(m), 3 * (size_t)s.frame_count));
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+}
+
+/* ---- sampling ------------------------------------------------------------------------ */
+
+/* Smallest distance between points, and whether each lies in [lo, hi]. */
+static double min_distance(const frm_real *p, int count)
+{
+    double best = HUGE_VAL;
+    int i, j;
+    for (i = 0; i < count; i++)
+        for (j = i + 1; j < count; j++) {
+            double d = 0;
+            int k;
+            for (k = 0; k < 3; k++) d += ((double)p[3 * i + k] - p[3 * j + k]) * ((double)p[3 * i + k] - p[3 * j + k]);
+            if (d < best) best = d;
+        }
+    return sqrt(best);
+}
+
+/* Poisson-disk sampling: distances at least the spacing, points inside the domain, the
+   domain covered (every point of a test grid within twice the spacing of a sample: a
+   maximal Poisson-disk set leaves no larger hole), volume split evenly, the same points
+   for the same seed, other points for another; inside a closed surface (the boundary of a
+   tetrahedral box, and a cylinder) likewise, with the enclosed volume. */
+static void test_poisson_sampling(void)
+{
+    frm_real lo[3] = {0, 0, 0}, hi[3] = {1, 0.6, 0.4};
+    frm_poisson_desc p = frm_poisson_default_desc();
+    frm_sampling a, b, c;
+    double vol = 0, hole = 0;
+    int i, x, y, z, same = 1, diff = 0;
+    p.frame_spacing = (frm_real)0.2;
+    p.sample_spacing = (frm_real)0.08;
+    REQUIRE(frm_sampling_box(&a, lo, hi, &p, NULL, NULL) == FRM_OK);
+    CHECK(min_distance(a.frame_positions, a.frame_count) >= 0.2 * (1 - 1e-6));
+    CHECK(min_distance(a.sample_positions, a.sample_count) >= 0.08 * (1 - 1e-6));
+    for (i = 0; i < a.sample_count; i++) {
+        int k;
+        for (k = 0; k < 3; k++) CHECK(a.sample_positions[3 * i + k] >= lo[k] && a.sample_positions[3 * i + k] <= hi[k]);
+        vol += a.sample_volumes[i];
+    }
+    CHECK_REL(0.24, vol, 1e-5);
+    for (z = 0; z <= 4; z++)
+        for (y = 0; y <= 6; y++)
+            for (x = 0; x <= 10; x++) {
+                double q[3], best = HUGE_VAL;
+                q[0] = 0.1 * x;
+                q[1] = 0.1 * y;
+                q[2] = 0.1 * z;
+                for (i = 0; i < a.sample_count; i++) {
+                    double d = 0;
+                    int k;
+                    for (k = 0; k < 3; k++) d += (q[k] - a.sample_positions[3 * i + k]) * (q[k] - a.sample_positions[3 * i + k]);
+                    if (d < best) best = d;
+                }
+                if (sqrt(best) > hole) hole = sqrt(best);
+            }
+    printf("    box: %d frames, %d samples, largest hole %.3f m (spacing 0.08)\n", a.frame_count, a.sample_count, hole);
+    CHECK(hole < 2 * 0.08);
+    REQUIRE(frm_sampling_box(&b, lo, hi, &p, NULL, NULL) == FRM_OK);
+    REQUIRE(a.sample_count == b.sample_count);
+    for (i = 0; i < 3 * a.sample_count; i++) same &= a.sample_positions[i] == b.sample_positions[i];
+    CHECK(same);
+    p.seed = 2;
+    REQUIRE(frm_sampling_box(&c, lo, hi, &p, NULL, NULL) == FRM_OK);
+    for (i = 0; i < 3 * (c.sample_count < a.sample_count ? c.sample_count : a.sample_count); i++)
+        diff |= a.sample_positions[i] != c.sample_positions[i];
+    CHECK(diff);
+    frm_sampling_free(&a);
+    frm_sampling_free(&b);
+    frm_sampling_free(&c);
+    { /* inside closed surfaces */
+        tetmesh t;
+        int *tris = NULL, tc = 0, pass;
+        for (pass = 0; pass < 2; pass++) {
+            frm_real *v;
+            double exact, box_lo[3] = {0.1, 0.2, -0.3}, box_hi[3] = {0.9, 0.7, 0.3}, sum = 0;
+            if (pass == 0) {
+                REQUIRE(tetmesh_box(&t, box_lo, box_hi, 4, 3, 3, TETMESH_SPLIT6) == TETMESH_OK);
+                exact = 0.8 * 0.5 * 0.6;
+            } else {
+                REQUIRE(tetmesh_cylinder(&t, 0.3, 0.8, 3, 24, 4) == TETMESH_OK);
+                exact = 24 / 2.0 * sin(2 * 3.14159265358979323846 / 24) * 0.09 * 0.8;
+            }
+            REQUIRE(tetmesh_boundary(t.tets, t.tet_count, t.node_count, &tris, &tc) == TETMESH_OK);
+            v = alloc_reals(3 * t.node_count);
+            for (i = 0; i < 3 * t.node_count; i++) v[i] = (frm_real)t.nodes[i];
+            p.seed = 5;
+            p.frame_spacing = (frm_real)0.15;
+            p.sample_spacing = (frm_real)0.07;
+            REQUIRE(frm_sampling_surface(&a, v, t.node_count, tris, tc, &p, NULL, NULL) == FRM_OK);
+            CHECK(min_distance(a.sample_positions, a.sample_count) >= 0.07 * (1 - 1e-6));
+            for (i = 0; i < a.sample_count; i++) sum += a.sample_volumes[i];
+            CHECK_REL(exact, sum, 1e-5);
+            for (i = 0; i < a.sample_count; i++) { /* inside: the box's bounds, the cylinder's radius */
+                const frm_real *q = a.sample_positions + 3 * i;
+                if (pass == 0) {
+                    int k;
+                    for (k = 0; k < 3; k++) CHECK(q[k] >= box_lo[k] - 1e-9 && q[k] <= box_hi[k] + 1e-9);
+                } else
+                    CHECK(q[0] * q[0] + q[1] * q[1] <= 0.09 + 1e-9 && q[2] >= 0 && q[2] <= 0.8);
+            }
+            printf("    %s: %d frames, %d samples inside\n", pass ? "cylinder" : "box surface", a.frame_count, a.sample_count);
+            CHECK(a.sample_count > 0.5 * exact / (0.07 * 0.07 * 0.07)); /* it fills the volume */
+            frm_sampling_free(&a);
+            free(tris);
+            free(v);
+            tetmesh_free(&t);
+        }
+    }
+}
+
+/* ---- boundary conditions, quaternions, failures ------------------------------------ */
+
+/* A spinning, bending cube for 300 implicit steps: quaternions stay unit to round-off;
+   a driven frame sits exactly at its target after each step; fixed frames never move. */
+static void test_quaternions_and_driven(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    scene sc;
+    int n, i, step, steps = TEST_IS_QUICK ? 60 : 300;
+    frm_real *vel, target[3] = {(frm_real)1.2, (frm_real)1.1, (frm_real)1.3}, q[4], x0[3];
+    double worst = 0, pi = 3.14159265358979323846;
+    REQUIRE(scene_hex(&sc, lo, hi, 2, 2, 2, 2, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    vel = alloc_reals(6 * n);
+    for (i = 0; i < n; i++) vel[6 * i + 5] = 3; /* spin about z at 3 rad/s */
+    REQUIRE(frm_model_set_velocities(sc.m, vel) == FRM_OK);
+    REQUIRE(frm_model_fix_frame(sc.m, 0) == FRM_OK);
+    memcpy(x0, frm_model_positions(sc.m), sizeof x0);
+    q[0] = (frm_real)sin(pi / 8);
+    q[1] = q[2] = 0;
+    q[3] = (frm_real)cos(pi / 8);
+    REQUIRE(frm_model_drive_frame(sc.m, n - 1, target, q) == FRM_OK);
+    CHECK_INT(2, frm_model_frame_state(sc.m, n - 1));
+    for (step = 0; step < steps; step++) {
+        REQUIRE(frm_model_step_ex(sc.m, (frm_real)5e-3) == FRM_OK);
+        for (i = 0; i < n; i++) {
+            const frm_real *o = frm_model_orientations(sc.m) + 4 * i;
+            double e = fabs(sqrt((double)o[0] * o[0] + (double)o[1] * o[1] + (double)o[2] * o[2] + (double)o[3] * o[3]) - 1);
+            if (e > worst) worst = e;
+        }
+        for (i = 0; i < 3; i++) CHECK(frm_model_positions(sc.m)[3 * (n - 1) + i] == target[i]);
+        for (i = 0; i < 3; i++) CHECK(frm_model_positions(sc.m)[i] == x0[i]);
+    }
+    printf("    | |q| - 1 | after %d steps: %.2g\n", steps, worst);
+    CHECK(worst < 10 * EPS);
+    free(vel);
+    scene_free(&sc);
+}
+
+/* Failed steps and solves leave the last valid state, bit for bit. */
+static void test_failed_step_keeps_state(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5};
+    scene sc;
+    int n, err;
+    frm_real *x0, *q0, *v0;
+    frm_real g[3] = {0, 0, (frm_real)-1e5};
+    REQUIRE(scene_hex(&sc, lo, hi, 2, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, 1e3, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    frm_model_fix_frame(sc.m, 0);
+    /* a huge load and a huge step: the Neo-Hookean samples invert, or CG gives up */
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    REQUIRE(frm_model_step_ex(sc.m, (frm_real)1e-4) == FRM_OK); /* a valid state with velocity */
+    get_poses(sc.m, &x0, &q0);
+    v0 = alloc_reals(6 * n);
+    memcpy(v0, frm_model_velocities(sc.m), sizeof(frm_real) * 6 * (size_t)n);
+    err = frm_model_step_ex(sc.m, (frm_real)10);
+    CHECK(err == FRM_ERR_INVERTED || err == FRM_ERR_NO_CONVERGENCE || err == FRM_ERR_NOT_FINITE);
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(q0, frm_model_orientations(sc.m), sizeof(frm_real) * 4 * (size_t)n) == 0);
+    CHECK(memcmp(v0, frm_model_velocities(sc.m), sizeof(frm_real) * 6 * (size_t)n) == 0);
+    /* a static solve that cannot converge in one iteration */
+    g[2] = (frm_real)-9.81;
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    REQUIRE(frm_model_set_solver(sc.m, (frm_real)1e-6, 1000, (frm_real)1e-12, 1) == FRM_OK);
+    CHECK_INT(FRM_ERR_NO_CONVERGENCE, frm_model_solve_static(sc.m));
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(q0, frm_model_orientations(sc.m), sizeof(frm_real) * 4 * (size_t)n) == 0);
+    CHECK(memcmp(v0, frm_model_velocities(sc.m), sizeof(frm_real) * 6 * (size_t)n) == 0);
+    free(x0);
+    free(q0);
+    free(v0);
+    scene_free(&sc);
+}
+
+/* The assembled blocks: K_ij = K_ji^T, the pattern is frame adjacency, blocks of frames
+   that share no sample are refused, and a block product equals the matrix-free one. */
+static void test_stiffness_blocks(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5};
+    scene sc;
+    const int *rs, *cols;
+    const frm_real *B;
+    frm_real K[36], Kt[36];
+    int n, i, e, k, far_found = 0;
+    REQUIRE(scene_hex(&sc, lo, hi, 4, 2, 2, 2, FRM_LAW_SVK, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    perturb(sc.m, 0.02, 0.1, 31);
+    n = frm_model_frame_count(sc.m);
+    REQUIRE(frm_model_assemble_stiffness(sc.m) == FRM_OK);
+    B = frm_model_stiffness_blocks(sc.m, &rs, &cols);
+    REQUIRE(B != NULL);
+    for (i = 0; i < n; i++)
+        for (e = rs[i]; e < rs[i + 1]; e++) {
+            double scale = 0;
+            REQUIRE(frm_model_stiffness_block(sc.m, cols[e], i, Kt) == FRM_OK);
+            for (k = 0; k < 36; k++) scale = fabs(B[36 * e + k]) > scale ? fabs(B[36 * e + k]) : scale;
+            for (k = 0; k < 36; k++) CHECK_NEAR(B[36 * e + k], Kt[6 * (k % 6) + k / 6], (IS_FLOAT ? 1e-5 : 1e-12) * scale);
+        }
+    for (i = 1; i < n && !far_found; i++)
+        if (frm_model_stiffness_block(sc.m, 0, i, K) == FRM_ERR_NOT_NEIGHBORS) far_found = 1;
+    CHECK(far_found);
+    CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_stiffness_block(sc.m, 0, n, K));
+    scene_free(&sc);
+    /* a model made without block storage refuses to assemble */
+    REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 1, FRM_LAW_SVK, 1e5, 0.3, 1000, FRM_STIFFNESS_PAIRS) == FRM_OK);
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_assemble_stiffness(sc.m));
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_set_stiffness_mode(sc.m, FRM_STIFFNESS_BLOCKS));
+    CHECK(frm_model_stiffness_blocks(sc.m, &rs, &cols) == NULL);
+    scene_free(&sc);
+}
+
+/* ---- determinism, allocation ----------------------------------------------------------- */
+
+/* A job system that splits the items in `workers` parts and runs them last part first. */
+static void reversed_parallel_for(int count, frm_task_fn task, void *ctx, void *user)
+{
+    int workers = *(int *)user, w;
+    for (w = workers - 1; w >= 0; w--) {
+        int b = (int)((long long)count * w / workers), e = (int)((long long)count * (w + 1) / workers);
+        if (e > b) task(ctx, b, e);
+    }
+}
+
+/* Static solve, then implicit steps, in both stiffness modes; hashes the poses. */
+static unsigned long long run_hashed(int threads, int workers)
+{
+    hexmesh h;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    double lo[3] = {0, -0.1, -0.1}, hi[3] = {1, 0.1, 0.1};
+    frm_real *x, g[3] = {0, 0, (frm_real)-0.5};
+    unsigned long long hash = 1469598103934665603ull;
+    int i, mode, step;
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#else
+    (void)threads;
+#endif
+    if (hexmesh_grid(&h, lo, hi, TEST_IS_QUICK ? 6 : 12, 2, 2) != TETMESH_OK) return 0;
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
+    free(x);
+    frm_sampling_apply(&s, &d);
+    d.material.law = FRM_LAW_NEO_HOOKEAN;
+    d.material.young_modulus = 1e5;
+    d.parallel_for = workers ? reversed_parallel_for : NULL;
+    d.parallel_user = &workers;
+    for (mode = 1; mode <= 2; mode++) {
+        d.stiffness_mode = (frm_stiffness_mode)mode;
+        if (frm_model_create(&d, &m) != FRM_OK) break;
+        for (i = 0; i < h.node_count; i++)
+            if (h.nodes[3 * i] == 0) frm_model_fix_frame(m, i);
+        frm_model_set_gravity(m, g);
+        frm_model_solve_static(m);
+        g[2] = (frm_real)-9.81;
+        frm_model_set_gravity(m, g);
+        for (step = 0; step < 10; step++) frm_model_step_ex(m, (frm_real)0.01);
+        {
+            const unsigned char *bytes = (const unsigned char *)frm_model_positions(m);
+            size_t k;
+            for (k = 0; k < sizeof(frm_real) * 3 * (size_t)h.node_count; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
+            bytes = (const unsigned char *)frm_model_orientations(m);
+            for (k = 0; k < sizeof(frm_real) * 4 * (size_t)h.node_count; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
+        }
+        CHECK(frm_model_pair_count(m) >= FRM_PARALLEL_MIN_PAIRS);
+        frm_model_destroy(m);
+        g[2] = (frm_real)-0.5;
+    }
+    frm_sampling_free(&s);
+    hexmesh_free(&h);
+    return hash;
+}
+
+/* Bit-identical results whatever the number of threads or the partition of the tasks:
+   serial, a job system splitting in 2 and 3 parts run in reverse, OpenMP with 1 and 2
+   threads when compiled with it. */
+static void test_threads_bit_identical(void)
+{
+    unsigned long long h1 = run_hashed(1, 0), h2 = run_hashed(2, 0), h3 = run_hashed(1, 2), h4 = run_hashed(1, 3);
+    printf("    hashes: 1 thread %016llx, 2 threads %016llx, 2 tasks %016llx, 3 tasks %016llx\n", h1, h2, h3, h4);
+    CHECK(h1 != 0);
+    CHECK(h1 == h2);
+    CHECK(h1 == h3);
+    CHECK(h1 == h4);
+}
+
+typedef struct counting_allocator {
+    int allocs, frees;
+    long long live;
+} counting_allocator;
+
+static void *count_alloc(size_t size, size_t align, void *user)
+{
+    counting_allocator *c = (counting_allocator *)user;
+    char *raw = (char *)malloc(size + align + sizeof(void *)), *p;
+    if (!raw) return NULL;
+    p = raw + sizeof(void *);
+    p += (align - (size_t)p % align) % align;
+    ((void **)p)[-1] = raw;
+    c->allocs++;
+    c->live += (long long)size;
+    return p;
+}
+
+static void count_free(void *ptr, size_t size, void *user)
+{
+    counting_allocator *c = (counting_allocator *)user;
+    c->frees++;
+    c->live -= (long long)size;
+    free(((void **)ptr)[-1]);
+}
+
+/* Nothing allocates after creation: steps, static solves, Newton steps, forces, energies,
+   stiffness products and assembly; the sampling helpers free their temporaries; the
+   model and the sampling free everything. */
+static void test_no_allocation_after_create(void)
+{
+    hexmesh h;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    counting_allocator c = {0, 0, 0};
+    frm_allocator a;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.4, 0.4};
+    frm_real *x, *v, *out, res;
+    const frm_real *f;
+    frm_energies en;
+    int i, allocs, mode;
+    a.alloc = count_alloc;
+    a.free = count_free;
+    a.user = &c;
+    REQUIRE(hexmesh_grid(&h, lo, hi, 3, 1, 1) == TETMESH_OK);
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    REQUIRE(frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_GAUSS, &a) == FRM_OK);
+    CHECK_INT(1, c.allocs);
+    v = alloc_reals(6 * h.node_count);
+    out = alloc_reals(6 * h.node_count);
+    for (i = 0; i < 6 * h.node_count; i++) v[i] = (frm_real)(0.01 * (i % 7));
+    for (mode = 1; mode <= 2; mode++) {
+        frm_sampling_apply(&s, &d);
+        d.allocator = a;
+        d.stiffness_mode = (frm_stiffness_mode)mode;
+        REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+        CHECK(frm_model_memory_bytes(m) > 0);
+        allocs = c.allocs;
+        frm_model_fix_frame(m, 0);
+        frm_model_fix_frame(m, 4);
+        frm_model_solve_static(m);
+        frm_model_newton_step(m, &res);
+        frm_model_step(m);
+        frm_model_step_ex(m, (frm_real)1e-3);
+        frm_model_forces(m, &f);
+        frm_model_total_forces(m, &f);
+        frm_model_energy(m, &en);
+        frm_model_prepare_stiffness(m);
+        frm_model_apply_stiffness(m, v, out, 0);
+        frm_model_apply_stiffness(m, v, out, 1);
+        if (mode == 2) frm_model_assemble_stiffness(m);
+        frm_model_sample_positions(m);
+        frm_model_deformation_gradients(m);
+        CHECK_INT(allocs, c.allocs);
+        frm_model_destroy(m);
+    }
+    frm_sampling_free(&s);
+    CHECK_INT(c.allocs, c.frees);
+    CHECK_INT(0, c.live);
+    { /* the Poisson helpers free their temporaries too */
+        frm_real blo[3] = {0, 0, 0}, bhi[3] = {0.5, 0.5, 0.5};
+        frm_poisson_desc p = frm_poisson_default_desc();
+        REQUIRE(frm_sampling_box(&s, blo, bhi, &p, NULL, &a) == FRM_OK);
+        frm_sampling_free(&s);
+        CHECK_INT(c.allocs, c.frees);
+        CHECK_INT(0, c.live);
+    }
+    free(x);
+    free(v);
+    free(out);
+    hexmesh_free(&h);
+}
+
+/* ---- validation ---------------------------------------------------------------------- */
+
+typedef struct log_capture {
+    int calls, last_code;
+} log_capture;
+
+static void capture_log(int code, const char *message, void *user)
+{
+    log_capture *c = (log_capture *)user;
+    c->calls++;
+    c->last_code = code;
+    (void)message;
+}
+
+static int try_create(const frm_desc *d)
+{
+    frm_model *m = (frm_model *)&m; /* must be reset to NULL on failure */
+    int err = frm_model_create(d, &m);
+    if (err) CHECK(m == NULL);
+    frm_model_destroy(m);
+    return err;
+}
+
+/* Every validation error of the model, the shape functions and the samplings. */
+static void test_validation_errors(void)
+{
+    /* two samples on two frames */
+    frm_real fx[6] = {0, 0, 0, 1, 0, 0}, sx[6] = {0.25f, 0, 0, 0.75f, 0, 0}, vol[2] = {0.5f, 0.5f};
+    frm_real w[4] = {0.75f, 0.25f, 0.25f, 0.75f}, g[12] = {-1, 0, 0, 1, 0, 0, -1, 0, 0, 1, 0, 0}, q[8] = {0, 0, 0, 1, 0, 0, 0, 1};
+    int start[3] = {0, 2, 4}, nb[4] = {0, 1, 0, 1}, bad_start[3], bad_nb[4], mats[2] = {0, 1}, i;
+    frm_real bad[12], many_w[17], many_g[51];
+    int many_nb[17], many_start[3];
+    frm_material table[2];
+    frm_desc base = frm_model_default_desc(), d;
+    log_capture lc = {0, 0};
+    frm_model *m;
+    base.frame_positions = fx;
+    base.frame_count = 2;
+    base.sample_positions = sx;
+    base.sample_volumes = vol;
+    base.sample_count = 2;
+    base.neighbor_start = start;
+    base.neighbor_frames = nb;
+    base.neighbor_weights = w;
+    base.neighbor_gradients = g;
+    base.log = capture_log;
+    base.log_user = &lc;
+    CHECK_INT(FRM_OK, try_create(&base));
+    CHECK_INT(FRM_ERR_ARG, frm_model_create(&base, NULL));
+    CHECK_INT(FRM_ERR_ARG, frm_model_create(NULL, &m));
+    d = base;
+    d.internal_cookie = 0;
+    CHECK_INT(FRM_ERR_DESC, try_create(&d));
+    CHECK_INT(FRM_ERR_DESC, lc.last_code); /* and the logger heard of it */
+    d = base;
+    d.frame_count = 0;
+    CHECK_INT(FRM_ERR_FRAME_COUNT, try_create(&d));
+    d = base;
+    d.sample_count = 0;
+    CHECK_INT(FRM_ERR_SAMPLE_COUNT, try_create(&d));
+    d = base;
+    d.neighbor_weights = NULL;
+    CHECK_INT(FRM_ERR_NEIGHBOR_TABLE, try_create(&d));
+    memcpy(bad, fx, sizeof fx);
+    bad[4] = (frm_real)HUGE_VAL;
+    d = base;
+    d.frame_positions = bad;
+    CHECK_INT(FRM_ERR_FRAME_NOT_FINITE, try_create(&d));
+    d = base;
+    d.frame_orientations = q;
+    CHECK_INT(FRM_OK, try_create(&d));
+    memcpy(bad, q, sizeof q);
+    bad[7] = (frm_real)0.9; /* |q| = 0.9: not unit */
+    d.frame_orientations = bad;
+    CHECK_INT(FRM_ERR_QUATERNION, try_create(&d));
+    memcpy(bad, sx, sizeof sx);
+    bad[1] = (frm_real)(HUGE_VAL - HUGE_VAL);
+    d = base;
+    d.sample_positions = bad;
+    CHECK_INT(FRM_ERR_SAMPLE_NOT_FINITE, try_create(&d));
+    for (i = 0; i < 2; i++) { /* zero and negative volumes */
+        frm_real bv[2] = {0.5f, 0.5f};
+        bv[1] = i ? (frm_real)-0.5 : 0;
+        d = base;
+        d.sample_volumes = bv;
+        CHECK_INT(FRM_ERR_SAMPLE_VOLUME, try_create(&d));
+    }
+    bad_start[0] = 0;
+    bad_start[1] = 2;
+    bad_start[2] = 2; /* sample 1 has no neighbour */
+    d = base;
+    d.neighbor_start = bad_start;
+    CHECK_INT(FRM_ERR_NO_NEIGHBOR, try_create(&d));
+    bad_start[0] = 1;
+    bad_start[2] = 4;
+    CHECK_INT(FRM_ERR_NEIGHBOR_TABLE, try_create(&d)); /* start[0] != 0 */
+    bad_start[0] = 0;
+    bad_start[1] = 3;
+    bad_start[2] = 2; /* decreasing */
+    CHECK_INT(FRM_ERR_NEIGHBOR_TABLE, try_create(&d));
+    memcpy(bad_nb, nb, sizeof nb);
+    bad_nb[1] = 2; /* out of range */
+    d = base;
+    d.neighbor_frames = bad_nb;
+    CHECK_INT(FRM_ERR_NEIGHBOR_TABLE, try_create(&d));
+    bad_nb[1] = 0; /* repeated */
+    CHECK_INT(FRM_ERR_NEIGHBOR_TABLE, try_create(&d));
+    { /* more than 16 neighbours */
+        frm_real many_fx[3 * 17];
+        for (i = 0; i < 17; i++) {
+            many_fx[3 * i] = (frm_real)i;
+            many_fx[3 * i + 1] = many_fx[3 * i + 2] = 0;
+            many_nb[i] = i;
+            many_w[i] = (frm_real)(1.0 / 17);
+            many_g[3 * i] = many_g[3 * i + 1] = many_g[3 * i + 2] = 0;
+        }
+        many_start[0] = 0;
+        many_start[1] = 17;
+        d = base;
+        d.frame_positions = many_fx;
+        d.frame_count = 17;
+        d.sample_count = 1;
+        d.neighbor_start = many_start;
+        d.neighbor_frames = many_nb;
+        d.neighbor_weights = many_w;
+        d.neighbor_gradients = many_g;
+        CHECK_INT(FRM_ERR_TOO_MANY_NEIGHBORS, try_create(&d));
+    }
+    memcpy(bad, w, sizeof w);
+    bad[0] = (frm_real)(HUGE_VAL - HUGE_VAL);
+    d = base;
+    d.neighbor_weights = bad;
+    CHECK_INT(FRM_ERR_WEIGHT_NOT_FINITE, try_create(&d));
+    memcpy(bad, g, sizeof g);
+    bad[3] = (frm_real)HUGE_VAL;
+    d = base;
+    d.neighbor_gradients = bad;
+    CHECK_INT(FRM_ERR_WEIGHT_NOT_FINITE, try_create(&d));
+    memcpy(bad, w, sizeof w);
+    bad[1] = (frm_real)0.3; /* sum 1.05 */
+    d = base;
+    d.neighbor_weights = bad;
+    CHECK_INT(FRM_ERR_WEIGHT_SUM, try_create(&d));
+    memcpy(bad, g, sizeof g);
+    bad[3] = (frm_real)1.1; /* sum 0.1 */
+    d = base;
+    d.neighbor_gradients = bad;
+    CHECK_INT(FRM_ERR_GRADIENT_SUM, try_create(&d));
+    { /* a frame no sample weighs: weights (1, 0) on both samples */
+        frm_real w1[4] = {1, 0, 1, 0};
+        d = base;
+        d.neighbor_weights = w1;
+        CHECK_INT(FRM_ERR_FRAME_UNUSED, try_create(&d));
+    }
+    d = base;
+    d.material.law = (frm_law)7;
+    CHECK_INT(FRM_ERR_MATERIAL, try_create(&d));
+    d = base;
+    d.material.young_modulus = 0;
+    CHECK_INT(FRM_ERR_YOUNG_MODULUS, try_create(&d));
+    d.material.young_modulus = (frm_real)HUGE_VAL;
+    CHECK_INT(FRM_ERR_YOUNG_MODULUS, try_create(&d));
+    d = base;
+    d.material.poisson_ratio = (frm_real)0.5;
+    CHECK_INT(FRM_ERR_POISSON_RATIO, try_create(&d));
+    d.material.poisson_ratio = -1;
+    CHECK_INT(FRM_ERR_POISSON_RATIO, try_create(&d));
+    d = base;
+    d.material.density = -1;
+    CHECK_INT(FRM_ERR_DENSITY, try_create(&d));
+    table[0] = base.material;
+    table[1] = base.material;
+    table[1].law = FRM_LAW_NEO_HOOKEAN;
+    d = base;
+    d.materials = table;
+    d.material_count = 2;
+    d.sample_materials = mats;
+    CHECK_INT(FRM_OK, try_create(&d));
+    mats[1] = 2;
+    CHECK_INT(FRM_ERR_MATERIAL, try_create(&d));
+    mats[1] = 1;
+    d.material_count = 0;
+    CHECK_INT(FRM_ERR_MATERIAL, try_create(&d));
+    d = base;
+    d.sample_materials = mats; /* indices without a table */
+    CHECK_INT(FRM_ERR_MATERIAL, try_create(&d));
+    d = base;
+    d.time_step = 0;
+    CHECK_INT(FRM_ERR_TIME_STEP, try_create(&d));
+    d = base;
+    d.mass_damping = -1;
+    CHECK_INT(FRM_ERR_DAMPING, try_create(&d));
+    d = base;
+    d.cg_max_iterations = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = base;
+    d.newton_tolerance = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = base;
+    d.static_regularization = -1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = base;
+    d.stiffness_mode = (frm_stiffness_mode)3;
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, try_create(&d));
+    d = base;
+    d.gravity[1] = (frm_real)HUGE_VAL;
+    CHECK_INT(FRM_ERR_ARG, try_create(&d));
+    d = base;
+    d.frame_coupling = -1;
+    CHECK_INT(FRM_ERR_ARG, try_create(&d));
+    d = base;
+    d.allocator.alloc = count_alloc; /* free missing */
+    CHECK_INT(FRM_ERR_ARG, try_create(&d));
+    CHECK(lc.calls > 10);
+
+    /* the functions of a model */
+    REQUIRE(frm_model_create(&base, &m) == FRM_OK);
+    {
+        frm_real pos[3] = {0, 0, 0}, unit[4] = {0, 0, 0, 1}, nonunit[4] = {0, 0, 0, 2}, nanv[3], poses[8], res;
+        nanv[0] = nanv[1] = nanv[2] = (frm_real)(HUGE_VAL - HUGE_VAL);
+        CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_fix_frame(m, 2));
+        CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_release_frame(m, -1));
+        CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_frame_state(m, 5));
+        CHECK_INT(FRM_ERR_QUATERNION, frm_model_drive_frame(m, 0, pos, nonunit));
+        CHECK_INT(FRM_ERR_ARG, frm_model_drive_frame(m, 0, nanv, unit));
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_external(m, 0, nanv, NULL));
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_gravity(m, nanv));
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_set_solver(m, 0, 10, (frm_real)1e-6, 10));
+        CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_set_stiffness_mode(m, (frm_stiffness_mode)9));
+        CHECK_INT(FRM_ERR_TIME_STEP, frm_model_step_ex(m, 0));
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_velocities(m, NULL));
+        memcpy(poses, q, sizeof q);
+        poses[3] = (frm_real)0.5;
+        CHECK_INT(FRM_ERR_QUATERNION, frm_model_set_poses(m, fx, poses));
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_poses(m, fx, NULL));
+        CHECK_INT(FRM_ERR_ARG, frm_model_apply_stiffness(m, NULL, poses, 1));
+        CHECK_INT(FRM_ERR_ARG, frm_model_newton_step(NULL, &res));
+        CHECK_INT(FRM_ERR_ARG, frm_model_energy(m, NULL));
+        CHECK_INT(FRM_ERR_ARG, frm_model_mass_block(m, 0, NULL));
+    }
+    { /* NOT_FINITE: a pose far beyond float/double range */
+        frm_real huge[6], f0[3] = {0, 0, 0};
+        const frm_real *f;
+        memcpy(huge, fx, sizeof fx);
+        huge[3] = (frm_real)(IS_FLOAT ? 1e30 : 1e200);
+        CHECK_INT(FRM_OK, frm_model_set_poses(m, huge, q));
+        CHECK_INT(FRM_ERR_NOT_FINITE, frm_model_forces(m, &f));
+        CHECK(f == NULL);
+        frm_model_set_poses(m, fx, q);
+        (void)f0;
+    }
+    frm_model_destroy(m);
+    { /* INVERTED: a Neo-Hookean sample turned inside out */
+        frm_real flip[6] = {0, 0, 0, -1, 0, 0};
+        const frm_real *f;
+        d = base;
+        d.material.law = FRM_LAW_NEO_HOOKEAN;
+        REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+        frm_model_set_poses(m, flip, q);
+        CHECK_INT(FRM_ERR_INVERTED, frm_model_forces(m, &f));
+        frm_model_destroy(m);
+    }
+
+    /* shape functions and samplings */
+    {
+        frm_sampling s;
+        frm_real nodes[24], wts[8], grd[24], xi[3] = {0.5f, 0.5f, 0.5f}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, flat_hi[3] = {1, 1, 0};
+        int hex[8] = {0, 1, 2, 3, 4, 5, 6, 7}, tet[4] = {0, 1, 2, 9};
+        frm_poisson_desc p = frm_poisson_default_desc();
+        frm_shape_desc sh = frm_shape_default_desc();
+        for (i = 0; i < 8; i++) {
+            nodes[3 * i] = (frm_real)(i & 1);
+            nodes[3 * i + 1] = (frm_real)((i >> 1) & 1);
+            nodes[3 * i + 2] = (frm_real)((i >> 2) & 1);
+        }
+        CHECK_INT(FRM_OK, frm_shape_hex(nodes, xi, NULL, wts, grd, NULL));
+        CHECK_INT(FRM_ERR_ARG, frm_shape_hex(nodes, NULL, NULL, wts, grd, NULL));
+        CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(nodes, 0, xi, 2, 0, wts, grd));
+        CHECK_INT(FRM_ERR_ARG, frm_shape_mls(nodes, 8, xi, 0, wts, grd));
+        CHECK_INT(FRM_ERR_INDEX_RANGE, frm_sampling_tets(&s, nodes, 8, tet, 1, 1, NULL, NULL));
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_tets(&s, nodes, 8, hex, 1, 3, NULL, NULL)); /* no preset for 3 */
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_hexes(&s, nodes, 8, hex, 1, 5, FRM_QUADRATURE_GAUSS, NULL));
+        hex[7] = 6;
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_sampling_hexes(&s, nodes, 8, hex, 1, 2, FRM_QUADRATURE_GAUSS, NULL));
+        hex[7] = 7;
+        nodes[23] = (frm_real)-2; /* corner 7 pushed through the cell: inverted at a sample */
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_sampling_hexes(&s, nodes, 8, hex, 1, 3, FRM_QUADRATURE_GAUSS, NULL));
+        nodes[23] = 1;
+        nodes[5] = (frm_real)HUGE_VAL;
+        CHECK_INT(FRM_ERR_FRAME_NOT_FINITE, frm_sampling_hexes(&s, nodes, 8, hex, 1, 2, FRM_QUADRATURE_GAUSS, NULL));
+        nodes[5] = 0;
+        CHECK(s.frame_count == 0 && s.neighbor_start == NULL); /* failures leave it empty */
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, flat_hi, &p, NULL, NULL)); /* flat without volume */
+        p.frame_spacing = 0;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, hi, &p, NULL, NULL));
+        p = frm_poisson_default_desc();
+        p.max_points = 10;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, hi, &p, NULL, NULL));
+        p = frm_poisson_default_desc();
+        sh.nearest = 17;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        sh = frm_shape_default_desc();
+        sh.support = FRM_SUPPORT_RADIUS;
+        sh.radius = (frm_real)0.05; /* samples with no frame in reach */
+        CHECK_INT(FRM_ERR_NO_NEIGHBOR, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        sh.radius = (frm_real)0.8; /* and with too many */
+        CHECK_INT(FRM_ERR_TOO_MANY_NEIGHBORS, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        sh = frm_shape_default_desc();
+        sh.shape = FRM_SHAPE_MLS;
+        p.volume = 1;
+        CHECK_INT(FRM_ERR_SHAPE_DEGENERATE, frm_sampling_box(&s, lo, flat_hi, &p, &sh, NULL)); /* coplanar MLS */
+        CHECK_INT(FRM_ERR_SAMPLE_VOLUME, frm_sampling_meshless(&s, nodes, 8, nodes, 8, 0, NULL, NULL));
+        { /* open and inconsistent surfaces */
+            int tris[12] = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2}, open_tris[9] = {0, 1, 2, 0, 2, 3, 0, 3, 1};
+            frm_real tv[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+            p = frm_poisson_default_desc();
+            p.frame_spacing = (frm_real)0.3;
+            p.sample_spacing = (frm_real)0.15;
+            CHECK_INT(FRM_OK, frm_sampling_surface(&s, tv, 4, tris, 4, &p, NULL, NULL));
+            frm_sampling_free(&s);
+            CHECK_INT(FRM_ERR_SURFACE, frm_sampling_surface(&s, tv, 4, open_tris, 3, &p, NULL, NULL));
+            tris[11] = 3; /* a degenerate triangle breaks closure */
+            CHECK_INT(FRM_ERR_SURFACE, frm_sampling_surface(&s, tv, 4, tris, 4, &p, NULL, NULL));
+            tris[11] = 7;
+            CHECK_INT(FRM_ERR_INDEX_RANGE, frm_sampling_surface(&s, tv, 4, tris, 4, &p, NULL, NULL));
+        }
+    }
+}
+
+/* Every code has its own message; unknown codes say so; the version string agrees. */
+static void test_error_strings(void)
+{
+    int c, k;
+    char v[32];
+    for (c = 0; c > FRM_ERR_LAST_; c--) {
+        CHECK(strcmp(frm_error_string(c), "unknown error code") != 0);
+        for (k = 0; k > c; k--) CHECK(strcmp(frm_error_string(c), frm_error_string(k)) != 0);
+    }
+    CHECK(strcmp(frm_error_string(FRM_ERR_LAST_), "unknown error code") == 0);
+    snprintf(v, sizeof v, "%d.%d.%d", FRM_VERSION_MAJOR, FRM_VERSION_MINOR, FRM_VERSION_PATCH);
+    CHECK(strcmp(frm_version(), v) == 0);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -1016,6 +1888,16 @@ static const test_case cases[] = {
     TEST(test_cantilever_r1),
     TEST(test_beam_frequency_r3),
     TEST(test_soft_cantilever_r2),
+    TEST(test_torsion_180),
+    TEST(test_shepard_sheet),
+    TEST(test_poisson_sampling),
+    TEST(test_quaternions_and_driven),
+    TEST(test_failed_step_keeps_state),
+    TEST(test_stiffness_blocks),
+    TEST(test_threads_bit_identical),
+    TEST(test_no_allocation_after_create),
+    TEST(test_validation_errors),
+    TEST(test_error_strings),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
