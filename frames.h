@@ -560,51 +560,74 @@ FRM_HOSTDEV static inline void frm_quat_integrate(frm_real q[4], const frm_real 
     q[3] = (frm_real)(q[3] / n);
 }
 
-/* Per frame: R from q and Q = R Rbar^T, the rotation since the rest pose (it maps the
-   rest axes to the current ones; the second term of eq. 3.40 uses it). */
-FRM_HOSTDEV static inline void frm_frame_rotations(const frm_real q[4], const frm_real rest_rotation[9],
-                                                   frm_real R[9], frm_real Q[9])
+/* Per frame: R from q, Q = R Rbar^T (the rotation since the rest pose; it maps the rest
+   axes to the current ones, the second term of eq. 3.40) and Qm = Q - I, from the
+   relative quaternion (v, w) = q qbar^* as 2 w [v]x + 2 [v]x^2, exact to the precision of
+   v (so small rotations keep their digits in float). */
+FRM_HOSTDEV static inline void frm_frame_rotations(const frm_real q[4], const frm_real rest_q[4], frm_real R[9],
+                                                   frm_real Q[9], frm_real Qm[9])
 {
-    int r, c;
+    frm_real c[4], d[4], x, y, z, w;
+    int k;
+    c[0] = -rest_q[0];
+    c[1] = -rest_q[1];
+    c[2] = -rest_q[2];
+    c[3] = rest_q[3];
     frm_quat_to_matrix(q, R);
-    for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++)
-            Q[3 * r + c] = R[3 * r] * rest_rotation[3 * c] + R[3 * r + 1] * rest_rotation[3 * c + 1] +
-                           R[3 * r + 2] * rest_rotation[3 * c + 2];
+    frm_quat_multiply(q, c, d);
+    x = d[0];
+    y = d[1];
+    z = d[2];
+    w = d[3];
+    Qm[0] = -2 * (y * y + z * z);
+    Qm[1] = 2 * (x * y - z * w);
+    Qm[2] = 2 * (x * z + y * w);
+    Qm[3] = 2 * (x * y + z * w);
+    Qm[4] = -2 * (x * x + z * z);
+    Qm[5] = 2 * (y * z - x * w);
+    Qm[6] = 2 * (x * z - y * w);
+    Qm[7] = 2 * (y * z + x * w);
+    Qm[8] = -2 * (x * x + y * y);
+    for (k = 0; k < 9; k++) Q[k] = Qm[k] + (k % 4 == 0 ? 1 : 0);
 }
 
 /* Per sample, eqs. 3.34 and 3.40. Its n neighbours: frame indices, weights w_k, gradients
-   (3 n), rest local positions lbar_k = Rbar_k^T (pbar_s - xbar_k) (3 n, eq. 3.33). Frame
-   arrays: positions (3 per frame), R (9), Q = R Rbar^T (9). Out: the deformation gradient
+   (3 n), rest levers abar_k = Rbar_k lbar_k = pbar_s - xbar_k (3 n, world axes; lbar is
+   eq. 3.33). Frame arrays: displacements u = x - xbar (3 per frame) and Qm = Q - I (9).
+   Out: the displacement gradient H = F - I of the deformation gradient
        F = sum_k d_k grad w_k^T + w_k Q_k,   d_k = x_k + R_k lbar_k,
-   the levers a_k = R_k lbar_k (3 n, may be NULL), the offsets d_k - p of each frame's own
-   prediction from the blended position (3 n, may be NULL; see the coupling term) and the
-   position p = sum_k w_k d_k (may be NULL). d_k is taken relative to d_0: the same F when
-   the gradients sum to zero, and no loss of precision far from the origin. */
+   the levers a_k = R_k lbar_k = Q_k abar_k (3 n, may be NULL), the offsets d_k - p of each
+   frame's own prediction from the blended position (3 n, may be NULL; see the coupling
+   term) and the position p = sum_k w_k d_k (may be NULL; needs sample_rest, the rest
+   position). Since xbar_k + abar_k = pbar_s for every neighbour, d_k - d_0 is exactly
+   (u_k - u_0) + (Qm_k abar_k - Qm_0 abar_0), and with sum w = 1,
+       H = sum_k (d_k - d_0) grad w_k^T + w_k Qm_k:
+   no large terms cancel, so the precision follows the strain, not the distance to the
+   origin or the size of 1 (which matters in float). */
 FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, const frm_real *weight,
-                                                      const frm_real *grad, const frm_real *local,
-                                                      const frm_real *frame_pos, const frm_real *frame_rot,
-                                                      const frm_real *frame_rel, frm_real F[9],
-                                                      frm_real *lever, frm_real *offset, frm_real *position)
+                                                      const frm_real *grad, const frm_real *rest_lever,
+                                                      const frm_real *sample_rest, const frm_real *frame_disp,
+                                                      const frm_real *frame_relm, frm_real H[9], frm_real *lever,
+                                                      frm_real *offset, frm_real *position)
 {
     int k, r, c, i0 = frame[0];
-    frm_real a0[3], p[3] = {0, 0, 0};
-    const frm_real *R0 = frame_rot + 9 * i0, *l0 = local;
-    for (r = 0; r < 3; r++) a0[r] = R0[3 * r] * l0[0] + R0[3 * r + 1] * l0[1] + R0[3 * r + 2] * l0[2];
-    for (r = 0; r < 9; r++) F[r] = 0;
+    frm_real da0[3], p[3] = {0, 0, 0};
+    const frm_real *Q0 = frame_relm + 9 * i0, *b0 = rest_lever;
+    for (r = 0; r < 3; r++) da0[r] = Q0[3 * r] * b0[0] + Q0[3 * r + 1] * b0[1] + Q0[3 * r + 2] * b0[2];
+    for (r = 0; r < 9; r++) H[r] = 0;
     for (k = 0; k < n; k++) {
         int i = frame[k];
-        const frm_real *R = frame_rot + 9 * i, *Q = frame_rel + 9 * i, *l = local + 3 * k, *g = grad + 3 * k;
-        frm_real a[3], e[3], w = weight[k];
+        const frm_real *Qm = frame_relm + 9 * i, *ab = rest_lever + 3 * k, *g = grad + 3 * k;
+        frm_real da[3], e[3], w = weight[k];
         for (r = 0; r < 3; r++) {
-            a[r] = R[3 * r] * l[0] + R[3 * r + 1] * l[1] + R[3 * r + 2] * l[2];
-            e[r] = (frame_pos[3 * i + r] - frame_pos[3 * i0 + r]) + (a[r] - a0[r]);
+            da[r] = Qm[3 * r] * ab[0] + Qm[3 * r + 1] * ab[1] + Qm[3 * r + 2] * ab[2];
+            e[r] = (frame_disp[3 * i + r] - frame_disp[3 * i0 + r]) + (da[r] - da0[r]);
             p[r] += w * e[r];
         }
         for (r = 0; r < 3; r++)
-            for (c = 0; c < 3; c++) F[3 * r + c] += e[r] * g[c] + w * Q[3 * r + c];
+            for (c = 0; c < 3; c++) H[3 * r + c] += e[r] * g[c] + w * Qm[3 * r + c];
         if (lever)
-            for (r = 0; r < 3; r++) lever[3 * k + r] = a[r];
+            for (r = 0; r < 3; r++) lever[3 * k + r] = ab[r] + da[r];
         if (offset)
             for (r = 0; r < 3; r++) offset[3 * k + r] = e[r];
     }
@@ -612,7 +635,16 @@ FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, c
         for (k = 0; k < n; k++)
             for (r = 0; r < 3; r++) offset[3 * k + r] -= p[r];
     if (position)
-        for (r = 0; r < 3; r++) position[r] = frame_pos[3 * i0 + r] + a0[r] + p[r];
+        for (r = 0; r < 3; r++) position[r] = sample_rest[r] + (frame_disp[3 * i0 + r] + da0[r] + p[r]);
+}
+
+/* det(I + H) - 1 by the invariants, without cancellation: tr H + (tr(H)^2 - tr(H^2))/2 + det H. */
+FRM_HOSTDEV static inline frm_real frm_det_minus_one(const frm_real H[9])
+{
+    frm_real tr = H[0] + H[4] + H[8];
+    frm_real tr2 = H[0] * H[0] + H[4] * H[4] + H[8] * H[8] + 2 * (H[1] * H[3] + H[2] * H[6] + H[5] * H[7]);
+    frm_real det = H[0] * (H[4] * H[8] - H[5] * H[7]) - H[1] * (H[3] * H[8] - H[5] * H[6]) + H[2] * (H[3] * H[7] - H[4] * H[6]);
+    return tr + (frm_real)0.5 * (tr * tr - tr2) + det;
 }
 
 /* Symmetric tensor (6) to a full 3x3. */
@@ -636,67 +668,68 @@ FRM_HOSTDEV static inline void frm_first_piola(const frm_real F[9], const frm_re
         for (c = 0; c < 3; c++) P[3 * r + c] = F[3 * r] * A[c] + F[3 * r + 1] * A[3 + c] + F[3 * r + 2] * A[6 + c];
 }
 
-/* The law at F: second Piola-Kirchhoff stress S (6), energy density psi (J/m^3) and the
-   tangent data (FRM_LAW_CACHE values) frm_material_dstress needs.
-       SVK (eq. 3.53):  S = lambda tr(E) I + 2 mu E,  E = (C - I) / 2,  C = F^T F
-       Neo-Hookean:     S = mu (I - C^-1) + lambda ln J C^-1,  J = det F
-   Returns 0, or FRM_ERR_INVERTED for a Neo-Hookean sample with J <= 0 (the energy is
-   infinite there). Room for more laws: add a case here and in frm_material_dstress. */
-FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real lambda, const frm_real F[9],
+/* The law at F = I + H (H the displacement gradient): second Piola-Kirchhoff stress S
+   (6), energy density psi (J/m^3) and the tangent data (FRM_LAW_CACHE values)
+   frm_material_dstress needs. With E = (H + H^T + H^T H) / 2 = (C - I) / 2:
+       SVK (eq. 3.53):  S = lambda tr(E) I + 2 mu E
+       Neo-Hookean:     S = mu (I - C^-1) + lambda ln J C^-1 = 2 mu C^-1 E + lambda ln J C^-1
+   (J - 1 by frm_det_minus_one, ln J by log1p: small strains keep their digits). Returns 0,
+   or FRM_ERR_INVERTED for a Neo-Hookean sample with J <= 0 (the energy is infinite
+   there). Room for more laws: add a case here and in frm_material_dstress. */
+FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real lambda, const frm_real H[9],
                                                   frm_real S[6], frm_real *psi, frm_real *cache)
 {
-    frm_real C[6];
-    C[0] = F[0] * F[0] + F[3] * F[3] + F[6] * F[6];
-    C[1] = F[1] * F[1] + F[4] * F[4] + F[7] * F[7];
-    C[2] = F[2] * F[2] + F[5] * F[5] + F[8] * F[8];
-    C[3] = F[1] * F[2] + F[4] * F[5] + F[7] * F[8];
-    C[4] = F[0] * F[2] + F[3] * F[5] + F[6] * F[8];
-    C[5] = F[0] * F[1] + F[3] * F[4] + F[6] * F[7];
+    frm_real E[6], tr;
+    int k;
+    E[0] = H[0] + (frm_real)0.5 * (H[0] * H[0] + H[3] * H[3] + H[6] * H[6]);
+    E[1] = H[4] + (frm_real)0.5 * (H[1] * H[1] + H[4] * H[4] + H[7] * H[7]);
+    E[2] = H[8] + (frm_real)0.5 * (H[2] * H[2] + H[5] * H[5] + H[8] * H[8]);
+    E[3] = (frm_real)0.5 * (H[5] + H[7] + H[1] * H[2] + H[4] * H[5] + H[7] * H[8]);
+    E[4] = (frm_real)0.5 * (H[2] + H[6] + H[0] * H[2] + H[3] * H[5] + H[6] * H[8]);
+    E[5] = (frm_real)0.5 * (H[1] + H[3] + H[0] * H[1] + H[3] * H[4] + H[6] * H[7]);
+    tr = E[0] + E[1] + E[2];
     if (law == FRM_LAW_NEO_HOOKEAN) {
-        frm_real J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-                     F[2] * (F[3] * F[7] - F[4] * F[6]);
-        frm_real lnJ, inv_det, ci[6];
+        frm_real jm1 = frm_det_minus_one(H), J = 1 + jm1, lnJ, inv_det, C[6], ci[9], e[9], x[9];
+        int r, c;
         if (!(J > 0)) return FRM_ERR_INVERTED;
-        lnJ = (frm_real)log((double)J);
+        lnJ = (frm_real)log1p((double)jm1);
+        for (k = 0; k < 6; k++) C[k] = 2 * E[k] + (k < 3 ? 1 : 0);
         inv_det = 1 / (J * J); /* det C = J^2 */
         ci[0] = (C[1] * C[2] - C[3] * C[3]) * inv_det;
-        ci[1] = (C[0] * C[2] - C[4] * C[4]) * inv_det;
-        ci[2] = (C[0] * C[1] - C[5] * C[5]) * inv_det;
-        ci[3] = (C[4] * C[5] - C[0] * C[3]) * inv_det;
-        ci[4] = (C[5] * C[3] - C[1] * C[4]) * inv_det;
-        ci[5] = (C[3] * C[4] - C[2] * C[5]) * inv_det;
-        S[0] = mu * (1 - ci[0]) + lambda * lnJ * ci[0];
-        S[1] = mu * (1 - ci[1]) + lambda * lnJ * ci[1];
-        S[2] = mu * (1 - ci[2]) + lambda * lnJ * ci[2];
-        S[3] = (lambda * lnJ - mu) * ci[3];
-        S[4] = (lambda * lnJ - mu) * ci[4];
-        S[5] = (lambda * lnJ - mu) * ci[5];
-        *psi = (frm_real)0.5 * mu * (C[0] + C[1] + C[2] - 3) - mu * lnJ + (frm_real)0.5 * lambda * lnJ * lnJ;
+        ci[4] = (C[0] * C[2] - C[4] * C[4]) * inv_det;
+        ci[8] = (C[0] * C[1] - C[5] * C[5]) * inv_det;
+        ci[5] = ci[7] = (C[4] * C[5] - C[0] * C[3]) * inv_det;
+        ci[2] = ci[6] = (C[5] * C[3] - C[1] * C[4]) * inv_det;
+        ci[1] = ci[3] = (C[3] * C[4] - C[2] * C[5]) * inv_det;
+        frm_sym_to_matrix(E, e);
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) x[3 * r + c] = ci[3 * r] * e[c] + ci[3 * r + 1] * e[3 + c] + ci[3 * r + 2] * e[6 + c];
+        S[0] = 2 * mu * x[0] + lambda * lnJ * ci[0];
+        S[1] = 2 * mu * x[4] + lambda * lnJ * ci[4];
+        S[2] = 2 * mu * x[8] + lambda * lnJ * ci[8];
+        S[3] = mu * (x[5] + x[7]) + lambda * lnJ * ci[5];
+        S[4] = mu * (x[2] + x[6]) + lambda * lnJ * ci[2];
+        S[5] = mu * (x[1] + x[3]) + lambda * lnJ * ci[1];
+        *psi = mu * (tr - lnJ) + (frm_real)0.5 * lambda * lnJ * lnJ;
         if (cache) {
-            int k;
-            for (k = 0; k < 6; k++) cache[k] = ci[k];
+            cache[0] = ci[0];
+            cache[1] = ci[4];
+            cache[2] = ci[8];
+            cache[3] = ci[5];
+            cache[4] = ci[2];
+            cache[5] = ci[1];
             cache[6] = lnJ;
         }
         return 0;
-    } else {
-        frm_real E[6], tr;
-        int k;
-        E[0] = (frm_real)0.5 * (C[0] - 1);
-        E[1] = (frm_real)0.5 * (C[1] - 1);
-        E[2] = (frm_real)0.5 * (C[2] - 1);
-        E[3] = (frm_real)0.5 * C[3];
-        E[4] = (frm_real)0.5 * C[4];
-        E[5] = (frm_real)0.5 * C[5];
-        tr = E[0] + E[1] + E[2];
-        for (k = 0; k < 6; k++) S[k] = 2 * mu * E[k];
-        S[0] += lambda * tr;
-        S[1] += lambda * tr;
-        S[2] += lambda * tr;
-        *psi = (frm_real)0.5 * lambda * tr * tr +
-               mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
-        (void)cache;
-        return 0;
     }
+    for (k = 0; k < 6; k++) S[k] = 2 * mu * E[k];
+    S[0] += lambda * tr;
+    S[1] += lambda * tr;
+    S[2] += lambda * tr;
+    *psi = (frm_real)0.5 * lambda * tr * tr +
+           mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
+    (void)cache;
+    return 0;
 }
 
 /* dS for a strain variation dE (6) at the state frm_material_stress cached (eq. 3.68):
@@ -1057,9 +1090,9 @@ struct frm_model {
     double newton_previous;                      /* |f| at the previous Newton iteration */
 
     /* frames */
-    frm_real *pos, *quat, *vel;                /* 3, 4, 6 */
+    frm_real *disp, *pos, *quat, *vel;         /* 3 (u = x - xbar, the state), 3 (xbar + u, output), 4, 6 */
     frm_real *rest_pos, *rest_quat, *rest_rot; /* 3, 4, 9 */
-    frm_real *rot, *rel;                       /* 9, 9: R and Q = R Rbar^T of the current pose */
+    frm_real *rot, *rel, *relm;                /* 9, 9, 9: R, Q = R Rbar^T and Q - I of the current pose */
     double *mass_local;                        /* 10: m, cbar (3), Jbar (6), frame axes */
     double *grav_local;                        /* 4: m_g, cbar_g (3), frame axes */
     frm_real *mass_world;                      /* 10: m, c (3), J (6), world axes (mass_update) */
@@ -1067,6 +1100,7 @@ struct frm_model {
     unsigned char *state;
     frm_real *target;      /* 7: prescribed position, orientation */
     frm_real *force;       /* 6: internal generalized force (last pass) */
+    double *force_scale;   /* 1: sum over the frame's pairs of |partial force|^2 (round-off scale) */
     frm_real *lin_torque;  /* 3: conservative torque at the linearisation */
     frm_real *lin_gravity; /* 3: world gravity moment c_g at the linearisation */
     frm_real *kdiag;       /* 36: K_ii (symmetric part) at the linearisation */
@@ -1085,7 +1119,7 @@ struct frm_model {
 
     /* pairs */
     int *p_frame, *p_sample;
-    frm_real *p_weight, *p_grad, *p_local; /* 1, 3, 3 */
+    frm_real *p_weight, *p_grad, *p_local, *p_rlev; /* 1, 3, 3, 3: rest lever abar = Rbar lbar = pbar - xbar */
     frm_real *p_G, *p_H, *p_A, *p_C;       /* 9, 6, 3 (lever), 3 (coupling g) at the linearisation */
     frm_real *p_out;                       /* 6: pass-1 partial contributions */
 
@@ -1265,6 +1299,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     size_t n = (size_t)m->frame_count, S = (size_t)m->sample_count, P = (size_t)m->pair_count;
     size_t B = (size_t)m->block_count, sq = (size_t)m->sq_total;
     int k;
+    FRM__CARVE(c, m->disp, frm_real, 3 * n);
     FRM__CARVE(c, m->pos, frm_real, 3 * n);
     FRM__CARVE(c, m->quat, frm_real, 4 * n);
     FRM__CARVE(c, m->vel, frm_real, 6 * n);
@@ -1273,6 +1308,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->rest_rot, frm_real, 9 * n);
     FRM__CARVE(c, m->rot, frm_real, 9 * n);
     FRM__CARVE(c, m->rel, frm_real, 9 * n);
+    FRM__CARVE(c, m->relm, frm_real, 9 * n);
     FRM__CARVE(c, m->mass_local, double, 10 * n);
     FRM__CARVE(c, m->grav_local, double, 4 * n);
     FRM__CARVE(c, m->mass_world, frm_real, 10 * n);
@@ -1280,6 +1316,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->state, unsigned char, n);
     FRM__CARVE(c, m->target, frm_real, 7 * n);
     FRM__CARVE(c, m->force, frm_real, 6 * n);
+    FRM__CARVE(c, m->force_scale, double, n);
     FRM__CARVE(c, m->lin_torque, frm_real, 3 * n);
     FRM__CARVE(c, m->lin_gravity, frm_real, 3 * n);
     FRM__CARVE(c, m->kdiag, frm_real, 36 * n);
@@ -1310,6 +1347,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_weight, frm_real, P);
     FRM__CARVE(c, m->p_grad, frm_real, 3 * P);
     FRM__CARVE(c, m->p_local, frm_real, 3 * P);
+    FRM__CARVE(c, m->p_rlev, frm_real, 3 * P);
     FRM__CARVE(c, m->p_G, frm_real, 9 * P);
     FRM__CARVE(c, m->p_H, frm_real, 6 * P);
     FRM__CARVE(c, m->p_A, frm_real, 3 * P);
@@ -1770,8 +1808,10 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         const frm_real *Rb = m->rest_rot + 9 * f;
         double dx[3];
         for (r = 0; r < 3; r++) dx[r] = (double)m->s_rest[3 * sm + r] - (double)m->rest_pos[3 * f + r];
-        for (r = 0; r < 3; r++)
+        for (r = 0; r < 3; r++) {
             m->p_local[3 * p + r] = (frm_real)(Rb[r] * dx[0] + Rb[3 + r] * dx[1] + Rb[6 + r] * dx[2]);
+            m->p_rlev[3 * p + r] = (frm_real)dx[r];
+        }
     }
     for (s = 0; s < S; s++) { /* c = eps mu v / h^2, h^2 the mean squared lever */
         double h2 = 0, wsum = 0;
@@ -1826,9 +1866,11 @@ FRMDEF void frm_model_destroy(frm_model *m)
 /* R and Q = R Rbar^T of every frame from its quaternion. */
 static void frm__update_frames(frm_model *m)
 {
-    int i;
-    for (i = 0; i < m->frame_count; i++)
-        frm_frame_rotations(m->quat + 4 * i, m->rest_rot + 9 * i, m->rot + 9 * i, m->rel + 9 * i);
+    int i, r;
+    for (i = 0; i < m->frame_count; i++) {
+        frm_frame_rotations(m->quat + 4 * i, m->rest_quat + 4 * i, m->rot + 9 * i, m->rel + 9 * i, m->relm + 9 * i);
+        for (r = 0; r < 3; r++) m->pos[3 * i + r] = m->rest_pos[3 * i + r] + m->disp[3 * i + r];
+    }
 }
 
 /* World gravity moment c_g = R cbar_g of frame i. */
@@ -1862,10 +1904,14 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e;
             frm_real F[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
             frm_real offset[3 * FRM_MAX_NEIGHBORS];
-            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_local + 3 * b, m->pos,
-                                   m->rot, m->rel, F, lever, offset, ctx->outputs ? m->s_pos + 3 * s : NULL);
+            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
+                                   m->s_rest + 3 * s, m->disp, m->relm, F, lever, offset,
+                                   ctx->outputs ? m->s_pos + 3 * s : NULL);
+            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], F, S, &psi, cache); /* F holds H here */
+            F[0] += 1; /* F = I + H from here on */
+            F[4] += 1;
+            F[8] += 1;
             if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
-            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], F, S, &psi, cache);
             if (e) {
                 err = e;
                 memset(m->p_out + 6 * (size_t)b, 0, sizeof(frm_real) * 6 * (size_t)n);
@@ -1900,6 +1946,7 @@ typedef struct frm__gather_ctx {
     const frm_model *m;
     const frm_real *src;
     frm_real *dst;
+    double *scale; /* when not NULL: per frame, sum over its pairs of |partial|^2 */
 } frm__gather_ctx;
 
 /* Pass 2 over frame chunks: each frame sums the partials of its pairs through the reverse
@@ -1914,23 +1961,27 @@ static void frm__gather_chunks(void *vctx, int begin, int end)
         int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
         if (i1 > m->frame_count) i1 = m->frame_count;
         for (i = i0; i < i1; i++) {
-            double sum[6] = {0, 0, 0, 0, 0, 0};
+            double sum[6] = {0, 0, 0, 0, 0, 0}, sq = 0;
             int e, k;
             for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
                 const frm_real *src = ctx->src + 6 * (size_t)m->rev_pair[e];
                 for (k = 0; k < 6; k++) sum[k] += (double)src[k];
+                if (ctx->scale)
+                    for (k = 0; k < 6; k++) sq += (double)src[k] * src[k];
             }
             for (k = 0; k < 6; k++) ctx->dst[6 * i + k] = (frm_real)sum[k];
+            if (ctx->scale) ctx->scale[i] = sq;
         }
     }
 }
 
-static void frm__gather(const frm_model *m, const frm_real *src, frm_real *dst)
+static void frm__gather(const frm_model *m, const frm_real *src, frm_real *dst, double *scale)
 {
     frm__gather_ctx g;
     g.m = m;
     g.src = src;
     g.dst = dst;
+    g.scale = scale;
     frm__run(m, m->frame_chunks, frm__gather_chunks, &g);
 }
 
@@ -1955,7 +2006,7 @@ static int frm__force_pass(frm_model *m, int linearize, int outputs, double *ene
     }
     if (energy) *energy = W;
     if (err) return err;
-    frm__gather(m, m->p_out, m->force);
+    frm__gather(m, m->p_out, m->force, m->force_scale);
     if (!frm__finite(W) || !frm__all_finite(m->force, 6 * (size_t)m->frame_count)) return FRM_ERR_NOT_FINITE;
     if (linearize) {
         int i, r;
@@ -1986,6 +2037,29 @@ static void frm__total_force(const frm_model *m, frm_real *f)
             f[6 * i + 3 + r] = m->force[6 * i + 3 + r] + tg[r] + m->ext[6 * i + 3 + r];
         }
     }
+}
+
+/* The residual's round-off floor, below which nothing more can be resolved (chiefly in
+   float): the sum of each frame's partial forces, which nearly cancel at equilibrium
+   (64 eps times the root of the sum of |partial|^2), and the force a displacement or an
+   orientation moves when rounded to the next representable value (K_ii times one ulp,
+   from the diagonal blocks of the last linearisation). */
+static double frm__round_off_floor(const frm_model *m)
+{
+    double sq = 0, pq = 0, eps = FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    int i, k;
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] == FRM__FREE) {
+            const frm_real *x = m->disp + 3 * i, *K = m->kdiag + 36 * (size_t)i;
+            double xm = fabs((double)x[0]) > fabs((double)x[1]) ? fabs((double)x[0]) : fabs((double)x[1]);
+            if (fabs((double)x[2]) > xm) xm = fabs((double)x[2]);
+            sq += m->force_scale[i];
+            for (k = 0; k < 6; k++) {
+                double t = fabs((double)K[7 * k]) * (k < 3 ? xm : 1.0) * eps;
+                pq += t * t;
+            }
+        }
+    return 64.0 * eps * sqrt(sq) + sqrt(pq);
 }
 
 /* Euclidean norm over the free frames. */
@@ -2092,13 +2166,14 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         g.m = m;
         g.src = v;
         g.dst = out;
+        g.scale = NULL;
         frm__run(m, m->frame_chunks, frm__block_chunks, &g);
     } else {
         frm__apply_ctx a;
         a.m = m;
         a.v = v;
         frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
-        frm__gather(m, m->p_out, out);
+        frm__gather(m, m->p_out, out, NULL);
         for (i = 0; i < m->frame_count; i++) {
             double K[9];
             frm__gravity_stiffness(m, i, K);
@@ -2251,6 +2326,7 @@ static void frm__prepare_mode(frm_model *m, int mode)
     g.m = m;
     g.src = NULL;
     g.dst = NULL;
+    g.scale = NULL;
     m->lin_mode = mode;
     m->stats.stiffness_mode = mode;
     frm__run(m, m->frame_chunks, mode == FRM_STIFFNESS_BLOCKS ? frm__assemble_chunks : frm__diag_chunks, &g);
@@ -2471,7 +2547,7 @@ static void frm__save_state(frm_model *m)
     int i;
     for (i = 0; i < m->frame_count; i++) {
         frm_real *b = m->backup + 13 * (size_t)i;
-        memcpy(b, m->pos + 3 * i, 3 * sizeof(frm_real));
+        memcpy(b, m->disp + 3 * i, 3 * sizeof(frm_real));
         memcpy(b + 3, m->quat + 4 * i, 4 * sizeof(frm_real));
         memcpy(b + 7, m->vel + 6 * i, 6 * sizeof(frm_real));
     }
@@ -2482,7 +2558,7 @@ static void frm__restore_state(frm_model *m)
     int i;
     for (i = 0; i < m->frame_count; i++) {
         const frm_real *b = m->backup + 13 * (size_t)i;
-        memcpy(m->pos + 3 * i, b, 3 * sizeof(frm_real));
+        memcpy(m->disp + 3 * i, b, 3 * sizeof(frm_real));
         memcpy(m->quat + 4 * i, b + 3, 4 * sizeof(frm_real));
         memcpy(m->vel + 6 * i, b + 7, 6 * sizeof(frm_real));
     }
@@ -2496,7 +2572,8 @@ static void frm__apply_driven(frm_model *m)
     int i;
     for (i = 0; i < m->frame_count; i++)
         if (m->state[i] == FRM__DRIVEN) {
-            memcpy(m->pos + 3 * i, m->target + 7 * i, 3 * sizeof(frm_real));
+            int r;
+            for (r = 0; r < 3; r++) m->disp[3 * i + r] = m->target[7 * i + r] - m->rest_pos[3 * i + r];
             memcpy(m->quat + 4 * i, m->target + 7 * i + 3, 4 * sizeof(frm_real));
         }
     frm__update_frames(m);
@@ -2512,7 +2589,7 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
         frm_real t[3];
         if (m->state[i] != FRM__FREE) continue;
         for (r = 0; r < 3; r++) {
-            m->pos[3 * i + r] = b[r] + (frm_real)alpha * step[6 * i + r];
+            m->disp[3 * i + r] = b[r] + (frm_real)alpha * step[6 * i + r];
             t[r] = (frm_real)alpha * step[6 * i + 3 + r];
         }
         memcpy(m->quat + 4 * i, b + 3, 4 * sizeof(frm_real));
@@ -2548,7 +2625,7 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
         if (norm > *ref) *ref = norm;
         m->stats.initial_residual = (frm_real)norm;
     }
-    if (norm <= (double)m->newton_tolerance * *ref) {
+    if (norm <= (double)m->newton_tolerance * *ref || norm <= frm__round_off_floor(m)) {
         *converged = 1;
         return FRM_OK;
     }
@@ -2587,7 +2664,7 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
             frm__gravity_moment(m, i, cg_new);
             for (r = 0; r < 3; r++) {
                 dphi -= (double)m->gravity[r] *
-                        (mg * ((double)m->pos[3 * i + r] - b[r]) + ((double)cg_new[r] - m->lin_gravity[3 * i + r]));
+                        (mg * ((double)m->disp[3 * i + r] - b[r]) + ((double)cg_new[r] - m->lin_gravity[3 * i + r]));
                 dphi -= alpha * ((double)m->ext[6 * i + r] * dq[6 * i + r] + (double)m->ext[6 * i + 3 + r] * dq[6 * i + 3 + r]);
             }
         }
@@ -2614,6 +2691,10 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
     frm__total_force(m, f);
     *res = frm__norm_free(m, f);
     m->stats.newton_iterations++;
+#ifdef FRM_DEBUG_NEWTON
+    fprintf(stderr, "newton: |f| %.3e -> %.3e (ref %.3e floor %.3e) eta %.1e cg %d (%.1e) halvings %d accepted %d slope %.3e\n", norm, *res,
+            *ref, frm__round_off_floor(m), eta, m->stats.cg_iterations_last, (double)m->stats.cg_residual, h - 1, accepted, slope);
+#endif
     return FRM_OK;
 }
 
@@ -2685,8 +2766,8 @@ static int frm__check_inversion(frm_model *m)
         frm_real F[9], J;
         if (m->s_law[s] != FRM_LAW_NEO_HOOKEAN) continue;
         frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
-                               m->p_local + 3 * b, m->pos, m->rot, m->rel, F, NULL, NULL, NULL);
-        J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+                               m->p_rlev + 3 * b, NULL, m->disp, m->relm, F, NULL, NULL, NULL);
+        J = 1 + frm_det_minus_one(F); /* F holds H */
         if (!(J > 0)) return FRM_ERR_INVERTED;
     }
     return FRM_OK;
@@ -2716,7 +2797,8 @@ static int frm__implicit_step(frm_model *m, double dt)
             frm_real w[3];
             frm__quat_delta(m->quat + 4 * i, m->target + 7 * i + 3, w);
             for (k = 0; k < 3; k++) {
-                drive[6 * i + k] = (frm_real)(((double)m->target[7 * i + k] - m->pos[3 * i + k]) / dt) - m->vel[6 * i + k];
+                drive[6 * i + k] = (frm_real)(((double)m->target[7 * i + k] - m->rest_pos[3 * i + k] - m->disp[3 * i + k]) / dt) -
+                                   m->vel[6 * i + k];
                 drive[6 * i + 3 + k] = (frm_real)(w[k] / dt) - m->vel[6 * i + 3 + k];
             }
             any_driven = 1;
@@ -2749,17 +2831,17 @@ static int frm__implicit_step(frm_model *m, double dt)
         }
         for (k = 0; k < 6; k++) v[k] += m->state[i] == FRM__DRIVEN ? drive[6 * i + k] : dv[6 * i + k];
         if (m->state[i] == FRM__DRIVEN) {
-            memcpy(m->pos + 3 * i, m->target + 7 * i, 3 * sizeof(frm_real));
+            for (k = 0; k < 3; k++) m->disp[3 * i + k] = m->target[7 * i + k] - m->rest_pos[3 * i + k];
             memcpy(m->quat + 4 * i, m->target + 7 * i + 3, 4 * sizeof(frm_real));
             continue;
         }
         for (k = 0; k < 3; k++) {
-            m->pos[3 * i + k] += (frm_real)dt * v[k];
+            m->disp[3 * i + k] += (frm_real)dt * v[k];
             th[k] = (frm_real)dt * v[3 + k];
         }
         frm_quat_integrate(m->quat + 4 * i, th);
     }
-    if (!frm__all_finite(m->pos, 3 * (size_t)m->frame_count) || !frm__all_finite(m->quat, 4 * (size_t)m->frame_count) ||
+    if (!frm__all_finite(m->disp, 3 * (size_t)m->frame_count) || !frm__all_finite(m->quat, 4 * (size_t)m->frame_count) ||
         !frm__all_finite(m->vel, 6 * (size_t)m->frame_count)) {
         frm__restore_state(m);
         return FRM_ERR_NOT_FINITE;
@@ -2913,7 +2995,7 @@ FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const fr
     if (!frm__all_finite(positions, 3 * (size_t)m->frame_count)) return FRM_ERR_ARG;
     for (i = 0; i < m->frame_count; i++)
         if (!frm__quat_valid(orientations + 4 * i)) return FRM_ERR_QUATERNION;
-    memcpy(m->pos, positions, sizeof(frm_real) * 3 * (size_t)m->frame_count);
+    for (i = 0; i < 3 * m->frame_count; i++) m->disp[i] = positions[i] - m->rest_pos[i];
     for (i = 0; i < m->frame_count; i++) frm__quat_normalized(orientations + 4 * i, m->quat + 4 * i);
     frm__update_frames(m);
     m->lin_valid = 0;
@@ -2937,9 +3019,13 @@ static void frm__outputs_chunks(void *vctx, int begin, int end)
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s];
+            frm_real *F = m->s_F + 9 * (size_t)s;
             frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
-                                   m->p_local + 3 * b, m->pos, m->rot, m->rel, m->s_F + 9 * (size_t)s, NULL,
-                                   NULL, m->s_pos + 3 * (size_t)s);
+                                   m->p_rlev + 3 * b, m->s_rest + 3 * (size_t)s, m->disp, m->relm, F, NULL, NULL,
+                                   m->s_pos + 3 * (size_t)s);
+            F[0] += 1;
+            F[4] += 1;
+            F[8] += 1;
         }
     }
 }
@@ -3009,7 +3095,7 @@ FRMDEF int frm_model_energy(frm_model *m, frm_energies *out)
         frm__gravity_moment(m, i, cg);
         for (r = 0; r < 6; r++) kin += 0.5 * (double)m->vel[6 * i + r] * mv[r];
         for (r = 0; r < 3; r++) {
-            double du = (double)m->pos[3 * i + r] - m->rest_pos[3 * i + r];
+            double du = (double)m->disp[3 * i + r];
             double c0 = Rb[3 * r] * gl[1] + Rb[3 * r + 1] * gl[2] + Rb[3 * r + 2] * gl[3];
             grav -= (double)m->gravity[r] * (gl[0] * du + ((double)cg[r] - c0));
             ext -= (double)m->ext[6 * i + r] * du;

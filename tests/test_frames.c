@@ -966,7 +966,7 @@ static void test_soft_cantilever_r2(void)
         }
         REQUIRE(scene_create(&sc, FRM_LAW_SVK, 40e3, 0.3, 5.0 / 16, FRM_STIFFNESS_AUTO) == FRM_OK);
         clamp_beam(sc.m, &sc.s);
-        REQUIRE(frm_model_set_solver(sc.m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-8), 5000, (frm_real)(IS_FLOAT ? 1e-4 : 1e-7), 100) ==
+        REQUIRE(frm_model_set_solver(sc.m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-8), 5000, (frm_real)(IS_FLOAT ? 1e-4 : 1e-6), 100) ==
                 FRM_OK);
         CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
         st = frm_model_last_stats(sc.m);
@@ -1390,7 +1390,7 @@ static unsigned long long run_hashed(int threads, int workers)
 #else
     (void)threads;
 #endif
-    if (hexmesh_grid(&h, lo, hi, TEST_IS_QUICK ? 6 : 12, 2, 2) != TETMESH_OK) return 0;
+    if (hexmesh_grid(&h, lo, hi, 6, 1, 1) != TETMESH_OK) return 0;
     x = alloc_reals(3 * h.node_count);
     for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
     frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
@@ -1406,10 +1406,11 @@ static unsigned long long run_hashed(int threads, int workers)
         for (i = 0; i < h.node_count; i++)
             if (h.nodes[3 * i] == 0) frm_model_fix_frame(m, i);
         frm_model_set_gravity(m, g);
-        frm_model_solve_static(m);
+        frm_model_set_solver(m, (frm_real)1e-6, 1000, (frm_real)1e-6, 3);
+        frm_model_solve_static(m); /* three Newton iterations, converged or not */
         g[2] = (frm_real)-9.81;
         frm_model_set_gravity(m, g);
-        for (step = 0; step < 10; step++) frm_model_step_ex(m, (frm_real)0.01);
+        for (step = 0; step < 5; step++) frm_model_step_ex(m, (frm_real)0.01);
         {
             const unsigned char *bytes = (const unsigned char *)frm_model_positions(m);
             size_t k;
