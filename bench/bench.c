@@ -44,9 +44,11 @@
 /* >>registry: one line per adapter table (each compiled in double and in float) */
 const bench_model *bench_models_tensormass_double(int *count);
 const bench_model *bench_models_tensormass_float(int *count);
+const bench_model *bench_models_heml_double(int *count);
+const bench_model *bench_models_heml_float(int *count);
 static const bench_models_fn registry[] = {
-    bench_models_tensormass_double,
-    bench_models_tensormass_float,
+    bench_models_tensormass_double, bench_models_tensormass_float,
+    bench_models_heml_double,       bench_models_heml_float,
 };
 
 #define BIT(i) (1u << (i))
@@ -278,7 +280,7 @@ static double relative_error(double value, double reference) { return fabs(value
 static void trade_r1(const bench_model *m, const options *o)
 {
     static const int levels[] = {1, 2, 3, 4, 6, 8};
-    int l, n = o->quick ? 2 : 6;
+    int l, n = o->quick ? 1 : 6;
     if (!(m->integrators & BIT(BENCH_STATIC))) return;
     for (l = 0; l < n; l++) {
         int k = levels[l];
@@ -303,7 +305,7 @@ static void trade_r1(const bench_model *m, const options *o)
 static void trade_r2(const bench_model *m, const options *o)
 {
     static const int levels[] = {1, 2, 3, 4, 6};
-    int l, n = o->quick ? 2 : 5;
+    int l, n = o->quick ? 1 : 5;
     if (!(m->integrators & BIT(BENCH_STATIC))) return;
     for (l = 0; l < n; l++) {
         int k = levels[l];
@@ -357,7 +359,7 @@ static void trade_r3(const bench_model *m, const options *o)
 {
     static const int levels[] = {1, 2, 3, 4};
     const double f_ref = 0.5069, T = 1.0 / f_ref; /* Timoshenko, REFERENCES.md R3 */
-    int l, it, n = o->quick ? 2 : 4;
+    int l, it, n = o->quick ? 1 : 4;
     if (!(m->integrators & BIT(BENCH_STATIC))) return;
     for (it = 0; it < BENCH_STATIC; it++) {
         int variants = it == BENCH_IMPLICIT_EULER ? 2 : 1, v;
@@ -441,7 +443,7 @@ static void trade_uniaxial(const bench_model *m, const options *o, int neo_hooke
     static const int levels[] = {1, 2, 3, 4};
     static const double stretches[] = {0.7, 1.3};
     const char *scene = neo_hookean ? "R5" : "R4";
-    int l, q, n = o->quick ? 2 : 4;
+    int l, q, n = o->quick ? 1 : 4;
     if (!(m->integrators & BIT(BENCH_STATIC))) return;
     if (strcmp(m->law, neo_hookean ? "neo-hookean" : "svk") && strcmp(m->law, "linear") && strcmp(m->law, "springs"))
         return;
@@ -528,7 +530,7 @@ static int in_notch(const double c[3], void *user)
 static void trade_cut(const bench_model *m, const options *o)
 {
     static const int levels[] = {1, 2, 3, 4, 6};
-    int l, n = o->quick ? 2 : 5, pass;
+    int l, n = o->quick ? 1 : 5, pass;
     if (!m->cut || !(m->integrators & BIT(BENCH_STATIC))) return;
     for (l = 0; l < n; l++) {
         int k = levels[l];

@@ -17,6 +17,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "bench.h"
+#include "body_mesh.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,9 +39,7 @@ static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
     tmass_real *x;
     int i, err;
     *out = NULL;
-    if (tetmesh_beam(&mesh, b->size[0], b->size[1], b->size[2], b->cells[0], b->cells[1], b->cells[2],
-                     TETMESH_SPLIT5))
-        return TMASS_ERR_ALLOC;
+    if (bench_body_mesh(b, &mesh)) return TMASS_ERR_ALLOC;
     x = (tmass_real *)malloc(sizeof(tmass_real) * 3 * (size_t)mesh.node_count);
     s = (tm_sim *)calloc(1, sizeof *s);
     if (!x || !s) {
@@ -49,20 +48,7 @@ static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
         tetmesh_free(&mesh);
         return TMASS_ERR_ALLOC;
     }
-    if (b->exclude) { /* keep the tets outside the excluded region */
-        int t, kept = 0, j, k;
-        for (t = 0; t < mesh.tet_count; t++) {
-            double c[3] = {0, 0, 0};
-            for (j = 0; j < 4; j++)
-                for (k = 0; k < 3; k++) c[k] += 0.25 * mesh.nodes[3 * mesh.tets[4 * t + j] + k];
-            if (!b->exclude(c, b->exclude_user)) memmove(mesh.tets + 4 * kept++, mesh.tets + 4 * t, 4 * sizeof(int));
-        }
-        mesh.tet_count = kept;
-    }
-    for (i = 0; i < 3 * mesh.node_count; i++) {
-        mesh.nodes[i] += b->offset[i % 3];
-        x[i] = (tmass_real)mesh.nodes[i];
-    }
+    for (i = 0; i < 3 * mesh.node_count; i++) x[i] = (tmass_real)mesh.nodes[i];
     d.rest_positions = x;
     d.node_count = mesh.node_count;
     d.tets = mesh.tets;
@@ -90,7 +76,7 @@ static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
     memcpy(s->offset, b->offset, sizeof s->offset);
     if (b->clamp)
         for (i = 0; i < s->nodes; i++)
-            if (s->rest[3 * i] - b->offset[0] <= 1e-9 * b->size[0]) tmass_fix_node(s->m, i);
+            if (bench_body_clamped(b, s->rest, i)) tmass_fix_node(s->m, i);
     *out = s;
     return 0;
 }

@@ -1,0 +1,190 @@
+/* model_heml.c - bench adapter of heml.h: its hyperelastic laws and the mass-spring
+   degenerate case. Compiled twice by the Makefile, in double and with -DBENCH_FLOAT. */
+#ifdef BENCH_FLOAT
+#define HEML_REAL float
+#define BENCH_TABLE bench_models_heml_float
+#define BENCH_PRECISION "float"
+#else
+#define BENCH_TABLE bench_models_heml_double
+#define BENCH_PRECISION "double"
+#endif
+#define HEML_STATIC
+#define HEML_IMPLEMENTATION
+#include "../heml.h"
+#define TETMESH_STATIC
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "bench.h"
+#include "body_mesh.h"
+#include <stdlib.h>
+
+typedef struct hm_sim {
+    heml_model *m;
+    int nodes, tets;
+    int *tet_nodes;
+    double *rest; /* 3n, with the offset, in double */
+    heml_real *dx, *out; /* K*v kernel vectors */
+} hm_sim;
+
+static int hm_create(const bench_body *b, heml_law law, void **out)
+{
+    tetmesh mesh;
+    heml_desc d = heml_default_desc();
+    hm_sim *s;
+    heml_real *x;
+    int i, err;
+    *out = NULL;
+    if (bench_body_mesh(b, &mesh)) return HEML_ERR_ALLOC;
+    x = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)mesh.node_count);
+    s = (hm_sim *)calloc(1, sizeof *s);
+    if (s) {
+        s->dx = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)mesh.node_count);
+        s->out = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)mesh.node_count);
+    }
+    if (!x || !s || !s->dx || !s->out) {
+        free(x);
+        if (s) free(s->dx), free(s->out);
+        free(s);
+        tetmesh_free(&mesh);
+        return HEML_ERR_ALLOC;
+    }
+    for (i = 0; i < 3 * mesh.node_count; i++) {
+        x[i] = (heml_real)mesh.nodes[i];
+        s->dx[i] = (heml_real)(1e-3 * ((i * 7919) % 13 - 6)); /* any fixed direction */
+    }
+    d.rest_positions = x;
+    d.node_count = mesh.node_count;
+    d.tets = mesh.tets;
+    d.tet_count = mesh.tet_count;
+    d.material = heml_material_from_young(law, b->young, b->poisson);
+    d.material.density = (heml_real)b->density;
+    d.mass_damping = (heml_real)b->damping;
+    for (i = 0; i < 3; i++) d.gravity[i] = (heml_real)b->gravity[i];
+    d.cg_max_iterations = 20000; /* stiff slender beams need many CG iterations */
+    err = heml_create(&d, &s->m);
+    free(x);
+    if (err) {
+        free(s->dx), free(s->out), free(s);
+        tetmesh_free(&mesh);
+        return err;
+    }
+    s->nodes = mesh.node_count;
+    s->tets = mesh.tet_count;
+    s->tet_nodes = mesh.tets;
+    s->rest = mesh.nodes;
+    if (b->clamp)
+        for (i = 0; i < s->nodes; i++)
+            if (bench_body_clamped(b, s->rest, i)) heml_fix_node(s->m, i);
+    *out = s;
+    return 0;
+}
+
+static int hm_create_svk(const bench_body *b, void **out) { return hm_create(b, HEML_STVK, out); }
+static int hm_create_nh(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, out); }
+static int hm_create_mr(const bench_body *b, void **out) { return hm_create(b, HEML_MOONEY_RIVLIN, out); }
+static int hm_create_springs(const bench_body *b, void **out) { return hm_create(b, HEML_MASS_SPRING, out); }
+
+static void hm_destroy(void *v)
+{
+    hm_sim *s = (hm_sim *)v;
+    if (!s) return;
+    heml_destroy(s->m);
+    free(s->tet_nodes);
+    free(s->rest);
+    free(s->dx);
+    free(s->out);
+    free(s);
+}
+
+static int hm_dof(void *v) { return 3 * ((hm_sim *)v)->nodes; }
+static int hm_node_count(void *v) { return ((hm_sim *)v)->nodes; }
+
+static void hm_rest(void *v, int i, double p[3])
+{
+    hm_sim *s = (hm_sim *)v;
+    int k;
+    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
+}
+
+/* Double rest plus the model's displacement (see model_tensormass.c). */
+static void hm_position(void *v, int i, double p[3])
+{
+    hm_sim *s = (hm_sim *)v;
+    const heml_real *x = heml_positions(s->m), *x0 = heml_rest_positions(s->m);
+    int k;
+    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k] + ((double)x[3 * i + k] - (double)x0[3 * i + k]);
+}
+
+static int hm_pin(void *v, int i, const double u[3], const double *rotation)
+{
+    heml_real w[3];
+    int k;
+    (void)rotation;
+    for (k = 0; k < 3; k++) w[k] = (heml_real)u[k];
+    return heml_set_displacement(((hm_sim *)v)->m, i, w);
+}
+
+static int hm_release(void *v, int i) { return heml_release_node(((hm_sim *)v)->m, i); }
+
+static int hm_set_gravity(void *v, const double g[3])
+{
+    heml_real w[3];
+    int k;
+    for (k = 0; k < 3; k++) w[k] = (heml_real)g[k];
+    return heml_set_gravity(((hm_sim *)v)->m, w);
+}
+
+static int hm_solve_static(void *v) { return heml_solve_static(((hm_sim *)v)->m); }
+
+static int hm_step(void *v, double dt, int integrator)
+{
+    if (integrator == BENCH_SEMI_IMPLICIT_EULER) /* eq. 32 is the symplectic Euler */
+        return heml_step_ex(((hm_sim *)v)->m, (heml_real)dt, HEML_SEMI_EXPLICIT_EULER);
+    if (integrator == BENCH_IMPLICIT_EULER) return heml_step_ex(((hm_sim *)v)->m, (heml_real)dt, HEML_IMPLICIT_EULER);
+    return BENCH_UNSUPPORTED;
+}
+
+static int hm_forces(void *v, double *f)
+{
+    hm_sim *s = (hm_sim *)v;
+    const heml_real *g = heml_compute_forces(s->m);
+    int i;
+    if (!g) return HEML_ERR_ARG;
+    for (i = 0; i < 3 * s->nodes; i++) f[i] = g[i];
+    return 0;
+}
+
+static double hm_elements(void *v) { return (double)((hm_sim *)v)->tets; }
+
+static double hm_kernel_bytes(void *v, int kernel)
+{
+    size_t r = 0, w = 0;
+    heml_kernel_bytes(((hm_sim *)v)->m, kernel, &r, &w);
+    return (double)(r + w);
+}
+
+static int hm_kernel(void *v, int kernel)
+{
+    hm_sim *s = (hm_sim *)v;
+    if (kernel == BENCH_KERNEL_FORCE) return heml_compute_forces(s->m) ? 0 : HEML_ERR_ARG;
+    return heml_apply_stiffness(s->m, s->dx, s->out);
+}
+
+#define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+#define HM_FUNCTIONS                                                                                          \
+    hm_destroy, hm_dof, hm_node_count, hm_rest, hm_position, hm_pin, hm_release, hm_set_gravity, hm_solve_static, \
+        hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL
+
+static const bench_model hm_models[] = {
+    {"heml", "svk", "svk", BENCH_PRECISION, HM_ALL, 1, "tet", hm_create_svk, HM_FUNCTIONS},
+    {"heml", "neo-hookean", "neo-hookean", BENCH_PRECISION, HM_ALL, 1, "tet", hm_create_nh, HM_FUNCTIONS},
+    {"heml", "mooney-rivlin", "mooney-rivlin", BENCH_PRECISION, HM_ALL, 1, "tet", hm_create_mr, HM_FUNCTIONS},
+    {"heml", "springs", "springs", BENCH_PRECISION, HM_ALL, 1, "tet", hm_create_springs, HM_FUNCTIONS},
+};
+
+const bench_model *BENCH_TABLE(int *count);
+const bench_model *BENCH_TABLE(int *count)
+{
+    *count = (int)(sizeof hm_models / sizeof hm_models[0]);
+    return hm_models;
+}
