@@ -220,6 +220,8 @@ typedef struct frm_desc {
     frm_allocator allocator;          /* all NULL: FRM_MALLOC / FRM_FREE */
     frm_parallel_for_fn parallel_for; /* NULL: OpenMP if compiled with it, else serial */
     void *parallel_user;
+    int parallel_min_pairs;           /* models with fewer pairs run serially (starting
+                                         threads costs more), default FRM_PARALLEL_MIN_PAIRS */
     void (*log)(int code, const char *message, void *user); /* validation details, or NULL */
     void *log_user;
 
@@ -1556,6 +1558,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.static_regularization = (frm_real)1e-6;
     d.frame_coupling = 0;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
     return d;
 }
@@ -1756,7 +1759,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->allocator = alloc;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = P >= FRM_PARALLEL_MIN_PAIRS;
+    m->parallel = P >= d->parallel_min_pairs;
     for (k = 0; k < 3; k++) m->gravity[k] = d->gravity[k];
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
