@@ -109,7 +109,7 @@
 
    THE MODEL (Goulette & Chen equation numbers; our derivations where the printed ones
    differ or where we use a cheaper equivalent form)
-       Tetrahedron (x0, x1, x2, x3), links (sec. 3.1, our 0-based lanes):
+       Tetrahedron (x0, x1, x2, x3) and its six links (sec. 3.1):
            v1 = x1 - x0, v2 = x2 - x0, v3 = x3 - x0, v4 = x2 - x1, v5 = x3 - x2, v6 = x1 - x3
        and v = (v1 v2 v3), V the same at rest. Squared lengths l_e = |v_e|^2.
        Appendix A: C = V^-T D V^-1 with D = v^T v the Gram matrix of the links, linear in l
@@ -127,7 +127,7 @@
            f_k = -( sum_j Sigma_jk v_j + gamma c_k ),   f_0 = -(f_1 + f_2 + f_3),
        c_1 = v2 x v3, c_2 = v3 x v1, c_3 = v1 x v2 (6 dVol/dx, eq. C.4) and gamma = w_J / 6
        (the volumetric term of eq. 30: Vol w_J dJ/dx = w_J / 6 c). So the links carry the
-       tensions, as the paper says, in 45 multiply-adds. This is the classical P1 force
+       tensions, as the paper says, in 36 multiply-adds and 6 additions. This is the classical P1 force
        -Vol P grad N (REFERENCES R7; a test checks it to round-off). Table 3's printed
        Saint Venant-Kirchhoff force lacks the factor 2 of d(l^T MW l)/dl; the derivation
        above, the finite-difference tests and the FEM test decide.
@@ -206,26 +206,50 @@
        started near, stable or not (e.g. St Venant-Kirchhoff compressed beyond the
        softening point): drive large motions in increments from the last solution.
 
-   PERFORMANCE: the force kernel streams, per tetrahedron, 4 int node indices and the 8
-   rest constants (HEML_KERNEL_BYTES_PER_TET: 80 bytes in double, 48 in float; springs
-   read 12 more reals, Prony 7 reals per term in and out) and gathers/scatters the
-   positions and forces of its 4 nodes (24 + 24 bytes per node in double, mostly from
-   cache when nodes are numbered with locality). Tetrahedra are stored in blocks of 16
-   (structure of arrays inside a block), so the arithmetic of a block vectorises; the
-   gather and scatter run in plain loops. The Neo-Hookean kernel needs no D, no I1 and no
-   I2: 9 subtractions, 3 cross products, the determinant, one logarithm (a branch-free
-   fdlibm polynomial that vectorises), two divisions and 36 multiply-adds per
-   tetrahedron. Measured on an AMD EPYC (Zen 5) core with AVX2, one thread, double,
-   96,000-tetrahedron beam (2 x 1 x 1 m, 40 x 20 x 20 cells, 6 per cell), median of 50
-   evaluations (figures from the measurement below):
-       gcc -O3 -march=native -DHEML_IMPLEMENTATION ... (see HISTORY for the command)
-       Neo-Hookean force           <NH_NS> ns per tet
-       Neo-Hookean differential    <NHD_NS> ns per tet
-       St Venant-Kirchhoff force   <SVK_NS> ns per tet
-       stream bound                <BOUND_NS> ns per tet (80 B at the triad rate measured
-                                   in the same run, <TRIAD> GB/s)
-   In ISO mode (-std=c99) gcc does not contract multiply-adds into FMAs; use -std=gnu99
-   or -ffp-contract=fast for the last 10 %.
+   PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 8 rest
+   constants (HEML_KERNEL_BYTES_PER_TET: 80 bytes in double, 48 in float; springs read 96
+   more, a Prony series 56 per term, which it also writes), gathers the positions of its 4
+   nodes (96 bytes, mostly cache hits when nodes are numbered with locality) and adds into
+   their forces (96 bytes read and written, likewise). heml_kernel_bytes gives the least a
+   pass must move from memory: the stream plus each node's position read once and force
+   written once (89 bytes per tetrahedron on the beam below). Tetrahedra sit in blocks of
+   16 (structure of arrays inside a block) and a block is one vectorised loop from the
+   links to the forces; gather and scatter are scalar loops (AVX2 has no scatter). The
+   Neo-Hookean kernel needs no D, no I1, no I2: 9 subtractions, 3 cross products, the
+   determinant, one logarithm (a branch-free fdlibm polynomial, which vectorises where
+   libm's log is a call), two divisions and 36 multiply-adds.
+   Measured with gcc 12, one thread, double unless stated, on tetmesh_beam(2, 1, 1, 40, 20,
+   20, TETMESH_SPLIT6) (96,000 tetrahedra, 18,081 nodes) stretched by up to 2 % with a
+   small perturbation, 150 calls of heml_compute_forces / heml_apply_stiffness, minimum
+   (median) per tetrahedron, on this project's AMD EPYC (Zen 5) virtual machine with AVX2:
+   two vCPUs shared with other jobs, an effective clock of 2.5 GHz measured by a dependent
+   add chain in the same session (the nominal 4.2 GHz was not available), STREAM-like
+   triad 24 GB/s. Command: gcc -O3 -march=native bench.c -lm, bench.c being the loop just
+   described (the bench/ program measures the same entry points).
+       Neo-Hookean force                   16.9 (20.0) ns
+       Neo-Hookean differential            28.4 (32.8) ns, 1.7 x the force
+       St Venant-Kirchhoff force           21.8 (25.4) ns; differential 1.8 x
+       Neo-Hookean, gcc -O2 -march=native  18.7 ns; -std=c99 (no FMA contraction) 18.9 ns;
+                                           -O2 for generic x86-64 (SSE2) 34.9 ns
+       Neo-Hookean, float                  12.1 ns
+       Neo-Hookean, 768,000 tetrahedra     25 ns (the stream no longer fits the 32 MB L3)
+       memory bound                        3.7 ns (89 bytes at 24 GB/s), 2.2 ns in float
+   Against the targets this work was designed for: the force sits at 4.6 times the memory
+   bound, not 2, and 17 ns rather than 15 at this session's clock. It is bound by the 62
+   scalar memory operations of the gather and scatter (8 index loads, 12 coordinate loads,
+   9 link stores, 9 + 12 loads and 12 stores of forces: about 8 ns) and by the vectorised
+   arithmetic (about 7 ns, the logarithm 2.7 of them), not by bandwidth. The differential
+   stays under twice the force. For comparison REFERENCES lists Bullet's Neo-Hookean at
+   181 ns and Vega's at 377 ns per tetrahedron on this machine kind. Mooney-Rivlin (split)
+   costs about 2.5 times Neo-Hookean (J^-2/3 by libm's cbrt, a call), springs about 3 times
+   (six square roots, calls under errno semantics). Rejected after measurement: a two-pass
+   gather (per-tetrahedron forces into a 96-byte-per-tetrahedron buffer, then a per-node
+   sum through a reverse table) cost 30 to 35 ns against 24 to 27 ns for the colouring in
+   the same runs (its first pass alone costs as much as the whole coloured pass); blocks of
+   32, interleaving neighbouring tetrahedra across lanes, computing node 0's force in the
+   vector loop, and software prefetch of the stream or of the next block's nodes did not
+   help (within the noise or worse). Vector gathers are slower than scalar loads here (4
+   against 3 ns), so the gather loop is kept scalar (HEML__SCALAR_FN).
 
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
