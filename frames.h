@@ -1105,7 +1105,8 @@ struct frm_model {
     double *force_scale;   /* 1: sum over the frame's pairs of |partial force|^2 (round-off scale) */
     frm_real *lin_torque;  /* 3: conservative torque at the linearisation */
     frm_real *lin_gravity; /* 3: world gravity moment c_g at the linearisation */
-    frm_real *kdiag;       /* 36: K_ii (symmetric part) at the linearisation */
+    frm_real *kdiag;       /* 36: K_ii (symmetric part) at the linearisation (pair mode: kdiag_rest rotated) */
+    frm_real *kdiag_rest;  /* 36: K_ii of the rest state without gravity (pair mode's preconditioner) */
     frm_real *precond;     /* 36: inverse of the block-Jacobi blocks */
     int *rev_start, *rev_pair; /* frame -> pairs (the reverse table) */
     int *blk_start, *blk_col;  /* block pattern (frame adjacency) */
@@ -1322,6 +1323,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->lin_torque, frm_real, 3 * n);
     FRM__CARVE(c, m->lin_gravity, frm_real, 3 * n);
     FRM__CARVE(c, m->kdiag, frm_real, 36 * n);
+    FRM__CARVE(c, m->kdiag_rest, frm_real, 36 * n);
     FRM__CARVE(c, m->precond, frm_real, 36 * n);
     FRM__CARVE(c, m->rev_start, int, n + 1);
     FRM__CARVE(c, m->rev_pair, int, P);
@@ -1671,6 +1673,7 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
 }
 
 static void frm__update_frames(frm_model *m);
+static void frm__rest_diagonal(frm_model *m);
 
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
 {
@@ -1852,6 +1855,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     frm__free(&alloc, tmp_block, tmp_bytes);
     m->lin_iterations = -1;
     frm__update_frames(m);
+    frm__rest_diagonal(m);
     *out = m;
     return FRM_OK;
 }
@@ -2221,7 +2225,9 @@ static frm_real frm__coupling_coef(const frm_model *m, int s, int a, int b)
 }
 
 /* Per-frame diagonal block of the stiffness (symmetric part) from its pairs, computed in
-   the gather pass (pair mode; the block mode takes it from the assembled row). */
+   a gather pass, once, at the rest state (kdiag_rest, for the pair mode's preconditioner;
+   the block mode takes the exact one from the assembled row). About 700 ns a pair: the
+   six tangent columns of every pair. */
 static void frm__diag_chunks(void *vctx, int begin, int end)
 {
     frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
@@ -2250,13 +2256,25 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                 }
                 for (k = 0; k < 36; k++) acc[k] += (double)K[k];
             }
-            frm__gravity_stiffness(m, i, Kg);
-            for (r = 0; r < 3; r++)
-                for (k = 0; k < 3; k++) acc[6 * (3 + r) + 3 + k] += Kg[3 * r + k];
+            (void)Kg; /* the rest blocks carry no gravity: the rotated ones get the current one */
             for (r = 0; r < 6; r++)
-                for (k = 0; k < 6; k++) m->kdiag[36 * (size_t)i + 6 * r + k] = (frm_real)(0.5 * (acc[6 * r + k] + acc[6 * k + r]));
+                for (k = 0; k < 6; k++) m->kdiag_rest[36 * (size_t)i + 6 * r + k] = (frm_real)(0.5 * (acc[6 * r + k] + acc[6 * k + r]));
         }
     }
+}
+
+/* The rest-state diagonal blocks for the pair mode's preconditioner (at creation). */
+static void frm__rest_diagonal(frm_model *m)
+{
+    frm__gather_ctx g;
+    g.m = m;
+    g.src = NULL;
+    g.dst = NULL;
+    g.scale = NULL;
+    frm__force_pass(m, 1, 0, NULL);
+    frm__run(m, m->frame_chunks, frm__diag_chunks, &g);
+    m->lin_valid = 0;
+    m->stats.force_evaluations = 0;
 }
 
 /* Assembly over frame chunks: row i's blocks from the pairs of frame i (slot a of sample
@@ -2300,13 +2318,14 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
     }
 }
 
-/* Cost model of AUTO (see PERFORMANCE): estimated time of a linear solve of `iterations`
-   CG iterations in each mode, from per-item costs measured on one core (double, ns). */
-#define FRM__COST_PAIR_ITER 14.0    /* pair-mode K v, per pair per iteration */
-#define FRM__COST_PAIR_DIAG 60.0    /* pair-mode diagonal block, per pair */
-#define FRM__COST_BLOCK_ITER 4.0    /* block-mode K v, per block per iteration */
-#define FRM__COST_ASSEMBLE_COL 60.0 /* assembly: tangent columns, per pair */
-#define FRM__COST_ASSEMBLE_BLK 20.0 /* assembly: one slot-pair block, per (pair, slot) */
+/* Cost model of AUTO (see PERFORMANCE): estimated time of a linear solve in each mode
+   from per-item costs measured with gcc -O2 on one core (double, ns): the pair mode pays
+   its product every iteration, the block mode assembles once and then streams 288 bytes
+   a block. With 8 neighbours blocks win beyond about 30 CG iterations a linearisation. */
+#define FRM__COST_PAIR_ITER 35.0      /* pair-mode K v, per pair per iteration */
+#define FRM__COST_BLOCK_ITER 8.0      /* block-mode K v, per block per iteration */
+#define FRM__COST_ASSEMBLE_PAIR 500.0 /* assembly: the tangent columns, per pair */
+#define FRM__COST_ASSEMBLE_SLOT 60.0  /* assembly: one slot-pair block, per (pair, slot) */
 
 static int frm__choose_mode(const frm_model *m)
 {
@@ -2315,8 +2334,9 @@ static int frm__choose_mode(const frm_model *m)
     if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS) return FRM_STIFFNESS_BLOCKS;
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
     it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
-    pairs = FRM__COST_PAIR_DIAG * m->pair_count + it * FRM__COST_PAIR_ITER * m->pair_count;
-    blocks = FRM__COST_ASSEMBLE_COL * m->pair_count + FRM__COST_ASSEMBLE_BLK * m->sq_total +
+    if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
+    pairs = it * FRM__COST_PAIR_ITER * m->pair_count;
+    blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
 }
@@ -2326,13 +2346,42 @@ static int frm__choose_mode(const frm_model *m)
 static void frm__prepare_mode(frm_model *m, int mode)
 {
     frm__gather_ctx g;
+    int i, r, k, l;
     g.m = m;
     g.src = NULL;
     g.dst = NULL;
     g.scale = NULL;
     m->lin_mode = mode;
     m->stats.stiffness_mode = mode;
-    frm__run(m, m->frame_chunks, mode == FRM_STIFFNESS_BLOCKS ? frm__assemble_chunks : frm__diag_chunks, &g);
+    if (mode == FRM_STIFFNESS_BLOCKS) {
+        frm__run(m, m->frame_chunks, frm__assemble_chunks, &g);
+        return;
+    }
+    /* pair mode: the block-Jacobi blocks are the rest ones turned with the frame,
+       T K_rest T^T with T = diag(Q, Q), plus the current gravity term: exact for a rigid
+       motion of the rest state, an approximation under strain (the preconditioner only) */
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *Q = m->rel + 9 * i, *K0 = m->kdiag_rest + 36 * (size_t)i;
+        frm_real *K = m->kdiag + 36 * (size_t)i;
+        double T[36], KT[36], Kg[9];
+        memset(T, 0, sizeof T);
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) T[6 * r + k] = T[6 * (r + 3) + k + 3] = Q[3 * r + k];
+        for (r = 0; r < 6; r++)
+            for (k = 0; k < 6; k++) {
+                double t = 0;
+                for (l = 0; l < 6; l++) t += (double)K0[6 * r + l] * T[6 * k + l];
+                KT[6 * r + k] = t; /* K0 T^T */
+            }
+        frm__gravity_stiffness(m, i, Kg);
+        for (r = 0; r < 6; r++)
+            for (k = 0; k < 6; k++) {
+                double t = 0;
+                for (l = 0; l < 6; l++) t += T[6 * r + l] * KT[6 * l + k];
+                if (r >= 3 && k >= 3) t += Kg[3 * (r - 3) + k - 3];
+                K[6 * r + k] = (frm_real)t;
+            }
+    }
 }
 
 /* World mass data (m, c = R cbar, J = R Jbar R^T) of every frame at its current pose. */
