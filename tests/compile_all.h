@@ -9,6 +9,9 @@
 #define HEML_IMPLEMENTATION
 #include "../heml.h"
 #include "../heml.h"
+#define FRAMES_IMPLEMENTATION
+#include "../frames.h"
+#include "../frames.h"
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "../examples/tetmesh.h"
@@ -67,9 +70,36 @@ static void test_heml_smoke(void)
     tetmesh_free(&mesh);
 }
 
+static void test_frames_smoke(void)
+{
+    tetmesh mesh;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    frm_real *x;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    int i;
+    REQUIRE(tetmesh_box(&mesh, lo, hi, 2, 2, 2, TETMESH_SPLIT6) == TETMESH_OK);
+    x = (frm_real *)calloc((size_t)3 * 27, sizeof(frm_real));
+    for (i = 0; i < 3 * mesh.node_count; i++) x[i] = (frm_real)mesh.nodes[i];
+    REQUIRE(frm_sampling_tets(&s, x, mesh.node_count, mesh.tets, mesh.tet_count, 1, NULL, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    CHECK_INT(FRM_OK, frm_model_create(&d, &m));
+    if (m) {
+        frm_model_fix_frame(m, 0);
+        CHECK_INT(FRM_OK, frm_model_step(m));
+        CHECK(frm_model_positions(m)[3 * 26 + 2] < (frm_real)1.0);
+        frm_model_destroy(m);
+    }
+    frm_sampling_free(&s);
+    free(x);
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_tensormass_smoke),
     TEST(test_heml_smoke),
+    TEST(test_frames_smoke),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
