@@ -213,10 +213,11 @@ static double timoshenko_tip(double L, double a, double young, double nu, double
 /* >>trade */
 
 typedef struct trade_row {
-    char scene[24], setting[32];
+    char scene[24], setting[48];
     const bench_model *m;
     int level, dof, status;
     double elements, setup_s, step_s, answer_s, value, reference, error;
+    double time_step; /* s, dynamic scenes */
 } trade_row;
 
 static trade_row rows[4096];
@@ -372,14 +373,16 @@ static void trade_r3(const bench_model *m, const options *o)
                        mu = b.young / (2 * (1 + b.poisson)), cp = sqrt((lambda + 2 * mu) / b.density), dt, t0,
                        *z, g0[3] = {0, 0, 0};
                 void *sim = NULL;
-                char setting[32];
+                char setting[48];
                 trade_row *r;
                 /* explicit schemes: a fifth of the P-wave transit time of a cell (below
                    their stability limit); implicit: 100 and 400 steps per period */
                 dt = it == BENCH_IMPLICIT_EULER ? T / (v ? 400 : 100) : 0.2 * h / cp;
-                snprintf(setting, sizeof setting, "%s dt=%.2g", integrator_name[it], dt);
+                snprintf(setting, sizeof setting, "%s dt=%s", integrator_name[it],
+                         it == BENCH_IMPLICIT_EULER ? (v ? "T/400" : "T/100") : "0.2h/c");
                 r = new_row("R3", m, setting, k);
                 if (!r) return;
+                r->time_step = dt;
                 r->reference = f_ref;
                 b.gravity[2] = -0.01;
                 t0 = now();
@@ -454,7 +457,7 @@ static void trade_uniaxial(const bench_model *m, const options *o, int neo_hooke
             double mu = b.young / (2 * (1 + b.poisson)),
                    lambda = b.young * b.poisson / ((1 + b.poisson) * (1 - 2 * b.poisson)), t, pzz, t0, *f;
             void *sim = NULL;
-            char setting[32];
+            char setting[48];
             trade_row *r;
             snprintf(setting, sizeof setting, "static s=%.1f", stretches[q]);
             r = new_row(scene, m, setting, k);
@@ -701,14 +704,14 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     }
     finish_r2();
     f = open_csv(o, "trade.csv",
-                 "scene,model,variant,precision,setting,level,dof,elements,setup_s,step_s,answer_s,value,"
-                 "reference,error,status");
+                 "scene,model,variant,precision,setting,level,dof,elements,time_step,setup_s,step_s,answer_s,"
+                 "value,reference,error,status");
     for (i = 0; i < row_count; i++) {
         const trade_row *r = rows + i;
         csv_prefix(f);
-        fprintf(f, "%s,%s,%s,%s,%s,%d,%d,%.0f,%.6g,%.6g,%.6g,%.9g,%.9g,%.6g,%d\n", r->scene, r->m->model,
-                r->m->variant, r->m->precision, r->setting, r->level, r->dof, r->elements, r->setup_s, r->step_s,
-                r->answer_s, r->value, r->reference, r->error, r->status);
+        fprintf(f, "%s,%s,%s,%s,%s,%d,%d,%.0f,%.6g,%.6g,%.6g,%.6g,%.9g,%.9g,%.6g,%d\n", r->scene, r->m->model,
+                r->m->variant, r->m->precision, r->setting, r->level, r->dof, r->elements, r->time_step, r->setup_s,
+                r->step_s, r->answer_s, r->value, r->reference, r->error, r->status);
     }
     fclose(f);
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) plot_scene(o, scenes + s);

@@ -30,7 +30,7 @@ static const char *svg__colour(int i)
 static int svg_plot(const char *path, const char *title, const char *x_label, const char *y_label,
                     const svg_series *s, int count)
 {
-    const double W = 820, left = 80, right = 310, top = 40, bottom = 60;
+    const double W = 900, left = 80, right = 390, top = 40, bottom = 60;
     const double H = 480 > 80 + 18.0 * count ? 480 : 80 + 18.0 * count; /* room for the legend */
     double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL}, pw = W - left - right,
            ph = H - top - bottom;
