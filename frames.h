@@ -1,6 +1,308 @@
 /* frames.h - v0.1.0 - 6-DoF frames and samples: meshless or mesh-based hyperelastic bodies - MIT or public domain
 
-   @@MANUAL@@
+   A drop-in model of soft bodies after Bosman, "Physically-based 6-DoF nodes deformable
+   models" (PhD thesis, Lille 2015, ch. 3-4) and Bosman, Duriez & Cotin, "Connective
+   tissues simulation on GPU" (2013): the body is carried by frames, 6-DoF nodes (a
+   position and a unit quaternion), and integrated at samples, points that know their
+   neighbouring frames through shape functions. Mesh-based (tetrahedral barycentric or
+   hexahedral trilinear) and meshless (Shepard, linear moving least squares) shape
+   functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff and
+   compressible Neo-Hookean samples, exact forces and stiffness (material and geometric),
+   a static Newton solver and implicit Euler, both with block-Jacobi conjugate gradient,
+   matrix-free or by assembled 6x6 blocks. The per-sample and per-frame math are
+   FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
+   uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
+   gathers them through a reverse table.
+
+   DO THIS in exactly one C or C++ file:
+
+       #define FRAMES_IMPLEMENTATION
+       #include "frames.h"
+
+   MINIMAL PROGRAM (a 4 x 1 x 1 m beam of 8 x 2 x 2 cells clamped at x = 0, sagging
+   under its own weight; cc app.c -lm)
+
+       #define FRAMES_IMPLEMENTATION
+       #include "frames.h"
+       #include <stdio.h>
+
+       int main(void)
+       {
+           frm_real nodes[81 * 3];
+           int hexes[32 * 8], i, c, a, err;
+           frm_sampling s;
+           frm_desc d = frm_model_default_desc();
+           frm_model *m;
+           for (i = 0; i < 81; i++) { // node i = x + 9 (y + 3 z) on a 0.5 m grid
+               nodes[3 * i] = (frm_real)(0.5 * (i % 9));
+               nodes[3 * i + 1] = (frm_real)(0.5 * (i / 9 % 3));
+               nodes[3 * i + 2] = (frm_real)(0.5 * (i / 27));
+           }
+           for (c = 0; c < 32; c++) // cell (c % 8, c / 8 % 2, c / 16), corner a = (a&1, a>>1&1, a>>2)
+               for (a = 0; a < 8; a++)
+                   hexes[8 * c + a] = (c % 8 + (a & 1)) + 9 * ((c / 8 % 2 + (a >> 1 & 1)) + 3 * (c / 16 + (a >> 2)));
+           err = frm_sampling_hexes(&s, nodes, 81, hexes, 32, 2, FRM_QUADRATURE_SUBCELL, NULL);
+           if (err) return printf("%s\n", frm_error_string(err)), 1;
+           frm_sampling_apply(&s, &d);      // frames at the nodes, 8 samples a cell
+           d.material.young_modulus = 1e8;  // Pa
+           d.material.density = 1000;       // kg/m^3
+           err = frm_model_create(&d, &m);
+           frm_sampling_free(&s);           // the model keeps its own copy
+           if (err) return printf("%s\n", frm_error_string(err)), 1;
+           for (i = 0; i < 81; i += 9) frm_model_fix_frame(m, i); // clamp the face x = 0
+           err = frm_model_solve_static(m);                       // sag under gravity
+           printf("%s: the tip sagged %.4f m\n", frm_error_string(err),
+                  0.5 - (double)frm_model_positions(m)[3 * 44 + 2]); // 0.0401, beam theory 0.040
+           for (i = 0; i < 100; i++) frm_model_step(m); // then one second of implicit dynamics
+           frm_model_destroy(m);
+           return 0;
+       }
+
+   More: examples/frames_beam.c (the thesis's steel cantilever Newton iteration by
+   Newton iteration, VTK of samples and frames, nanoseconds per pair of the CG product).
+
+   OVERRIDES (define before including the implementation)
+
+       FRM_REAL        float or double (default double). Kernels and stored data are
+                       FRM_REAL; creation, shape functions, sampling, dot products and
+                       energies run in double. In float builds the entry points that take
+                       or make FRM_REAL data are renamed (..._f32), so float and double
+                       translation units cannot be linked together.
+       FRM_MALLOC(size, user) / FRM_FREE(ptr, user)
+                       default allocator (malloc/free) when the desc gives none.
+       FRM_ASSERT(x)   internal sanity checks (default: assert from <assert.h>).
+       FRM_STATIC      make every function static (private to the including file).
+       FRM_PARALLEL_MIN_PAIRS
+                       default of desc.parallel_min_pairs (20000).
+       FRAMES_KERNELS  define (without FRAMES_IMPLEMENTATION) to get only the
+                       FRM_HOSTDEV kernels, e.g. in a .cu file (FRM_HOSTDEV is
+                       __host__ __device__ under nvcc, empty otherwise).
+
+   STEP BY STEP
+       1. Frames, samples and the neighbour table: frm_sampling_hexes / _tets (mesh-based),
+          frm_sampling_meshless (given points), frm_sampling_box / _surface (Poisson disks);
+          or fill the table yourself (any weights that sum to one, gradients to zero).
+       2. frm_desc d = frm_model_default_desc(); frm_sampling_apply(&s, &d); set the
+          material (or a per-sample table), gravity, time step, solver settings.
+       3. frm_model_create(&d, &m) validates everything and allocates all memory once.
+       4. Boundary conditions and loads: frm_model_fix_frame, frm_model_drive_frame (a
+          prescribed pose), frm_model_release_frame, frm_model_set_external (force and
+          torque), frm_model_set_gravity.
+       5. frm_model_step (implicit Euler) or frm_model_solve_static (Newton), or
+          frm_model_newton_step to watch a solve; frm_model_last_stats for iterations.
+       6. Read frm_model_positions / _orientations / _velocities, and
+          frm_model_sample_positions / _deformation_gradients, to render or measure.
+       7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
+
+   UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, volumes m^3,
+   time s, forces N, torques N m, rotations rad (world axes), gravity m/s^2 (default 9.81
+   along -z), mass_damping 1/s, stiffness_damping s.
+
+   MEMORY: frm_model_create makes one allocation (one block, every array in it 64-byte
+   aligned) through the desc's allocator (or FRM_MALLOC), plus temporary tables it frees
+   before returning. A custom allocator must honour the alignment it is asked for (64).
+   Nothing else allocates: forces, stiffness products and assembly, steps and solves
+   reuse the block. Per (sample, neighbour) pair the model holds about 230 bytes in
+   double (index, weight, gradient, levers, the linearisation's G and Hs, the pass-1
+   buffer), per block 292 when block storage is reserved (every stiffness mode but
+   FRM_STIFFNESS_PAIRS), per sample about 200, per frame about 1 kB; frm_model_memory_bytes
+   tells. The description's arrays are read during frm_model_create only. The samplings
+   allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
+
+   ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
+   names it, and the optional desc.log callback receives a detailed message for validation
+   failures (the library never prints). Creation refuses: counts out of range, non-finite
+   positions, orientations that are not unit quaternions (|q|^2 off by more than 1e-5),
+   zero, negative or non-finite sample volumes, samples without neighbours or with more
+   than FRM_MAX_NEIGHBORS (16), frame indices out of range or repeated in a sample,
+   weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
+   (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
+   E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
+   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
+   Neo-Hookean sample (FRM_ERR_INVERTED) or without convergence (FRM_ERR_NO_CONVERGENCE)
+   leaves positions, orientations and velocities exactly as they were.
+
+   THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
+   time, different models by different threads. The per-sample and per-frame passes run
+   through desc.parallel_for (an engine's job system) when given, through OpenMP when
+   compiled with -fopenmp, serially otherwise, and serially for models under
+   desc.parallel_min_pairs pairs. The work is cut into fixed chunks (64 samples, 32
+   frames) that do not depend on the thread count; every frame sums its pairs'
+   contributions in pair order through the reverse table (pass 2), energies add chunk
+   partial sums in chunk order, and the CG's vector work is serial: results are
+   bit-identical whatever the number of threads or the job system's split. No atomics.
+
+   THE MODEL (thesis equations; our derivations where the printed ones differ)
+       Kinematics. A sample s has rest position pbar_s, volume v_s and neighbours i with
+       weight w_i, gradient grad w_i (rest coordinates) and rest local position
+       lbar_i = Rbar_i^T (pbar_s - xbar_i) (eq. 3.33). Its position (eq. 3.34) and
+       deformation gradient (eq. 3.40) are
+           p_s = sum_i w_i d_i,   d_i = x_i + R_i lbar_i,
+           F_s = sum_i d_i grad w_i^T + w_i R_i Rbar_i^T.
+       The kernels form H = F - I without cancellation: since xbar_i + Rbar_i lbar_i =
+       pbar_s, d_i - d_0 = (u_i - u_0) + (Q_i - I) abar_i - (Q_0 - I) abar_0 with u = x -
+       xbar, Q_i = R_i Rbar_i^T (Q - I from the relative quaternion) and abar_i =
+       pbar_s - xbar_i; the state is kept as displacements u. Float keeps small strains.
+       Variations. A frame's rotation varies as R -> exp([dtheta]x) R, dtheta in world
+       axes, and its generalized vectors are (translation, rotation): 6 per frame. Then
+       (eqs. 3.42-3.44; our form of the 9 x 6 matrix B)
+           dF = sum_i dx_i grad w_i^T + [dtheta_i]x G_i,   G_i = a_i grad w_i^T + w_i Q_i,
+       a_i = R_i lbar_i the lever. Forces (eq. 3.52) need no M: with dE = sym(F^T dF),
+       S : dE = (F S) : dF, so M^T {S} = B^T vec(P) with P = F S, and
+           f_i = -sum_s v_s (P grad w_i,  sum_j g_ij x p_j)      (force, torque)
+       (g_ij, p_j the columns of G_i and P). The printed eq. 3.49 repeats [B]^4 where
+       [B]^3 belongs, and the cross-product matrix of eq. A.3 has its last row's middle
+       sign wrong ((-v1, v0, 0) is right); the finite-difference tests decided.
+       Laws (per sample): St Venant-Kirchhoff S = lambda tr(E) I + 2 mu E (eq. 3.53) and
+       compressible Neo-Hookean W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
+       S = mu (I - C^-1) + lambda ln J C^-1.
+       Stiffness, K = -df/dq (the thesis writes K = df/dq). Differentiating f:
+           K v = sum_s v_s B^T vec(dP) + H dtheta,  dP = dF S + F dS,  dS = C : sym(F^T dF)
+       where F dS is the material part (eqs. 3.67-3.70), dF S the geometric part of
+       eqs. 3.71-3.73, and H_i = v_s (G_i P^T - tr(G_i^T P) I) the derivative of B through
+       the frame's own rotation (eqs. 3.74-3.75, appendix B's K^R). Gravity acting on the
+       samples adds the torque's stiffness per frame. K is not symmetric: because
+       rotations do not commute, the rotational diagonal blocks carry an antisymmetric
+       part 1/2 [tau_i]x, tau_i the frame's internal plus gravity torque (it vanishes at
+       equilibrium without external torques). The solvers use the symmetric part, which
+       is the Hessian of the energy in rotation-vector coordinates;
+       frm_model_apply_stiffness gives either.
+       Coupling term (optional, desc.frame_coupling = eps, default 0 = the thesis's model):
+           E_c = 1/2 sum_s eps mu_s v_s / h_s^2 sum_i |w_i| |d_i - p_s|^2,
+       h_s^2 the weighted mean squared lever: it ties each frame's own prediction of a
+       sample to the blended position. Zero under rigid motion, of higher order for smooth
+       fields, it stiffens the rotations a trilinear grid cannot see (see LIMITS), at the
+       price of bending stiffness on coarse, elongated cells.
+
+   MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
+   split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
+   sees its shares as points rigidly attached to it: the kinetic energy
+       T = 1/2 sum_s m_s sum_i mu_is |xdot_i + omega_i x a_is|^2
+   bounds the interpolated field's 1/2 sum_s m_s |sum_i w_is (xdot_i + omega_i x a_is)|^2
+   from above (Jensen, weights >= 0) and equals it for every rigid motion, since then all
+   frames predict the same sample velocity. So the frames carry the body's mass, mass
+   centre and inertia tensor exactly. Each sample is a ball of its volume (its own
+   inertia 2/5 m r^2), which keeps every block positive definite. Per frame, world axes:
+       M_i = [m_i I, -[c_i]x; [c_i]x, J_i],   m_i = sum_s mu m,  c_i = sum_s mu m a,
+       J_i = sum_s mu m (|a|^2 I - a a^T + 2/5 r_s^2 I),
+   rotated with the frame (c = R cbar, J = R Jbar R^T), evaluated at the start of each
+   step (gyroscopic terms neglected). Gravity uses the signed weights, m_gi = sum_s w m,
+   c_gi = sum_s w m a: it is the exact weight of the interpolated samples, a force m_gi g
+   and a torque c_gi x g per frame.
+
+   SOLVERS
+       Static (sec. 3.6): Newton iterations K dq = f on the free frames (f the total
+       force), each by block-Jacobi preconditioned CG stopped at an Eisenstat-Walker
+       relative residual (1e-3, then as fast as the residual falls, never below
+       cg_tolerance, never tighter than the step can use), then a backtracking Armijo line
+       search on the total potential (elastic + gravity - f_ext . dq; constant torques have
+       no potential, their work along the step is exact); a CG that meets non-positive
+       curvature returns its last iterate (a descent direction). Converged when
+       |f| <= newton_tolerance |load| or |f| falls below the round-off floor (64 eps times
+       the size of the partial forces it sums, plus K times one ulp of the displacements).
+       static_regularization (default 1e-6) adds that fraction of |K_ii| to each frame's
+       rotational diagonal inside CG only: the forces and the equilibrium are unchanged.
+       Implicit Euler (eq. 3.64) with Rayleigh damping, one linearisation per step:
+           (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
+       then v += dv, x += dt v, q = exp(dt omega) q renormalised (|q| = 1 to round-off for
+       ever). Fixed frames do not move, driven frames reach their targets in the step and
+       enter the right-hand side through K. The CG starts from the previous step's dv.
+       Preconditioner: 6x6 block Jacobi, the inverse of a_M M_i + a_K K_ii per frame
+       (Cholesky; the absolute diagonal if a block is not positive definite). In block
+       mode K_ii is exact; in pair mode it is the rest state's, turned with the frame
+       (T K_rest T^T, T = diag(Q, Q)), plus the current gravity term: exact for rigid
+       motions, an approximation under strain, and free where the exact blocks cost
+       about 25 CG iterations.
+
+   SHAPE FUNCTIONS AND SAMPLING (sec. 4.1)
+       frm_shape_tet: barycentric (4 neighbours). frm_shape_hex: trilinear (8), gradients
+       through the inverse Jacobian. frm_shape_shepard: 1/d^p (eqs. 4.8-4.9, or the
+       Franke-Little ((R - d)+ / (R d))^p with a radius), any layout of frames, zero
+       order. frm_shape_mls: linear moving least squares, Wendland C2 kernel, first order
+       (reproduces linear fields), needs 4 frames not coplanar in its radius. All sum to
+       one with gradients summing to zero, and are tested against finite differences.
+       Mesh-based sampling puts frames at the nodes and samples at chosen points of each
+       element with the element's volume split over them: sub-cell centres or Gauss
+       points in hexahedra, centroid, the 4-point Gauss rule or any barycentric points in
+       tetrahedra. Meshless sampling: Poisson-disk points (Bridson 2007, then a fill pass
+       that seeds every empty cell, so thin and separate parts get points) inside a box
+       (an axis may be flat) or a closed triangle surface (parity of a +z ray, triangles
+       binned by their xy boxes, shared edges counted once), frames from a coarser
+       distance than samples, the volume split evenly; the k nearest frames or all within
+       a radius (a grid search). The same seed gives the same points everywhere.
+
+   PERFORMANCE
+       Bytes each kernel streams per (sample, neighbour) pair, double (float about half):
+           force pass (frm_model_forces)         pass 1 reads 60 (index, weight,
+               gradient, rest lever) and writes 48, pass 2 reads 52: 160; linearising
+               (before a solve) writes 120 more (G, Hs), 168 with the coupling term.
+           K v, pair mode (matrix-free)           pass 1 reads 148 (index, gradient, G,
+               Hs) and writes 48, pass 2 reads 52: 248, plus the sample's F, S (and the
+               Neo-Hookean tangent) over its neighbours, 15 to 45 a pair; 48 more with
+               the coupling term. About 130 flops a pair.
+           K v, block mode                        292 per 6x6 block (36 reals and a
+               column index), about 0.5 block a pair with 8 neighbours (hexahedra), 0.2
+               with 4 (tetrahedra).
+       Within a Newton iteration or a step the linearisation is fixed, so both modes
+       prepare once: the pair mode stores G and Hs per pair in the force pass; the block
+       mode assembles row by row (about 1 us a pair with 8 neighbours). Measured on the
+       development machine (a shared 2-core AMD EPYC VM at 2.45 GHz streaming 17.5 GB/s,
+       one core, double, gcc -std=c99 -O2; examples/frames_beam.c and a timing harness on
+       the thesis cantilever, 25 x 5 x 5 frames, 24576 pairs):
+           force pass 42 ns a pair; K v pair mode 28-42 ns a pair (20.6 with -O3
+           -march=native); K v block mode 7-8 ns a block, 3.6-4 ns a pair; assembly
+           0.8-1.7 us a pair; so blocks pay off after 4 to 25 CG iterations.
+       On the reference machine of REFERENCES.md (4.2 GHz, 40 GB/s) expect about half.
+       FRM_STIFFNESS_AUTO assembles when the previous solve's iteration count (50 before
+       any) times the pair mode's cost exceeds the assembly plus the block products
+       (measured per-item costs above): with 8 neighbours, beyond about 30 iterations.
+       Thesis figures on this machine (one core): 72 frames, 400 samples, 4 neighbours,
+       50 CG iterations a step: 3.3 ms a step matrix-free, 1.6 ms by blocks (thesis:
+       32.65 ms, Xeon W3520); 34,610 samples, 4 neighbours, 60 iterations: 402 ms
+       matrix-free, 139 ms by blocks (thesis: 3468 ms CPU, 66.1 ms on a GTX 570).
+
+   ACCURACY (tests/test_frames.c prints these)
+       R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.39 % of Timoshenko
+       (0.82 % in float); with Gauss points -1.7 % (Poisson locking of 4 cells across).
+       R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.289,
+       6.132, 6.327 m, order 1.6, limit 6.54 m, about 40,000 DoF for 1 % of it.
+       R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.96 %.
+       A 180 degree torsion of a 10-frame Shepard bar (thesis fig. 4.11) spreads linearly
+       to within 3.5 degrees; a coplanar Shepard sheet under 300 N (fig. 4.10) converges.
+
+   LIMITS
+       - Invisible rotations: on tensor-product (extruded) hexahedral grids, a layer of
+         frames normal to an axis turning about that axis moves no sample at all (the
+         bilinear face interpolation reproduces the in-plane coordinates), so the energy
+         is flat along those directions. Small deformations solve well (the static
+         regularisation picks an orientation); under large deformation and compression
+         they turn into soft, unstable modes and Newton or the implicit step can fail:
+         use tetrahedral or meshless frames there, or frame_coupling = 1e-2 (which makes
+         coarse, elongated cells stiffer in bending: R1 at 25 x 5 x 5 becomes 31 % too
+         stiff). One cell across a hexahedral beam is too few (spurious distortion of the
+         section): use two or more.
+       - Hexahedral frames with Gauss points lock in bending near incompressibility, like
+         trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
+         across); sub-cell samples lock less. Tetrahedral frames converge slowly (R2).
+       - St Venant-Kirchhoff softens and can collapse under strong compression; a
+         Neo-Hookean sample cannot invert (steps refuse with FRM_ERR_INVERTED).
+       - Shepard functions are zero-order (no linear reproduction): meshless Shepard
+         bodies are stiffer and less accurate than MLS ones, but take any point layout
+         (coplanar, collinear); MLS needs 3D spread and may give negative weights (the
+         mass uses |w|).
+       - The mass is lumped per frame (exact rigid-body inertia, not the consistent mass)
+         and taken at the start of each step; gyroscopic terms are neglected.
+       - Constant external torques have no potential: with them the static Newton's
+         symmetric Jacobian converges linearly, not quadratically.
+       - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m);
+         steel-like stiffness needs the round-off floor to stop Newton (R1 float +0.82 %).
+       - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
+         chain solver, inverse actuation and the CUDA companion are not in this version.
+
+   HISTORY
+       0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
+             and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
+             Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
 
    Licence at the end of the file. */
 #ifndef FRAMES_H
@@ -2743,10 +3045,6 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
     frm__total_force(m, f);
     *res = frm__norm_free(m, f);
     m->stats.newton_iterations++;
-#ifdef FRM_DEBUG_NEWTON
-    fprintf(stderr, "newton: |f| %.3e -> %.3e (ref %.3e floor %.3e) eta %.1e cg %d (%.1e) halvings %d accepted %d slope %.3e\n", norm, *res,
-            *ref, frm__round_off_floor(m), eta, m->stats.cg_iterations_last, (double)m->stats.cg_residual, h - 1, accepted, slope);
-#endif
     return FRM_OK;
 }
 
