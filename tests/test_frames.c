@@ -1553,6 +1553,22 @@ static void capture_log(int code, const char *message, void *user)
     (void)message;
 }
 
+/* An allocator with nothing to give. */
+static void *failing_alloc(size_t size, size_t align, void *user)
+{
+    (void)size;
+    (void)align;
+    (void)user;
+    return NULL;
+}
+
+static void failing_free(void *ptr, size_t size, void *user)
+{
+    (void)ptr;
+    (void)size;
+    (void)user;
+}
+
 static int try_create(const frm_desc *d)
 {
     frm_model *m = (frm_model *)&m; /* must be reset to NULL on failure */
@@ -1752,6 +1768,17 @@ static void test_validation_errors(void)
     d = base;
     d.allocator.alloc = count_alloc; /* free missing */
     CHECK_INT(FRM_ERR_ARG, try_create(&d));
+    d.allocator.alloc = failing_alloc; /* out of memory: the model and the samplings */
+    d.allocator.free = failing_free;
+    CHECK_INT(FRM_ERR_ALLOC, try_create(&d));
+    {
+        frm_sampling s;
+        frm_real lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+        frm_poisson_desc p = frm_poisson_default_desc();
+        CHECK_INT(FRM_ERR_ALLOC, frm_sampling_box(&s, lo, hi, &p, NULL, &d.allocator));
+        CHECK_INT(FRM_ERR_ALLOC, frm_sampling_meshless(&s, fx, 2, sx, 2, 1, NULL, &d.allocator));
+        CHECK(s.frame_positions == NULL);
+    }
     CHECK(lc.calls > 10);
 
     /* the functions of a model */
