@@ -3955,7 +3955,7 @@ static void frm__gauss(int n, double *x, double *w)
 }
 
 FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node_count, const int *hexes, int hex_count,
-                              int gauss, frm_quadrature rule, const frm_allocator *allocator)
+                              int points, frm_quadrature rule, const frm_allocator *allocator)
 {
     double gx[4], gw[4];
     int err, h, a, b, i, j, k, r, s = 0, g3;
@@ -3963,9 +3963,9 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
     memset(out, 0, sizeof *out);
     err = frm__check_mesh(nodes, node_count, hexes, hex_count, 8);
     if (err) return err;
-    if (gauss < 1 || gauss > 4 || ((int)rule != FRM_QUADRATURE_SUBCELL && (int)rule != FRM_QUADRATURE_GAUSS))
+    if (points < 1 || points > 4 || ((int)rule != FRM_QUADRATURE_SUBCELL && (int)rule != FRM_QUADRATURE_GAUSS))
         return FRM_ERR_SAMPLING;
-    g3 = gauss * gauss * gauss;
+    g3 = points * points * points;
     if ((long long)hex_count * g3 * 8 > 2000000000LL) return FRM_ERR_SAMPLING;
     for (h = 0; h < hex_count; h++)
         for (a = 0; a < 8; a++)
@@ -3974,19 +3974,19 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
     err = frm__sampling_alloc(out, node_count, hex_count * g3, hex_count * g3 * 8, allocator);
     if (err) return err;
     memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
-    if (rule == FRM_QUADRATURE_GAUSS) frm__gauss(gauss, gx, gw);
+    if (rule == FRM_QUADRATURE_GAUSS) frm__gauss(points, gx, gw);
     else
-        for (i = 0; i < gauss; i++) {
-            gx[i] = (i + 0.5) / gauss;
-            gw[i] = 1.0 / gauss;
+        for (i = 0; i < points; i++) {
+            gx[i] = (i + 0.5) / points;
+            gw[i] = 1.0 / points;
         }
     for (h = 0; h < hex_count; h++) {
         double X[8][3];
         for (a = 0; a < 8; a++)
             for (r = 0; r < 3; r++) X[a][r] = (double)nodes[3 * hexes[8 * h + a] + r];
-        for (k = 0; k < gauss; k++)
-            for (j = 0; j < gauss; j++)
-                for (i = 0; i < gauss; i++, s++) {
+        for (k = 0; k < points; k++)
+            for (j = 0; j < points; j++)
+                for (i = 0; i < points; i++, s++) {
                     double xi[3], p[3], w[8], g[8][3], det;
                     xi[0] = gx[i];
                     xi[1] = gx[j];
