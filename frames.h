@@ -358,6 +358,15 @@ typedef FRM_REAL frm_real;
    memory, thesis sec. 4.4). */
 #define FRM_MAX_NEIGHBORS 16
 
+/* The least bytes each kernel streams per (sample, neighbour) pair (see PERFORMANCE), for
+   bandwidth bounds: the force pass (pass 1 reads index, weight, gradient and rest lever,
+   writes 6 reals; pass 2 reads them back with the pair index), the matrix-free K v (pass 1
+   reads index, gradient, G and Hs, then the same 6-real round trip), and one assembled
+   6x6 block with its column index (block mode). Sample data (F, S) comes on top. */
+#define FRM_FORCE_BYTES_PER_PAIR (2 * sizeof(int) + 19 * sizeof(frm_real))
+#define FRM_KV_BYTES_PER_PAIR (2 * sizeof(int) + 30 * sizeof(frm_real))
+#define FRM_KV_BYTES_PER_BLOCK (sizeof(int) + 36 * sizeof(frm_real))
+
 /* Pairs (sample, neighbour) below which loops run serially (starting threads costs more
    than it saves on small models). */
 #ifndef FRM_PARALLEL_MIN_PAIRS
@@ -489,11 +498,11 @@ typedef struct frm_desc {
     const int *sample_materials; /* optional sample_count indices into `materials` (NULL:
                                     every sample uses materials[0]) */
 
-    frm_real frame_coupling; /* dimensionless, default 1e-2: weight of the coupling term that
-                                ties each frame's own prediction of a sample to the blended
-                                position (see MODEL); it stiffens the rotations a trilinear
-                                grid cannot see and is of higher order for smooth fields.
-                                0 gives the thesis's model exactly */
+    frm_real frame_coupling; /* dimensionless, default 0 (the thesis's model exactly): weight
+                                of the coupling term that ties each frame's own prediction
+                                of a sample to the blended position (see MODEL); 1e-2
+                                stiffens the rotations a trilinear grid cannot see and is of
+                                higher order for smooth fields */
 
     /* dynamics */
     frm_real gravity[3];        /* m/s^2, default (0, 0, -9.81) */
