@@ -46,9 +46,11 @@ const bench_model *bench_models_tensormass_double(int *count);
 const bench_model *bench_models_tensormass_float(int *count);
 const bench_model *bench_models_heml_double(int *count);
 const bench_model *bench_models_heml_float(int *count);
+const bench_model *bench_models_frames_double(int *count);
+const bench_model *bench_models_frames_float(int *count);
 static const bench_models_fn registry[] = {
-    bench_models_tensormass_double, bench_models_tensormass_float,
-    bench_models_heml_double,       bench_models_heml_float,
+    bench_models_tensormass_double, bench_models_tensormass_float, bench_models_heml_double,
+    bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
 };
 
 #define BIT(i) (1u << (i))
@@ -1060,7 +1062,7 @@ static double time_kernel(const bench_model *m, void *sim, int kernel, double mi
 static void run_kernels(const options *o, const bench_model *const *models, int count)
 {
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
-    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v"};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk"};
     double bandwidth[3];
     int i, s, th, kern, sizes = o->quick ? 2 : 4, max_threads = o->threads;
     FILE *f;

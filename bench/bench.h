@@ -24,7 +24,12 @@ enum {
 #define BENCH_UNSUPPORTED 1000
 
 /* Kernels timed by the throughput part. */
-enum { BENCH_KERNEL_FORCE = 0, BENCH_KERNEL_KV = 1, BENCH_KERNEL_COUNT = 2 };
+enum {
+    BENCH_KERNEL_FORCE = 0,     /* the internal force */
+    BENCH_KERNEL_KV = 1,        /* K * v, matrix-free (the force differential) */
+    BENCH_KERNEL_KV_BLOCKS = 2, /* K * v by assembled blocks, where a model has them */
+    BENCH_KERNEL_COUNT = 3
+};
 
 typedef struct bench_body {
     double size[3];     /* L, W, H, m */

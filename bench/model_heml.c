@@ -167,6 +167,7 @@ static int hm_kernel(void *v, int kernel)
 {
     hm_sim *s = (hm_sim *)v;
     if (kernel == BENCH_KERNEL_FORCE) return heml_compute_forces(s->m) ? 0 : HEML_ERR_ARG;
+    if (kernel != BENCH_KERNEL_KV) return BENCH_UNSUPPORTED;
     return heml_apply_stiffness(s->m, s->dx, s->out);
 }
 

@@ -1,0 +1,262 @@
+/* model_frames.c - bench adapter of frames.h: 6-DoF frames at the nodes of a hexahedral
+   grid (trilinear, 8 sub-cell samples a cell) or of the bench's tetrahedral mesh
+   (barycentric, one sample a tet), St Venant-Kirchhoff or Neo-Hookean. The bench's "nodes"
+   are the frames. Compiled twice by the Makefile, in double and with -DBENCH_FLOAT. */
+#ifdef BENCH_FLOAT
+#define FRM_REAL float
+#define BENCH_TABLE bench_models_frames_float
+#define BENCH_PRECISION "float"
+#else
+#define BENCH_TABLE bench_models_frames_double
+#define BENCH_PRECISION "double"
+#endif
+#define FRM_STATIC
+#define FRAMES_IMPLEMENTATION
+#include "../frames.h"
+#define TETMESH_STATIC
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "bench.h"
+#include "body_mesh.h"
+#include <math.h>
+#include <stdlib.h>
+
+typedef struct fr_sim {
+    frm_model *m;
+    int frames, prepared; /* prepared: the stiffness is linearised at the current state */
+    double *rest;         /* 3 per frame, with the offset, in double */
+    frm_real *v, *out;    /* K*v kernel vectors, 6 per frame */
+} fr_sim;
+
+/* Frames and samples of the body: hexahedral (8 sub-cell samples a cell) or tetrahedral
+   (the centroid of each tet); node coordinates in double, copied to frm_real. */
+static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **rest)
+{
+    frm_real *x;
+    double *nodes;
+    int n, i, err;
+    if (hex) {
+        hexmesh mesh;
+        double lo[3], hi[3];
+        for (i = 0; i < 3; i++) {
+            lo[i] = (i ? -0.5 * b->size[i] : 0) + b->offset[i];
+            hi[i] = (i ? 0.5 * b->size[i] : b->size[0]) + b->offset[i];
+        }
+        if (hexmesh_grid(&mesh, lo, hi, b->cells[0], b->cells[1], b->cells[2])) return FRM_ERR_ALLOC;
+        n = mesh.node_count;
+        x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
+        if (!x) return hexmesh_free(&mesh), FRM_ERR_ALLOC;
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)mesh.nodes[i];
+        err = frm_sampling_hexes(s, x, n, mesh.hexes, mesh.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
+        nodes = mesh.nodes;
+        free(mesh.hexes);
+    } else {
+        tetmesh mesh;
+        if (bench_body_mesh(b, &mesh)) return FRM_ERR_ALLOC;
+        n = mesh.node_count;
+        x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
+        if (!x) return tetmesh_free(&mesh), FRM_ERR_ALLOC;
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)mesh.nodes[i];
+        err = frm_sampling_tets(s, x, n, mesh.tets, mesh.tet_count, 1, NULL, NULL);
+        nodes = mesh.nodes;
+        free(mesh.tets);
+    }
+    free(x);
+    if (err) {
+        free(nodes);
+        return err;
+    }
+    *rest = nodes;
+    return 0;
+}
+
+static int fr_create(const bench_body *b, int hex, frm_law law, void **out)
+{
+    frm_sampling smp;
+    frm_desc d = frm_model_default_desc();
+    fr_sim *s;
+    double *rest = NULL;
+    int i, err;
+    *out = NULL;
+    if (b->exclude) return BENCH_UNSUPPORTED; /* frames do not cut */
+    err = fr_sampling(b, hex, &smp, &rest);
+    if (err) return err;
+    s = (fr_sim *)calloc(1, sizeof *s);
+    if (s) {
+        s->v = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)smp.frame_count);
+        s->out = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)smp.frame_count);
+    }
+    if (!s || !s->v || !s->out) {
+        if (s) free(s->v), free(s->out);
+        free(s);
+        free(rest);
+        frm_sampling_free(&smp);
+        return FRM_ERR_ALLOC;
+    }
+    frm_sampling_apply(&smp, &d);
+    d.material.law = law;
+    d.material.young_modulus = (frm_real)b->young;
+    d.material.poisson_ratio = (frm_real)b->poisson;
+    d.material.density = (frm_real)b->density;
+    d.mass_damping = (frm_real)b->damping;
+    for (i = 0; i < 3; i++) d.gravity[i] = (frm_real)b->gravity[i];
+    d.cg_max_iterations = 20000; /* stiff slender beams need many CG iterations */
+    err = frm_model_create(&d, &s->m);
+    frm_sampling_free(&smp);
+    if (err) {
+        free(s->v), free(s->out), free(s), free(rest);
+        return err;
+    }
+    s->frames = frm_model_frame_count(s->m);
+    s->rest = rest;
+    for (i = 0; i < 6 * s->frames; i++) s->v[i] = (frm_real)(1e-3 * ((i * 7919) % 13 - 6)); /* any direction */
+    if (b->clamp)
+        for (i = 0; i < s->frames; i++)
+            if (bench_body_clamped(b, s->rest, i)) frm_model_fix_frame(s->m, i);
+    *out = s;
+    return 0;
+}
+
+static int fr_create_svk_hex(const bench_body *b, void **out) { return fr_create(b, 1, FRM_LAW_SVK, out); }
+static int fr_create_nh_hex(const bench_body *b, void **out) { return fr_create(b, 1, FRM_LAW_NEO_HOOKEAN, out); }
+static int fr_create_svk_tet(const bench_body *b, void **out) { return fr_create(b, 0, FRM_LAW_SVK, out); }
+static int fr_create_nh_tet(const bench_body *b, void **out) { return fr_create(b, 0, FRM_LAW_NEO_HOOKEAN, out); }
+
+static void fr_destroy(void *v)
+{
+    fr_sim *s = (fr_sim *)v;
+    if (!s) return;
+    frm_model_destroy(s->m);
+    free(s->rest), free(s->v), free(s->out), free(s);
+}
+
+static int fr_dof(void *v) { return 6 * ((fr_sim *)v)->frames; }
+static int fr_node_count(void *v) { return ((fr_sim *)v)->frames; }
+
+static void fr_rest(void *v, int i, double p[3])
+{
+    fr_sim *s = (fr_sim *)v;
+    int k;
+    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
+}
+
+static void fr_position(void *v, int i, double p[3])
+{
+    const frm_real *x = frm_model_positions(((fr_sim *)v)->m);
+    int k;
+    for (k = 0; k < 3; k++) p[k] = (double)x[3 * i + k];
+}
+
+/* Unit quaternion (x, y, z, w) of a rotation matrix (row-major), largest-component form. */
+static void fr_quaternion(const double *R, frm_real q[4])
+{
+    double t = R[0] + R[4] + R[8], x, y, z, w, r;
+    if (t > 0) {
+        r = sqrt(1 + t) * 2;
+        w = 0.25 * r, x = (R[7] - R[5]) / r, y = (R[2] - R[6]) / r, z = (R[3] - R[1]) / r;
+    } else if (R[0] > R[4] && R[0] > R[8]) {
+        r = sqrt(1 + R[0] - R[4] - R[8]) * 2;
+        w = (R[7] - R[5]) / r, x = 0.25 * r, y = (R[1] + R[3]) / r, z = (R[2] + R[6]) / r;
+    } else if (R[4] > R[8]) {
+        r = sqrt(1 + R[4] - R[0] - R[8]) * 2;
+        w = (R[2] - R[6]) / r, x = (R[1] + R[3]) / r, y = 0.25 * r, z = (R[5] + R[7]) / r;
+    } else {
+        r = sqrt(1 + R[8] - R[0] - R[4]) * 2;
+        w = (R[3] - R[1]) / r, x = (R[2] + R[6]) / r, y = (R[5] + R[7]) / r, z = 0.25 * r;
+    }
+    r = 1 / sqrt(x * x + y * y + z * z + w * w);
+    q[0] = (frm_real)(x * r), q[1] = (frm_real)(y * r), q[2] = (frm_real)(z * r), q[3] = (frm_real)(w * r);
+}
+
+static int fr_pin(void *v, int i, const double u[3], const double *rotation)
+{
+    fr_sim *s = (fr_sim *)v;
+    frm_real p[3], q[4] = {0, 0, 0, 1};
+    int k;
+    for (k = 0; k < 3; k++) p[k] = (frm_real)(s->rest[3 * i + k] + u[k]);
+    if (rotation) fr_quaternion(rotation, q);
+    s->prepared = 0;
+    return frm_model_drive_frame(s->m, i, p, q);
+}
+
+static int fr_release(void *v, int i) { return frm_model_release_frame(((fr_sim *)v)->m, i); }
+
+static int fr_set_gravity(void *v, const double g[3])
+{
+    frm_real w[3];
+    int k;
+    for (k = 0; k < 3; k++) w[k] = (frm_real)g[k];
+    return frm_model_set_gravity(((fr_sim *)v)->m, w);
+}
+
+static int fr_solve_static(void *v)
+{
+    ((fr_sim *)v)->prepared = 0;
+    return frm_model_solve_static(((fr_sim *)v)->m);
+}
+
+static int fr_step(void *v, double dt, int integrator)
+{
+    if (integrator != BENCH_IMPLICIT_EULER) return BENCH_UNSUPPORTED;
+    ((fr_sim *)v)->prepared = 0;
+    return frm_model_step_ex(((fr_sim *)v)->m, (frm_real)dt);
+}
+
+static int fr_forces(void *v, double *f)
+{
+    fr_sim *s = (fr_sim *)v;
+    const frm_real *g = NULL;
+    int i, k, err = frm_model_forces(s->m, &g);
+    for (i = 0; !err && i < s->frames; i++)
+        for (k = 0; k < 3; k++) f[3 * i + k] = g[6 * i + k];
+    return err;
+}
+
+static double fr_elements(void *v) { return (double)frm_model_pair_count(((fr_sim *)v)->m); }
+
+static double fr_kernel_bytes(void *v, int kernel)
+{
+    fr_sim *s = (fr_sim *)v;
+    double pairs = (double)frm_model_pair_count(s->m);
+    const int *row_start = NULL, *cols = NULL;
+    if (kernel == BENCH_KERNEL_FORCE) return pairs * (double)FRM_FORCE_BYTES_PER_PAIR;
+    if (kernel == BENCH_KERNEL_KV) return pairs * (double)FRM_KV_BYTES_PER_PAIR;
+    frm_model_stiffness_blocks(s->m, &row_start, &cols);
+    return row_start ? (double)row_start[s->frames] * (double)FRM_KV_BYTES_PER_BLOCK : 0;
+}
+
+/* K*v in pair mode (matrix-free) or block mode (assembled 6x6 blocks); the
+   linearisation is prepared once per state, outside the timed calls after the first. */
+static int fr_kernel(void *v, int kernel)
+{
+    fr_sim *s = (fr_sim *)v;
+    const frm_real *g;
+    int err = 0;
+    if (kernel == BENCH_KERNEL_FORCE) return frm_model_forces(s->m, &g);
+    if (s->prepared != kernel) {
+        err = frm_model_set_stiffness_mode(s->m, kernel == BENCH_KERNEL_KV ? FRM_STIFFNESS_PAIRS : FRM_STIFFNESS_BLOCKS);
+        if (!err) err = kernel == BENCH_KERNEL_KV ? frm_model_prepare_stiffness(s->m) : frm_model_assemble_stiffness(s->m);
+        if (err) return err;
+        s->prepared = kernel;
+    }
+    return frm_model_apply_stiffness(s->m, s->v, s->out, 1);
+}
+
+#define FR_ALL ((1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+#define FR_FUNCTIONS                                                                                          \
+    fr_destroy, fr_dof, fr_node_count, fr_rest, fr_position, fr_pin, fr_release, fr_set_gravity, fr_solve_static, \
+        fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL
+
+static const bench_model fr_models[] = {
+    {"frames", "svk hex8", "svk", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_svk_hex, FR_FUNCTIONS},
+    {"frames", "nh hex8", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_nh_hex, FR_FUNCTIONS},
+    {"frames", "svk tet4", "svk", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_svk_tet, FR_FUNCTIONS},
+    {"frames", "nh tet4", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_nh_tet, FR_FUNCTIONS},
+};
+
+const bench_model *BENCH_TABLE(int *count);
+const bench_model *BENCH_TABLE(int *count)
+{
+    *count = (int)(sizeof fr_models / sizeof fr_models[0]);
+    return fr_models;
+}
