@@ -323,6 +323,8 @@ typedef HEML_REAL heml_real;
 #define heml_apply_stiffness heml_apply_stiffness_f32
 #define heml_positions heml_positions_f32
 #define heml_set_positions heml_set_positions_f32
+#define heml_displacements heml_displacements_f32
+#define heml_set_displacements heml_set_displacements_f32
 #define heml_energy heml_energy_f32
 #else
 #define HEML__FLOAT 0
@@ -333,10 +335,10 @@ typedef HEML_REAL heml_real;
 #define HEML_PARALLEL_MIN_TETS 16384
 #endif
 
-/* Bytes the force kernel streams per tetrahedron (node indices and rest constants), not
-   counting the gathered positions and scattered forces of its nodes (see PERFORMANCE and
-   heml_kernel_bytes). */
-#define HEML_KERNEL_BYTES_PER_TET (4 * sizeof(int) + 8 * sizeof(heml_real))
+/* Bytes the force kernel streams per tetrahedron (4 node indices and 10 rest constants:
+   the gradients of N_1..N_3 and the rest volume), not counting the gathered displacements
+   and scattered forces of its nodes (see PERFORMANCE and heml_kernel_bytes). */
+#define HEML_KERNEL_BYTES_PER_TET (4 * sizeof(int) + 10 * sizeof(heml_real))
 
 /* Error codes and their messages, one list so they cannot drift apart. */
 #define HEML_ERROR_LIST(X) \
@@ -367,13 +369,14 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_NODE_RANGE, -24, "node index out of range") \
     X(HEML_ERR_TET_RANGE, -25, "tetrahedron index out of range") \
     X(HEML_ERR_NO_SECOND_DERIVATIVES, -26, "the user law gives no second derivatives (needed for the force differential)") \
-    X(HEML_ERR_INVERTED, -27, "tetrahedron inverted or flat (J <= 0): Cauchy stress undefined")
+    X(HEML_ERR_INVERTED, -27, "tetrahedron inverted or flat (J <= 0): Cauchy stress undefined") \
+    X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
     HEML_ERROR_LIST(HEML__ENUM)
 #undef HEML__ENUM
-    HEML_ERR_LAST_ = -28
+    HEML_ERR_LAST_ = -29
 };
 
 typedef enum heml_law {
@@ -481,10 +484,13 @@ typedef struct heml_desc {
     heml_real time_step;             /* s, default 1e-3, used by heml_step */
     heml_integrator integrator;      /* default HEML_SEMI_EXPLICIT_EULER */
     int newton_iterations;           /* implicit step, default 1 */
-    heml_real cg_tolerance;          /* relative residual of CG solves, default 1e-6 (1e-5 float) */
-    int cg_max_iterations;           /* default 1000 */
-    int static_max_iterations;       /* Newton iterations of heml_solve_static, default 50 */
-    heml_real static_tolerance;      /* its relative residual, default 1e-9 (1e-5 float) */
+    heml_real cg_tolerance;          /* relative residual of the implicit step's CG, default 1e-6
+                                        (1e-5 float) */
+    int cg_max_iterations;           /* Krylov iterations per linear solve, default 1000 */
+    int static_max_iterations;       /* Newton iterations of heml_solve_static per load step,
+                                        default 50 */
+    heml_real static_tolerance;      /* its residual relative to the larger of the loads and the
+                                        internal forces (see STATIC SOLVE), default 1e-9 (1e-5 float) */
 
     /* environment */
     heml_allocator allocator;          /* all NULL: HEML_MALLOC / HEML_FREE */
@@ -498,8 +504,9 @@ typedef struct heml_desc {
 
 /* Statistics of the last step, solve or force evaluation (read with heml_last_stats). */
 typedef struct heml_stats {
-    int cg_iterations;         /* CG (implicit step) or MINRES (static solve) iterations,
-                                  summed over Newton iterations */
+    int cg_iterations;         /* CG (implicit step) or MINRES (static solve, and the implicit
+                                  step after negative curvature) iterations, summed over Newton
+                                  iterations */
     heml_real cg_residual;     /* final relative residual |r| / |b| of the last Krylov solve */
     int newton_iterations;     /* Newton iterations done */
     int force_evaluations;     /* force passes */
@@ -508,6 +515,9 @@ typedef struct heml_stats {
     int below_threshold;       /* tetrahedra with J < J0 at the last force evaluation */
     int inverted;              /* tetrahedra with J <= 0 at the last force evaluation */
     heml_real static_residual; /* heml_solve_static: last |r| over its reference scale */
+    int load_steps;            /* heml_solve_static: load increments (1 when the full load
+                                  converged at once) */
+    int line_search_halvings;  /* heml_solve_static: halvings of the Newton step, summed */
 } heml_stats;
 
 /* Energies of the current state (heml_energy). */
@@ -579,12 +589,15 @@ HEMLDEF int heml_step(heml_model *m);
 /* One step of dt seconds with the given integrator. */
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator);
 /* Moves the free degrees of freedom to the static equilibrium under gravity, external
-   forces and the pinned axes (Newton with MINRES and a backtracking line search on the
-   residual, with adaptive load stepping when a full step fails; the fully relaxed Prony
-   response), sets velocities to zero and the viscous state to its relaxed value. On
-   failure (HEML_ERR_NO_CONVERGENCE: static_max_iterations Newton iterations per load
-   step were not enough even with steps of 1/1024 of the load; HEML_ERR_NOT_FINITE) the
-   state is unchanged. */
+   forces and the pinned axes (inexact Newton with MINRES, a backtracking line search on
+   the residual or the potential energy, and adaptive load stepping when the full load
+   fails; the fully relaxed Prony response), sets velocities to zero and the viscous state
+   to its relaxed value. Returns HEML_OK only when the residual is below static_tolerance
+   (see STATIC SOLVE). On failure the state is unchanged: HEML_ERR_NO_CONVERGENCE
+   (static_max_iterations Newton iterations per load step were not enough even with steps
+   of 1/1024 of the load), HEML_ERR_ROUND_OFF (the residual stopped falling at the
+   round-off level of the forces, above the tolerance: loosen it or use double),
+   HEML_ERR_NOT_FINITE. */
 HEMLDEF int heml_solve_static(heml_model *m);
 
 /* ---- kernels (for benchmarks and custom solvers) ---- */
@@ -607,13 +620,19 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
 
 HEMLDEF int heml_node_count(const heml_model *m);
 HEMLDEF int heml_tet_count(const heml_model *m);
-HEMLDEF const heml_real *heml_positions(const heml_model *m);      /* 3n, m */
+HEMLDEF const heml_real *heml_positions(const heml_model *m);      /* 3n, m: rest + displacement */
+/* The state: displacements from rest, u = x - X (3n, m). Forces are computed from them, so
+   small deformations keep their relative precision far from the origin and in float. */
+HEMLDEF const heml_real *heml_displacements(const heml_model *m);  /* 3n, m */
 HEMLDEF const heml_real *heml_velocities(const heml_model *m);     /* 3n, m/s */
 HEMLDEF const heml_real *heml_rest_positions(const heml_model *m); /* 3n, m */
 HEMLDEF const heml_real *heml_masses(const heml_model *m);         /* n lumped masses, kg */
 /* Overwrites the positions (3n values, m) or velocities (m/s) of all nodes, for example
-   to start from a deformed state. Values must be finite. */
+   to start from a deformed state. Values must be finite. heml_set_positions stores
+   u = x - X (rounded once: in float, positions far from the origin carry the resolution
+   of their coordinates); heml_set_displacements sets u itself (exact). */
 HEMLDEF int heml_set_positions(heml_model *m, const heml_real *positions);
+HEMLDEF int heml_set_displacements(heml_model *m, const heml_real *displacements);
 HEMLDEF int heml_set_velocities(heml_model *m, const heml_real *velocities);
 /* Statistics of the last step, static solve or force evaluation. */
 HEMLDEF const heml_stats *heml_last_stats(const heml_model *m);
@@ -702,10 +721,12 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__ALIGN 64
 #define HEML__W 16          /* tetrahedra per block: the SIMD width of the kernels' loops */
 #define HEML__CHUNK 16      /* blocks per chunk: the unit of threading and colouring */
-#define HEML__NR 8          /* rest constants per tetrahedron: G00 G11 G22 G01 G02 G12 Vol 1/detV */
-#define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
-#define HEML__NQ 7          /* Prony state per tetrahedron and term: Sigma (6), gamma */
-#define HEML__SCRATCH 16    /* 3n scratch vectors */
+#define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
+#define HEML__NS 21         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses,
+                               the rest links V1, V2, V3 */
+#define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
+                               (c0, a, w_J, M), see heml__coefficients */
+#define HEML__SCRATCH 17    /* 3n scratch vectors */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
@@ -727,6 +748,8 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__DIFF 1
 #define HEML__ENERGY 2
 #define HEML__STRESS 3
+#define HEML__FORCE_ENERGY 4 /* forces and the elastic energy (static line search) */
+#define HEML__ABS 5          /* sum of |tetrahedron force| per dof (the round-off floor) */
 
 /* A material in kernel form. */
 typedef struct heml__mat {
@@ -745,7 +768,7 @@ struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, colour_count;
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     heml_integrator integrator;
-    heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, static_tolerance;
+    heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
     int cg_max_iterations, newton_iterations, static_max_iterations;
     int parallel;
 
@@ -755,12 +778,12 @@ struct heml_model {
     void *block;
     size_t block_bytes;
 
-    /* nodes */
-    heml_real *rest, *pos, *vel, *force, *ext, *target, *mass, *inv_mass;
+    /* nodes; the state is the displacement u (disp), pos = rest + u is kept for rendering */
+    heml_real *rest, *pos, *disp, *vel, *force, *ext, *target, *mass, *inv_mass;
     heml_real *free_mask, *pin_mask; /* per degree of freedom: 1 free / 1 pinned */
     heml_real *diag;                 /* per degree of freedom: small-strain stiffness diagonal */
-    double force_floor;              /* round-off level of |f|, N (see heml__static_newton) */
-    unsigned char *axes;             /* pinned axes per node */
+    double energy_noise;             /* J: round-off of the energy of user laws (static line search) */
+    unsigned char *axes;             /* pinned axes per node; target: their displacements */
 
     /* tetrahedra, in blocks of HEML__W slots (structure of arrays inside a block) */
     int *blk_idx;         /* 4 W per block: node j of lane k at [4 W b + W j + k] */
@@ -897,54 +920,151 @@ static double heml__rest_constants(const heml_real *p0, const heml_real *p1, con
     return det;
 }
 
+/* x - log(1 + x) for x > -1 without cancellation at small |x| (the energies' volumetric
+   part, in double): the series 2 u^3 (1/3 + u^2/5 + ...) subtracted from u x,
+   u = x / (2 + x), below |x| = 0.1. */
+static double heml__x_minus_log1p(double x)
+{
+    double u, u2, sum = 0.0;
+    int k;
+    if (!(fabs(x) < 0.1)) return x - log1p(x);
+    u = x / (2.0 + x);
+    u2 = u * u;
+    for (k = 8; k >= 0; k--) sum = sum * u2 + 1.0 / (2 * k + 3);
+    return u * x - 2.0 * u * u2 * sum;
+}
+
 /* links of the mass-spring law, as (start, end) lanes: v_e = x_end - x_start (sec. 3.1) */
 static const int heml__link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
 
 /* >>laws ------------------------------------------------------------------------------ */
 
 /* The workspace of one block of HEML__W tetrahedra: every stage of a kernel is a loop
-   over the lanes of these arrays. */
+   over the lanes of these arrays. Everything that vanishes at rest is formed from the
+   displacements without cancellation (see THE MODEL). */
 typedef struct heml__blk {
-    heml_real e[9][HEML__W];  /* links v1, v2, v3: component r of v_(j+1) at [3 j + r] */
-    heml_real c[9][HEML__W];  /* c_1 = v2 x v3, c_2 = v3 x v1, c_3 = v1 x v2 (same layout) */
-    heml_real J[HEML__W], Jc[HEML__W], dJ0[HEML__W]; /* J, max(J, J0), min(J - J0, 0) */
-    heml_real I1[HEML__W], I2[HEML__W];
-    heml_real D[6][HEML__W];   /* D = v^T v: 00 11 22 01 02 12 */
-    heml_real GD[9][HEML__W];  /* G D, row-major */
-    heml_real GDG[6][HEML__W]; /* G D G (symmetric, as D) */
+    heml_real e[9][HEML__W];  /* link displacements du_j = u_j - u_0: component r of j at [3 (j-1) + r] */
+    heml_real H[9][HEML__W];  /* displacement gradient H = F - I = du V^-1, row-major */
+    heml_real K[9][HEML__W];  /* cof F - I = tr H I - H^T + cof H, row-major */
+    heml_real E2[6][HEML__W]; /* C - I = H + H^T + H^T H (twice the Green strain): 00 11 22 01 02 12 */
+    heml_real jm1[HEML__W];   /* J - 1 = tr H + tr cof H + det H */
+    heml_real jc1[HEML__W], Jc[HEML__W], dJ0[HEML__W]; /* Jc - 1, Jc = max(J, J0), min(J - J0, 0) */
+    heml_real I1m3[HEML__W], I2m3[HEML__W]; /* I1 - 3 = tr E2, I2 - 3 = 2 (I1 - 3) + ((I1 - 3)^2 - tr2) / 2 */
+    heml_real tr2[HEML__W];   /* tr (C - I)^2 */
+    heml_real q1[HEML__W];    /* I1 - 3 - 2 (J - 1) = |H|^2 - 2 tr cof H - 2 det H (energies) */
+    heml_real I1[HEML__W], I2[HEML__W]; /* user laws */
     heml_real w[HEML__W], w1[HEML__W], w2[HEML__W], wJ[HEML__W];
-    heml_real h[6][HEML__W];   /* w_11 w_12 w_1J w_22 w_2J w_JJ */
-    heml_real sig[7][HEML__W]; /* Sigma (as D) and gamma; springs: six link tensions */
-    heml_real f[9][HEML__W];   /* forces (or differentials) on nodes 1..3 */
-    heml_real de[9][HEML__W];  /* differential: dv1, dv2, dv3 */
-    heml_real dsig[7][HEML__W];
+    heml_real s0[HEML__W];    /* 2 w_1 + 4 w_2 + w_J, zero at rest, formed without cancellation */
+    heml_real h[6][HEML__W];  /* w_11 w_12 w_1J w_22 w_2J w_JJ */
+    heml_real co[9][HEML__W]; /* stress coefficients c0 a w_J M (heml__coefficients); springs:
+                                 the six link tensions */
+    heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
+    heml_real de[9][HEML__W]; /* differential: the links of dx */
     heml_real len[6][HEML__W]; /* springs: clamped link lengths */
 } heml__blk;
 
-/* J continuation below J0: Jc = max(J, J0) and the (non-positive) distance J - Jc. */
-static void heml__clamp_J(heml_real J0, heml__blk *b)
+/* Kinematics of the block from its link displacements (e) and rest gradients (R): H, cof F - I,
+   J - 1, C - I and the invariants, each a polynomial in H without a constant term (a
+   tetrahedron at rest gives exact zeros, small strains keep their relative precision). */
+static void heml__kinematics(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real J = b->J[k], Jc = heml__max(J, J0);
-        b->Jc[k] = Jc;
-        b->dJ0[k] = J - Jc;
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+        heml_real E00 = 2 * H00 + (H00 * H00 + H10 * H10 + H20 * H20);
+        heml_real E11 = 2 * H11 + (H01 * H01 + H11 * H11 + H21 * H21);
+        heml_real E22 = 2 * H22 + (H02 * H02 + H12 * H12 + H22 * H22);
+        heml_real E01 = H01 + H10 + (H00 * H01 + H10 * H11 + H20 * H21);
+        heml_real E02 = H02 + H20 + (H00 * H02 + H10 * H12 + H20 * H22);
+        heml_real E12 = H12 + H21 + (H01 * H02 + H11 * H12 + H21 * H22);
+        heml_real t = E00 + E11 + E22;
+        heml_real tr2 = E00 * E00 + E11 * E11 + E22 * E22 + 2 * (E01 * E01 + E02 * E02 + E12 * E12);
+        heml_real hh = H00 * H00 + H01 * H01 + H02 * H02 + H10 * H10 + H11 * H11 + H12 * H12 + H20 * H20 +
+                       H21 * H21 + H22 * H22;
+        b->H[0][k] = H00;
+        b->H[1][k] = H01;
+        b->H[2][k] = H02;
+        b->H[3][k] = H10;
+        b->H[4][k] = H11;
+        b->H[5][k] = H12;
+        b->H[6][k] = H20;
+        b->H[7][k] = H21;
+        b->H[8][k] = H22;
+        b->K[0][k] = tr - H00 + c00;
+        b->K[1][k] = c01 - H10;
+        b->K[2][k] = c02 - H20;
+        b->K[3][k] = c10 - H01;
+        b->K[4][k] = tr - H11 + c11;
+        b->K[5][k] = c12 - H21;
+        b->K[6][k] = c20 - H02;
+        b->K[7][k] = c21 - H12;
+        b->K[8][k] = tr - H22 + c22;
+        b->E2[0][k] = E00;
+        b->E2[1][k] = E11;
+        b->E2[2][k] = E22;
+        b->E2[3][k] = E01;
+        b->E2[4][k] = E02;
+        b->E2[5][k] = E12;
+        b->jm1[k] = tr + i2 + det;
+        b->I1m3[k] = t;
+        b->tr2[k] = tr2;
+        b->I2m3[k] = 2 * t + (t * t - tr2) / 2;
+        b->q1[k] = hh - 2 * (i2 + det);
     }
 }
 
-/* K_RAW: w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J,
-   U' = (kappa ln J - p0) / J, U'' = (kappa (1 - ln J) + p0) / J^2, continued below J0
-   by U(J0) + U'(J0) d + U''(J0) d^2 / 2 (d = J - J0): the tangent of the volumetric
-   stress, sec. 4.4. Neo-Hookean eq. 26: c1 = mu/2, c2 = 0, p0 = mu, kappa = lambda. */
+/* J continuation below J0 (jm1_0 = J0 - 1): Jc - 1 = max(J, J0) - 1, Jc, and the
+   (non-positive) distance d = J - Jc. */
+static void heml__clamp_J(heml_real jm1_0, heml__blk *b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real j = b->jm1[k], jc = heml__max(j, jm1_0);
+        b->jc1[k] = jc;
+        b->Jc[k] = 1 + jc;
+        b->dJ0[k] = j - jc;
+    }
+}
+
+/* ln Jc = log1p(Jc - 1), accurate at small strains: the rounding of 1 + (Jc - 1) corrected
+   to first order (iJ = 1 / Jc). */
+HEML__INLINE heml_real heml__log_jc(heml_real Jc, heml_real jc1, heml_real iJ)
+{
+    return heml__log(Jc) + (jc1 - (Jc - 1)) * iJ;
+}
+
+/* K_RAW: w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J (p0 = 2 c1 +
+   4 c2), U' = (kappa ln J - p0) / J, U'' = (kappa (1 - ln J) + p0) / J^2, continued below
+   J0 by U(J0) + U'(J0) d + U''(J0) d^2 / 2 (d = J - J0): the tangent of the volumetric
+   stress, sec. 4.4. Neo-Hookean eq. 26: c1 = mu/2, c2 = 0, p0 = mu, kappa = lambda.
+   s0 = p0 + w_J = (kappa ln Jc + p0 (Jc - 1)) / Jc + U'' d. The energy uses
+   c1 (I1 - 3) - 2 c1 ln J = c1 (q1 + 2 d + 2 (x - log1p x)), x = Jc - 1, and
+   I2 - 3 - 4 ln J = 2 (I1 - 3 - 2 ln J) + ((I1 - 3)^2 - tr2) / 2. */
 static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
 {
     const heml_real c1 = mt->c1, c2 = mt->c2, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real Jc = b->Jc[k], d = b->dJ0[k];
-        heml_real L = heml__log(Jc), iJ = 1 / Jc;
-        heml_real p = (kappa * L - p0) * iJ, hh = (kappa * (1 - L) + p0) * iJ * iJ;
-        b->wJ[k] = p + hh * d;
+        heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], iJ = 1 / Jc;
+        heml_real L = heml__log_jc(Jc, jc1, iJ);
+        heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
+        heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
+        b->s0[k] = s0;
+        b->wJ[k] = s0 - p0;
         b->h[5][k] = hh;
         b->w1[k] = c1;
         b->w2[k] = c2;
@@ -953,70 +1073,88 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
         for (k = 0; k < HEML__W; k++) b->h[0][k] = b->h[1][k] = b->h[2][k] = b->h[3][k] = b->h[4][k] = 0;
     if (want & HEML__WANT_ENERGY)
         for (k = 0; k < HEML__W; k++) {
-            heml_real Jc = b->Jc[k], d = b->dJ0[k], L = heml__log(Jc), iJ = 1 / Jc;
-            heml_real p = (kappa * L - p0) * iJ, hh = (kappa * (1 - L) + p0) * iJ * iJ;
-            b->w[k] = c1 * (b->I1[k] - 3) + c2 * (b->I2[k] - 3) + L * (kappa / 2 * L - p0) +
-                      d * (p + hh / 2 * d);
+            double Jc = (double)b->Jc[k], jc1 = (double)b->jc1[k], d = (double)b->dJ0[k], t = (double)b->I1m3[k];
+            double L = log1p(jc1), up = ((double)kappa * L - (double)p0) / Jc;
+            double hh = ((double)kappa * (1 - L) + (double)p0) / (Jc * Jc);
+            double q = (double)b->q1[k] + 2 * d + 2 * heml__x_minus_log1p(jc1);
+            b->w[k] = (heml_real)((double)c1 * q + (double)c2 * (2 * q + (t * t - (double)b->tr2[k]) / 2) +
+                                  (double)kappa / 2 * L * L + d * (up + hh / 2 * d));
         }
 }
 
 /* K_SPLIT (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
-   (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). */
+   (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
+   2 a + I1 a' = 2/3 a (3 (Jc - 1) - (I1 - 3)) / Jc and 4 b + I2 b' = 4/3 b (3 (Jc - 1) -
+   (I2 - 3)) / Jc, plus the continuation terms in d. */
 static void heml__law_split(const heml__mat *mt, heml__blk *b, int want)
 {
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real Jc = b->Jc[k], d = b->dJ0[k], J = b->J[k], I1 = b->I1[k], I2 = b->I2[k];
+        heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
+        heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], I1 = 3 + I1m3, I2 = 3 + I2m3;
         heml_real t = (heml_real)cbrt((double)Jc), iJ = 1 / Jc;
         heml_real a = 1 / (t * t), bq = a * a;
         heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
         heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
         heml_real at = a + d * (a1 + d / 2 * a2), at1 = a1 + d * a2;
         heml_real bt = bq + d * (b1 + d / 2 * b2), bt1 = b1 + d * b2;
+        heml_real sa = (heml_real)(2.0 / 3.0) * a * iJ * (3 * jc1 - I1m3) + d * (2 * a1 + I1 * a2 + d * a2);
+        heml_real sb = (heml_real)(4.0 / 3.0) * bq * iJ * (3 * jc1 - I2m3) + d * (4 * b1 + I2 * b2 + 2 * d * b2);
         b->w1[k] = c1 * at;
         b->w2[k] = c2 * bt;
-        b->wJ[k] = c1 * I1 * at1 + c2 * I2 * bt1 + kappa * (J - 1);
+        b->wJ[k] = c1 * I1 * at1 + c2 * I2 * bt1 + kappa * jm1;
+        b->s0[k] = c1 * sa + c2 * sb + kappa * jm1;
         b->h[0][k] = b->h[1][k] = b->h[3][k] = 0;
         b->h[2][k] = c1 * at1;
         b->h[4][k] = c2 * bt1;
         b->h[5][k] = c1 * I1 * a2 + c2 * I2 * b2 + kappa;
-        if (want & HEML__WANT_ENERGY)
-            b->w[k] = c1 * (I1 * at - 3) + c2 * (I2 * bt - 3) + kappa / 2 * (J - 1) * (J - 1);
+        if (want & HEML__WANT_ENERGY) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+            double L = log1p((double)jc1), dd = (double)d;
+            double am1 = expm1(-2.0 / 3.0 * L) + dd * ((double)a1 + dd / 2 * (double)a2);
+            double bm1 = expm1(-4.0 / 3.0 * L) + dd * ((double)b1 + dd / 2 * (double)b2);
+            b->w[k] = (heml_real)((double)c1 * (3 * am1 + (double)I1m3 * (1 + am1)) +
+                                  (double)c2 * (3 * bm1 + (double)I2m3 * (1 + bm1)) + (double)kappa / 2 * jm1 * jm1);
+        }
     }
 }
 
-/* K_SVK (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3),
-   w_1 = lambda/4 (I1 - 3) + mu/2 (I1 - 1), w_2 = -mu/2, plus the guard
-   (lambda + 2 mu)/2 d^2 below J0. */
+/* K_SVK (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
+   = lambda/8 (I1 - 3)^2 + mu/4 tr (C - I)^2, w_1 = lambda/4 (I1 - 3) + mu/2 (I1 - 1),
+   w_2 = -mu/2, s0 = (lambda/2 + mu) (I1 - 3) + w_J, plus the guard (lambda + 2 mu)/2 d^2
+   below J0. */
 static void heml__law_svk(const heml__mat *mt, heml__blk *b, int want)
 {
     const heml_real mu = mt->mu, lambda = mt->lambda, guard = mt->guard;
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real I1 = b->I1[k], d = b->dJ0[k];
-        b->w1[k] = lambda / 4 * (I1 - 3) + mu / 2 * (I1 - 1);
+        heml_real t = b->I1m3[k], d = b->dJ0[k];
+        b->w1[k] = lambda / 4 * t + mu / 2 * (t + 2);
         b->w2[k] = -mu / 2;
         b->wJ[k] = guard * d;
+        b->s0[k] = (lambda / 2 + mu) * t + guard * d;
         b->h[0][k] = lambda / 4 + mu / 2;
         b->h[1][k] = b->h[2][k] = b->h[3][k] = b->h[4][k] = 0;
         b->h[5][k] = d < 0 ? guard : 0;
-        if (want & HEML__WANT_ENERGY)
-            b->w[k] = lambda / 8 * (I1 - 3) * (I1 - 3) +
-                      mu / 4 * (I1 * I1 - 2 * I1 - 2 * b->I2[k] + 3) + guard / 2 * d * d;
+        if (want & HEML__WANT_ENERGY) b->w[k] = lambda / 8 * t * t + mu / 4 * b->tr2[k] + guard / 2 * d * d;
     }
 }
 
 /* K_USER: the callbacks at (I1, I2, Jc) for the `valid` lanes (padding lanes get zeros),
    continued below J0 to first order in J: w += w_J d + w_JJ d^2 / 2, w_1 += w_1J d,
    w_2 += w_2J d, w_J += w_JJ d (second derivatives held at J0); without `second`, w_J is
-   held at its J0 value. */
+   held at its J0 value. s0 = 2 w_1 + 4 w_2 + w_J is formed from the callbacks' values, so
+   the rest state cancels only to their round-off. */
 static void heml__law_user(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
     heml_law_points p;
     int k, below = 0, second = mt->user.second != NULL;
-    for (k = 0; k < HEML__W; k++) below |= b->dJ0[k] < 0;
+    for (k = 0; k < HEML__W; k++) {
+        below |= b->dJ0[k] < 0;
+        b->I1[k] = 3 + b->I1m3[k];
+        b->I2[k] = 3 + b->I2m3[k];
+    }
     p.count = valid;
     p.I1 = b->I1;
     p.I2 = b->I2;
@@ -1054,6 +1192,7 @@ static void heml__law_user(const heml__mat *mt, heml__blk *b, int valid, int wan
         b->w[k] = b->w1[k] = b->w2[k] = b->wJ[k] = 0;
         for (r = 0; r < 6; r++) b->h[r][k] = 0;
     }
+    for (k = 0; k < HEML__W; k++) b->s0[k] = 2 * b->w1[k] + 4 * b->w2[k] + b->wJ[k];
 }
 
 static void heml__law(const heml__mat *mt, heml__blk *b, int valid, int want)
@@ -1066,24 +1205,19 @@ static void heml__law(const heml__mat *mt, heml__blk *b, int valid, int want)
     }
 }
 
-/* Evaluates a law at one point in double-free form for creation checks: fills w_1, w_2,
-   w_J and the second derivatives (h) at (I1, I2, J), lane 0 of a workspace. */
-static void heml__law_point(const heml__mat *mt, heml_real J0, heml_real I1, heml_real I2,
-                            heml_real J, heml__blk *b, int want)
+/* Evaluates a law at rest (I1 = I2 = 3, J = 1) for creation checks: fills w_1, w_2, w_J,
+   s0 and the second derivatives (h) in lane 0 of a workspace. */
+static void heml__law_at_rest(const heml__mat *mt, heml_real jm1_0, heml__blk *b)
 {
     int k;
-    for (k = 0; k < HEML__W; k++) {
-        b->I1[k] = I1;
-        b->I2[k] = I2;
-        b->J[k] = J;
-    }
-    heml__clamp_J(J0, b);
-    heml__law(mt, b, 1, want | HEML__WANT_SECOND);
+    for (k = 0; k < HEML__W; k++) b->I1m3[k] = b->I2m3[k] = b->tr2[k] = b->q1[k] = b->jm1[k] = 0;
+    heml__clamp_J(jm1_0, b);
+    heml__law(mt, b, 1, HEML__WANT_SECOND);
 }
 
 /* >>forces ---------------------------------------------------------------------------- */
 
-/* Links v1, v2, v3 of the block's lanes from node positions x (or any 3n field). */
+/* Links du_1, du_2, du_3 of the block's lanes from a 3n field (displacements or dx). */
 HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
                                          heml_real (*HEML__RESTRICT e)[HEML__W])
 {
@@ -1120,103 +1254,45 @@ static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTR
     }
 }
 
-/* c_j (6 dVol/dx_j, eq. C.4) and J = det v / det V. */
-static void heml__cofactors(const heml_real *HEML__RESTRICT R, heml__blk *b)
-{
-    const heml_real *inv_det = R + 7 * HEML__W;
-    int k;
-    for (k = 0; k < HEML__W; k++) {
-        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
-        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
-        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
-        heml_real c0 = b1 * d2 - b2 * d1, c1 = b2 * d0 - b0 * d2, c2 = b0 * d1 - b1 * d0;
-        b->c[0][k] = c0;
-        b->c[1][k] = c1;
-        b->c[2][k] = c2;
-        b->c[3][k] = d1 * a2 - d2 * a1;
-        b->c[4][k] = d2 * a0 - d0 * a2;
-        b->c[5][k] = d0 * a1 - d1 * a0;
-        b->c[6][k] = a1 * b2 - a2 * b1;
-        b->c[7][k] = a2 * b0 - a0 * b2;
-        b->c[8][k] = a0 * b1 - a1 * b0;
-        b->J[k] = (a0 * c0 + a1 * c1 + a2 * c2) * inv_det[k];
-    }
-}
-
-/* D = v^T v (eq. A.4), I1 = G : D and, when uses_i2, G D, G D G and
-   I2 = (I1^2 - tr(G D G D)) / 2 (eq. C.1 without the 6x6 Mtr); I2 = 0 otherwise. */
-static void heml__invariants(const heml_real *HEML__RESTRICT R, heml__blk *b, int uses_i2)
-{
-    int k;
-    for (k = 0; k < HEML__W; k++) {
-        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
-        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
-        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
-        heml_real D00 = a0 * a0 + a1 * a1 + a2 * a2, D11 = b0 * b0 + b1 * b1 + b2 * b2;
-        heml_real D22 = d0 * d0 + d1 * d1 + d2 * d2, D01 = a0 * b0 + a1 * b1 + a2 * b2;
-        heml_real D02 = a0 * d0 + a1 * d1 + a2 * d2, D12 = b0 * d0 + b1 * d1 + b2 * d2;
-        b->D[0][k] = D00;
-        b->D[1][k] = D11;
-        b->D[2][k] = D22;
-        b->D[3][k] = D01;
-        b->D[4][k] = D02;
-        b->D[5][k] = D12;
-        b->I1[k] = R[k] * D00 + R[HEML__W + k] * D11 + R[2 * HEML__W + k] * D22 +
-                   2 * (R[3 * HEML__W + k] * D01 + R[4 * HEML__W + k] * D02 + R[5 * HEML__W + k] * D12);
-        b->I2[k] = 0;
-    }
-    if (!uses_i2) { /* zeros, so that the differential needs no branch */
-        int r;
-        for (r = 0; r < 6; r++)
-            for (k = 0; k < HEML__W; k++) b->GDG[r][k] = 0;
-        return;
-    }
-    for (k = 0; k < HEML__W; k++) {
-        heml_real g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
-        heml_real g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
-        heml_real d00 = b->D[0][k], d11 = b->D[1][k], d22 = b->D[2][k];
-        heml_real d01 = b->D[3][k], d02 = b->D[4][k], d12 = b->D[5][k];
-        heml_real m00 = g00 * d00 + g01 * d01 + g02 * d02, m01 = g00 * d01 + g01 * d11 + g02 * d12;
-        heml_real m02 = g00 * d02 + g01 * d12 + g02 * d22, m10 = g01 * d00 + g11 * d01 + g12 * d02;
-        heml_real m11 = g01 * d01 + g11 * d11 + g12 * d12, m12 = g01 * d02 + g11 * d12 + g12 * d22;
-        heml_real m20 = g02 * d00 + g12 * d01 + g22 * d02, m21 = g02 * d01 + g12 * d11 + g22 * d12;
-        heml_real m22 = g02 * d02 + g12 * d12 + g22 * d22;
-        heml_real tr2 = m00 * m00 + m11 * m11 + m22 * m22 + 2 * (m01 * m10 + m02 * m20 + m12 * m21);
-        heml_real I1 = b->I1[k];
-        b->GD[0][k] = m00;
-        b->GD[1][k] = m01;
-        b->GD[2][k] = m02;
-        b->GD[3][k] = m10;
-        b->GD[4][k] = m11;
-        b->GD[5][k] = m12;
-        b->GD[6][k] = m20;
-        b->GD[7][k] = m21;
-        b->GD[8][k] = m22;
-        b->GDG[0][k] = m00 * g00 + m01 * g01 + m02 * g02;
-        b->GDG[1][k] = m10 * g01 + m11 * g11 + m12 * g12;
-        b->GDG[2][k] = m20 * g02 + m21 * g12 + m22 * g22;
-        b->GDG[3][k] = m00 * g01 + m01 * g11 + m02 * g12;
-        b->GDG[4][k] = m00 * g02 + m01 * g12 + m02 * g22;
-        b->GDG[5][k] = m10 * g02 + m11 * g12 + m12 * g22;
-        b->I2[k] = (I1 * I1 - tr2) / 2;
-    }
-}
-
-/* Sigma = 2 Vol [(w_1 + I1 w_2) G - w_2 G D G], gamma = w_J / 6 (eqs. 29-30 in edge form). */
-static void heml__sigma(const heml_real *HEML__RESTRICT R, heml__blk *b, int uses_i2)
+/* The same with absolute values (the size of the terms each node's force sums). */
+static void heml__scatter_abs(const int *idx, heml_real (*f)[HEML__W], heml_real *out)
 {
     int k, r;
     for (k = 0; k < HEML__W; k++) {
-        heml_real v2 = 2 * R[6 * HEML__W + k];
-        heml_real s = v2 * (b->w1[k] + b->I1[k] * b->w2[k]), t = v2 * b->w2[k];
-        for (r = 0; r < 6; r++) b->sig[r][k] = s * R[r * HEML__W + k] - (uses_i2 ? t * b->GDG[r][k] : 0);
-        b->sig[6][k] = b->wJ[k] * HEML__SIXTH;
+        heml_real *o0 = out + 3 * idx[k], *o1 = out + 3 * idx[HEML__W + k];
+        heml_real *o2 = out + 3 * idx[2 * HEML__W + k], *o3 = out + 3 * idx[3 * HEML__W + k];
+        for (r = 0; r < 3; r++) {
+            heml_real a = f[r][k], b = f[3 + r][k], c = f[6 + r][k];
+            o1[r] += (heml_real)fabs((double)a);
+            o2[r] += (heml_real)fabs((double)b);
+            o3[r] += (heml_real)fabs((double)c);
+            o0[r] += (heml_real)fabs((double)((a + b) + c));
+        }
     }
 }
 
+/* Stress coefficients of P = c0 I + 2 a H + w_J K - F M (K = cof F - I), the first
+   Piola-Kirchhoff stress of w(I1, I2, J) written so that no term survives at rest:
+       P = 2 w_1 F + 2 w_2 (I1 F - F C) + w_J cof F = 2 a F - F M + w_J cof F,
+       a = w_1 + (I1 - 1) w_2,  M = 2 w_2 (C - I),  c0 = 2 a + w_J = s0 + 2 w_2 (I1 - 3).
+   In the paper's terms the second Piola-Kirchhoff stress is S = 2 a I - M + w_J J C^-1 and
+   the link tensions Sigma = Vol V^-1 S V^-T (eqs. 29-30). */
+static void heml__coefficients(heml__blk *b, int uses_i2)
+{
+    int k, r;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real w2 = b->w2[k], t = b->I1m3[k];
+        b->co[0][k] = b->s0[k] + 2 * w2 * t;
+        b->co[1][k] = b->w1[k] + (2 + t) * w2;
+        b->co[2][k] = b->wJ[k];
+    }
+    for (r = 0; r < 6; r++)
+        for (k = 0; k < HEML__W; k++) b->co[3 + r][k] = uses_i2 ? 2 * b->w2[k] * b->E2[r][k] : 0;
+}
+
 /* Prony (eq. 20) on the block's `comps` stress components: the force uses
-   s Sigma - sum_i b_i Q_i (s = 1 - sum_i a_i) and, when `write`, the new state
-   a_i Sigma + b_i Q_i goes to the next buffer. */
+   s X - sum_i b_i Q_i (s = 1 - sum_i a_i) and, when `write`, the new state
+   a_i X + b_i Q_i goes to the next buffer. */
 static void heml__prony(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int comps,
                         int write)
 {
@@ -1227,13 +1303,13 @@ static void heml__prony(const heml_model *m, const heml__mat *mt, int blk, heml_
     for (r = 0; r < comps; r++) {
         heml_real raw[HEML__W];
         for (k = 0; k < HEML__W; k++) {
-            raw[k] = b->sig[r][k];
-            b->sig[r][k] = s * raw[k];
+            raw[k] = b->co[r][k];
+            b->co[r][k] = s * raw[k];
         }
         for (i = 0; i < mt->prony_count; i++) {
             heml_real a = m->prony_a[mt->prony_first + i], bb = m->prony_b[mt->prony_first + i];
             const heml_real *qi = q + (size_t)(i * HEML__NQ + r) * HEML__W;
-            for (k = 0; k < HEML__W; k++) b->sig[r][k] -= bb * qi[k];
+            for (k = 0; k < HEML__W; k++) b->co[r][k] -= bb * qi[k];
             if (write) {
                 heml_real *qni = qn + (size_t)(i * HEML__NQ + r) * HEML__W;
                 for (k = 0; k < HEML__W; k++) qni[k] = a * raw[k] + bb * qi[k];
@@ -1242,157 +1318,196 @@ static void heml__prony(const heml_model *m, const heml__mat *mt, int blk, heml_
     }
 }
 
-/* f_k = -(sum_j Sigma_jk v_j + gamma c_k), k = 1..3. */
-static void heml__link_forces(heml__blk *b)
+/* f_k = -Vol P grad N_k (k = 1..3), P = c0 I + 2 a H + w_J K - M - H M. */
+static void heml__pk1_forces(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
-    int k, r;
+    int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real s00 = b->sig[0][k], s11 = b->sig[1][k], s22 = b->sig[2][k];
-        heml_real s01 = b->sig[3][k], s02 = b->sig[4][k], s12 = b->sig[5][k], g = b->sig[6][k];
-        for (r = 0; r < 3; r++) {
-            heml_real a = b->e[r][k], bb = b->e[3 + r][k], d = b->e[6 + r][k];
-            b->f[r][k] = -(s00 * a + s01 * bb + s02 * d + g * b->c[r][k]);
-            b->f[3 + r][k] = -(s01 * a + s11 * bb + s12 * d + g * b->c[3 + r][k]);
-            b->f[6 + r][k] = -(s02 * a + s12 * bb + s22 * d + g * b->c[6 + r][k]);
-        }
+        heml_real vol = R[9 * HEML__W + k];
+        heml_real c0 = vol * b->co[0][k], a2 = 2 * vol * b->co[1][k], wj = vol * b->co[2][k];
+        heml_real M00 = vol * b->co[3][k], M11 = vol * b->co[4][k], M22 = vol * b->co[5][k];
+        heml_real M01 = vol * b->co[6][k], M02 = vol * b->co[7][k], M12 = vol * b->co[8][k];
+        heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
+        heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
+        heml_real H20 = b->H[6][k], H21 = b->H[7][k], H22 = b->H[8][k];
+        heml_real P00 = c0 + a2 * H00 + wj * b->K[0][k] - M00 - (H00 * M00 + H01 * M01 + H02 * M02);
+        heml_real P01 = a2 * H01 + wj * b->K[1][k] - M01 - (H00 * M01 + H01 * M11 + H02 * M12);
+        heml_real P02 = a2 * H02 + wj * b->K[2][k] - M02 - (H00 * M02 + H01 * M12 + H02 * M22);
+        heml_real P10 = a2 * H10 + wj * b->K[3][k] - M01 - (H10 * M00 + H11 * M01 + H12 * M02);
+        heml_real P11 = c0 + a2 * H11 + wj * b->K[4][k] - M11 - (H10 * M01 + H11 * M11 + H12 * M12);
+        heml_real P12 = a2 * H12 + wj * b->K[5][k] - M12 - (H10 * M02 + H11 * M12 + H12 * M22);
+        heml_real P20 = a2 * H20 + wj * b->K[6][k] - M02 - (H20 * M00 + H21 * M01 + H22 * M02);
+        heml_real P21 = a2 * H21 + wj * b->K[7][k] - M12 - (H20 * M01 + H21 * M11 + H22 * M12);
+        heml_real P22 = c0 + a2 * H22 + wj * b->K[8][k] - M22 - (H20 * M02 + H21 * M12 + H22 * M22);
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
+        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
+        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
+        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
+        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
+        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
+        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
+        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
+        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
     }
 }
 
-/* The fast path of K_RAW without I2 (Neo-Hookean): Sigma = 2 Vol c1 G needs no D. */
-static void heml__sigma_nh(const heml__mat *mt, const heml_real *HEML__RESTRICT R, heml__blk *b)
-{
-    const heml_real c1 = 2 * mt->c1;
-    int k, r;
-    for (k = 0; k < HEML__W; k++) {
-        heml_real s = c1 * R[6 * HEML__W + k];
-        for (r = 0; r < 6; r++) b->sig[r][k] = s * R[r * HEML__W + k];
-        b->sig[6][k] = b->wJ[k] * HEML__SIXTH;
-    }
-}
-
-/* Mass-spring (sec. 5.3): link lengths and tensions t = k (l - L) / l (eq. 35), into
-   len and sig[0..5]; with `energy`, w (per lane, J) = sum k/2 (l - L)^2. Lengths are
-   clamped at 1e-12 L so coincident nodes give finite forces. */
+/* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
+   l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
+   t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
+   `energy`, w (per lane, J) = sum k/2 (l - L)^2. Lengths are clamped at 1e-12 L so
+   coincident nodes give finite forces. v (18 values per lane) receives the links
+   V + du of the six springs. */
 static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *b, int energy)
 {
     int k, l;
     for (k = 0; k < HEML__W; k++) {
-        heml_real v[6][3], we = 0;
+        heml_real du[6][3], V[6][3];
+        double we = 0.0;
         int r;
         for (r = 0; r < 3; r++) {
-            v[0][r] = b->e[r][k];
-            v[1][r] = b->e[3 + r][k];
-            v[2][r] = b->e[6 + r][k];
-            v[3][r] = v[1][r] - v[0][r];
-            v[4][r] = v[2][r] - v[1][r];
-            v[5][r] = v[0][r] - v[2][r];
+            du[0][r] = b->e[r][k];
+            du[1][r] = b->e[3 + r][k];
+            du[2][r] = b->e[6 + r][k];
+            du[3][r] = du[1][r] - du[0][r];
+            du[4][r] = du[2][r] - du[1][r];
+            du[5][r] = du[0][r] - du[2][r];
+            V[0][r] = S[(12 + r) * HEML__W + k];
+            V[1][r] = S[(15 + r) * HEML__W + k];
+            V[2][r] = S[(18 + r) * HEML__W + k];
+            V[3][r] = V[1][r] - V[0][r];
+            V[4][r] = V[2][r] - V[1][r];
+            V[5][r] = V[0][r] - V[2][r];
         }
         for (l = 0; l < 6; l++) {
             heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k];
-            heml_real len = (heml_real)sqrt((double)(v[l][0] * v[l][0] + v[l][1] * v[l][1] + v[l][2] * v[l][2]));
-            heml_real lc = heml__max(len, (heml_real)1e-12 * L);
+            heml_real dl2 = 2 * (V[l][0] * du[l][0] + V[l][1] * du[l][1] + V[l][2] * du[l][2]) +
+                            (du[l][0] * du[l][0] + du[l][1] * du[l][1] + du[l][2] * du[l][2]);
+            heml_real len = (heml_real)sqrt((double)heml__max(L * L + dl2, 0));
+            heml_real lc = heml__max(len, (heml_real)1e-12 * L), ext = dl2 / (lc + L); /* l - L */
             b->len[l][k] = lc;
-            b->sig[l][k] = kk * (lc - L) / lc;
-            we += kk / 2 * (len - L) * (len - L);
+            b->co[l][k] = kk * ext / lc;
+            if (energy) {
+                double e = (double)dl2 / ((double)len + (double)L);
+                we += (double)kk / 2 * e * e;
+            }
         }
-        if (energy) b->w[k] = we;
+        if (energy) b->w[k] = (heml_real)we;
     }
 }
 
-/* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end. */
-static void heml__spring_forces(heml__blk *b, heml_real (*HEML__RESTRICT t)[HEML__W],
-                                heml_real (*HEML__RESTRICT v)[HEML__W],
-                                heml_real (*HEML__RESTRICT dt)[HEML__W],
-                                heml_real (*HEML__RESTRICT dv)[HEML__W])
+/* The six spring links v_e = V_e + du_e of lane k into v. */
+static void heml__spring_links(const heml_real *S, const heml__blk *b, int k, heml_real v[6][3])
 {
-    /* f1 = -t1 v1 + t4 v4 - t6 v6, f2 = -t2 v2 - t4 v4 + t5 v5, f3 = -t3 v3 - t5 v5 + t6 v6,
-       with v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3. With dt/dv (differential) each term
-       t v becomes t dv + dt v. */
-    int k, r;
-    for (k = 0; k < HEML__W; k++)
+    int r;
+    for (r = 0; r < 3; r++) {
+        v[0][r] = S[(12 + r) * HEML__W + k] + b->e[r][k];
+        v[1][r] = S[(15 + r) * HEML__W + k] + b->e[3 + r][k];
+        v[2][r] = S[(18 + r) * HEML__W + k] + b->e[6 + r][k];
+    }
+    for (r = 0; r < 3; r++) {
+        v[3][r] = (S[(15 + r) * HEML__W + k] - S[(12 + r) * HEML__W + k]) + (b->e[3 + r][k] - b->e[r][k]);
+        v[4][r] = (S[(18 + r) * HEML__W + k] - S[(15 + r) * HEML__W + k]) + (b->e[6 + r][k] - b->e[3 + r][k]);
+        v[5][r] = (S[(12 + r) * HEML__W + k] - S[(18 + r) * HEML__W + k]) + (b->e[r][k] - b->e[6 + r][k]);
+    }
+}
+
+/* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
+   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3). With dt (differential) each term t v becomes
+   t dv + dt v, dv the links of de. */
+static void heml__spring_forces(const heml_real *S, heml__blk *b, heml_real (*HEML__RESTRICT t)[HEML__W],
+                                heml_real (*HEML__RESTRICT dt)[HEML__W])
+{
+    int k, r, l;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real v[6][3], p[6][3];
+        heml__spring_links(S, b, k, v);
         for (r = 0; r < 3; r++) {
-            heml_real v1 = v[r][k], v2 = v[3 + r][k], v3 = v[6 + r][k];
-            heml_real v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3;
-            heml_real p1, p2, p3, p4, p5, p6;
             if (dt) {
-                heml_real d1 = dv[r][k], d2 = dv[3 + r][k], d3 = dv[6 + r][k];
-                p1 = t[0][k] * d1 + dt[0][k] * v1;
-                p2 = t[1][k] * d2 + dt[1][k] * v2;
-                p3 = t[2][k] * d3 + dt[2][k] * v3;
-                p4 = t[3][k] * (d2 - d1) + dt[3][k] * v4;
-                p5 = t[4][k] * (d3 - d2) + dt[4][k] * v5;
-                p6 = t[5][k] * (d1 - d3) + dt[5][k] * v6;
+                heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
+                heml_real dv[6];
+                dv[0] = d1;
+                dv[1] = d2;
+                dv[2] = d3;
+                dv[3] = d2 - d1;
+                dv[4] = d3 - d2;
+                dv[5] = d1 - d3;
+                for (l = 0; l < 6; l++) p[l][r] = t[l][k] * dv[l] + dt[l][k] * v[l][r];
             } else {
-                p1 = t[0][k] * v1;
-                p2 = t[1][k] * v2;
-                p3 = t[2][k] * v3;
-                p4 = t[3][k] * v4;
-                p5 = t[4][k] * v5;
-                p6 = t[5][k] * v6;
+                for (l = 0; l < 6; l++) p[l][r] = t[l][k] * v[l][r];
             }
-            b->f[r][k] = -p1 + p4 - p6;
-            b->f[3 + r][k] = -p2 - p4 + p5;
-            b->f[6 + r][k] = -p3 - p5 + p6;
+            b->f[r][k] = -p[0][r] + p[3][r] - p[5][r];
+            b->f[3 + r][k] = -p[1][r] - p[3][r] + p[4][r];
+            b->f[6 + r][k] = -p[2][r] - p[4][r] + p[5][r];
         }
+    }
 }
 
 /* The Neo-Hookean kernel (K_RAW without I2 and without Prony) in one loop, so that the
-   intermediate quantities stay in registers: c_j, J, the volumetric stress
-   gamma = U'(J) / 6 (continued below J0), Sigma = 2 Vol c1 G and the forces. The same
-   arithmetic as heml__cofactors, heml__law_raw, heml__sigma_nh and heml__link_forces. */
-static void heml__forces_nh(const heml__mat *mt, heml_real J0, const heml_real *HEML__RESTRICT R,
-                            heml__blk *b)
+   intermediate quantities stay in registers: H, cof H, J - 1, the volumetric stress
+   w_J = U'(J) (continued below J0), s0 = p0 + w_J and
+       P = s0 I + 2 c1 H + w_J (tr H I - H^T + cof H),   f_k = -Vol P grad N_k.
+   The same arithmetic as heml__kinematics, heml__law_raw, heml__coefficients and
+   heml__pk1_forces. */
+static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                            heml__blk *HEML__RESTRICT b)
 {
-    const heml_real c1 = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
         heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
         heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
-        heml_real c[9], J, Jc, d, L, iJ, g, s;
-        heml_real s00, s11, s22, s01, s02, s12;
-        c[0] = b1 * d2 - b2 * d1;
-        c[1] = b2 * d0 - b0 * d2;
-        c[2] = b0 * d1 - b1 * d0;
-        c[3] = d1 * a2 - d2 * a1;
-        c[4] = d2 * a0 - d0 * a2;
-        c[5] = d0 * a1 - d1 * a0;
-        c[6] = a1 * b2 - a2 * b1;
-        c[7] = a2 * b0 - a0 * b2;
-        c[8] = a0 * b1 - a1 * b0;
-        J = (a0 * c[0] + a1 * c[1] + a2 * c[2]) * R[7 * HEML__W + k];
-        Jc = heml__max(J, J0);
-        d = J - Jc;
-        L = heml__log(Jc);
-        iJ = 1 / Jc;
-        g = ((kappa * L - p0) * iJ + (kappa * (1 - L) + p0) * iJ * iJ * d) * HEML__SIXTH;
-        s = c1 * R[6 * HEML__W + k];
-        s00 = s * R[k];
-        s11 = s * R[HEML__W + k];
-        s22 = s * R[2 * HEML__W + k];
-        s01 = s * R[3 * HEML__W + k];
-        s02 = s * R[4 * HEML__W + k];
-        s12 = s * R[5 * HEML__W + k];
-        b->J[k] = J;
-        /* f_k = -(sum_j Sigma_jk v_j + gamma c_k), written out (an inner loop would keep
-           gcc -O2 from vectorising the lane loop) */
-        b->f[0][k] = -(s00 * a0 + s01 * b0 + s02 * d0 + g * c[0]);
-        b->f[1][k] = -(s00 * a1 + s01 * b1 + s02 * d1 + g * c[1]);
-        b->f[2][k] = -(s00 * a2 + s01 * b2 + s02 * d2 + g * c[2]);
-        b->f[3][k] = -(s01 * a0 + s11 * b0 + s12 * d0 + g * c[3]);
-        b->f[4][k] = -(s01 * a1 + s11 * b1 + s12 * d1 + g * c[4]);
-        b->f[5][k] = -(s01 * a2 + s11 * b2 + s12 * d2 + g * c[5]);
-        b->f[6][k] = -(s02 * a0 + s12 * b0 + s22 * d0 + g * c[6]);
-        b->f[7][k] = -(s02 * a1 + s12 * b1 + s22 * d1 + g * c[7]);
-        b->f[8][k] = -(s02 * a2 + s12 * b2 + s22 * d2 + g * c[8]);
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22;
+        heml_real jm1 = tr + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
+        heml_real jc1 = heml__max(jm1, jm1_0), Jc = 1 + jc1, d = jm1 - jc1, iJ = 1 / Jc;
+        heml_real L = heml__log_jc(Jc, jc1, iJ);
+        heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
+        heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
+        heml_real sv = s0 * vol, mv = mu * vol, wv = (s0 - p0) * vol, tw = wv * tr;
+        heml_real P00 = sv + mv * H00 + wv * (c00 - H00) + tw, P11 = sv + mv * H11 + wv * (c11 - H11) + tw;
+        heml_real P22 = sv + mv * H22 + wv * (c22 - H22) + tw;
+        heml_real P01 = mv * H01 + wv * (c01 - H10), P02 = mv * H02 + wv * (c02 - H20);
+        heml_real P10 = mv * H10 + wv * (c10 - H01), P12 = mv * H12 + wv * (c12 - H21);
+        heml_real P20 = mv * H20 + wv * (c20 - H02), P21 = mv * H21 + wv * (c21 - H12);
+        b->jm1[k] = jm1;
+        /* written out (an inner loop would keep gcc -O2 from vectorising the lane loop) */
+        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
+        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
+        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
+        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
+        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
+        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
+        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
+        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
+        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
     }
 }
 
-/* The Neo-Hookean force differential in one loop (see heml__block_diff for the
-   formulas; here dSigma = 0 and dgamma = U''(J) dJ / 6). */
-static void heml__diff_nh(const heml__mat *mt, heml_real J0, const heml_real *HEML__RESTRICT R, heml__blk *b)
+/* The Neo-Hookean force differential in one loop: with F = I + H, dH = dv V^-1,
+   dJ = cof F : dH,
+       dP = 2 c1 dH + U''(J) dJ cof F + w_J dcof F,   df_k = -Vol dP grad N_k,
+   dcof F the derivative of the cofactors (column j of cof F is the cross product of the
+   other two columns of F). Positions enter only through F, so no rest cancellation
+   matters here. */
+static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                          heml__blk *HEML__RESTRICT b)
 {
-    const heml_real c1 = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
@@ -1401,205 +1516,230 @@ static void heml__diff_nh(const heml__mat *mt, heml_real J0, const heml_real *HE
         heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
         heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
         heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
-        heml_real c[9], dc[9], J, Jc, d, L, iJ, hh, g, dg, s, dJ;
-        heml_real s00, s11, s22, s01, s02, s12;
-        c[0] = b1 * d2 - b2 * d1;
-        c[1] = b2 * d0 - b0 * d2;
-        c[2] = b0 * d1 - b1 * d0;
-        c[3] = d1 * a2 - d2 * a1;
-        c[4] = d2 * a0 - d0 * a2;
-        c[5] = d0 * a1 - d1 * a0;
-        c[6] = a1 * b2 - a2 * b1;
-        c[7] = a2 * b0 - a0 * b2;
-        c[8] = a0 * b1 - a1 * b0;
-        dc[0] = y1 * d2 - y2 * d1 + b1 * z2 - b2 * z1;
-        dc[1] = y2 * d0 - y0 * d2 + b2 * z0 - b0 * z2;
-        dc[2] = y0 * d1 - y1 * d0 + b0 * z1 - b1 * z0;
-        dc[3] = z1 * a2 - z2 * a1 + d1 * x2 - d2 * x1;
-        dc[4] = z2 * a0 - z0 * a2 + d2 * x0 - d0 * x2;
-        dc[5] = z0 * a1 - z1 * a0 + d0 * x1 - d1 * x0;
-        dc[6] = x1 * b2 - x2 * b1 + a1 * y2 - a2 * y1;
-        dc[7] = x2 * b0 - x0 * b2 + a2 * y0 - a0 * y2;
-        dc[8] = x0 * b1 - x1 * b0 + a0 * y1 - a1 * y0;
-        J = (a0 * c[0] + a1 * c[1] + a2 * c[2]) * R[7 * HEML__W + k];
-        dJ = (x0 * c[0] + x1 * c[1] + x2 * c[2] + y0 * c[3] + y1 * c[4] + y2 * c[5] + z0 * c[6] + z1 * c[7] +
-              z2 * c[8]) * R[7 * HEML__W + k];
-        Jc = heml__max(J, J0);
-        d = J - Jc;
-        L = heml__log(Jc);
-        iJ = 1 / Jc;
-        hh = (kappa * (1 - L) + p0) * iJ * iJ;
-        g = ((kappa * L - p0) * iJ + hh * d) * HEML__SIXTH;
-        dg = hh * dJ * HEML__SIXTH;
-        s = c1 * R[6 * HEML__W + k];
-        s00 = s * R[k];
-        s11 = s * R[HEML__W + k];
-        s22 = s * R[2 * HEML__W + k];
-        s01 = s * R[3 * HEML__W + k];
-        s02 = s * R[4 * HEML__W + k];
-        s12 = s * R[5 * HEML__W + k];
-        b->f[0][k] = -(s00 * x0 + s01 * y0 + s02 * z0 + dg * c[0] + g * dc[0]);
-        b->f[1][k] = -(s00 * x1 + s01 * y1 + s02 * z1 + dg * c[1] + g * dc[1]);
-        b->f[2][k] = -(s00 * x2 + s01 * y2 + s02 * z2 + dg * c[2] + g * dc[2]);
-        b->f[3][k] = -(s01 * x0 + s11 * y0 + s12 * z0 + dg * c[3] + g * dc[3]);
-        b->f[4][k] = -(s01 * x1 + s11 * y1 + s12 * z1 + dg * c[4] + g * dc[4]);
-        b->f[5][k] = -(s01 * x2 + s11 * y2 + s12 * z2 + dg * c[5] + g * dc[5]);
-        b->f[6][k] = -(s02 * x0 + s12 * y0 + s22 * z0 + dg * c[6] + g * dc[6]);
-        b->f[7][k] = -(s02 * x1 + s12 * y1 + s22 * z1 + dg * c[7] + g * dc[7]);
-        b->f[8][k] = -(s02 * x2 + s12 * y2 + s22 * z2 + dg * c[8] + g * dc[8]);
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k];
+        heml_real F00 = 1 + (a0 * g10 + b0 * g20 + d0 * g30), F01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real F02 = a0 * g12 + b0 * g22 + d0 * g32, F10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real F11 = 1 + (a1 * g11 + b1 * g21 + d1 * g31), F12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real F20 = a2 * g10 + b2 * g20 + d2 * g30, F21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real F22 = 1 + (a2 * g12 + b2 * g22 + d2 * g32);
+        heml_real D00 = x0 * g10 + y0 * g20 + z0 * g30, D01 = x0 * g11 + y0 * g21 + z0 * g31;
+        heml_real D02 = x0 * g12 + y0 * g22 + z0 * g32, D10 = x1 * g10 + y1 * g20 + z1 * g30;
+        heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
+        heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
+        heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32;
+        heml_real C00 = F11 * F22 - F12 * F21, C01 = F12 * F20 - F10 * F22, C02 = F10 * F21 - F11 * F20;
+        heml_real C10 = F02 * F21 - F01 * F22, C11 = F00 * F22 - F02 * F20, C12 = F01 * F20 - F00 * F21;
+        heml_real C20 = F01 * F12 - F02 * F11, C21 = F02 * F10 - F00 * F12, C22 = F00 * F11 - F01 * F10;
+        heml_real dC00 = D11 * F22 + F11 * D22 - D12 * F21 - F12 * D21;
+        heml_real dC01 = D12 * F20 + F12 * D20 - D10 * F22 - F10 * D22;
+        heml_real dC02 = D10 * F21 + F10 * D21 - D11 * F20 - F11 * D20;
+        heml_real dC10 = D02 * F21 + F02 * D21 - D01 * F22 - F01 * D22;
+        heml_real dC11 = D00 * F22 + F00 * D22 - D02 * F20 - F02 * D20;
+        heml_real dC12 = D01 * F20 + F01 * D20 - D00 * F21 - F00 * D21;
+        heml_real dC20 = D01 * F12 + F01 * D12 - D02 * F11 - F02 * D11;
+        heml_real dC21 = D02 * F10 + F02 * D10 - D00 * F12 - F00 * D12;
+        heml_real dC22 = D00 * F11 + F00 * D11 - D01 * F10 - F01 * D10;
+        heml_real J = F00 * C00 + F01 * C01 + F02 * C02;
+        heml_real jc1 = heml__max(J - 1, jm1_0), Jc = 1 + jc1, d = (J - 1) - jc1, iJ = 1 / Jc;
+        heml_real L = heml__log(Jc);
+        heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
+        heml_real wv = ((kappa * L - p0) * iJ + hh * d) * vol, mv = mu * vol;
+        heml_real dJ = C00 * D00 + C01 * D01 + C02 * D02 + C10 * D10 + C11 * D11 + C12 * D12 + C20 * D20 +
+                       C21 * D21 + C22 * D22;
+        heml_real hv = hh * dJ * vol;
+        heml_real P00 = mv * D00 + hv * C00 + wv * dC00, P01 = mv * D01 + hv * C01 + wv * dC01;
+        heml_real P02 = mv * D02 + hv * C02 + wv * dC02, P10 = mv * D10 + hv * C10 + wv * dC10;
+        heml_real P11 = mv * D11 + hv * C11 + wv * dC11, P12 = mv * D12 + hv * C12 + wv * dC12;
+        heml_real P20 = mv * D20 + hv * C20 + wv * dC20, P21 = mv * D21 + hv * C21 + wv * dC21;
+        heml_real P22 = mv * D22 + hv * C22 + wv * dC22;
+        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
+        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
+        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
+        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
+        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
+        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
+        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
+        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
+        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
     }
 }
 
-/* Forces of one block at positions x into b->f (and J, for the statistics). */
-static void heml__block_forces(const heml_model *m, const heml__mat *mt, int blk, const heml_real *x,
-                               heml__blk *b, int prony_write)
+/* Kinematics, law and stress coefficients of one general block (not springs), Prony
+   applied (written to the next state when prony_write). */
+static void heml__block_stress(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want,
+                               int prony_write)
+{
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    heml__kinematics(R, b);
+    heml__clamp_J(m->jm1_0, b);
+    heml__law(mt, b, m->blk_valid[blk], want);
+    heml__coefficients(b, mt->uses_i2);
+    if (mt->prony_count) heml__prony(m, mt, blk, b, mt->uses_i2 ? 9 : 3, prony_write);
+}
+
+/* Elastic energy of the block's valid lanes (J, sum Vol w, in double) from a workspace
+   whose law was evaluated with HEML__WANT_ENERGY. */
+static double heml__lanes_energy(const heml_model *m, const heml__mat *mt, int blk, const heml__blk *b)
+{
+    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    double sum = 0.0;
+    int k, valid = m->blk_valid[blk];
+    for (k = 0; k < valid; k++) sum += (mt->kind == HEML__K_SPRING ? 1.0 : (double)R[9 * HEML__W + k]) * (double)b->w[k];
+    return sum;
+}
+
+/* Forces of one block at displacements u into b->f (and J - 1, for the statistics);
+   with want_energy also its elastic energy (returned, J; 0 otherwise). */
+static double heml__block_forces(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
+                                 heml__blk *b, int prony_write, int want_energy)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    heml__gather(idx, x, b->e);
+    heml__gather(idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
-        heml__cofactors(R, b);
-        heml__spring_tensions(S, b, 0);
+        heml__kinematics(R, b); /* J for the statistics */
+        heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
-        heml__spring_forces(b, b->sig, b->e, NULL, NULL);
-        return;
+        heml__spring_forces(S, b, b->co, NULL);
+        return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
-        heml__forces_nh(mt, m->J0, R, b);
-        return;
+    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count && !want_energy) {
+        heml__forces_nh(mt, m->jm1_0, R, b);
+        return 0.0;
     }
-    heml__cofactors(R, b);
-    heml__clamp_J(m->J0, b);
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2) {
-        heml__law_raw(mt, b, 0);
-        heml__sigma_nh(mt, R, b);
-    } else {
-        heml__invariants(R, b, mt->uses_i2);
-        heml__law(mt, b, m->blk_valid[blk], 0);
-        heml__sigma(R, b, mt->uses_i2);
-    }
-    if (mt->prony_count) heml__prony(m, mt, blk, b, 7, prony_write);
-    heml__link_forces(b);
+    heml__block_stress(m, mt, blk, b, want_energy ? HEML__WANT_ENERGY : 0, prony_write);
+    heml__pk1_forces(R, b);
+    return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
 }
 
-/* The differential's last stage, one loop for dJ, dD, dI1, dI2, G dD G, dw, dSigma,
-   dgamma, dc and df (see heml__block_diff), written out so that it vectorises (also at
-   gcc -O2; restrict parameters: the workspace escapes to user callbacks). */
+/* The differential's last stage, one loop (see heml__block_diff), written out so that it
+   vectorises (restrict parameters: the workspace escapes to user callbacks). */
 static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
-        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
-        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
         heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
         heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
         heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
-        heml_real g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
-        heml_real g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
-        heml_real v2 = 2 * R[6 * HEML__W + k], w2 = b->w2[k], I1 = b->I1[k];
-        heml_real dJ = (b->c[0][k] * x0 + b->c[1][k] * x1 + b->c[2][k] * x2 + b->c[3][k] * y0 + b->c[4][k] * y1 +
-                        b->c[5][k] * y2 + b->c[6][k] * z0 + b->c[7][k] * z1 + b->c[8][k] * z2) * R[7 * HEML__W + k];
-        /* dD (symmetric) */
-        heml_real q00 = 2 * (a0 * x0 + a1 * x1 + a2 * x2), q11 = 2 * (b0 * y0 + b1 * y1 + b2 * y2);
-        heml_real q22 = 2 * (d0 * z0 + d1 * z1 + d2 * z2);
-        heml_real q01 = a0 * y0 + a1 * y1 + a2 * y2 + x0 * b0 + x1 * b1 + x2 * b2;
-        heml_real q02 = a0 * z0 + a1 * z1 + a2 * z2 + x0 * d0 + x1 * d1 + x2 * d2;
-        heml_real q12 = b0 * z0 + b1 * z1 + b2 * z2 + y0 * d0 + y1 * d1 + y2 * d2;
-        heml_real dI1 = g00 * q00 + g11 * q11 + g22 * q22 + 2 * (g01 * q01 + g02 * q02 + g12 * q12);
-        /* G dD (full) and G dD G (symmetric); without I2, w_2 = 0 and G D G = 0 make these
-           terms vanish */
-        heml_real n00 = g00 * q00 + g01 * q01 + g02 * q02, n01 = g00 * q01 + g01 * q11 + g02 * q12;
-        heml_real n02 = g00 * q02 + g01 * q12 + g02 * q22, n10 = g01 * q00 + g11 * q01 + g12 * q02;
-        heml_real n11 = g01 * q01 + g11 * q11 + g12 * q12, n12 = g01 * q02 + g11 * q12 + g12 * q22;
-        heml_real n20 = g02 * q00 + g12 * q01 + g22 * q02, n21 = g02 * q01 + g12 * q11 + g22 * q12;
-        heml_real n22 = g02 * q02 + g12 * q12 + g22 * q22;
-        heml_real dI2 = I1 * dI1 - (b->GDG[0][k] * q00 + b->GDG[1][k] * q11 + b->GDG[2][k] * q22 +
-                                    2 * (b->GDG[3][k] * q01 + b->GDG[4][k] * q02 + b->GDG[5][k] * q12));
-        heml_real p0 = n00 * g00 + n01 * g01 + n02 * g02, p1 = n10 * g01 + n11 * g11 + n12 * g12;
-        heml_real p2 = n20 * g02 + n21 * g12 + n22 * g22, p3 = n00 * g01 + n01 * g11 + n02 * g12;
-        heml_real p4 = n00 * g02 + n01 * g12 + n02 * g22, p5 = n10 * g02 + n11 * g12 + n12 * g22;
-        heml_real dw1, dw2, dwJ, ds, dt, dg, t00, t11, t22, t01, t02, t12, w;
-        heml_real s00 = b->sig[0][k], s11 = b->sig[1][k], s22 = b->sig[2][k];
-        heml_real s01 = b->sig[3][k], s02 = b->sig[4][k], s12 = b->sig[5][k], g = b->sig[6][k];
-        heml_real dc0, dc1, dc2, dc3, dc4, dc5, dc6, dc7, dc8;
-        dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
-        dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
-        dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
-        ds = sp * v2 * (dw1 + dI1 * w2 + I1 * dw2);
-        dt = sp * v2 * dw2;
-        w = sp * v2 * w2;
-        t00 = ds * g00 - (dt * b->GDG[0][k] + w * p0);
-        t11 = ds * g11 - (dt * b->GDG[1][k] + w * p1);
-        t22 = ds * g22 - (dt * b->GDG[2][k] + w * p2);
-        t01 = ds * g01 - (dt * b->GDG[3][k] + w * p3);
-        t02 = ds * g02 - (dt * b->GDG[4][k] + w * p4);
-        t12 = ds * g12 - (dt * b->GDG[5][k] + w * p5);
-        dg = sp * dwJ * HEML__SIXTH;
-        /* dc_1 = dv2 x v3 + v2 x dv3, dc_2 = dv3 x v1 + v3 x dv1, dc_3 = dv1 x v2 + v1 x dv2 */
-        dc0 = y1 * d2 - y2 * d1 + b1 * z2 - b2 * z1;
-        dc1 = y2 * d0 - y0 * d2 + b2 * z0 - b0 * z2;
-        dc2 = y0 * d1 - y1 * d0 + b0 * z1 - b1 * z0;
-        dc3 = z1 * a2 - z2 * a1 + d1 * x2 - d2 * x1;
-        dc4 = z2 * a0 - z0 * a2 + d2 * x0 - d0 * x2;
-        dc5 = z0 * a1 - z1 * a0 + d0 * x1 - d1 * x0;
-        dc6 = x1 * b2 - x2 * b1 + a1 * y2 - a2 * y1;
-        dc7 = x2 * b0 - x0 * b2 + a2 * y0 - a0 * y2;
-        dc8 = x0 * b1 - x1 * b0 + a0 * y1 - a1 * y0;
-        b->f[0][k] = -(s00 * x0 + s01 * y0 + s02 * z0 + t00 * a0 + t01 * b0 + t02 * d0 + dg * b->c[0][k] + g * dc0);
-        b->f[1][k] = -(s00 * x1 + s01 * y1 + s02 * z1 + t00 * a1 + t01 * b1 + t02 * d1 + dg * b->c[1][k] + g * dc1);
-        b->f[2][k] = -(s00 * x2 + s01 * y2 + s02 * z2 + t00 * a2 + t01 * b2 + t02 * d2 + dg * b->c[2][k] + g * dc2);
-        b->f[3][k] = -(s01 * x0 + s11 * y0 + s12 * z0 + t01 * a0 + t11 * b0 + t12 * d0 + dg * b->c[3][k] + g * dc3);
-        b->f[4][k] = -(s01 * x1 + s11 * y1 + s12 * z1 + t01 * a1 + t11 * b1 + t12 * d1 + dg * b->c[4][k] + g * dc4);
-        b->f[5][k] = -(s01 * x2 + s11 * y2 + s12 * z2 + t01 * a2 + t11 * b2 + t12 * d2 + dg * b->c[5][k] + g * dc5);
-        b->f[6][k] = -(s02 * x0 + s12 * y0 + s22 * z0 + t02 * a0 + t12 * b0 + t22 * d0 + dg * b->c[6][k] + g * dc6);
-        b->f[7][k] = -(s02 * x1 + s12 * y1 + s22 * z1 + t02 * a1 + t12 * b1 + t22 * d1 + dg * b->c[7][k] + g * dc7);
-        b->f[8][k] = -(s02 * x2 + s12 * y2 + s22 * z2 + t02 * a2 + t12 * b2 + t22 * d2 + dg * b->c[8][k] + g * dc8);
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k];
+        heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
+        heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
+        heml_real H20 = b->H[6][k], H21 = b->H[7][k], H22 = b->H[8][k];
+        heml_real F00 = 1 + H00, F11 = 1 + H11, F22 = 1 + H22;
+        heml_real C00 = 1 + b->K[0][k], C01 = b->K[1][k], C02 = b->K[2][k];
+        heml_real C10 = b->K[3][k], C11 = 1 + b->K[4][k], C12 = b->K[5][k];
+        heml_real C20 = b->K[6][k], C21 = b->K[7][k], C22 = 1 + b->K[8][k];
+        heml_real E00 = b->E2[0][k], E11 = b->E2[1][k], E22 = b->E2[2][k];
+        heml_real E01 = b->E2[3][k], E02 = b->E2[4][k], E12 = b->E2[5][k];
+        heml_real t = b->I1m3[k], w2 = b->w2[k];
+        heml_real D00 = x0 * g10 + y0 * g20 + z0 * g30, D01 = x0 * g11 + y0 * g21 + z0 * g31;
+        heml_real D02 = x0 * g12 + y0 * g22 + z0 * g32, D10 = x1 * g10 + y1 * g20 + z1 * g30;
+        heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
+        heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
+        heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32;
+        /* dE2 = dH^T F + F^T dH (symmetric) */
+        heml_real q00 = 2 * (D00 * F00 + D10 * H10 + D20 * H20);
+        heml_real q11 = 2 * (D01 * H01 + D11 * F11 + D21 * H21);
+        heml_real q22 = 2 * (D02 * H02 + D12 * H12 + D22 * F22);
+        heml_real q01 = D00 * H01 + D10 * F11 + D20 * H21 + F00 * D01 + H10 * D11 + H20 * D21;
+        heml_real q02 = D00 * H02 + D10 * H12 + D20 * F22 + F00 * D02 + H10 * D12 + H20 * D22;
+        heml_real q12 = D01 * H02 + D11 * H12 + D21 * F22 + H01 * D02 + F11 * D12 + H21 * D22;
+        heml_real dI1 = q00 + q11 + q22;
+        heml_real dI2 = (2 + t) * dI1 - (E00 * q00 + E11 * q11 + E22 * q22 + 2 * (E01 * q01 + E02 * q02 + E12 * q12));
+        heml_real dJ = C00 * D00 + C01 * D01 + C02 * D02 + C10 * D10 + C11 * D11 + C12 * D12 + C20 * D20 +
+                       C21 * D21 + C22 * D22;
+        heml_real dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
+        heml_real dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
+        heml_real dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
+        heml_real da2 = 2 * sp * vol * (dw1 + (2 + t) * dw2 + w2 * dI1), dwj = sp * vol * dwJ;
+        heml_real a2 = 2 * vol * b->co[1][k], wj = vol * b->co[2][k];
+        /* M~ (filtered) and s dM = 2 s (dw2 E2 + w2 dE2), both times Vol */
+        heml_real m00 = vol * b->co[3][k], m11 = vol * b->co[4][k], m22 = vol * b->co[5][k];
+        heml_real m01 = vol * b->co[6][k], m02 = vol * b->co[7][k], m12 = vol * b->co[8][k];
+        heml_real sd = 2 * sp * vol * dw2, sw = 2 * sp * vol * w2;
+        heml_real n00 = sd * E00 + sw * q00, n11 = sd * E11 + sw * q11, n22 = sd * E22 + sw * q22;
+        heml_real n01 = sd * E01 + sw * q01, n02 = sd * E02 + sw * q02, n12 = sd * E12 + sw * q12;
+        /* dcof F */
+        heml_real dC00 = D11 * F22 + F11 * D22 - D12 * H21 - H12 * D21;
+        heml_real dC01 = D12 * H20 + H12 * D20 - D10 * F22 - H10 * D22;
+        heml_real dC02 = D10 * H21 + H10 * D21 - D11 * H20 - F11 * D20;
+        heml_real dC10 = D02 * H21 + H02 * D21 - D01 * F22 - H01 * D22;
+        heml_real dC11 = D00 * F22 + F00 * D22 - D02 * H20 - H02 * D20;
+        heml_real dC12 = D01 * H20 + H01 * D20 - D00 * H21 - F00 * D21;
+        heml_real dC20 = D01 * H12 + H01 * D12 - D02 * F11 - H02 * D11;
+        heml_real dC21 = D02 * H10 + H02 * D10 - D00 * H12 - F00 * D12;
+        heml_real dC22 = D00 * F11 + F00 * D11 - D01 * H10 - H01 * D10;
+        /* dP = 2 s da F + s dw_J cof F + 2 a dH + w_J dcof F - dH M~ - F s dM */
+        heml_real P00 = da2 * F00 + dwj * C00 + a2 * D00 + wj * dC00 - (D00 * m00 + D01 * m01 + D02 * m02) -
+                        (F00 * n00 + H01 * n01 + H02 * n02);
+        heml_real P01 = da2 * H01 + dwj * C01 + a2 * D01 + wj * dC01 - (D00 * m01 + D01 * m11 + D02 * m12) -
+                        (F00 * n01 + H01 * n11 + H02 * n12);
+        heml_real P02 = da2 * H02 + dwj * C02 + a2 * D02 + wj * dC02 - (D00 * m02 + D01 * m12 + D02 * m22) -
+                        (F00 * n02 + H01 * n12 + H02 * n22);
+        heml_real P10 = da2 * H10 + dwj * C10 + a2 * D10 + wj * dC10 - (D10 * m00 + D11 * m01 + D12 * m02) -
+                        (H10 * n00 + F11 * n01 + H12 * n02);
+        heml_real P11 = da2 * F11 + dwj * C11 + a2 * D11 + wj * dC11 - (D10 * m01 + D11 * m11 + D12 * m12) -
+                        (H10 * n01 + F11 * n11 + H12 * n12);
+        heml_real P12 = da2 * H12 + dwj * C12 + a2 * D12 + wj * dC12 - (D10 * m02 + D11 * m12 + D12 * m22) -
+                        (H10 * n02 + F11 * n12 + H12 * n22);
+        heml_real P20 = da2 * H20 + dwj * C20 + a2 * D20 + wj * dC20 - (D20 * m00 + D21 * m01 + D22 * m02) -
+                        (H20 * n00 + H21 * n01 + F22 * n02);
+        heml_real P21 = da2 * H21 + dwj * C21 + a2 * D21 + wj * dC21 - (D20 * m01 + D21 * m11 + D22 * m12) -
+                        (H20 * n01 + H21 * n11 + F22 * n12);
+        heml_real P22 = da2 * F22 + dwj * C22 + a2 * D22 + wj * dC22 - (D20 * m02 + D21 * m12 + D22 * m22) -
+                        (H20 * n02 + H21 * n12 + F22 * n22);
+        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
+        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
+        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
+        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
+        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
+        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
+        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
+        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
+        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
     }
 }
 
-/* The force differential of one block at x in direction dx into b->f:
-       df_k = -( sum_j (Sigma_jk dv_j + dSigma_jk v_j) + dgamma c_k + gamma dc_k )
-   with dD = dv^T v + v^T dv, dI1 = G : dD, dI2 = I1 dI1 - G D G : dD,
-   dJ = (c . dv) / det V, dw_a = sum_b w_ab dI_b, d(G D G) = G dD G and
-       dSigma = s 2 Vol [(dw_1 + dI1 w_2 + I1 dw_2) G - dw_2 G D G - w_2 G dD G],
-       dgamma = s dw_J / 6,   dc_1 = dv2 x v3 + v2 x dv3 (and cyclically),
-   s the Prony factor (1 without viscosity). Springs: d(t v) = t dv + dt v,
-   dt = s k L (v . dv) / l^3. */
-static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *x,
+/* The force differential of one block at displacements u in direction dx into b->f:
+   df_k = -Vol dP grad N_k with dF = dH = dv V^-1, dE2 = dH^T F + F^T dH, dI1 = tr dE2,
+   dI2 = (I1 - 1) dI1 - (C - I) : dE2, dJ = cof F : dH, dw_a = sum_b w_ab dI_b,
+       dP = 2 s da F + s dw_J cof F + 2 a dH + w_J dcof F - dH M - s F dM,
+       da = dw_1 + (I1 - 1) dw_2 + w_2 dI1,   dM = 2 (dw_2 (C - I) + w_2 dE2),
+   a, w_J and M those of the force (Prony-filtered), s the Prony factor (1 without
+   viscosity). Springs: d(t v) = t dv + dt v, dt = s k L (v . dv) / l^3. */
+static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
                              const heml_real *dx, heml__blk *b)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     const heml_real sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
-    const int i2 = mt->uses_i2;
-    int k, r;
-    heml__gather(idx, x, b->e);
+    int k;
+    heml__gather(idx, u, b->e);
     heml__gather(idx, dx, b->de);
     if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
-        heml__diff_nh(mt, m->J0, R, b);
+        heml__diff_nh(mt, m->jm1_0, R, b);
         return;
     }
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
+        heml_real dsig[6][HEML__W];
         heml__spring_tensions(S, b, 0);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, 0);
         for (k = 0; k < HEML__W; k++) {
             heml_real v[6][3], dv[6][3];
-            int l;
+            int l, r;
+            heml__spring_links(S, b, k, v);
             for (r = 0; r < 3; r++) {
-                v[0][r] = b->e[r][k];
-                v[1][r] = b->e[3 + r][k];
-                v[2][r] = b->e[6 + r][k];
                 dv[0][r] = b->de[r][k];
                 dv[1][r] = b->de[3 + r][k];
                 dv[2][r] = b->de[6 + r][k];
-            }
-            for (r = 0; r < 3; r++) {
-                v[3][r] = v[1][r] - v[0][r];
-                v[4][r] = v[2][r] - v[1][r];
-                v[5][r] = v[0][r] - v[2][r];
                 dv[3][r] = dv[1][r] - dv[0][r];
                 dv[4][r] = dv[2][r] - dv[1][r];
                 dv[5][r] = dv[0][r] - dv[2][r];
@@ -1607,48 +1747,21 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
             for (l = 0; l < 6; l++) {
                 heml_real lc = b->len[l][k], L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k];
                 heml_real vdv = v[l][0] * dv[l][0] + v[l][1] * dv[l][1] + v[l][2] * dv[l][2];
-                b->dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
+                dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
             }
         }
-        heml__spring_forces(b, b->sig, b->e, b->dsig, b->de);
+        heml__spring_forces(S, b, b->co, dsig);
         return;
     }
-    heml__cofactors(R, b);
-    heml__clamp_J(m->J0, b);
     /* (raw laws without I2 reach here only with Prony: the general path covers them, with
        zero I-derivatives) */
-    heml__invariants(R, b, i2);
-    heml__law(mt, b, m->blk_valid[blk], HEML__WANT_SECOND);
-    heml__sigma(R, b, i2);
-    if (mt->prony_count) heml__prony(m, mt, blk, b, 7, 0);
+    heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
-}
-
-/* Elastic energy of one block's valid lanes, J (sum Vol w, in double). */
-static double heml__block_energy(const heml_model *m, const heml__mat *mt, int blk, const heml_real *x,
-                                 heml__blk *b)
-{
-    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    int k, valid = m->blk_valid[blk];
-    double sum = 0.0;
-    heml__gather(idx, x, b->e);
-    if (mt->kind == HEML__K_SPRING) {
-        heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, b, 1);
-        for (k = 0; k < valid; k++) sum += (double)b->w[k];
-        return sum;
-    }
-    heml__cofactors(R, b);
-    heml__clamp_J(m->J0, b);
-    heml__invariants(R, b, 1);
-    heml__law(mt, b, valid, HEML__WANT_ENERGY);
-    for (k = 0; k < valid; k++) sum += (double)R[6 * HEML__W + k] * (double)b->w[k];
-    return sum;
 }
 
 /* Stress of one lane from its node forces (double): P = -(1/Vol) sum_k f_k V_k^T (the
    virtual-work identity behind f_k = -Vol P grad N_k); Cauchy sigma = P F^T / J with
-   F = v V^-1. Returns 1 when a Cauchy stress was asked for a tetrahedron with J <= 0
+   F = I + du V^-1. Returns 1 when a Cauchy stress was asked for a tetrahedron with J <= 0
    (out then holds NaN). */
 static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__blk *b,
                              heml_stress_kind kind, heml_real *out)
@@ -1674,10 +1787,10 @@ static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__bl
             for (s = 0; s < 3; s++) out[3 * r + s] = (heml_real)P[r][s];
         return 0;
     }
-    /* F = v V^-1: rows of V^-1 are g[j] */
+    /* F = I + du V^-1: rows of V^-1 are g[j] */
     for (r = 0; r < 3; r++)
         for (s = 0; s < 3; s++) {
-            double acc = 0.0;
+            double acc = r == s ? 1.0 : 0.0;
             for (j = 0; j < 3; j++) acc += (double)b->e[3 * j + r][k] * g[j][s];
             F[r][s] = acc;
         }
@@ -1744,20 +1857,36 @@ static void heml__chunks(void *vctx, int begin, int end)
             int valid = m->blk_valid[blk];
             switch (p->mode) {
             case HEML__FORCE:
-                heml__block_forces(m, mt, blk, p->x, &b, p->prony_write);
+            case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
+                energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
+                          (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
                 heml__scatter(idx, b.f, p->out);
                 for (k = 0; k < valid; k++) {
-                    below += b.J[k] < m->J0;
-                    inverted += b.J[k] <= 0;
+                    below += b.jm1[k] < m->jm1_0;
+                    inverted += b.jm1[k] <= -1;
                 }
                 break;
             case HEML__DIFF:
                 heml__block_diff(m, mt, blk, p->x, p->dx, &b);
                 heml__scatter(idx, b.f, p->out);
                 break;
-            case HEML__ENERGY: energy += heml__block_energy(m, mt, blk, p->x, &b); break;
+            case HEML__ABS:
+                heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
+                heml__scatter_abs(idx, b.f, p->out);
+                break;
+            case HEML__ENERGY:
+                heml__gather(idx, p->x, b.e);
+                if (mt->kind == HEML__K_SPRING) {
+                    heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
+                } else {
+                    heml__kinematics(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
+                    heml__clamp_J(m->jm1_0, &b);
+                    heml__law(mt, &b, valid, HEML__WANT_ENERGY);
+                }
+                energy += heml__lanes_energy(m, mt, blk, &b);
+                break;
             default:
-                heml__block_forces(m, mt, blk, p->x, &b, 0);
+                heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 for (k = 0; k < valid; k++)
                     inverted += heml__lane_stress(m, blk, k, &b, p->kind,
                                                   p->out + 9 * (size_t)m->slot_tet[blk * HEML__W + k]);
@@ -1785,7 +1914,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     p.x = x;
     p.dx = dx;
     p.out = out;
-    if (mode == HEML__FORCE || mode == HEML__DIFF)
+    if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
         memset(out, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (p.colour = 0; p.colour < m->colour_count; p.colour++)
         heml__run(m, m->colour_start[p.colour + 1] - m->colour_start[p.colour], heml__chunks, &p);
@@ -1794,7 +1923,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
         below += m->chunk_below[c];
         inverted += m->chunk_inverted[c];
     }
-    if (mode == HEML__FORCE) {
+    if (mode == HEML__FORCE || mode == HEML__FORCE_ENERGY) {
         m->stats.below_threshold = below;
         m->stats.inverted = inverted;
         m->stats.force_evaluations++;
@@ -1884,6 +2013,7 @@ static void heml__layout(heml_model *m, heml__carver *c)
     int i;
     HEML__CARVE(c, m->rest, heml_real, 3 * n);
     HEML__CARVE(c, m->pos, heml_real, 3 * n);
+    HEML__CARVE(c, m->disp, heml_real, 3 * n);
     HEML__CARVE(c, m->vel, heml_real, 3 * n);
     HEML__CARVE(c, m->force, heml_real, 3 * n);
     HEML__CARVE(c, m->ext, heml_real, 3 * n);
@@ -1985,7 +2115,7 @@ static void heml__make_mat(const heml_material *src, heml__mat *mt)
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
    MODEL); springs count as nu = 1/4. Returns 0, or -1 if a derivative is not finite. */
-static int heml__small_strain(heml__mat *mt, heml_real J0, double *mu, double *lambda)
+static int heml__small_strain(heml__mat *mt, heml_real jm1_0, double *mu, double *lambda)
 {
     heml__blk b;
     double w2, wJ;
@@ -1994,7 +2124,7 @@ static int heml__small_strain(heml__mat *mt, heml_real J0, double *mu, double *l
         *mu = *lambda = 0.4 * (double)mt->young;
         return 0;
     }
-    heml__law_point(mt, J0, 3, 3, 1, &b, 0);
+    heml__law_at_rest(mt, jm1_0, &b);
     w2 = (double)b.w2[0];
     wJ = (double)b.wJ[0];
     if (!heml__finite((double)b.w1[0]) || !heml__finite(w2) || !heml__finite(wJ)) return -1;
@@ -2009,7 +2139,7 @@ static int heml__small_strain(heml__mat *mt, heml_real J0, double *mu, double *l
     return 0;
 }
 
-static int heml__validate_material(const heml_material *src, heml_real J0, int index, char *msg,
+static int heml__validate_material(const heml_material *src, heml_real jm1_0, int index, char *msg,
                                    size_t msg_size)
 {
     heml__mat mt;
@@ -2076,11 +2206,11 @@ static int heml__validate_material(const heml_material *src, heml_real J0, int i
             return HEML_ERR_USER_LAW;
         }
         heml__make_mat(src, &mt);
-        heml__law_point(&mt, J0, 3, 3, 1, &b, 0);
+        heml__law_at_rest(&mt, jm1_0, &b);
         w1 = (double)b.w1[0];
         w2 = (double)b.w2[0];
         wJ = (double)b.wJ[0];
-        if (heml__small_strain(&mt, J0, &mu, &lambda) ||
+        if (heml__small_strain(&mt, jm1_0, &mu, &lambda) ||
             !(fabs(2 * w1 + 4 * w2 + wJ) <= tol * (2 * fabs(w1) + 4 * fabs(w2) + fabs(wJ))) ||
             !(mu > 0.0) || !(lambda + 2.0 * mu / 3.0 > 0.0)) {
             snprintf(msg, msg_size, "material %d: user law at rest: 2 w_1 + 4 w_2 + w_J = %g, "
@@ -2127,7 +2257,7 @@ static int heml__validate(const heml_desc *d)
                                                       "(and tet_material needs materials)");
     for (i = 0; i < M; i++) {
         err = heml__validate_material(d->materials ? d->materials + i : &d->material,
-                                      d->inversion_threshold, i, msg, sizeof msg);
+                                      (heml_real)((double)d->inversion_threshold - 1.0), i, msg, sizeof msg);
         if (err) return heml__fail(d, err, msg);
     }
     for (i = 0; i < 3 * d->node_count; i++)
@@ -2233,9 +2363,9 @@ static void heml__set_masks(heml_model *m, int i)
 static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc, double *diag_acc)
 {
     int s, blk, k, j, r, l;
-    double *scale_acc = diag_acc + 3 * (size_t)m->node_count, floor2 = 0.0;
+    double noise2 = 0.0;
     memset(mass_acc, 0, sizeof(double) * (size_t)m->node_count);
-    memset(diag_acc, 0, sizeof(double) * 4 * (size_t)m->node_count);
+    memset(diag_acc, 0, sizeof(double) * 3 * (size_t)m->node_count);
     for (s = 0; s < m->slot_count; s++) {
         int t = m->slot_tet[s], *idx;
         heml_real *R;
@@ -2247,10 +2377,7 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             for (j = 0; j < 4; j++) idx[j * HEML__W + k] = idx[0];
             for (r = 0; r < HEML__NR; r++) R[r * HEML__W + k] = 0;
             if (m->blk_spring)
-                for (l = 0; l < 6; l++) {
-                    m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = 1;
-                    m->blk_spring[((size_t)blk * HEML__NS + 6 + l) * HEML__W + k] = 0;
-                }
+                for (l = 0; l < HEML__NS; l++) m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = l < 6;
             continue;
         }
         {
@@ -2260,22 +2387,23 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             det = heml__rest_constants(m->rest + 3 * q[0], m->rest + 3 * q[1], m->rest + 3 * q[2],
                                        m->rest + 3 * q[3], g + 1, G);
             vol = det / 6.0;
+            if (mt->kind == HEML__K_USER) { /* its w is a sum of terms of the size of the moduli */
+                double e = (HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON) * vol * (mt->small_lambda + 2.0 * mt->small_mu);
+                noise2 += e * e;
+            }
             for (j = 0; j < 4; j++) idx[j * HEML__W + k] = q[j];
-            for (r = 0; r < 6; r++) R[r * HEML__W + k] = (heml_real)G[r];
-            R[6 * HEML__W + k] = (heml_real)vol;
-            R[7 * HEML__W + k] = (heml_real)(1.0 / det);
+            for (j = 0; j < 3; j++)
+                for (r = 0; r < 3; r++) R[(3 * j + r) * HEML__W + k] = (heml_real)g[j + 1][r];
+            R[9 * HEML__W + k] = (heml_real)vol;
             for (r = 0; r < 3; r++) g[0][r] = -(g[1][r] + g[2][r] + g[3][r]);
             for (j = 0; j < 4; j++) {
                 double gg = g[j][0] * g[j][0] + g[j][1] * g[j][1] + g[j][2] * g[j][2];
                 mass_acc[q[j]] += mt->density * vol / 4.0;
-                /* the size of each of the terms of this tetrahedron's force on node j (they
-                   cancel at rest): Vol (lambda + 2 mu) |grad N_j| */
-                scale_acc[q[j]] += vol * (mt->small_lambda + 2.0 * mt->small_mu) * sqrt(gg);
                 for (r = 0; r < 3; r++)
                     diag_acc[3 * q[j] + r] +=
                         vol * ((mt->small_lambda + mt->small_mu) * g[j][r] * g[j][r] + mt->small_mu * gg);
             }
-            if (mt->kind == HEML__K_SPRING)
+            if (mt->kind == HEML__K_SPRING) {
                 for (l = 0; l < 6; l++) {
                     const heml_real *pa = m->rest + 3 * q[heml__link[l][0]], *pb = m->rest + 3 * q[heml__link[l][1]];
                     double dx = (double)pb[0] - pa[0], dy = (double)pb[1] - pa[1], dz = (double)pb[2] - pa[2];
@@ -2284,16 +2412,17 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
                     m->blk_spring[((size_t)blk * HEML__NS + 6 + l) * HEML__W + k] =
                         (heml_real)((double)mt->young * vol / L2);
                 }
-            else if (m->blk_spring)
-                for (l = 0; l < 6; l++) {
-                    m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = 1;
-                    m->blk_spring[((size_t)blk * HEML__NS + 6 + l) * HEML__W + k] = 0;
-                }
+                for (j = 1; j < 4; j++) /* the rest links V1, V2, V3, in double */
+                    for (r = 0; r < 3; r++)
+                        m->blk_spring[((size_t)blk * HEML__NS + 9 + 3 * j + r) * HEML__W + k] =
+                            (heml_real)((double)m->rest[3 * q[j] + r] - (double)m->rest[3 * q[0] + r]);
+            } else if (m->blk_spring) {
+                for (l = 0; l < HEML__NS; l++) m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = l < 6;
+            }
             m->blk_valid[blk] = k + 1;
         }
     }
-    for (s = 0; s < m->node_count; s++) floor2 += scale_acc[s] * scale_acc[s];
-    m->force_floor = (HEML__FLOAT ? 6e-8 : 1.1e-16) * sqrt(floor2);
+    m->energy_noise = sqrt(noise2);
     for (s = 0; s < m->node_count; s++) {
         m->mass[s] = (heml_real)mass_acc[s];
         m->inv_mass[s] = mass_acc[s] > 0 ? (heml_real)(1.0 / mass_acc[s]) : (heml_real)0;
@@ -2362,7 +2491,7 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.cg_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-6);
     d.cg_max_iterations = 1000;
     d.static_max_iterations = 50;
-    d.static_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-9);
+    d.static_tolerance = (heml_real)(HEML__FLOAT ? 1e-4 : 1e-9);
     d.internal_cookie = HEML__COOKIE;
     return d;
 }
@@ -2390,12 +2519,12 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
     /* temporary: per-material counters, node stamps, chunk colours and reorder space,
        mass and diagonal accumulators */
-    tmp_bytes = sizeof(double) * 5 * (size_t)n + sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
     tmp_block = heml__alloc(&alloc, tmp_bytes);
     if (!tmp_block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
     mass_acc = (double *)tmp_block;
     diag_acc = mass_acc + n;
-    counts = (int *)(diag_acc + 4 * (size_t)n);
+    counts = (int *)(diag_acc + 3 * (size_t)n);
     fill = counts + M;
     bstart = fill + M;
     stamp = bstart + M;
@@ -2446,6 +2575,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->static_max_iterations = d->static_max_iterations;
     m->static_tolerance = d->static_tolerance;
     m->J0 = d->inversion_threshold;
+    m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
     m->allocator = alloc;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
@@ -2453,7 +2583,6 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
 
     memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
     memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
-    memcpy(m->target, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
     /* materials and their Prony terms */
     for (i = 0, t = 0; i < M; i++) {
         heml__mat *mt = m->mats + i;
@@ -2464,7 +2593,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
-        (void)heml__small_strain(mt, m->J0, &mt->small_mu, &mt->small_lambda);
+        (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
     }
@@ -2537,21 +2666,33 @@ static void heml__cg_apply(heml_model *m, const heml_real *diag, double c, const
     for (i = 0; i < n3; i++) q[i] = m->free_mask[i] * ((diag ? diag[i] * p[i] : 0) - cc * q[i]);
 }
 
+/* The Jacobi preconditioner of D - c df/dx: 1 / (D + c times the small-strain stiffness
+   diagonal) on the free degrees of freedom, 0 on the others. */
+static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, heml_real *pinv)
+{
+    int i, n3 = 3 * m->node_count;
+    for (i = 0; i < n3; i++) {
+        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)m->diag[i];
+        pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
+    }
+}
+
+#define HEML__NEGATIVE_CURVATURE 1 /* private result of heml__cg */
+
 /* Solves (D - c df/dx(x_lin)) x = b on the free degrees of freedom by Jacobi-
-   preconditioned CG (the preconditioner: D + c times the small-strain stiffness
-   diagonal). x holds the initial guess; pinned entries are held at 0. Stops when
-   |r| <= cg_tolerance |b|, after cg_max_iterations, or at a direction of negative
-   curvature (the iterate so far is kept). Scratch s[0..4]. */
+   preconditioned CG. x holds the initial guess; pinned entries are held at 0. Returns
+   HEML_OK when |r| <= rtol |b|, HEML_ERR_NO_CONVERGENCE after cg_max_iterations (x is
+   the last iterate), HEML__NEGATIVE_CURVATURE at a direction of non-positive curvature
+   (the system is not positive definite; x is the iterate before it). Scratch s[0..4]. */
 static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
-                    const heml_real *b, heml_real *x, heml_real **s)
+                    const heml_real *b, heml_real *x, double rtol, heml_real **s)
 {
     heml_real *r = s[0], *z = s[1], *p = s[2], *q = s[3], *pinv = s[4];
     int n3 = 3 * m->node_count, i, it;
     double bb, rr, rz, tol2;
     m->lin_x = x_lin;
+    heml__jacobi(m, diag, c, pinv);
     for (i = 0; i < n3; i++) {
-        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)m->diag[i];
-        pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
         x[i] *= m->free_mask[i];
         r[i] = b[i] * m->free_mask[i];
     }
@@ -2561,7 +2702,7 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
         memset(x, 0, sizeof(heml_real) * (size_t)n3);
         return HEML_OK;
     }
-    tol2 = (double)m->cg_tolerance * (double)m->cg_tolerance * bb;
+    tol2 = rtol * rtol * bb;
     heml__cg_apply(m, diag, c, x, q);
     for (i = 0; i < n3; i++) {
         r[i] -= q[i];
@@ -2576,7 +2717,8 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
         pq = heml__dot(p, q, n3);
         if (!(pq > 0.0)) {
             m->stats.negative_curvature++;
-            break;
+            m->stats.cg_iterations += it;
+            return HEML__NEGATIVE_CURVATURE;
         }
         alpha = rz / pq;
         for (i = 0; i < n3; i++) {
@@ -2595,21 +2737,23 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
     return rr <= tol2 ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
 }
 
-/* Solves K x = b (K = -df/dx(x_lin), symmetric, possibly indefinite) on the free degrees
-   of freedom by MINRES (Paige & Saunders 1975) preconditioned with the inverse of the
-   small-strain stiffness diagonal, from x = 0. Used by the static solve, whose Newton
-   iterates can be far from equilibrium where K is indefinite (CG would stop there).
-   Scratch s[0..7]. */
-static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *b, heml_real *x,
-                        heml_real **s)
+/* Solves (D - c df/dx(x_lin)) x = b (symmetric, possibly indefinite) on the free degrees
+   of freedom by MINRES (Paige & Saunders 1975) with the Jacobi preconditioner, from
+   x = 0, until the preconditioned residual is below rtol times its initial value or after
+   cg_max_iterations (x is then the last iterate: its residual never exceeds |b|). Used
+   by the static solve (Newton iterates far from equilibrium, or beyond a buckling load,
+   have an indefinite tangent, where CG would stop) and by the implicit step after CG met
+   negative curvature. Returns HEML_OK or HEML_ERR_NO_CONVERGENCE. Scratch s[0..7]. */
+static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
+                        const heml_real *b, heml_real *x, double rtol, heml_real **s)
 {
     heml_real *r1 = s[0], *r2 = s[1], *y = s[2], *v = s[3], *w = s[4], *w1 = s[5], *w2 = s[6];
     heml_real *pinv = s[7];
     int n3 = 3 * m->node_count, i, it;
     double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol;
     m->lin_x = x_lin;
+    heml__jacobi(m, diag, c, pinv);
     for (i = 0; i < n3; i++) {
-        pinv[i] = (heml_real)(m->free_mask[i] > 0 && m->diag[i] > 0 ? 1.0 / (double)m->diag[i] : 0.0);
         x[i] = w[i] = w2[i] = 0;
         r1[i] = r2[i] = b[i] * m->free_mask[i];
         y[i] = pinv[i] * r1[i];
@@ -2619,11 +2763,11 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     if (!(beta1 > 0.0)) return HEML_OK;
     beta1 = sqrt(beta1);
     beta = phibar = beta1;
-    tol = (double)m->cg_tolerance * beta1;
+    tol = rtol * beta1;
     for (it = 0; it < m->cg_max_iterations && phibar > tol; it++) {
         double alfa, oldeps, delta, gbar, gamma, phi, sb = 1.0 / beta;
         for (i = 0; i < n3; i++) v[i] = (heml_real)(sb * y[i]);
-        heml__cg_apply(m, NULL, 1.0, v, y); /* y = K v on the free degrees of freedom */
+        heml__cg_apply(m, diag, c, v, y); /* y = A v on the free degrees of freedom */
         if (it > 0)
             for (i = 0; i < n3; i++) y[i] -= (heml_real)(beta / oldb) * r1[i];
         alfa = heml__dot(v, y, n3);
@@ -2663,24 +2807,32 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
 
 /* >>integrators ----------------------------------------------------------------------- */
 
-/* Working copies (x0, v0) of positions and velocities with pinned axes moved to their
-   targets over this step: v = (target - x) / dt, x = target. */
-static void heml__begin_step(heml_model *m, heml_real dt, heml_real *x0, heml_real *v0)
+/* Working copies (u0, v0) of displacements and velocities with pinned axes moved to their
+   targets over this step: v = (target - u) / dt, u = target. */
+static void heml__begin_step(heml_model *m, heml_real dt, heml_real *u0, heml_real *v0)
 {
     int i, n3 = 3 * m->node_count;
     heml_real inv_dt = 1 / dt;
     for (i = 0; i < n3; i++) {
-        heml_real pin = m->pin_mask[i], jump = m->target[i] - m->pos[i];
-        x0[i] = m->pos[i] + pin * jump;
+        heml_real pin = m->pin_mask[i], jump = m->target[i] - m->disp[i];
+        u0[i] = m->disp[i] + pin * jump;
         v0[i] = pin ? jump * inv_dt : m->vel[i] * (m->free_mask[i] > 0);
     }
 }
 
-/* Commits positions x and velocities v (NULL: zero) and the Prony state being built. */
-static void heml__commit(heml_model *m, const heml_real *x, const heml_real *v)
+/* pos = rest + u */
+static void heml__update_positions(heml_model *m)
+{
+    int i, n3 = 3 * m->node_count;
+    for (i = 0; i < n3; i++) m->pos[i] = m->rest[i] + m->disp[i];
+}
+
+/* Commits displacements u and velocities v (NULL: zero) and the Prony state being built. */
+static void heml__commit(heml_model *m, const heml_real *u, const heml_real *v)
 {
     size_t n3 = 3 * (size_t)m->node_count;
-    memcpy(m->pos, x, sizeof(heml_real) * n3);
+    memcpy(m->disp, u, sizeof(heml_real) * n3);
+    heml__update_positions(m);
     if (v) memcpy(m->vel, v, sizeof(heml_real) * n3);
     else memset(m->vel, 0, sizeof(heml_real) * n3);
     if (m->has_prony) {
@@ -2690,67 +2842,71 @@ static void heml__commit(heml_model *m, const heml_real *x, const heml_real *v)
     }
 }
 
-/* eq. 32: v1 = v0 + dt a(x0, v0), x1 = x0 + dt v1; a = (f + f_ext)/m + g - alpha v0. */
-static void heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *x0, const heml_real *v0,
-                                heml_real *x1, heml_real *v1)
+/* eq. 32: v1 = v0 + dt a(u0, v0), u1 = u0 + dt v1; a = (f + f_ext)/m + g - alpha v0. */
+static void heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                                heml_real *u1, heml_real *v1)
 {
     int i, r, n = m->node_count;
     heml_real *f = m->scratch[4], alpha = m->mass_damping;
-    heml__forces(m, x0, f, 1);
+    heml__forces(m, u0, f, 1);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
             heml_real fm = m->free_mask[j];
             heml_real a = (f[j] + m->ext[j]) * m->inv_mass[i] + m->gravity[r] - alpha * v0[j];
             v1[j] = v0[j] + fm * dt * a;
-            x1[j] = x0[j] + fm * dt * v1[j];
+            u1[j] = u0[j] + fm * dt * v1[j];
         }
 }
 
-/* Backward Euler by Newton on dx = x1 - x0 from dx = 0:
-       (M (1 + dt alpha) - dt^2 df/dx(x0 + dx)) delta = dt^2 R,
-       R = f(x0 + dx) + f_ext + M g - alpha M dx / dt - M (dx - dt v0) / dt^2,
-   dx += delta; the first iteration is the linearly implicit (Baraff-Witkin) step.
-   The real-time step accepts the CG iterate when the iteration cap is reached. */
-static int heml__implicit(heml_model *m, heml_real dt, const heml_real *x0, const heml_real *v0,
-                          heml_real *x1, heml_real *v1)
+/* Backward Euler by Newton on du = u1 - u0 from du = 0:
+       (M (1 + dt alpha) - dt^2 df/du(u0 + du)) delta = dt^2 R,
+       R = f(u0 + du) + f_ext + M g - alpha M du / dt - M (du - dt v0) / dt^2,
+   du += delta; the first iteration is the linearly implicit (Baraff-Witkin) step. Each
+   linear solve is CG, or MINRES when CG meets negative curvature; one that does not reach
+   cg_tolerance in cg_max_iterations fails the step (HEML_ERR_NO_CONVERGENCE). */
+static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                          heml_real *u1, heml_real *v1)
 {
-    int i, r, it, n = m->node_count, n3 = 3 * n;
-    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *dx = m->scratch[6], *rhs = m->scratch[7];
-    heml_real *delta = m->scratch[8], *cg_scratch[5], alpha = m->mass_damping;
+    int i, r, it, err, n = m->node_count, n3 = 3 * n;
+    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *du = m->scratch[6], *rhs = m->scratch[7];
+    heml_real *delta = m->scratch[8], *krylov[8], alpha = m->mass_damping;
     double dt2 = (double)dt * dt;
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[9 + i];
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[9 + i];
     for (i = 0; i < n3; i++) {
         dmass[i] = (heml_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
-        dx[i] = 0;
+        du[i] = 0;
     }
     for (it = 0; it < m->newton_iterations; it++) {
         double dd = 0.0, xx = 0.0;
-        for (i = 0; i < n3; i++) x1[i] = x0[i] + dx[i];
-        heml__forces(m, x1, f, 1);
+        for (i = 0; i < n3; i++) u1[i] = u0[i] + du[i];
+        heml__forces(m, u1, f, 1);
         for (i = 0; i < n; i++)
             for (r = 0; r < 3; r++) {
                 int j = 3 * i + r;
                 double mi = (double)m->mass[i];
                 double R = (double)f[j] + (double)m->ext[j] + mi * (double)m->gravity[r] -
-                           (double)alpha * mi * (double)dx[j] / (double)dt -
-                           mi * ((double)dx[j] - (double)dt * (double)v0[j]) / dt2;
+                           (double)alpha * mi * (double)du[j] / (double)dt -
+                           mi * ((double)du[j] - (double)dt * (double)v0[j]) / dt2;
                 rhs[j] = (heml_real)(dt2 * R) * m->free_mask[j];
                 delta[j] = it == 0 ? dt * (v0[j] + m->dv_prev[j]) : 0;
             }
-        (void)heml__cg(m, x1, dmass, dt2, rhs, delta, cg_scratch);
+        if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
+        err = heml__cg(m, u1, dmass, dt2, rhs, delta, (double)m->cg_tolerance, krylov);
+        if (err == HEML__NEGATIVE_CURVATURE) err = heml__minres(m, u1, dmass, dt2, rhs, delta, (double)m->cg_tolerance, krylov);
+        if (err) return err;
         for (i = 0; i < n3; i++) {
-            dx[i] += delta[i] * m->free_mask[i];
+            du[i] += delta[i] * m->free_mask[i];
             dd += (double)delta[i] * delta[i];
-            xx += (double)dx[i] * dx[i];
+            xx += (double)du[i] * du[i];
         }
         m->stats.newton_iterations = it + 1;
         if (it > 0 && dd <= (double)m->cg_tolerance * m->cg_tolerance * xx) break;
     }
     for (i = 0; i < n3; i++) {
         heml_real fm = m->free_mask[i];
-        x1[i] = x0[i] + dx[i];
-        v1[i] = fm > 0 ? dx[i] / dt : v0[i];
+        u1[i] = u0[i] + du[i];
+        v1[i] = fm > 0 ? du[i] / dt : v0[i];
         m->dv_prev[i] = (v1[i] - v0[i]) * fm;
     }
     return HEML_OK;
@@ -2758,30 +2914,29 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *x0, cons
 
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator)
 {
-    heml_real *x0, *v0, *x1, *v1;
+    heml_real *u0, *v0, *u1, *v1;
     size_t n3;
+    int err = HEML_OK;
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)dt) && dt > 0)) return HEML_ERR_TIME_STEP;
     if ((int)integrator < 0 || (int)integrator > 1) return HEML_ERR_INTEGRATOR;
     if (integrator == HEML_IMPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * (size_t)m->node_count;
-    x0 = m->scratch[0];
+    u0 = m->scratch[0];
     v0 = m->scratch[1];
-    x1 = m->scratch[2];
+    u1 = m->scratch[2];
     v1 = m->scratch[3];
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, (double)dt);
-    heml__begin_step(m, dt, x0, v0);
-    if (integrator == HEML_SEMI_EXPLICIT_EULER) {
-        heml__semi_explicit(m, dt, x0, v0, x1, v1);
-    } else {
-        heml__implicit(m, dt, x0, v0, x1, v1);
-    }
-    if (!heml__all_finite(x1, n3) || !heml__all_finite(v1, n3)) {
+    heml__begin_step(m, dt, u0, v0);
+    if (integrator == HEML_SEMI_EXPLICIT_EULER) heml__semi_explicit(m, dt, u0, v0, u1, v1);
+    else err = heml__implicit(m, dt, u0, v0, u1, v1);
+    if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
+    if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);
-        return HEML_ERR_NOT_FINITE;
+        return err;
     }
-    heml__commit(m, x1, v1);
+    heml__commit(m, u1, v1);
     return HEML_OK;
 }
 
@@ -2793,108 +2948,181 @@ HEMLDEF int heml_step(heml_model *m)
 
 /* >>static ---------------------------------------------------------------------------- */
 
-/* R = mask (f + lambda (f_ext + M g)); returns |R|. */
-static double heml__static_residual(heml_model *m, const heml_real *f, double lambda, heml_real *R)
+/* One evaluation of the static problem at u under the load vector `load` (free degrees of
+   freedom only): internal forces f, residual R = mask (f + load), its norm, the reference
+   scale max(|load|, |f|) (f over every degree of freedom, so the pinned ones' reactions
+   count), the elastic energy W of the relaxed response, the work load . u, the potential
+   W - load . u and its round-off size. */
+typedef struct heml__static_point {
+    double res, scale, energy, work, potential, noise;
+} heml__static_point;
+
+static void heml__static_eval(heml_model *m, const heml_real *u, const heml_real *load, heml_real *f,
+                              heml_real *R, heml__static_point *pt)
 {
-    int i, r, n = m->node_count;
-    heml_real l = (heml_real)lambda;
-    for (i = 0; i < n; i++)
-        for (r = 0; r < 3; r++) {
-            int j = 3 * i + r;
-            R[j] = (f[j] + l * (m->ext[j] + m->mass[i] * m->gravity[r])) * m->free_mask[j];
-        }
-    return sqrt(heml__dot(R, R, 3 * n));
+    int i, n3 = 3 * m->node_count;
+    double W = heml__pass_run(m, HEML__FORCE_ENERGY, u, NULL, f, 1, HEML_STRESS_PK1), ff, ll;
+    for (i = 0; i < n3; i++) R[i] = (f[i] + load[i]) * m->free_mask[i];
+    ff = heml__dot(f, f, n3);
+    ll = heml__dot(load, load, n3);
+    pt->res = sqrt(heml__dot(R, R, n3));
+    pt->scale = sqrt(ff > ll ? ff : ll);
+    pt->energy = W;
+    pt->work = heml__dot(load, u, n3);
+    pt->potential = W - pt->work;
+    pt->noise = 64.0 * (HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON) * (fabs(W) + fabs(pt->work)) + 4.0 * m->energy_noise;
 }
 
-/* Newton at load factor lambda from x (pinned axes already placed): K delta = R
-   (K = -df/dx) by MINRES, backtracking on |R| (the exact Newton direction is a descent
-   direction of |R|^2 even where K is indefinite). Converged when |R| is below
-   static_tolerance times the largest of the first residual, the internal forces at the
-   start (pinned axes included: the reactions) and the applied loads, or below 4 times the
-   round-off level of the forces: each tetrahedron's force is the difference of terms of
-   size Vol (lambda + 2 mu) |grad N| that cancel at rest, so |f| carries about EPS times
-   their norm whatever the deformation (in float, 1e-3 of a gravity load on stiff tissue).
-   Scratch 1..14; x is updated in place. */
-static int heml__static_newton(heml_model *m, double lambda, heml_real *x)
+/* The round-off level of the residual at u (one pass): per free degree of freedom the
+   unit round-off times the size of the terms its force sums, and the force that rounding
+   the displacements moves (the stiffness diagonal times one ulp of the node's largest
+   displacement component), in quadrature. */
+static double heml__round_off_floor(heml_model *m, const heml_real *u, heml_real *scratch)
 {
-    heml_real *f = m->scratch[1], *R = m->scratch[2], *delta = m->scratch[3], *xt = m->scratch[4];
-    heml_real *ft = m->scratch[5], *Rt = m->scratch[6], *krylov[8];
-    int i, r, it, n3 = 3 * m->node_count;
-    double res, scale, load = 0.0;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[7 + i];
-    heml__forces(m, x, f, 1);
-    res = heml__static_residual(m, f, lambda, R);
-    scale = sqrt(heml__dot(f, f, n3));
-    for (i = 0; i < m->node_count; i++)
+    int i, r;
+    double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, sum = 0.0;
+    heml__pass_run(m, HEML__ABS, u, NULL, scratch, 0, HEML_STRESS_PK1);
+    for (i = 0; i < m->node_count; i++) {
+        double umax = 0.0;
+        for (r = 0; r < 3; r++)
+            if (fabs((double)u[3 * i + r]) > umax) umax = fabs((double)u[3 * i + r]);
         for (r = 0; r < 3; r++) {
-            double l = lambda * ((double)m->ext[3 * i + r] + (double)m->mass[i] * m->gravity[r]) *
-                       m->free_mask[3 * i + r];
-            load += l * l;
+            int j = 3 * i + r;
+            double a = (double)scratch[j], k = (double)m->diag[j] * umax;
+            if (m->free_mask[j] > 0) sum += eps * eps * (a * a + k * k);
         }
-    if (res > scale) scale = res;
-    if (sqrt(load) > scale) scale = sqrt(load);
+    }
+    return sqrt(sum);
+}
+
+/* Newton made no more progress at u (current point pt, direction delta with slope
+   R . delta, minres_ok whether MINRES reached its tolerance). Within 100 times the
+   round-off floor the answer is accepted (HEML_OK) only when it is converged in energy:
+   the Newton correction's energy R . K^-1 R (the slope) is below static_tolerance^2
+   times the energy of the answer, max(|load . u|, 2 W), i.e. the energy-norm error is
+   below static_tolerance; otherwise HEML_ERR_ROUND_OFF. Above the floor:
+   HEML_ERR_NO_CONVERGENCE. */
+static int heml__static_stalled(heml_model *m, const heml_real *u, const heml__static_point *pt, double slope,
+                                int minres_ok, heml_real *scratch)
+{
+    double tol = (double)m->static_tolerance, ref = fabs(pt->work);
+    if (heml__finite(pt->energy) && 2.0 * fabs(pt->energy) > ref) ref = 2.0 * fabs(pt->energy);
+    if (!(pt->res <= 100.0 * heml__round_off_floor(m, u, scratch))) return HEML_ERR_NO_CONVERGENCE;
+    if (minres_ok && slope > 0 && slope <= tol * tol * ref) return HEML_OK;
+    return HEML_ERR_ROUND_OFF;
+}
+
+#define HEML__HALVINGS 10   /* line search: steps down to 2^-10 */
+#define HEML__STALL 4       /* Newton iterations without progress that end a load step */
+
+/* Newton at one load (pinned axes already placed in u): K delta = R (K = -df/du) by
+   MINRES to the Eisenstat-Walker relative residual eta (1e-3, then (|R_k| / |R_k-1|)^2
+   times 0.9, never tighter than the tolerance needs), then a backtracking line search
+   that accepts a step when it lowers the residual (which also converges to unstable
+   equilibria) or the potential W - load . u (Armijo, up to its round-off: the Newton step
+   of a slender body often raises the residual on its way to the solution). Converged when
+   |R| <= static_tolerance max(|load|, |f|). When neither the residual nor the potential
+   made progress in HEML__STALL iterations, or the line search found no acceptable step,
+   or after static_max_iterations: heml__static_stalled decides. Scratch 1..14; u is
+   updated in place. */
+static int heml__static_newton(heml_model *m, const heml_real *load, heml_real *u)
+{
+    heml_real *f = m->scratch[1], *R = m->scratch[2], *delta = m->scratch[3], *ut = m->scratch[4];
+    heml_real *ft = m->scratch[5], *Rt = m->scratch[6], *krylov[8];
+    int i, it, n3 = 3 * m->node_count, quiet = 0;
+    double best, prev = 0.0, eta = 1e-3, tol = (double)m->static_tolerance;
+    heml__static_point pt, tp;
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[7 + i];
+    heml__static_eval(m, u, load, f, R, &pt);
+    best = pt.res;
     for (it = 0;; it++) {
-        double step = 1.0, res_t = 0.0;
-        int ls;
-        m->stats.static_residual = (heml_real)(scale > 0 ? res / scale : 0.0);
-        if (!heml__finite(res)) return HEML_ERR_NOT_FINITE;
-        if (res <= (double)m->static_tolerance * scale || res <= 4.0 * m->force_floor) return HEML_OK;
-        if (it == m->static_max_iterations) return HEML_ERR_NO_CONVERGENCE;
-        (void)heml__minres(m, x, R, delta, krylov);
-        m->stats.newton_iterations++;
-        for (ls = 0; ls < 12; ls++, step *= 0.5) {
-            for (i = 0; i < n3; i++) xt[i] = x[i] + (heml_real)step * delta[i];
-            heml__forces(m, xt, ft, 1);
-            res_t = heml__static_residual(m, ft, lambda, Rt);
-            if (res_t < res) break;
+        double step = 1.0, slope;
+        int ls, accepted = 0, minres_ok, kerr;
+        m->stats.static_residual = (heml_real)(pt.scale > 0 ? pt.res / pt.scale : 0.0);
+        if (!heml__finite(pt.res)) return HEML_ERR_NOT_FINITE;
+        if (pt.res <= tol * pt.scale) return HEML_OK;
+        if (it > 0) {
+            eta = 0.9 * (pt.res / prev) * (pt.res / prev);
+            if (eta > 1e-3) eta = 1e-3;
         }
-        if (!(res_t < res)) /* no descent along the Newton direction */
-            return heml__finite(res_t) ? HEML_ERR_NO_CONVERGENCE : HEML_ERR_NOT_FINITE;
-        memcpy(x, xt, sizeof(heml_real) * (size_t)n3);
+        if (eta < 0.1 * tol * pt.scale / pt.res) eta = 0.1 * tol * pt.scale / pt.res;
+        if (eta > 1e-3) eta = 1e-3; /* (at the round-off floor the smooth error needs it) */
+        /* CG (its rounding errors grow like the condition number, MINRES's like its square:
+           in float only CG resolves a slender body); MINRES where the tangent is indefinite.
+           A capped solve still gives a usable direction. */
+        memset(delta, 0, sizeof(heml_real) * (size_t)n3);
+        kerr = heml__cg(m, u, NULL, 1.0, R, delta, eta, krylov);
+        if (kerr == HEML__NEGATIVE_CURVATURE) kerr = heml__minres(m, u, NULL, 1.0, R, delta, eta, krylov);
+        minres_ok = kerr == HEML_OK;
+        slope = heml__dot(R, delta, n3);
+        if (it == m->static_max_iterations || quiet >= HEML__STALL)
+            return heml__static_stalled(m, u, &pt, slope, minres_ok, ft);
+        m->stats.newton_iterations++;
+        for (ls = 0; ls <= HEML__HALVINGS && !accepted; ls++, step *= 0.5) {
+            heml_real t = (heml_real)step;
+            for (i = 0; i < n3; i++) ut[i] = u[i] + t * delta[i];
+            heml__static_eval(m, ut, load, ft, Rt, &tp);
+            if (!heml__finite(tp.res)) continue;
+            accepted = tp.res <= (1.0 - 1e-4 * step) * pt.res ||
+                       (slope > 0 && tp.potential - pt.potential <= -1e-4 * step * slope + pt.noise);
+            m->stats.line_search_halvings += !accepted;
+        }
+        if (!accepted) return heml__static_stalled(m, u, &pt, slope, minres_ok, ft);
+        quiet = tp.res < 0.9 * best || tp.potential < pt.potential - pt.noise ? 0 : quiet + 1;
+        if (tp.res < best) best = tp.res;
+        prev = pt.res;
+        pt = tp;
+        memcpy(u, ut, sizeof(heml_real) * (size_t)n3);
         memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
-        res = res_t;
     }
 }
 
 /* Equilibrium by load stepping: loads (gravity, external forces) and the pinned axes'
    moves to their targets are applied with a factor lambda from 0 to 1, first in one
    step; when Newton fails at a factor, the increment is halved from the last converged
-   one (down to 1/1024) and doubled again after a success. */
+   one (down to 1/1024) and doubled again after a success. A round-off stall ends the
+   solve at once (a smaller load would not help). */
 HEMLDEF int heml_solve_static(heml_model *m)
 {
-    heml_real *x, *saved;
-    int i, n3, err = HEML_OK;
+    heml_real *u, *saved, *load;
+    int i, r, n3, err = HEML_OK;
     double lambda = 0.0, increment = 1.0;
     if (!m) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * m->node_count;
-    x = m->scratch[0];
+    u = m->scratch[0];
     saved = m->scratch[15];
+    load = m->scratch[16];
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, -1.0);
-    memcpy(x, m->pos, sizeof(heml_real) * (size_t)n3);
+    memcpy(u, m->disp, sizeof(heml_real) * (size_t)n3);
     while (lambda < 1.0) {
         double trial = lambda + increment > 1.0 ? 1.0 : lambda + increment;
         heml_real t = (heml_real)trial;
-        memcpy(saved, x, sizeof(heml_real) * (size_t)n3);
-        for (i = 0; i < n3; i++)
-            if (m->pin_mask[i] > 0) x[i] = m->pos[i] + t * (m->target[i] - m->pos[i]);
-        err = heml__static_newton(m, trial, x);
+        memcpy(saved, u, sizeof(heml_real) * (size_t)n3);
+        for (i = 0; i < m->node_count; i++)
+            for (r = 0; r < 3; r++) {
+                int j = 3 * i + r;
+                load[j] = t * (m->ext[j] + m->mass[i] * m->gravity[r]) * m->free_mask[j];
+                if (m->pin_mask[j] > 0) u[j] = m->disp[j] + t * (m->target[j] - m->disp[j]);
+            }
+        err = heml__static_newton(m, load, u);
         if (err == HEML_OK) {
             lambda = trial;
             increment *= 2.0;
+            m->stats.load_steps++;
         } else {
-            memcpy(x, saved, sizeof(heml_real) * (size_t)n3);
+            memcpy(u, saved, sizeof(heml_real) * (size_t)n3);
             increment *= 0.5;
-            if (increment < 1.0 / 1024) break;
+            if (err == HEML_ERR_ROUND_OFF || increment < 1.0 / 1024) break;
         }
     }
     if (lambda < 1.0) return err;
-    if (!heml__all_finite(x, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-    if (m->has_prony) { /* the Prony state of the last pass at x: make sure it is at x */
-        heml__forces(m, x, m->scratch[1], 1);
+    if (!heml__all_finite(u, (size_t)n3)) return HEML_ERR_NOT_FINITE;
+    if (m->has_prony) { /* the Prony state of the last pass at u: make sure it is at u */
+        heml__forces(m, u, m->scratch[1], 1);
     }
-    heml__commit(m, x, NULL);
+    heml__commit(m, u, NULL);
     memset(m->dv_prev, 0, sizeof(heml_real) * (size_t)n3);
     return HEML_OK;
 }
@@ -2918,7 +3146,7 @@ HEMLDEF int heml_fix_node(heml_model *m, int i)
     int err = heml__check_node(m, i), r;
     if (err) return err;
     m->axes[i] = 7;
-    for (r = 0; r < 3; r++) m->target[3 * i + r] = m->pos[3 * i + r];
+    for (r = 0; r < 3; r++) m->target[3 * i + r] = m->disp[3 * i + r];
     heml__set_masks(m, i);
     return HEML_OK;
 }
@@ -2930,7 +3158,7 @@ HEMLDEF int heml_set_displacement_axes(heml_model *m, int i, unsigned axes, cons
     if (axes > 7 || (axes && !heml__vec3_finite(u))) return HEML_ERR_ARG;
     m->axes[i] = (unsigned char)axes;
     for (r = 0; r < 3; r++)
-        if ((axes >> r) & 1) m->target[3 * i + r] = m->rest[3 * i + r] + u[r];
+        if ((axes >> r) & 1) m->target[3 * i + r] = u[r];
     heml__set_masks(m, i);
     return HEML_OK;
 }
@@ -3003,6 +3231,7 @@ HEMLDEF int heml_set_inversion_threshold(heml_model *m, heml_real J0)
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)J0) && J0 > 0 && J0 < 1)) return HEML_ERR_THRESHOLD;
     m->J0 = J0;
+    m->jm1_0 = (heml_real)((double)J0 - 1.0);
     return HEML_OK;
 }
 
@@ -3019,6 +3248,7 @@ HEMLDEF void heml_reset_viscous_state(heml_model *m)
 HEMLDEF int heml_node_count(const heml_model *m) { return m ? m->node_count : 0; }
 HEMLDEF int heml_tet_count(const heml_model *m) { return m ? m->tet_count : 0; }
 HEMLDEF const heml_real *heml_positions(const heml_model *m) { return m ? m->pos : NULL; }
+HEMLDEF const heml_real *heml_displacements(const heml_model *m) { return m ? m->disp : NULL; }
 HEMLDEF const heml_real *heml_velocities(const heml_model *m) { return m ? m->vel : NULL; }
 HEMLDEF const heml_real *heml_rest_positions(const heml_model *m) { return m ? m->rest : NULL; }
 HEMLDEF const heml_real *heml_masses(const heml_model *m) { return m ? m->mass : NULL; }
@@ -3027,9 +3257,20 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m) { return m ? m->block_byte
 
 HEMLDEF int heml_set_positions(heml_model *m, const heml_real *positions)
 {
+    int i;
     if (!m || !positions) return HEML_ERR_ARG;
     if (!heml__all_finite(positions, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
+    for (i = 0; i < 3 * m->node_count; i++) m->disp[i] = positions[i] - m->rest[i];
     memcpy(m->pos, positions, sizeof(heml_real) * 3 * (size_t)m->node_count);
+    return HEML_OK;
+}
+
+HEMLDEF int heml_set_displacements(heml_model *m, const heml_real *displacements)
+{
+    if (!m || !displacements) return HEML_ERR_ARG;
+    if (!heml__all_finite(displacements, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
+    memcpy(m->disp, displacements, sizeof(heml_real) * 3 * (size_t)m->node_count);
+    heml__update_positions(m);
     return HEML_OK;
 }
 
@@ -3048,7 +3289,7 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m)
 {
     if (!m) return NULL;
     heml__prony_coefficients(m, (double)m->time_step);
-    heml__forces(m, m->pos, m->force, 0);
+    heml__forces(m, m->disp, m->force, 0);
     return m->force;
 }
 
@@ -3057,7 +3298,7 @@ HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *
     if (!m || !dx || !out) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     heml__prony_coefficients(m, (double)m->time_step);
-    heml__pass_run(m, HEML__DIFF, m->pos, dx, out, 0, HEML_STRESS_PK1);
+    heml__pass_run(m, HEML__DIFF, m->disp, dx, out, 0, HEML_STRESS_PK1);
     return HEML_OK;
 }
 
@@ -3088,10 +3329,10 @@ HEMLDEF int heml_energy(heml_model *m, heml_energies *out)
     double kinetic = 0.0, grav = 0.0, ext = 0.0;
     if (!m || !out) return HEML_ERR_ARG;
     n = m->node_count;
-    out->elastic = heml__pass_run(m, HEML__ENERGY, m->pos, NULL, NULL, 0, HEML_STRESS_PK1);
+    out->elastic = heml__pass_run(m, HEML__ENERGY, m->disp, NULL, NULL, 0, HEML_STRESS_PK1);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
-            double v = m->vel[3 * i + r], u = (double)m->pos[3 * i + r] - (double)m->rest[3 * i + r];
+            double v = m->vel[3 * i + r], u = (double)m->disp[3 * i + r];
             kinetic += 0.5 * (double)m->mass[i] * v * v;
             grav -= (double)m->mass[i] * m->gravity[r] * u;
             ext -= (double)m->ext[3 * i + r] * u;
@@ -3110,18 +3351,25 @@ HEMLDEF int heml_tet_volume_ratios(const heml_model *m, heml_real *out)
         const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
         const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
         for (k = 0; k < m->blk_valid[blk]; k++) {
-            const heml_real *p0 = m->pos + 3 * idx[k], *p1 = m->pos + 3 * idx[HEML__W + k];
-            const heml_real *p2 = m->pos + 3 * idx[2 * HEML__W + k], *p3 = m->pos + 3 * idx[3 * HEML__W + k];
-            double a[3], b[3], c[3];
-            int r;
-            for (r = 0; r < 3; r++) {
-                a[r] = (double)p1[r] - p0[r];
-                b[r] = (double)p2[r] - p0[r];
-                c[r] = (double)p3[r] - p0[r];
-            }
+            /* J = 1 + tr H + tr cof H + det H, H = du V^-1, in double */
+            const heml_real *u0 = m->disp + 3 * idx[k];
+            double H[3][3], c0, c1, c2;
+            int r, s2, j;
+            for (r = 0; r < 3; r++)
+                for (s2 = 0; s2 < 3; s2++) {
+                    double acc = 0.0;
+                    for (j = 0; j < 3; j++)
+                        acc += ((double)m->disp[3 * idx[(j + 1) * HEML__W + k] + r] - (double)u0[r]) *
+                               (double)R[(3 * j + s2) * HEML__W + k];
+                    H[r][s2] = acc;
+                }
+            c0 = H[1][1] * H[2][2] - H[1][2] * H[2][1];
+            c1 = H[1][2] * H[2][0] - H[1][0] * H[2][2];
+            c2 = H[1][0] * H[2][1] - H[1][1] * H[2][0];
             out[m->slot_tet[blk * HEML__W + k]] =
-                (heml_real)((a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
-                             a[2] * (b[0] * c[1] - b[1] * c[0])) * (double)R[7 * HEML__W + k]);
+                (heml_real)(1.0 + (H[0][0] + H[1][1] + H[2][2]) + (c0 + (H[0][0] * H[2][2] - H[0][2] * H[2][0]) +
+                                                                     (H[0][0] * H[1][1] - H[0][1] * H[1][0])) +
+                            (H[0][0] * c0 + H[0][1] * c1 + H[0][2] * c2));
         }
     }
     return HEML_OK;
@@ -3131,7 +3379,7 @@ HEMLDEF int heml_tet_stresses(heml_model *m, heml_stress_kind kind, heml_real *o
 {
     if (!m || !out || (kind != HEML_STRESS_PK1 && kind != HEML_STRESS_CAUCHY)) return HEML_ERR_ARG;
     heml__prony_coefficients(m, (double)m->time_step);
-    return heml__pass_run(m, HEML__STRESS, m->pos, NULL, out, 0, kind) > 0 ? HEML_ERR_INVERTED : HEML_OK;
+    return heml__pass_run(m, HEML__STRESS, m->disp, NULL, out, 0, kind) > 0 ? HEML_ERR_INVERTED : HEML_OK;
 }
 
 HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_real out[9])
@@ -3147,7 +3395,7 @@ HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_
         int c, mi = 0;
         for (c = 0; c < m->chunk_count; c++)
             if (blk >= m->chunk_begin[c] && blk < m->chunk_end[c]) mi = m->chunk_material[c];
-        heml__block_forces(m, m->mats + mi, blk, m->pos, &b, 0);
+        heml__block_forces(m, m->mats + mi, blk, m->disp, &b, 0, 0);
     }
     return heml__lane_stress(m, blk, slot % HEML__W, &b, kind, out) ? HEML_ERR_INVERTED : HEML_OK;
 }
@@ -3164,11 +3412,19 @@ HEMLDEF double heml_stable_time_step(const heml_model *m)
             const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
             for (k = 0; k < m->blk_valid[blk]; k++) {
                 /* |grad N_j| = 1 / altitude_j; node 0's gradient is minus the sum */
-                double g00 = R[k], g11 = R[HEML__W + k], g22 = R[2 * HEML__W + k];
-                double g01 = R[3 * HEML__W + k], g02 = R[4 * HEML__W + k], g12 = R[5 * HEML__W + k];
-                double gmax = g00 > g11 ? g00 : g11, g0 = g00 + g11 + g22 + 2 * (g01 + g02 + g12), h;
-                if (g22 > gmax) gmax = g22;
-                if (g0 > gmax) gmax = g0;
+                double gmax = 0.0, g0[3] = {0, 0, 0}, h, gg;
+                int j, r;
+                for (j = 0; j < 3; j++) {
+                    gg = 0.0;
+                    for (r = 0; r < 3; r++) {
+                        double g = (double)R[(3 * j + r) * HEML__W + k];
+                        gg += g * g;
+                        g0[r] += g;
+                    }
+                    if (gg > gmax) gmax = gg;
+                }
+                gg = g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2];
+                if (gg > gmax) gmax = gg;
                 h = 0.5 / sqrt(gmax);
                 if (speed > 0 && h / speed < best) best = h / speed;
             }
