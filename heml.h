@@ -1436,44 +1436,45 @@ static void heml__pk1_forces(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
    `energy`, w (per lane, J) = sum k/2 (l - L)^2. Lengths are clamped at 1e-12 L so
-   coincident nodes give finite forces. v (18 values per lane) receives the links
-   V + du of the six springs. */
-static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *b, int energy)
+   coincident nodes give finite forces. The rest links V4..V6 are differences of the
+   stored V1..V3, the same in the force (heml__spring_forces), so the energy's gradient is
+   exact. */
+static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *HEML__RESTRICT b, int energy)
 {
-    int k, l;
-    for (k = 0; k < HEML__W; k++) {
-        heml_real du[6][3], V[6][3];
-        double we = 0.0;
-        int r;
-        for (r = 0; r < 3; r++) {
-            du[0][r] = b->e[r][k];
-            du[1][r] = b->e[3 + r][k];
-            du[2][r] = b->e[6 + r][k];
-            du[3][r] = du[1][r] - du[0][r];
-            du[4][r] = du[2][r] - du[1][r];
-            du[5][r] = du[0][r] - du[2][r];
-            V[0][r] = S[(12 + r) * HEML__W + k];
-            V[1][r] = S[(15 + r) * HEML__W + k];
-            V[2][r] = S[(18 + r) * HEML__W + k];
-            V[3][r] = V[1][r] - V[0][r];
-            V[4][r] = V[2][r] - V[1][r];
-            V[5][r] = V[0][r] - V[2][r];
-        }
-        for (l = 0; l < 6; l++) {
-            heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k];
-            heml_real dl2 = 2 * (V[l][0] * du[l][0] + V[l][1] * du[l][1] + V[l][2] * du[l][2]) +
-                            (du[l][0] * du[l][0] + du[l][1] * du[l][1] + du[l][2] * du[l][2]);
-            heml_real len = (heml_real)sqrt((double)heml__max(L * L + dl2, 0));
-            heml_real lc = heml__max(len, (heml_real)1e-12 * L), ext = dl2 / (lc + L); /* l - L */
-            b->len[l][k] = lc;
-            b->co[l][k] = kk * ext / lc;
-            if (energy) {
-                double e = (double)dl2 / ((double)len + (double)L);
-                we += (double)kk / 2 * e * e;
+    static const int from[6] = {-1, -1, -1, 0, 1, 2}, to[6] = {0, 1, 2, 1, 2, 0}; /* link l = to - from */
+    heml_real dl2[6][HEML__W];
+    int k, l, r;
+    for (l = 0; l < 6; l++) /* l^2 - L^2 = 2 V . du + |du|^2 (vectorised) */
+        for (k = 0; k < HEML__W; k++) {
+            heml_real acc = 0;
+            for (r = 0; r < 3; r++) {
+                heml_real V = S[(12 + 3 * to[l] + r) * HEML__W + k] - (from[l] < 0 ? 0 : S[(12 + 3 * from[l] + r) * HEML__W + k]);
+                heml_real du = b->e[3 * to[l] + r][k] - (from[l] < 0 ? 0 : b->e[3 * from[l] + r][k]);
+                acc += (2 * V + du) * du;
             }
+            dl2[l][k] = acc;
         }
-        if (energy) b->w[k] = (heml_real)we;
-    }
+    for (l = 0; l < 6; l++) /* the square roots (library calls) */
+        for (k = 0; k < HEML__W; k++) {
+            heml_real L = S[l * HEML__W + k];
+            b->len[l][k] = (heml_real)sqrt((double)heml__max(L * L + dl2[l][k], 0));
+        }
+    for (l = 0; l < 6; l++)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k], len = b->len[l][k];
+            heml_real lc = heml__max(len, (heml_real)1e-12 * L);
+            b->len[l][k] = lc;
+            b->co[l][k] = kk * dl2[l][k] / ((lc + L) * lc); /* k (l - L) / l */
+        }
+    if (energy)
+        for (k = 0; k < HEML__W; k++) {
+            double we = 0.0;
+            for (l = 0; l < 6; l++) {
+                double L = (double)S[l * HEML__W + k], e = (double)dl2[l][k] / ((double)b->len[l][k] + L);
+                we += (double)S[(6 + l) * HEML__W + k] / 2 * e * e;
+            }
+            b->w[k] = (heml_real)we;
+        }
 }
 
 /* The six spring links v_e = V_e + du_e of lane k into v. */
@@ -1484,51 +1485,85 @@ static void heml__spring_links(const heml_real *S, const heml__blk *b, int k, he
         v[0][r] = S[(12 + r) * HEML__W + k] + b->e[r][k];
         v[1][r] = S[(15 + r) * HEML__W + k] + b->e[3 + r][k];
         v[2][r] = S[(18 + r) * HEML__W + k] + b->e[6 + r][k];
-    }
-    for (r = 0; r < 3; r++) {
-        v[3][r] = (S[(15 + r) * HEML__W + k] - S[(12 + r) * HEML__W + k]) + (b->e[3 + r][k] - b->e[r][k]);
-        v[4][r] = (S[(18 + r) * HEML__W + k] - S[(15 + r) * HEML__W + k]) + (b->e[6 + r][k] - b->e[3 + r][k]);
-        v[5][r] = (S[(12 + r) * HEML__W + k] - S[(18 + r) * HEML__W + k]) + (b->e[r][k] - b->e[6 + r][k]);
+        v[3][r] = v[1][r] - v[0][r];
+        v[4][r] = v[2][r] - v[1][r];
+        v[5][r] = v[0][r] - v[2][r];
     }
 }
 
 /* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
-   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3). With dt (differential) each term t v becomes
-   t dv + dt v, dv the links of de. */
-static void heml__spring_forces(const heml_real *S, heml__blk *b, heml_real (*HEML__RESTRICT t)[HEML__W],
-                                heml_real (*HEML__RESTRICT dt)[HEML__W])
+   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). With dt (differential) each term
+   t v becomes t dv + dt v, dv the links of de. */
+static void heml__spring_forces(const heml_real *HEML__RESTRICT S, heml__blk *HEML__RESTRICT b,
+                                heml_real (*HEML__RESTRICT t)[HEML__W], heml_real (*HEML__RESTRICT dt)[HEML__W])
 {
-    int k, r, l;
-    for (k = 0; k < HEML__W; k++) {
-        heml_real v[6][3], p[6][3];
-        heml__spring_links(S, b, k, v);
-        for (r = 0; r < 3; r++) {
+    int k, r;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real v1 = S[(12 + r) * HEML__W + k] + b->e[r][k], v2 = S[(15 + r) * HEML__W + k] + b->e[3 + r][k];
+            heml_real v3 = S[(18 + r) * HEML__W + k] + b->e[6 + r][k];
+            heml_real p1 = t[0][k] * v1, p2 = t[1][k] * v2, p3 = t[2][k] * v3;
+            heml_real p4 = t[3][k] * (v2 - v1), p5 = t[4][k] * (v3 - v2), p6 = t[5][k] * (v1 - v3);
             if (dt) {
                 heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
-                heml_real dv[6];
-                dv[0] = d1;
-                dv[1] = d2;
-                dv[2] = d3;
-                dv[3] = d2 - d1;
-                dv[4] = d3 - d2;
-                dv[5] = d1 - d3;
-                for (l = 0; l < 6; l++) p[l][r] = t[l][k] * dv[l] + dt[l][k] * v[l][r];
-            } else {
-                for (l = 0; l < 6; l++) p[l][r] = t[l][k] * v[l][r];
+                p1 = t[0][k] * d1 + dt[0][k] * v1;
+                p2 = t[1][k] * d2 + dt[1][k] * v2;
+                p3 = t[2][k] * d3 + dt[2][k] * v3;
+                p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
+                p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
+                p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
             }
-            b->f[r][k] = -p[0][r] + p[3][r] - p[5][r];
-            b->f[3 + r][k] = -p[1][r] - p[3][r] + p[4][r];
-            b->f[6 + r][k] = -p[2][r] - p[4][r] + p[5][r];
+            b->f[r][k] = -p1 + p4 - p6;
+            b->f[3 + r][k] = -p2 - p4 + p5;
+            b->f[6 + r][k] = -p3 - p5 + p6;
         }
+}
+
+/* J - 1 of spring tetrahedra, for the statistics only: det(V + du) / (6 Vol) - 1. */
+static void heml__spring_J(const heml_real *HEML__RESTRICT S, const heml_real *HEML__RESTRICT R,
+                           heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = S[12 * HEML__W + k] + b->e[0][k], a1 = S[13 * HEML__W + k] + b->e[1][k];
+        heml_real a2 = S[14 * HEML__W + k] + b->e[2][k], b0 = S[15 * HEML__W + k] + b->e[3][k];
+        heml_real b1 = S[16 * HEML__W + k] + b->e[4][k], b2 = S[17 * HEML__W + k] + b->e[5][k];
+        heml_real d0 = S[18 * HEML__W + k] + b->e[6][k], d1 = S[19 * HEML__W + k] + b->e[7][k];
+        heml_real d2 = S[20 * HEML__W + k] + b->e[8][k], v6 = 6 * R[9 * HEML__W + k];
+        heml_real det = a0 * (b1 * d2 - b2 * d1) + a1 * (b2 * d0 - b0 * d2) + a2 * (b0 * d1 - b1 * d0);
+        b->jm1[k] = v6 > 0 ? det / v6 - 1 : 0;
     }
 }
 
-/* The Neo-Hookean kernel (K_RAW without I2 and without Prony) in one loop, so that the
-   intermediate quantities stay in registers: H, cof H, J - 1, the volumetric stress
-   w_J = U'(J) (continued below J0), s0 = p0 + w_J and
-       P = s0 I + 2 c1 H + w_J (tr H I - H^T + cof H),   f_k = -Vol P grad N_k.
-   The same arithmetic as heml__kinematics, heml__law_raw, heml__coefficients and
-   heml__pk1_forces. */
+/* f_k = -P grad N_k (k = 1..3) for the Vol-scaled P held in b->K. */
+static void heml__p_times_grad(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real P00 = b->K[0][k], P01 = b->K[1][k], P02 = b->K[2][k];
+        heml_real P10 = b->K[3][k], P11 = b->K[4][k], P12 = b->K[5][k];
+        heml_real P20 = b->K[6][k], P21 = b->K[7][k], P22 = b->K[8][k];
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
+        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
+        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
+        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
+        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
+        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
+        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
+        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
+        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
+    }
+}
+
+/* The Neo-Hookean kernel (K_RAW without I2 and without Prony): one loop for H, cof H,
+   J - 1, the volumetric stress w_J = U'(J) (continued below J0), s0 = p0 + w_J and
+       P = s0 I + 2 c1 H + w_J (tr H I - H^T + cof H)   (times Vol, into b->K),
+   then f_k = -P grad N_k (two loops: one would spill the 16 AVX2 registers; measured
+   about 10 % faster). The same arithmetic as heml__kinematics, heml__law_raw,
+   heml__coefficients and heml__pk1_forces. */
 static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
                             heml__blk *HEML__RESTRICT b)
 {
@@ -1557,37 +1592,32 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
         heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
         heml_real sv = s0 * vol, mv = mu * vol, wv = (s0 - p0) * vol, tw = wv * tr;
-        heml_real P00 = sv + mv * H00 + wv * (c00 - H00) + tw, P11 = sv + mv * H11 + wv * (c11 - H11) + tw;
-        heml_real P22 = sv + mv * H22 + wv * (c22 - H22) + tw;
-        heml_real P01 = mv * H01 + wv * (c01 - H10), P02 = mv * H02 + wv * (c02 - H20);
-        heml_real P10 = mv * H10 + wv * (c10 - H01), P12 = mv * H12 + wv * (c12 - H21);
-        heml_real P20 = mv * H20 + wv * (c20 - H02), P21 = mv * H21 + wv * (c21 - H12);
         b->jm1[k] = jm1;
-        /* written out (an inner loop would keep gcc -O2 from vectorising the lane loop) */
-        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
-        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
-        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
-        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
-        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
-        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
-        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
-        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
-        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
+        b->K[0][k] = sv + mv * H00 + wv * (c00 - H00) + tw;
+        b->K[4][k] = sv + mv * H11 + wv * (c11 - H11) + tw;
+        b->K[8][k] = sv + mv * H22 + wv * (c22 - H22) + tw;
+        b->K[1][k] = mv * H01 + wv * (c01 - H10);
+        b->K[2][k] = mv * H02 + wv * (c02 - H20);
+        b->K[3][k] = mv * H10 + wv * (c10 - H01);
+        b->K[5][k] = mv * H12 + wv * (c12 - H21);
+        b->K[6][k] = mv * H20 + wv * (c20 - H02);
+        b->K[7][k] = mv * H21 + wv * (c21 - H12);
     }
+    heml__p_times_grad(R, b);
 }
 
-/* The Neo-Hookean force differential in one loop: with F = I + H, dH = dv V^-1,
-   dJ = cof F : dH,
+/* The Neo-Hookean force differential: with F = I + H, dH = dv V^-1, dJ = cof F : dH,
        dP = 2 c1 dH + U''(J) dJ cof F + w_J dcof F,   df_k = -Vol dP grad N_k,
    dcof F the derivative of the cofactors (column j of cof F is the cross product of the
-   other two columns of F). Positions enter only through F, so no rest cancellation
-   matters here. */
+   other two columns of F). It is not small at rest, so F is formed directly. Three
+   loops (H and dH, dP, the product with the gradients) spill fewer registers than one
+   (measured: 10 % faster). */
 static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
                           heml__blk *HEML__RESTRICT b)
 {
     const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
-    for (k = 0; k < HEML__W; k++) {
+    for (k = 0; k < HEML__W; k++) { /* H and dH */
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
         heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
         heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
@@ -1597,29 +1627,36 @@ static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real 
         heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
         heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
         heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        b->H[0][k] = a0 * g10 + b0 * g20 + d0 * g30;
+        b->H[1][k] = a0 * g11 + b0 * g21 + d0 * g31;
+        b->H[2][k] = a0 * g12 + b0 * g22 + d0 * g32;
+        b->H[3][k] = a1 * g10 + b1 * g20 + d1 * g30;
+        b->H[4][k] = a1 * g11 + b1 * g21 + d1 * g31;
+        b->H[5][k] = a1 * g12 + b1 * g22 + d1 * g32;
+        b->H[6][k] = a2 * g10 + b2 * g20 + d2 * g30;
+        b->H[7][k] = a2 * g11 + b2 * g21 + d2 * g31;
+        b->H[8][k] = a2 * g12 + b2 * g22 + d2 * g32;
+        b->K[0][k] = x0 * g10 + y0 * g20 + z0 * g30;
+        b->K[1][k] = x0 * g11 + y0 * g21 + z0 * g31;
+        b->K[2][k] = x0 * g12 + y0 * g22 + z0 * g32;
+        b->K[3][k] = x1 * g10 + y1 * g20 + z1 * g30;
+        b->K[4][k] = x1 * g11 + y1 * g21 + z1 * g31;
+        b->K[5][k] = x1 * g12 + y1 * g22 + z1 * g32;
+        b->K[6][k] = x2 * g10 + y2 * g20 + z2 * g30;
+        b->K[7][k] = x2 * g11 + y2 * g21 + z2 * g31;
+        b->K[8][k] = x2 * g12 + y2 * g22 + z2 * g32;
+    }
+    for (k = 0; k < HEML__W; k++) { /* dP (into K) */
+        heml_real F00 = 1 + b->H[0][k], F01 = b->H[1][k], F02 = b->H[2][k];
+        heml_real F10 = b->H[3][k], F11 = 1 + b->H[4][k], F12 = b->H[5][k];
+        heml_real F20 = b->H[6][k], F21 = b->H[7][k], F22 = 1 + b->H[8][k];
+        heml_real D00 = b->K[0][k], D01 = b->K[1][k], D02 = b->K[2][k];
+        heml_real D10 = b->K[3][k], D11 = b->K[4][k], D12 = b->K[5][k];
+        heml_real D20 = b->K[6][k], D21 = b->K[7][k], D22 = b->K[8][k];
         heml_real vol = R[9 * HEML__W + k];
-        heml_real F00 = 1 + (a0 * g10 + b0 * g20 + d0 * g30), F01 = a0 * g11 + b0 * g21 + d0 * g31;
-        heml_real F02 = a0 * g12 + b0 * g22 + d0 * g32, F10 = a1 * g10 + b1 * g20 + d1 * g30;
-        heml_real F11 = 1 + (a1 * g11 + b1 * g21 + d1 * g31), F12 = a1 * g12 + b1 * g22 + d1 * g32;
-        heml_real F20 = a2 * g10 + b2 * g20 + d2 * g30, F21 = a2 * g11 + b2 * g21 + d2 * g31;
-        heml_real F22 = 1 + (a2 * g12 + b2 * g22 + d2 * g32);
-        heml_real D00 = x0 * g10 + y0 * g20 + z0 * g30, D01 = x0 * g11 + y0 * g21 + z0 * g31;
-        heml_real D02 = x0 * g12 + y0 * g22 + z0 * g32, D10 = x1 * g10 + y1 * g20 + z1 * g30;
-        heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
-        heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
-        heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32;
         heml_real C00 = F11 * F22 - F12 * F21, C01 = F12 * F20 - F10 * F22, C02 = F10 * F21 - F11 * F20;
         heml_real C10 = F02 * F21 - F01 * F22, C11 = F00 * F22 - F02 * F20, C12 = F01 * F20 - F00 * F21;
         heml_real C20 = F01 * F12 - F02 * F11, C21 = F02 * F10 - F00 * F12, C22 = F00 * F11 - F01 * F10;
-        heml_real dC00 = D11 * F22 + F11 * D22 - D12 * F21 - F12 * D21;
-        heml_real dC01 = D12 * F20 + F12 * D20 - D10 * F22 - F10 * D22;
-        heml_real dC02 = D10 * F21 + F10 * D21 - D11 * F20 - F11 * D20;
-        heml_real dC10 = D02 * F21 + F02 * D21 - D01 * F22 - F01 * D22;
-        heml_real dC11 = D00 * F22 + F00 * D22 - D02 * F20 - F02 * D20;
-        heml_real dC12 = D01 * F20 + F01 * D20 - D00 * F21 - F00 * D21;
-        heml_real dC20 = D01 * F12 + F01 * D12 - D02 * F11 - F02 * D11;
-        heml_real dC21 = D02 * F10 + F02 * D10 - D00 * F12 - F00 * D12;
-        heml_real dC22 = D00 * F11 + F00 * D11 - D01 * F10 - F01 * D10;
         heml_real J = F00 * C00 + F01 * C01 + F02 * C02;
         heml_real jc1 = heml__max(J - 1, jm1_0), Jc = 1 + jc1, d = (J - 1) - jc1, iJ = 1 / Jc;
         heml_real L = heml__log(Jc);
@@ -1628,21 +1665,17 @@ static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real 
         heml_real dJ = C00 * D00 + C01 * D01 + C02 * D02 + C10 * D10 + C11 * D11 + C12 * D12 + C20 * D20 +
                        C21 * D21 + C22 * D22;
         heml_real hv = hh * dJ * vol;
-        heml_real P00 = mv * D00 + hv * C00 + wv * dC00, P01 = mv * D01 + hv * C01 + wv * dC01;
-        heml_real P02 = mv * D02 + hv * C02 + wv * dC02, P10 = mv * D10 + hv * C10 + wv * dC10;
-        heml_real P11 = mv * D11 + hv * C11 + wv * dC11, P12 = mv * D12 + hv * C12 + wv * dC12;
-        heml_real P20 = mv * D20 + hv * C20 + wv * dC20, P21 = mv * D21 + hv * C21 + wv * dC21;
-        heml_real P22 = mv * D22 + hv * C22 + wv * dC22;
-        b->f[0][k] = -(P00 * g10 + P01 * g11 + P02 * g12);
-        b->f[1][k] = -(P10 * g10 + P11 * g11 + P12 * g12);
-        b->f[2][k] = -(P20 * g10 + P21 * g11 + P22 * g12);
-        b->f[3][k] = -(P00 * g20 + P01 * g21 + P02 * g22);
-        b->f[4][k] = -(P10 * g20 + P11 * g21 + P12 * g22);
-        b->f[5][k] = -(P20 * g20 + P21 * g21 + P22 * g22);
-        b->f[6][k] = -(P00 * g30 + P01 * g31 + P02 * g32);
-        b->f[7][k] = -(P10 * g30 + P11 * g31 + P12 * g32);
-        b->f[8][k] = -(P20 * g30 + P21 * g31 + P22 * g32);
+        b->K[0][k] = mv * D00 + hv * C00 + wv * (D11 * F22 + F11 * D22 - D12 * F21 - F12 * D21);
+        b->K[1][k] = mv * D01 + hv * C01 + wv * (D12 * F20 + F12 * D20 - D10 * F22 - F10 * D22);
+        b->K[2][k] = mv * D02 + hv * C02 + wv * (D10 * F21 + F10 * D21 - D11 * F20 - F11 * D20);
+        b->K[3][k] = mv * D10 + hv * C10 + wv * (D02 * F21 + F02 * D21 - D01 * F22 - F01 * D22);
+        b->K[4][k] = mv * D11 + hv * C11 + wv * (D00 * F22 + F00 * D22 - D02 * F20 - F02 * D20);
+        b->K[5][k] = mv * D12 + hv * C12 + wv * (D01 * F20 + F01 * D20 - D00 * F21 - F00 * D21);
+        b->K[6][k] = mv * D20 + hv * C20 + wv * (D01 * F12 + F01 * D12 - D02 * F11 - F02 * D11);
+        b->K[7][k] = mv * D21 + hv * C21 + wv * (D02 * F10 + F02 * D10 - D00 * F12 - F00 * D12);
+        b->K[8][k] = mv * D22 + hv * C22 + wv * (D00 * F11 + F00 * D11 - D01 * F10 - F01 * D10);
     }
+    heml__p_times_grad(R, b);
 }
 
 /* Kinematics, law and stress coefficients of one general block (not springs), Prony
@@ -1679,7 +1712,7 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
     heml__gather(idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
-        heml__kinematics(R, b); /* J for the statistics */
+        heml__spring_J(S, R, b);
         heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
         heml__spring_forces(S, b, b->co, NULL);
