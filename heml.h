@@ -792,8 +792,7 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__W 16          /* tetrahedra per block: the SIMD width of the kernels' loops */
 #define HEML__CHUNK 16      /* blocks per chunk: the unit of threading and colouring */
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
-#define HEML__NS 21         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses,
-                               the rest links V1, V2, V3 */
+#define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__SCRATCH 17    /* 3n scratch vectors */
@@ -1432,12 +1431,36 @@ static void heml__pk1_forces(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
     }
 }
 
+/* The rest links V1, V2, V3 of the block's lanes into b->H (springs do not use H), from
+   the rest gradients: V = (V^-1)^-1 = 6 Vol adj(V^-1), V_1 = 6 Vol grad N_2 x grad N_3 and
+   cyclically. Force, energy and differential use the same V, so the energy's gradient is
+   exact whatever its rounding; the stream stays 10 rest constants per tetrahedron. */
+static void heml__spring_rest_links(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real v6 = 6 * R[9 * HEML__W + k];
+        b->H[0][k] = v6 * (g21 * g32 - g22 * g31);
+        b->H[1][k] = v6 * (g22 * g30 - g20 * g32);
+        b->H[2][k] = v6 * (g20 * g31 - g21 * g30);
+        b->H[3][k] = v6 * (g31 * g12 - g32 * g11);
+        b->H[4][k] = v6 * (g32 * g10 - g30 * g12);
+        b->H[5][k] = v6 * (g30 * g11 - g31 * g10);
+        b->H[6][k] = v6 * (g11 * g22 - g12 * g21);
+        b->H[7][k] = v6 * (g12 * g20 - g10 * g22);
+        b->H[8][k] = v6 * (g10 * g21 - g11 * g20);
+    }
+}
+
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
    `energy`, w (per lane, J) = sum k/2 (l - L)^2. Lengths are clamped at 1e-12 L so
-   coincident nodes give finite forces. The rest links V4..V6 are differences of the
-   stored V1..V3, the same in the force (heml__spring_forces), so the energy's gradient is
+   coincident nodes give finite forces. The rest links are those of heml__spring_rest_links
+   (V4..V6 the differences of V1..V3), the same in the force, so the energy's gradient is
    exact. */
 static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *HEML__RESTRICT b, int energy)
 {
@@ -1448,7 +1471,7 @@ static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *
         for (k = 0; k < HEML__W; k++) {
             heml_real acc = 0;
             for (r = 0; r < 3; r++) {
-                heml_real V = S[(12 + 3 * to[l] + r) * HEML__W + k] - (from[l] < 0 ? 0 : S[(12 + 3 * from[l] + r) * HEML__W + k]);
+                heml_real V = b->H[3 * to[l] + r][k] - (from[l] < 0 ? 0 : b->H[3 * from[l] + r][k]);
                 heml_real du = b->e[3 * to[l] + r][k] - (from[l] < 0 ? 0 : b->e[3 * from[l] + r][k]);
                 acc += (2 * V + du) * du;
             }
@@ -1478,13 +1501,13 @@ static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *
 }
 
 /* The six spring links v_e = V_e + du_e of lane k into v. */
-static void heml__spring_links(const heml_real *S, const heml__blk *b, int k, heml_real v[6][3])
+static void heml__spring_links(const heml__blk *b, int k, heml_real v[6][3])
 {
     int r;
     for (r = 0; r < 3; r++) {
-        v[0][r] = S[(12 + r) * HEML__W + k] + b->e[r][k];
-        v[1][r] = S[(15 + r) * HEML__W + k] + b->e[3 + r][k];
-        v[2][r] = S[(18 + r) * HEML__W + k] + b->e[6 + r][k];
+        v[0][r] = b->H[r][k] + b->e[r][k];
+        v[1][r] = b->H[3 + r][k] + b->e[3 + r][k];
+        v[2][r] = b->H[6 + r][k] + b->e[6 + r][k];
         v[3][r] = v[1][r] - v[0][r];
         v[4][r] = v[2][r] - v[1][r];
         v[5][r] = v[0][r] - v[2][r];
@@ -1494,14 +1517,14 @@ static void heml__spring_links(const heml_real *S, const heml__blk *b, int k, he
 /* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
    (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). With dt (differential) each term
    t v becomes t dv + dt v, dv the links of de. */
-static void heml__spring_forces(const heml_real *HEML__RESTRICT S, heml__blk *HEML__RESTRICT b,
+static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
                                 heml_real (*HEML__RESTRICT t)[HEML__W], heml_real (*HEML__RESTRICT dt)[HEML__W])
 {
     int k, r;
     for (r = 0; r < 3; r++)
         for (k = 0; k < HEML__W; k++) {
-            heml_real v1 = S[(12 + r) * HEML__W + k] + b->e[r][k], v2 = S[(15 + r) * HEML__W + k] + b->e[3 + r][k];
-            heml_real v3 = S[(18 + r) * HEML__W + k] + b->e[6 + r][k];
+            heml_real v1 = b->H[r][k] + b->e[r][k], v2 = b->H[3 + r][k] + b->e[3 + r][k];
+            heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
             heml_real p1 = t[0][k] * v1, p2 = t[1][k] * v2, p3 = t[2][k] * v3;
             heml_real p4 = t[3][k] * (v2 - v1), p5 = t[4][k] * (v3 - v2), p6 = t[5][k] * (v1 - v3);
             if (dt) {
@@ -1520,16 +1543,15 @@ static void heml__spring_forces(const heml_real *HEML__RESTRICT S, heml__blk *HE
 }
 
 /* J - 1 of spring tetrahedra, for the statistics only: det(V + du) / (6 Vol) - 1. */
-static void heml__spring_J(const heml_real *HEML__RESTRICT S, const heml_real *HEML__RESTRICT R,
-                           heml__blk *HEML__RESTRICT b)
+static void heml__spring_J(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real a0 = S[12 * HEML__W + k] + b->e[0][k], a1 = S[13 * HEML__W + k] + b->e[1][k];
-        heml_real a2 = S[14 * HEML__W + k] + b->e[2][k], b0 = S[15 * HEML__W + k] + b->e[3][k];
-        heml_real b1 = S[16 * HEML__W + k] + b->e[4][k], b2 = S[17 * HEML__W + k] + b->e[5][k];
-        heml_real d0 = S[18 * HEML__W + k] + b->e[6][k], d1 = S[19 * HEML__W + k] + b->e[7][k];
-        heml_real d2 = S[20 * HEML__W + k] + b->e[8][k], v6 = 6 * R[9 * HEML__W + k];
+        heml_real a0 = b->H[0][k] + b->e[0][k], a1 = b->H[1][k] + b->e[1][k];
+        heml_real a2 = b->H[2][k] + b->e[2][k], b0 = b->H[3][k] + b->e[3][k];
+        heml_real b1 = b->H[4][k] + b->e[4][k], b2 = b->H[5][k] + b->e[5][k];
+        heml_real d0 = b->H[6][k] + b->e[6][k], d1 = b->H[7][k] + b->e[7][k];
+        heml_real d2 = b->H[8][k] + b->e[8][k], v6 = 6 * R[9 * HEML__W + k];
         heml_real det = a0 * (b1 * d2 - b2 * d1) + a1 * (b2 * d0 - b0 * d2) + a2 * (b0 * d1 - b1 * d0);
         b->jm1[k] = v6 > 0 ? det / v6 - 1 : 0;
     }
@@ -1712,10 +1734,11 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
     heml__gather(idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
-        heml__spring_J(S, R, b);
+        heml__spring_rest_links(R, b);
+        heml__spring_J(R, b);
         heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
-        heml__spring_forces(S, b, b->co, NULL);
+        heml__spring_forces(b, b->co, NULL);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count && !want_energy) {
@@ -1841,12 +1864,13 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml_real dsig[6][HEML__W];
+        heml__spring_rest_links(R, b);
         heml__spring_tensions(S, b, 0);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, 0);
         for (k = 0; k < HEML__W; k++) {
             heml_real v[6][3], dv[6][3];
             int l, r;
-            heml__spring_links(S, b, k, v);
+            heml__spring_links(b, k, v);
             for (r = 0; r < 3; r++) {
                 dv[0][r] = b->de[r][k];
                 dv[1][r] = b->de[3 + r][k];
@@ -1861,7 +1885,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
                 dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
             }
         }
-        heml__spring_forces(S, b, b->co, dsig);
+        heml__spring_forces(b, b->co, dsig);
         return;
     }
     /* (raw laws without I2 reach here only with Prony: the general path covers them, with
@@ -1988,6 +2012,7 @@ static void heml__chunks(void *vctx, int begin, int end)
             case HEML__ENERGY:
                 heml__gather(idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
+                    heml__spring_rest_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
                 } else {
                     heml__kinematics(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
@@ -2528,10 +2553,6 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
                     m->blk_spring[((size_t)blk * HEML__NS + 6 + l) * HEML__W + k] =
                         (heml_real)((double)mt->young * vol / L2);
                 }
-                for (j = 1; j < 4; j++) /* the rest links V1, V2, V3, in double */
-                    for (r = 0; r < 3; r++)
-                        m->blk_spring[((size_t)blk * HEML__NS + 9 + 3 * j + r) * HEML__W + k] =
-                            (heml_real)((double)m->rest[3 * q[j] + r] - (double)m->rest[3 * q[0] + r]);
             } else if (m->blk_spring) {
                 for (l = 0; l < HEML__NS; l++) m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = l < 6;
             }
