@@ -86,7 +86,9 @@
    else allocates: steps, forces, stiffness products, solves and diagnostics reuse that
    block. The description's arrays (and the materials' Prony arrays) are read during
    heml_create only. Pointers returned by heml_positions and friends point into the model
-   and stay valid until heml_destroy.
+   and stay valid until heml_destroy. Meshes of 96 nodes or more also hold the static
+   solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
+   24, at most 64: up to 1.2 MB).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
