@@ -328,13 +328,16 @@
          about 1e-7 of the forces themselves, but the state u is stored in float, so a
          strain is resolved to about eps |u| / (h |strain|) (eps = 6e-8, h the element
          size): deflections and rigid motions large against the strains cost digits. On the
-         steel cantilever R1 (strains 1e-4, tip 0.05 to 0.15 m) the tip deflection is within
-         1e-4 of double's at one or two cells across and about 1e-3 at eight; the static
-         solve's residual stalls there at the stiffness times one ulp of u, far above a
-         double-like tolerance (float's default static_tolerance is 1e-4, met through the
-         energy criterion of STATIC SOLVE). heml_set_positions rounds u = x - X once (at
-         1e3 m from the origin that is 6e-5 m); heml_set_displacements sets u exactly. Use
-         double for stiff slender bodies that need more than 3 to 4 digits.
+         steel cantilever R1 (strains 1e-4, tip 0.05 to 0.15 m) the static solve's residual
+         stalls at the stiffness times one ulp of u, where the energy-norm error is 3e-5 at
+         one cell across, 8e-5 at two, 1.2e-4 at three, 2.8e-4 at six and 3.9e-4 at eight:
+         with float's default static_tolerance (1e-4) the solve succeeds at one and two
+         cells across and returns HEML_ERR_ROUND_OFF from three on; with 5e-4 it succeeds
+         at every level and the tip deflection is within 1e-4 of double's. Softer bodies
+         with larger strains (R2: within 2e-5 of double) are not limited.
+         heml_set_positions rounds u = x - X once (at 1e3 m from the origin that is
+         6e-5 m); heml_set_displacements sets u exactly. Use double for stiff slender
+         bodies that need more than 3 to 4 digits.
        - User laws (HEML_USER): s0 = 2 w_1 + 4 w_2 + w_J is summed from the callbacks'
          values, so their rest state cancels only to the callbacks' round-off (eps times
          the moduli: in float, the forces of strains below about 1e-5 drown) and their

@@ -822,6 +822,89 @@ static void test_differential_with_prony(void)
 
 /* ---- tests: frame indifference (R6) ---------------------------------------------- */
 
+/* The displacement form (THE MODEL, "how it is evaluated"): a mesh at rest gives exactly
+   zero force, and small strains keep their relative precision far from the origin. A
+   1 m cube of 2 x 2 x 2 cells whose rest positions are offset by (1e3, -2e3, 16) m (in
+   float their resolution is 6e-5 m) is given u = E X' (X' the offset-free coordinates) for
+   a mixed strain E of size 1e-6 (and 1e-4), set with heml_set_displacements, and every
+   continuum law's forces are compared with the linear P1 forces -Vol sigma(E) grad N of
+   its small-strain moduli, computed here in double: the difference is the law's
+   nonlinearity (of relative order |E|) plus round-off, so 3e-6 at 1e-6 in double and
+   3e-4 at 1e-4; float adds its relative round-off, about 1e-6. (Computed from positions,
+   float's forces at 1e-6 would be noise: 6e-5 m of resolution against 5e-7 m of
+   stretch per cell.) */
+static void test_rest_and_small_strains(void)
+{
+    static const double offset[3] = {1e3, -2e3, 16};
+    static const double Edir[3][3] = {{0.8, 0.3, -0.2}, {0.1, -0.5, 0.4}, {-0.3, 0.2, 0.6}};
+    tetmesh mesh;
+    int li, si;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    for (li = 0; li < NLAWS - 2; li++) { /* the built-in continuum laws */
+        heml_material mt = material_of(all_laws[li]);
+        heml_desc d = heml_default_desc();
+        heml_model *m;
+        int n = mesh.node_count, i, r, s, t, j;
+        heml_real *X = alloc_reals(3 * n), *u = alloc_reals(3 * n);
+        double *fl = (double *)calloc(3 * (size_t)n, sizeof(double)), worst[2] = {0, 0}, mu, lambda;
+        const heml_real *f;
+        int zero = 1;
+        for (i = 0; i < 3 * n; i++) X[i] = (heml_real)(mesh.nodes[i] + offset[i % 3]);
+        d.rest_positions = X;
+        d.node_count = n;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        d.material = mt;
+        REQUIRE(heml_create(&d, &m) == HEML_OK);
+        mu = m->mats[0].small_mu; /* (the moduli the law has at rest, see THE MODEL) */
+        lambda = m->mats[0].small_lambda;
+        f = heml_compute_forces(m);
+        for (i = 0; i < 3 * n; i++) zero &= f[i] == 0;
+        CHECK(zero);
+        for (si = 0; si < 2; si++) {
+            double eps = si ? 1e-4 : 1e-6, fmax = 0.0, err = 0.0, E[3][3], sig[3][3], tr;
+            for (r = 0; r < 3; r++)
+                for (s = 0; s < 3; s++) E[r][s] = eps * Edir[r][s];
+            for (i = 0; i < n; i++)
+                for (r = 0; r < 3; r++) {
+                    double a = 0.0;
+                    for (s = 0; s < 3; s++) a += E[r][s] * mesh.nodes[3 * i + s];
+                    u[3 * i + r] = (heml_real)a;
+                }
+            CHECK_INT(HEML_OK, heml_set_displacements(m, u));
+            /* linear P1: sigma = lambda tr eps I + 2 mu eps (eps the symmetric part of E) */
+            tr = E[0][0] + E[1][1] + E[2][2];
+            for (r = 0; r < 3; r++)
+                for (s = 0; s < 3; s++) sig[r][s] = mu * (E[r][s] + E[s][r]) + (r == s ? lambda * tr : 0.0);
+            memset(fl, 0, sizeof(double) * 3 * (size_t)n);
+            for (t = 0; t < mesh.tet_count; t++) {
+                const double *p[4];
+                double g[4][3], vol;
+                for (j = 0; j < 4; j++) p[j] = mesh.nodes + 3 * mesh.tets[4 * t + j];
+                vol = fem_gradients(p, g);
+                for (j = 0; j < 4; j++)
+                    for (r = 0; r < 3; r++)
+                        for (s = 0; s < 3; s++) fl[3 * mesh.tets[4 * t + j] + r] -= vol * sig[r][s] * g[j][s];
+            }
+            f = heml_compute_forces(m);
+            for (i = 0; i < 3 * n; i++) {
+                fmax = fabs(fl[i]) > fmax ? fabs(fl[i]) : fmax;
+                err = fabs((double)f[i] - fl[i]) > err ? fabs((double)f[i] - fl[i]) : err;
+            }
+            worst[si] = err / fmax;
+        }
+        printf("    %-18s at rest: exactly zero %d; |f - f_linear| / |f| = %.2g at strain 1e-6, %.2g at 1e-4\n",
+               law_name[li], zero, worst[0], worst[1]);
+        CHECK(worst[0] <= (IS_FLOAT ? 1e-5 : 3e-6));
+        CHECK(worst[1] <= 3e-4);
+        free(X);
+        free(u);
+        free(fl);
+        heml_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
 /* For every law: forces under a rigid rotation of 90 degrees about x, y and z plus the
    translation (1e3, -2e3, 5e2) m are zero to round-off relative to the forces of a 1 %
    stretch. Tolerances: double, 1e-8 (coordinates near 2e3 m carry 2e-13 m of rounding on
@@ -1256,6 +1339,7 @@ static const test_case cases[] = {
     TEST(test_paper_appendix_quantities),
     TEST(test_differential_is_force_derivative),
     TEST(test_differential_with_prony),
+    TEST(test_rest_and_small_strains),
     TEST(test_rigid_motion_zero_force),
     TEST(test_mass_spring_is_classical_springs),
     TEST(test_inversion_recovers),
