@@ -258,50 +258,71 @@
        in float, 7 or 8, the energy criterion ending them (see LIMITS for what float
        resolves). Drive large motions in increments from the last solution.
 
-   PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 8 rest
-   constants (HEML_KERNEL_BYTES_PER_TET: 80 bytes in double, 48 in float; springs read 96
-   more, a Prony series 56 per term, which it also writes), gathers the positions of its 4
-   nodes (96 bytes, mostly cache hits when nodes are numbered with locality) and adds into
-   their forces (96 bytes read and written, likewise). heml_kernel_bytes gives the least a
-   pass must move from memory: the stream plus each node's position read once and force
-   written once (89 bytes per tetrahedron on the beam below). Tetrahedra sit in blocks of
-   16 (structure of arrays inside a block) and a block is one vectorised loop from the
-   links to the forces; gather and scatter are scalar loops (AVX2 has no scatter). The
-   Neo-Hookean kernel needs no D, no I1, no I2: 9 subtractions, 3 cross products, the
-   determinant, one logarithm (a branch-free fdlibm polynomial, which vectorises where
-   libm's log is a call), two divisions and 36 multiply-adds.
-   Measured with gcc 12, one thread, double unless stated, on tetmesh_beam(2, 1, 1, 40, 20,
-   20, TETMESH_SPLIT6) (96,000 tetrahedra, 18,081 nodes) stretched by up to 2 % with a
-   small perturbation, 150 calls of heml_compute_forces / heml_apply_stiffness, minimum
-   (median) per tetrahedron, on this project's AMD EPYC (Zen 5) virtual machine with AVX2:
-   two vCPUs shared with other jobs, an effective clock of 2.5 GHz measured by a dependent
-   add chain in the same session (the nominal 4.2 GHz was not available), STREAM-like
-   triad 24 GB/s. Command: gcc -O3 -march=native bench.c -lm, bench.c being the loop just
-   described (the bench/ program measures the same entry points).
-       Neo-Hookean force                   16.9 (20.0) ns
-       Neo-Hookean differential            28.4 (32.8) ns, 1.7 x the force
-       St Venant-Kirchhoff force           21.8 (25.4) ns; differential 1.8 x
-       Neo-Hookean, gcc -O2 -march=native  18.7 ns; -std=c99 (no FMA contraction) 18.9 ns;
-                                           -O2 for generic x86-64 (SSE2) 34.9 ns
-       Neo-Hookean, float                  12.1 ns
-       Neo-Hookean, 768,000 tetrahedra     25 ns (the stream no longer fits the 32 MB L3)
-       memory bound                        3.7 ns (89 bytes at 24 GB/s), 2.2 ns in float
-   Against the targets this work was designed for: the force sits at 4.6 times the memory
-   bound, not 2, and 17 ns rather than 15 at this session's clock. It is bound by the 62
-   scalar memory operations of the gather and scatter (8 index loads, 12 coordinate loads,
-   9 link stores, 9 + 12 loads and 12 stores of forces: about 8 ns) and by the vectorised
-   arithmetic (about 7 ns, the logarithm 2.7 of them), not by bandwidth. The differential
-   stays under twice the force. For comparison REFERENCES lists Bullet's Neo-Hookean at
-   181 ns and Vega's at 377 ns per tetrahedron on this machine kind. Mooney-Rivlin (split)
-   costs about 2.5 times Neo-Hookean (J^-2/3 by libm's cbrt, a call), springs about 3 times
-   (six square roots, calls under errno semantics). Rejected after measurement: a two-pass
-   gather (per-tetrahedron forces into a 96-byte-per-tetrahedron buffer, then a per-node
-   sum through a reverse table) cost 30 to 35 ns against 24 to 27 ns for the colouring in
-   the same runs (its first pass alone costs as much as the whole coloured pass); blocks of
-   32, interleaving neighbouring tetrahedra across lanes, computing node 0's force in the
-   vector loop, and software prefetch of the stream or of the next block's nodes did not
-   help (within the noise or worse). Vector gathers are slower than scalar loads here (4
-   against 3 ns), so the gather loop is kept scalar (HEML__SCALAR_FN).
+   PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
+   constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
+   more, a Prony series 72 per term, which it also writes), gathers the displacements of
+   its 4 nodes (96 bytes, mostly cache hits when nodes are numbered with locality) and adds
+   into their forces (96 bytes read and written, likewise). heml_kernel_bytes gives the
+   least a pass must move from memory: the stream plus each node's displacement read once
+   and force written once (105 bytes per tetrahedron on the beam below). Tetrahedra sit in
+   blocks of 16 (structure of arrays inside a block); a block's arithmetic is vectorised
+   loops over its lanes; gather and scatter are scalar loops (AVX2 has no scatter). The
+   Neo-Hookean force: 9 subtractions (the link displacements), H = du V^-1 (27
+   multiply-adds), cof H (18), J - 1, one logarithm with its log1p correction (a
+   branch-free fdlibm polynomial, which vectorises where libm's log is a call), two
+   divisions, P (about 30 operations) and P grad N (27 multiply-adds): about 140
+   operations, where 0.1.0's position form needed about 90 (it let the rest terms cancel,
+   which cost float its small strains).
+   Measured with gcc 12, one thread, on tetmesh_beam(2, 1, 1, n, n/2, n/2, TETMESH_SPLIT6)
+   stretched by up to 2 % with a small perturbation, minimum (median) per tetrahedron of
+   150 calls of heml_compute_forces / heml_apply_stiffness (400 for the small beam),
+   0.1.0 and 0.2.0 built and run interleaved in the same session, min over 3 to 5 rounds;
+   gcc -O3 -march=native (FMA contraction on) unless stated. Machine: this project's AMD
+   EPYC (Zen 5) virtual machine with AVX2, two vCPUs shared with other jobs (figures move
+   by 20 % between runs; compare within a row), an effective clock of 3.1 GHz by a
+   dependent add chain, triad 18.8 GB/s, both measured in the same session.
+                                           0.1.0            0.2.0
+       n = 20: 12,000 tetrahedra (1.2 MB, cache-resident)
+       Neo-Hookean force                   15.8 ns          19.9 ns
+       Neo-Hookean differential            21.4             25.1
+       Neo-Hookean, float: force, diff.    11.7, 15.7       14.4, 17.9
+       St Venant-Kirchhoff force, diff.    20.2, 34.8       21.4, 34.9
+       Mooney-Rivlin (split) force, diff.  44.6, 59.2       52.4, 65.5
+       springs force, diff.                42.1, 58.3       45.5, 50.4
+       n = 40: 96,000 tetrahedra, 18,081 nodes (10 MB)
+       Neo-Hookean force                   19.1 (30.3)      20.9 (24.8)
+       Neo-Hookean differential            30.6 (44.1)      30.5 (39.4)
+       Neo-Hookean, float: force, diff.    12.0, 16.1       14.6, 18.3
+       St Venant-Kirchhoff force, diff.    24.7, 39.6       22.1, 38.6
+       Neo-Hookean force, -O2 -march=native 20.1             22.9
+       -std=c99 -O3 (no FMA contraction)   19.4             23.4
+       -O2, generic x86-64 (SSE2)          34.3             41.0
+       memory bound (bytes at 18.8 GB/s)   4.7 ns (89 B)    5.6 ns (105 B), float 3.2 ns
+   So the displacement form costs the Neo-Hookean force about 25 % on cache-resident
+   meshes and under 10 % on larger ones (where 0.1.0's extra memory stalls hide the
+   arithmetic), about 20 % in float; the differential up to 15 %. It sits at 3.7 times
+   the memory bound in double (4.6 in float), not 2, and at 20 ns rather than the 15 ns
+   this work was designed for: the gather and scatter alone (62 scalar memory operations:
+   a kernel doing only them and the stream reads runs at 10 ns on the small beam) and the
+   vectorised arithmetic (about 10 ns) each exceed the bound. For comparison REFERENCES lists Bullet's Neo-Hookean at 181 ns and
+   Vega's at 377 ns per tetrahedron on this machine kind. Mooney-Rivlin (split) costs
+   about 2.6 times Neo-Hookean (J^-2/3 by libm's cbrt, a call), springs about 2.3 times
+   (six square roots, calls under errno semantics). Rejected after measurement: one fused
+   loop for the Neo-Hookean force or differential (it spills the 16 AVX2 registers: 10 %
+   slower than the split loops kept); the link form with the rest terms regrouped
+   analytically (Sigma V + gamma C = s0 C / 6 ...), which needs the rest links besides
+   their inverse (17 constants, 152 bytes) and no fewer operations; springs streaming
+   their rest links (9 more constants) instead of recomputing them from V^-1 (20 % slower
+   on the small beam, 40 % on the large one). From 0.1.0: a two-pass gather (per-tetrahedron forces into a
+   buffer, then a per-node sum) cost 30 to 35 ns against 24 to 27 ns for the colouring;
+   blocks of 32, interleaving neighbouring tetrahedra across lanes, computing node 0's
+   force in the vector loop and software prefetch did not help; vector gathers are slower
+   than scalar loads (4 against 3 ns), so the gather loop is kept scalar
+   (HEML__SCALAR_FN).
+   Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
+   3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
+   dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
+   dof). Without the coarse space the same solves took 10 ms, 1.2 s and 21 s.
 
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
