@@ -408,13 +408,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_SHAPE_DEGENERATE, -30, "shape function undefined: flat or inverted element, coincident or coplanar frames") \
     X(FRM_ERR_INDEX_RANGE, -31, "element or triangle node index out of range") \
     X(FRM_ERR_SAMPLING, -32, "sampling settings invalid (spacing, Gauss order, support) or too many points") \
-    X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume")
+    X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume") \
+    X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -34
+    FRM_ERR_LAST_ = -35
 };
 
 /* Constitutive laws (per sample). Both are written in terms of the Green-Lagrange strain
@@ -498,6 +499,12 @@ typedef struct frm_desc {
     const int *sample_materials; /* optional sample_count indices into `materials` (NULL:
                                     every sample uses materials[0]) */
 
+    frm_real rotation_stabilization; /* dimensionless, default 0.5 (0: the thesis's model exactly):
+                                        ties the rotations that a frame's samples do not see
+                                        at first order (collinear or single samples, e.g. the
+                                        boundary frames of tetrahedra with one sample each) to
+                                        the samples' rotation; frames whose samples spread in
+                                        3D are not affected (see MODEL and LIMITS) */
     frm_real frame_coupling; /* dimensionless, default 0 (the thesis's model exactly): weight
                                 of the coupling term that ties each frame's own prediction
                                 of a sample to the blended position (see MODEL); 1e-2
@@ -548,6 +555,8 @@ typedef struct frm_stats {
     frm_real residual;         /* static solve: final |f| over the free frames (N and N m) */
     frm_real initial_residual; /* static solve: |f| before the first iteration */
     int line_search_halvings;  /* static solve: step halvings, summed */
+    int definite_solves;       /* linear solves redone with the positive-definite part of K because the
+                                  linearisation was indefinite (see SOLVERS) */
     int stiffness_mode;        /* FRM_STIFFNESS_PAIRS or FRM_STIFFNESS_BLOCKS (last linearisation) */
     int force_evaluations;     /* force passes in the step */
     int stiffness_products;    /* K * v products in the step */
@@ -767,6 +776,9 @@ FRMDEF const frm_stats *frm_model_last_stats(const frm_model *m);
 FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36]);
 /* Bytes held by the model. */
 FRMDEF size_t frm_model_memory_bytes(const frm_model *m);
+/* Frames whose rotation the rotation stabilisation holds (their samples do not see it at
+   first order; see MODEL), 0 with rotation_stabilization = 0. */
+FRMDEF int frm_model_stabilized_frames(const frm_model *m);
 
 /* ---- stiffness (K = -df/dq, 6 per frame: translation, then rotation about world axes:
    a rotation dtheta moves R to exp([dtheta]x) R) ---- */
@@ -1171,19 +1183,20 @@ FRM_HOSTDEV static inline void frm_sample_dP(int law, frm_real mu, frm_real lamb
     for (r = 0; r < 9; r++) dP[r] += t[r];
 }
 
-/* Pass 1 of K v: what one pair gives its frame, v B^T vec(dP) + (0, Hs dtheta):
-       (v dP grad w,  v sum_j g_j x dp_j + Hs dtheta). */
+/* Pass 1 of K v: what one pair gives its frame, v B^T vec(dP):
+       (v dP grad w,  v sum_j g_j x dp_j).
+   The derivative of B^T through the frame's own rotation (the pairs' Hs) is summed per
+   frame once per linearisation and applied in pass 2 (frm__stiffness_product). */
 FRM_HOSTDEV static inline void frm_pair_apply(frm_real volume, const frm_real dP[9], const frm_real grad[3],
-                                              const frm_real G[9], const frm_real Hs[6], const frm_real dtheta[3],
-                                              frm_real out[6])
+                                              const frm_real G[9], frm_real out[6])
 {
     frm_real t[3];
     int r;
     for (r = 0; r < 3; r++) out[r] = volume * (dP[3 * r] * grad[0] + dP[3 * r + 1] * grad[1] + dP[3 * r + 2] * grad[2]);
     frm_column_cross_sum(G, dP, t);
-    out[3] = volume * t[0] + Hs[0] * dtheta[0] + Hs[5] * dtheta[1] + Hs[4] * dtheta[2];
-    out[4] = volume * t[1] + Hs[5] * dtheta[0] + Hs[1] * dtheta[1] + Hs[3] * dtheta[2];
-    out[5] = volume * t[2] + Hs[4] * dtheta[0] + Hs[3] * dtheta[1] + Hs[2] * dtheta[2];
+    out[3] = volume * t[0];
+    out[4] = volume * t[1];
+    out[5] = volume * t[2];
 }
 
 /* The coupling term (see MODEL): E_c = 1/2 sum_k c |w_k| |d_k - p|^2 per sample, c =
@@ -1219,11 +1232,12 @@ FRM_HOSTDEV static inline frm_real frm_sample_coupling_force(int n, const frm_re
 
 /* Its stiffness applied to v (6 per frame, gathered through frame[]), added to out (6 per
    slot): the Gauss-Newton part, y_k = c |w_k| (dd_k - dp) - w_k sum_j c |w_j| (dd_j - dp)
-   with dd = dx + dtheta x a and dp = sum w dd, mapped as (y, a x y), plus the rotation's
-   second-order part M dtheta, M = (g a^T + a g^T)/2 - (g . a) I. */
+   with dd = dx + dtheta x a and dp = sum w dd, mapped as (y, a x y). The rotation's
+   second-order part M dtheta (frm_pair_coupling_rotation) is a frame-own term: the
+   linearisation adds it to the pair's Hs. */
 FRM_HOSTDEV static inline void frm_sample_coupling_apply(int n, const int *frame, const frm_real *weight,
-                                                         const frm_real *lever, const frm_real *g, frm_real c,
-                                                         const frm_real *v, frm_real *out)
+                                                         const frm_real *lever, frm_real c, const frm_real *v,
+                                                         frm_real *out)
 {
     frm_real dd[3 * FRM_MAX_NEIGHBORS], dp[3] = {0, 0, 0}, rbar[3] = {0, 0, 0};
     int k, r;
@@ -1244,14 +1258,13 @@ FRM_HOSTDEV static inline void frm_sample_coupling_apply(int n, const int *frame
         }
     }
     for (k = 0; k < n; k++) {
-        const frm_real *th = v + 6 * frame[k] + 3, *a = lever + 3 * k, *gk = g + 3 * k;
-        frm_real y[3], t[3], at = a[0] * th[0] + a[1] * th[1] + a[2] * th[2];
-        frm_real gt = gk[0] * th[0] + gk[1] * th[1] + gk[2] * th[2], ga = gk[0] * a[0] + gk[1] * a[1] + gk[2] * a[2];
+        const frm_real *a = lever + 3 * k;
+        frm_real y[3], t[3];
         for (r = 0; r < 3; r++) y[r] = dd[3 * k + r] - weight[k] * rbar[r];
         frm_cross(a, y, t);
         for (r = 0; r < 3; r++) {
             out[6 * k + r] += y[r];
-            out[6 * k + 3 + r] += t[r] + (frm_real)0.5 * (gk[r] * at + a[r] * gt) - ga * th[r];
+            out[6 * k + 3 + r] += t[r];
         }
     }
 }
@@ -1282,14 +1295,124 @@ FRM_HOSTDEV static inline void frm_pair_coupling_block(frm_real coef, const frm_
         for (c = 0; c < 3; c++) K[6 * (3 + r) + 3 + c] += coef * ((r == c ? ab : 0) - lb[r] * la[c]);
 }
 
-/* The coupling's second-order rotational part M = (g a^T + a g^T)/2 - (g . a) I, added to
-   the rotational block of a 6x6. */
-FRM_HOSTDEV static inline void frm_pair_coupling_rotation(const frm_real g[3], const frm_real a[3], frm_real K[36])
+/* The coupling's second-order rotational part M = (g a^T + a g^T)/2 - (g . a) I of one
+   slot, added to its Hs (6, Voigt). */
+FRM_HOSTDEV static inline void frm_pair_coupling_rotation(const frm_real g[3], const frm_real a[3], frm_real Hs[6])
 {
     frm_real ga = g[0] * a[0] + g[1] * a[1] + g[2] * a[2];
-    int r, c;
+    Hs[0] += g[0] * a[0] - ga;
+    Hs[1] += g[1] * a[1] - ga;
+    Hs[2] += g[2] * a[2] - ga;
+    Hs[3] += (frm_real)0.5 * (g[1] * a[2] + a[1] * g[2]);
+    Hs[4] += (frm_real)0.5 * (g[0] * a[2] + a[0] * g[2]);
+    Hs[5] += (frm_real)0.5 * (g[0] * a[1] + a[0] * g[1]);
+}
+
+/* axial(skew A) = ((A21 - A12)... ): the vector u with skew(A) = [u]x; u . axial(A) =
+   [u]x : A / 2. */
+FRM_HOSTDEV static inline void frm_skew_axial(const frm_real A[9], frm_real u[3])
+{
+    u[0] = (frm_real)0.5 * (A[7] - A[5]);
+    u[1] = (frm_real)0.5 * (A[2] - A[6]);
+    u[2] = (frm_real)0.5 * (A[3] - A[1]);
+}
+
+/* T = c/2 Q [u]x with Q = I + Qm. */
+FRM_HOSTDEV static inline void frm_stab_stress(frm_real c, const frm_real Qm[9], const frm_real u[3], frm_real T[9])
+{
+    frm_real X[9], h = (frm_real)0.5 * c;
+    int r, k;
+    X[0] = 0, X[1] = -u[2], X[2] = u[1];
+    X[3] = u[2], X[4] = 0, X[5] = -u[0];
+    X[6] = -u[1], X[7] = u[0], X[8] = 0;
     for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++) K[6 * (3 + r) + 3 + c] += (frm_real)0.5 * (g[r] * a[c] + a[r] * g[c]) - (r == c ? ga : 0);
+        for (k = 0; k < 3; k++)
+            T[3 * r + k] = h * (X[3 * r + k] + Qm[3 * r] * X[k] + Qm[3 * r + 1] * X[3 + k] + Qm[3 * r + 2] * X[6 + k]);
+}
+
+/* The rotation stabilisation of one (sample, frame) pair (see MODEL): with A = Q^T F the
+   sample's deformation seen in the frame's rest axes, omega = axial(skew A) its rotation
+   relative to the frame and m = N omega (N the frame's projector on the rotations its
+   samples do not see, rest axes, 6 Voigt),
+       E = c/2 omega . m,   T = c/2 Q [m]x,   dE = T : dF - dtheta . sum_j f_j x t_j
+   (f_j, t_j the columns of F, T; dtheta the frame's rotation). The caller adds T / v to
+   the sample's P (the T : dF part reaches every frame through B^T); the frame's own share
+   torque = sum_j f_j x t_j is returned with T, m and E. H = F - I and Qm = Q - I keep
+   small rotations' digits: skew(Q^T F) = skew(Qm^T + H + Qm^T H). */
+FRM_HOSTDEV static inline frm_real frm_pair_stab_force(const frm_real H[9], const frm_real F[9], const frm_real Qm[9],
+                                                       const frm_real N[6], frm_real c, frm_real T[9],
+                                                       frm_real torque[3], frm_real m[3])
+{
+    frm_real A[9], om[3], Nm[9];
+    int r, k;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++)
+            A[3 * r + k] = Qm[3 * k + r] + H[3 * r + k] + Qm[r] * H[k] + Qm[3 + r] * H[3 + k] + Qm[6 + r] * H[6 + k];
+    frm_skew_axial(A, om);
+    frm_sym_to_matrix(N, Nm);
+    for (r = 0; r < 3; r++) m[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
+    frm_stab_stress(c, Qm, m, T);
+    frm_column_cross_sum(F, T, torque);
+    return (frm_real)0.5 * c * (om[0] * m[0] + om[1] * m[1] + om[2] * m[2]);
+}
+
+/* The frame-own second-order part of the stabilisation, X = sym(F T^T) - tr(F^T T) I (6,
+   Voigt), added to the pair's Hs at the linearisation (dtheta . X dtheta = T : [dtheta]x^2 F). */
+FRM_HOSTDEV static inline void frm_pair_stab_rotation(const frm_real F[9], const frm_real T[9], frm_real Hs[6])
+{
+    frm_real h[9], tr;
+    int r, k;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) h[3 * r + k] = F[3 * r] * T[3 * k] + F[3 * r + 1] * T[3 * k + 1] + F[3 * r + 2] * T[3 * k + 2];
+    tr = h[0] + h[4] + h[8];
+    Hs[0] += h[0] - tr;
+    Hs[1] += h[4] - tr;
+    Hs[2] += h[8] - tr;
+    Hs[3] += (frm_real)0.5 * (h[5] + h[7]);
+    Hs[4] += (frm_real)0.5 * (h[2] + h[6]);
+    Hs[5] += (frm_real)0.5 * (h[1] + h[3]);
+}
+
+/* The stabilisation's stiffness (symmetric part, less the frame-own X above) for one pair:
+   for the sample's dF and the frame's dtheta,
+       omega1 = axial(skew(Q^T (dF - [dtheta]x F))),   Ta = c/2 Q [N omega1]x,
+       dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
+   dPx a stress-like term (absolute: the caller divides by the volume and adds it to dP,
+   which B^T takes to every frame), torque the frame's own row. definite = 1 keeps the
+   Gauss-Newton part only (Ta; -sum f_j x ta_j), which is positive semi-definite. m is
+   the linearisation's m = N omega. */
+FRM_HOSTDEV static inline void frm_pair_stab_apply(const frm_real F[9], const frm_real dF[9], const frm_real Qm[9],
+                                                   const frm_real N[6], frm_real c, const frm_real m[3],
+                                                   const frm_real dtheta[3], int definite, frm_real dPx[9],
+                                                   frm_real torque[3])
+{
+    frm_real D[9], A[9], om[3], u[3], Nm[9], t[3];
+    int r, k;
+    for (k = 0; k < 3; k++) { /* D = dF - [dtheta]x F, column by column */
+        D[k] = dF[k] - (dtheta[1] * F[6 + k] - dtheta[2] * F[3 + k]);
+        D[3 + k] = dF[3 + k] - (dtheta[2] * F[k] - dtheta[0] * F[6 + k]);
+        D[6 + k] = dF[6 + k] - (dtheta[0] * F[3 + k] - dtheta[1] * F[k]);
+    }
+    for (r = 0; r < 3; r++) /* A = Q^T D */
+        for (k = 0; k < 3; k++)
+            A[3 * r + k] = D[3 * r + k] + Qm[r] * D[k] + Qm[3 + r] * D[3 + k] + Qm[6 + r] * D[6 + k];
+    frm_skew_axial(A, om);
+    frm_sym_to_matrix(N, Nm);
+    for (r = 0; r < 3; r++) u[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
+    frm_stab_stress(c, Qm, u, dPx);
+    frm_column_cross_sum(F, dPx, torque);
+    for (r = 0; r < 3; r++) torque[r] = -torque[r];
+    if (!definite) {
+        frm_real T[9];
+        frm_stab_stress(c, Qm, m, T);
+        frm_column_cross_sum(dF, T, t);
+        for (r = 0; r < 3; r++) torque[r] -= t[r];
+        for (k = 0; k < 3; k++) { /* dPx += [dtheta]x T */
+            dPx[k] += dtheta[1] * T[6 + k] - dtheta[2] * T[3 + k];
+            dPx[3 + k] += dtheta[2] * T[k] - dtheta[0] * T[6 + k];
+            dPx[6 + k] += dtheta[0] * T[3 + k] - dtheta[1] * T[k];
+        }
+    }
 }
 
 /* Assembly: the 6 tangent columns cols[c] = A B e_c (9 each) of one pair, A = dP/dF. */
@@ -1400,7 +1523,10 @@ struct frm_model {
     int cg_max_iterations, newton_max_iterations, cg_fail_at_cap;
     int stiffness_mode, has_blocks;
     double regularization, solve_regularization; /* static solves: eps added to K's rotational diagonal */
+    frm_real stab_beta;                          /* rotation_stabilization */
+    int stab_frames;                             /* frames with a rotation their samples do not see */
     double newton_previous;                      /* |f| at the previous Newton iteration */
+    double floor_residual;                       /* |f| of the last iteration below the round-off floor, or 0 */
 
     /* frames */
     frm_real *disp, *pos, *quat, *vel;         /* 3 (u = x - xbar, the state), 3 (xbar + u, output), 4, 6 */
@@ -1416,6 +1542,10 @@ struct frm_model {
     double *force_scale;   /* 1: sum over the frame's pairs of |partial force|^2 (round-off scale) */
     frm_real *lin_torque;  /* 3: conservative torque at the linearisation */
     frm_real *lin_gravity; /* 3: world gravity moment c_g at the linearisation */
+    frm_real *lin_hrot;    /* 6: the frame-own rotational term at the linearisation: sum of its pairs' Hs + the
+                              gravity stiffness (projected on its positive part when definite) */
+    frm_real *f_stab;      /* 6: projector on the rotations the frame's samples do not see (rest axes), or 0 */
+    unsigned char *f_stab_on; /* 1: f_stab is not zero */
     frm_real *kdiag;       /* 36: K_ii (symmetric part) at the linearisation (pair mode: kdiag_rest rotated) */
     frm_real *kdiag_rest;  /* 36: K_ii of the rest state without gravity (pair mode's preconditioner) */
     frm_real *precond;     /* 36: inverse of the block-Jacobi blocks */
@@ -1426,7 +1556,7 @@ struct frm_model {
 
     /* samples */
     frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
-    unsigned char *s_law;
+    unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
     frm_real *s_pos, *s_F;               /* outputs: 3, 9 */
@@ -1436,6 +1566,8 @@ struct frm_model {
     frm_real *p_weight, *p_grad, *p_local, *p_rlev; /* 1, 3, 3, 3: rest lever abar = Rbar lbar = pbar - xbar */
     frm_real *p_G, *p_H, *p_A, *p_C;       /* 9, 6, 3 (lever), 3 (coupling g) at the linearisation */
     frm_real *p_out;                       /* 6: pass-1 partial contributions */
+    frm_real *p_stab;                      /* 3: m = N omega of the stabilisation at the linearisation
+                                              (pairs of stabilised frames; NULL when there are none) */
 
     /* per sample chunk: energy partial sums and errors of the last pass */
     double *chunk_energy;
@@ -1447,6 +1579,7 @@ struct frm_model {
     frm_real *start_state; /* 13 per frame: the state a static solve started from */
 
     int lin_valid, lin_mode, lin_iterations;
+    int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
 };
 
@@ -1492,6 +1625,75 @@ static int frm__invert6(const double A[36], double inv[36])
         }
     }
     return 1;
+}
+
+/* Eigen-decomposition of a symmetric n x n matrix (n <= 6, row-major, destroyed) by cyclic
+   Jacobi rotations: eigenvalues in ev, eigenvectors in the columns of V. A fixed order of
+   rotations: deterministic. */
+static void frm__jacobi(double *A, int n, double *V, double *ev)
+{
+    int sweep, p, q, k;
+    for (p = 0; p < n * n; p++) V[p] = 0;
+    for (p = 0; p < n; p++) V[(n + 1) * p] = 1;
+    for (sweep = 0; sweep < 60; sweep++) {
+        double off = 0, diag = 0;
+        for (p = 0; p < n; p++) {
+            diag += A[(n + 1) * p] * A[(n + 1) * p];
+            for (q = p + 1; q < n; q++) off += A[n * p + q] * A[n * p + q];
+        }
+        if (!(off > 1e-30 * diag)) break;
+        for (p = 0; p < n; p++)
+            for (q = p + 1; q < n; q++) {
+                double apq = A[n * p + q], theta, t, c, sn;
+                if (apq == 0) continue;
+                theta = (A[(n + 1) * q] - A[(n + 1) * p]) / (2 * apq);
+                t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
+                c = 1 / sqrt(t * t + 1);
+                sn = t * c;
+                for (k = 0; k < n; k++) { /* A <- J^T A J */
+                    double akp = A[n * k + p], akq = A[n * k + q];
+                    A[n * k + p] = c * akp - sn * akq;
+                    A[n * k + q] = sn * akp + c * akq;
+                }
+                for (k = 0; k < n; k++) {
+                    double apk = A[n * p + k], aqk = A[n * q + k];
+                    A[n * p + k] = c * apk - sn * aqk;
+                    A[n * q + k] = sn * apk + c * aqk;
+                }
+                for (k = 0; k < n; k++) {
+                    double vkp = V[n * k + p], vkq = V[n * k + q];
+                    V[n * k + p] = c * vkp - sn * vkq;
+                    V[n * k + q] = sn * vkp + c * vkq;
+                }
+            }
+    }
+    for (p = 0; p < n; p++) ev[p] = A[(n + 1) * p];
+}
+
+/* The positive part of a symmetric 3x3 (6 values, Voigt 00 11 22 12 02 01): its negative
+   eigenvalues set to zero. */
+static void frm__positive_part3(double s[6])
+{
+    double A[9], V[9], ev[3];
+    int r, c, k;
+    if (s[3] == 0 && s[4] == 0 && s[5] == 0) {
+        for (k = 0; k < 3; k++)
+            if (s[k] < 0) s[k] = 0;
+        return;
+    }
+    A[0] = s[0], A[4] = s[1], A[8] = s[2];
+    A[5] = A[7] = s[3], A[2] = A[6] = s[4], A[1] = A[3] = s[5];
+    frm__jacobi(A, 3, V, ev);
+    if (ev[0] >= 0 && ev[1] >= 0 && ev[2] >= 0) return;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) {
+            double t = 0;
+            for (k = 0; k < 3; k++)
+                if (ev[k] > 0) t += V[3 * r + k] * ev[k] * V[3 * c + k];
+            A[3 * r + c] = t;
+        }
+    s[0] = A[0], s[1] = A[4], s[2] = A[8];
+    s[3] = 0.5 * (A[5] + A[7]), s[4] = 0.5 * (A[2] + A[6]), s[5] = 0.5 * (A[1] + A[3]);
 }
 
 /* Rotation vector (rad) of the rotation taking quaternion a to quaternion b: b = exp(t) a. */
@@ -1633,6 +1835,9 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->force_scale, double, n);
     FRM__CARVE(c, m->lin_torque, frm_real, 3 * n);
     FRM__CARVE(c, m->lin_gravity, frm_real, 3 * n);
+    FRM__CARVE(c, m->lin_hrot, frm_real, 6 * n);
+    FRM__CARVE(c, m->f_stab, frm_real, 6 * n);
+    FRM__CARVE(c, m->f_stab_on, unsigned char, n);
     FRM__CARVE(c, m->kdiag, frm_real, 36 * n);
     FRM__CARVE(c, m->kdiag_rest, frm_real, 36 * n);
     FRM__CARVE(c, m->precond, frm_real, 36 * n);
@@ -1651,6 +1856,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_lambda, frm_real, S);
     FRM__CARVE(c, m->s_couple, frm_real, S);
     FRM__CARVE(c, m->s_law, unsigned char, S);
+    FRM__CARVE(c, m->s_stab, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
     FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
     FRM__CARVE(c, m->lin_S, frm_real, 6 * S);
@@ -1668,6 +1874,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_A, frm_real, 3 * P);
     FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
+    if (m->stab_frames) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
     for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
@@ -1720,6 +1927,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
     if (!(frm__finite((double)d->frame_coupling) && d->frame_coupling >= 0))
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
+    if (!(frm__finite((double)d->rotation_stabilization) && d->rotation_stabilization >= 0))
+        return frm__fail(d, FRM_ERR_ARG, "rotation_stabilization must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -1868,8 +2077,9 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.cg_fail_at_cap = 1;
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
-    d.static_regularization = (frm_real)1e-6;
+    d.static_regularization = (frm_real)1e-10;
     d.frame_coupling = 0;
+    d.rotation_stabilization = (frm_real)0.5;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
@@ -1983,6 +2193,100 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
     return -1;
 }
 
+/* Second moment J = tr(L) I - L of a set of points (L their covariance about the mean),
+   accumulated by frm__spread_add: sums in acc[0..2] (coordinates), acc[3..11] (products),
+   acc[12] (count). A rotation dtheta moves some point relative to the others at first
+   order iff dtheta . J dtheta > 0. */
+static void frm__spread_add(double acc[13], const frm_real *x)
+{
+    int r, c;
+    for (r = 0; r < 3; r++) {
+        acc[r] += (double)x[r];
+        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += (double)x[r] * x[c];
+    }
+    acc[12] += 1;
+}
+
+static void frm__spread_J(const double acc[13], double J[9])
+{
+    double L[9], n = acc[12] > 0 ? acc[12] : 1;
+    int r, c;
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) L[3 * r + c] = acc[3 + 3 * r + c] / n - (acc[r] / n) * (acc[c] / n);
+    for (r = 0; r < 9; r++) J[r] = -L[r];
+    for (r = 0; r < 3; r++) J[4 * r] += L[0] + L[4] + L[8];
+}
+
+/* The rotations of frame i its samples do not see at first order (see MODEL, rotation
+   stabilisation): a rotation dtheta with the translation -dtheta x a_s leaves every
+   sample s's prediction d = x + R lbar where it was iff dtheta x (p_s - p_t) = 0 for all
+   its samples: the kernel of their J (collinear samples: the line; a single sample: every
+   axis). N (6, Voigt, world rest axes) = sum over J's eigenvectors e of
+   phi(lambda_e / lambda_max) (1 - phi(e . J2 e / lambda2_max)) e e^T with
+   phi(x) = clamp(1 - x / 1e-2, 0, 1): exact kernels get 1, well-spread samples 0; J2 is
+   the same moment over the samples of every frame that shares a sample with i, so that a
+   rotation the whole neighbourhood cannot see either (a rod of collinear samples, the
+   thesis's fig. 4.11, whose torsion lives in that rotation) is left to the thesis's
+   model. Counts every sample that uses a frame (weight or gradient not zero). Returns 1
+   if N is not zero. */
+static int frm__invisible_rotations(const frm_desc *d, const int *rev_start, const int *rev_pair,
+                                    const int *pair_sample, int i, double N[6])
+{
+    double acc[13], acc2[13], J[9], J2[9], V[9], ev[3], top, top2, ev2[3], A2[9], V2[9];
+    int e, r, c, any = 0;
+    for (r = 0; r < 6; r++) N[r] = 0;
+    memset(acc, 0, sizeof acc);
+    memset(acc2, 0, sizeof acc2);
+    for (e = rev_start[i]; e < rev_start[i + 1]; e++) {
+        int p = rev_pair[e], s = pair_sample[p];
+        const frm_real *g = d->neighbor_gradients + 3 * (size_t)p;
+        if (d->neighbor_weights[p] == 0 && g[0] == 0 && g[1] == 0 && g[2] == 0) continue;
+        frm__spread_add(acc, d->sample_positions + 3 * (size_t)s);
+    }
+    if (acc[12] == 0) return 0;
+    frm__spread_J(acc, J);
+    frm__jacobi(J, 3, V, ev);
+    top = ev[0] > ev[1] ? ev[0] : ev[1];
+    if (ev[2] > top) top = ev[2];
+    for (c = 0; c < 3; c++)
+        if (!(top > 0) || ev[c] < 1e-2 * top) any = 1;
+    if (!any) return 0;
+    any = 0;
+    for (e = rev_start[i]; e < rev_start[i + 1]; e++) { /* the neighbourhood's samples */
+        int s = pair_sample[rev_pair[e]], q;
+        for (q = d->neighbor_start[s]; q < d->neighbor_start[s + 1]; q++) {
+            int j = d->neighbor_frames[q], f;
+            for (f = rev_start[j]; f < rev_start[j + 1]; f++)
+                frm__spread_add(acc2, d->sample_positions + 3 * (size_t)pair_sample[rev_pair[f]]);
+        }
+    }
+    frm__spread_J(acc2, J2);
+    memcpy(A2, J2, sizeof A2);
+    frm__jacobi(A2, 3, V2, ev2); /* only the largest eigenvalue is needed */
+    top2 = ev2[0] > ev2[1] ? ev2[0] : ev2[1];
+    if (ev2[2] > top2) top2 = ev2[2];
+    for (c = 0; c < 3; c++) {
+        double phi = top > 0 ? 1 - ev[c] / (1e-2 * top) : 1, u[3], m2, psi;
+        if (phi <= 0) continue;
+        if (phi > 1) phi = 1;
+        for (r = 0; r < 3; r++) u[r] = V[3 * r + c];
+        m2 = 0;
+        for (r = 0; r < 3; r++) m2 += u[r] * (J2[3 * r] * u[0] + J2[3 * r + 1] * u[1] + J2[3 * r + 2] * u[2]);
+        psi = top2 > 0 ? m2 / (1e-2 * top2) : 0;
+        if (psi > 1) psi = 1;
+        phi *= psi;
+        if (phi <= 0) continue;
+        any = 1;
+        N[0] += phi * u[0] * u[0];
+        N[1] += phi * u[1] * u[1];
+        N[2] += phi * u[2] * u[2];
+        N[3] += phi * u[1] * u[2];
+        N[4] += phi * u[0] * u[2];
+        N[5] += phi * u[0] * u[1];
+    }
+    return any;
+}
+
 static void frm__update_frames(frm_model *m);
 static void frm__rest_diagonal(frm_model *m);
 
@@ -2054,6 +2358,12 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         tmp.block_count = (int)blocks;
         tmp.sq_total = (int)sq;
     }
+    tmp.stab_beta = d->rotation_stabilization;
+    if (tmp.stab_beta > 0)
+        for (i = 0; i < n; i++) {
+            double N[6];
+            tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+        }
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
     frm__layout(&tmp, &carver);
@@ -2101,6 +2411,13 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
     memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
     memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
+    if (m->stab_frames)
+        for (i = 0; i < n; i++) {
+            double N[6];
+            m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+            for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)N[k];
+            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
+        }
 
     /* samples */
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
@@ -2219,14 +2536,15 @@ static void frm__force_chunks(void *vctx, int begin, int end)
         double energy = 0;
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e;
-            frm_real F[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
-            frm_real offset[3 * FRM_MAX_NEIGHBORS];
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
+            frm_real F[9], H[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
+            frm_real offset[3 * FRM_MAX_NEIGHBORS], sT[9 * FRM_MAX_NEIGHBORS], stq[3 * FRM_MAX_NEIGHBORS];
             frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
-                                   m->s_rest + 3 * s, m->disp, m->relm, F, lever, offset,
+                                   m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
                                    ctx->outputs ? m->s_pos + 3 * s : NULL);
-            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], F, S, &psi, cache); /* F holds H here */
-            F[0] += 1; /* F = I + H from here on */
+            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], H, S, &psi, cache);
+            memcpy(F, H, sizeof F);
+            F[0] += 1; /* F = I + H */
             F[4] += 1;
             F[8] += 1;
             if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
@@ -2237,9 +2555,24 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             }
             energy += (double)v * (double)psi;
             frm_first_piola(F, S, P);
+            if (stab) { /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
+                frm_real cst = m->stab_beta * m->s_mu[s] * v, mv[3];
+                for (k = 0; k < n; k++) {
+                    int i = m->p_frame[b + k];
+                    if (!m->f_stab_on[i]) continue;
+                    energy += (double)frm_pair_stab_force(H, F, m->relm + 9 * i, m->f_stab + 6 * i, cst, sT + 9 * k,
+                                                          stq + 3 * k, mv);
+                    if (ctx->linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mv, sizeof mv);
+                    for (r = 0; r < 9; r++) P[r] += sT[9 * k + r] / v;
+                }
+            }
             for (k = 0; k < n; k++)
                 frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
+            if (stab)
+                for (k = 0; k < n; k++)
+                    if (m->f_stab_on[m->p_frame[b + k]])
+                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
                 energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
                                                             m->p_out + 6 * (size_t)b,
@@ -2247,12 +2580,24 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             if (ctx->linearize) {
                 memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
+                if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
+                                              Neo-Hookean tangent's 2 (mu - lambda ln J) kept >= 0 */
+                    double Sd[6];
+                    for (r = 0; r < 6; r++) Sd[r] = (double)S[r];
+                    frm__positive_part3(Sd);
+                    for (r = 0; r < 6; r++) S[r] = (frm_real)Sd[r];
+                    if (m->s_law[s] == FRM_LAW_NEO_HOOKEAN && m->s_lambda[s] * cache[6] > m->s_mu[s])
+                        cache[6] = m->s_mu[s] / m->s_lambda[s];
+                }
                 memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
                 memcpy(m->lin_cache + FRM_LAW_CACHE * (size_t)s, cache, sizeof cache);
-                for (k = 0; k < n; k++)
+                for (k = 0; k < n; k++) {
+                    frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
-                                       m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k),
-                                       m->p_H + 6 * (size_t)(b + k));
+                                       m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k), Hs);
+                    if (stab && m->f_stab_on[m->p_frame[b + k]]) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
+                    if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)(b + k), lever + 3 * k, Hs);
+                }
             }
         }
         m->chunk_energy[c] = energy;
@@ -2303,8 +2648,11 @@ static void frm__gather(const frm_model *m, const frm_real *src, frm_real *dst, 
     frm__run(m, m->frame_chunks, frm__gather_chunks, &g);
 }
 
-/* Internal forces into m->force (both passes) and the elastic energy. With linearize, the
-   stiffness data of the state too (and lin_torque, lin_gravity). Returns FRM_OK,
+static void frm__gravity_stiffness(const frm_model *m, int i, double K[9]);
+
+/* Internal forces into m->force (both passes) and the elastic energy. With linearize (1:
+   the symmetric part of K; 2: its positive-definite part, see SOLVERS), the stiffness data
+   of the state too (and lin_torque, lin_gravity, lin_hrot). Returns FRM_OK,
    FRM_ERR_INVERTED or FRM_ERR_NOT_FINITE. */
 static int frm__force_pass(frm_model *m, int linearize, int outputs, double *energy)
 {
@@ -2328,15 +2676,23 @@ static int frm__force_pass(frm_model *m, int linearize, int outputs, double *ene
     if (!frm__finite(W) || !frm__all_finite(m->force, 6 * (size_t)m->frame_count)) return FRM_ERR_NOT_FINITE;
     if (linearize) {
         int i, r;
+        frm__gather(m, m->p_H, m->lin_hrot, NULL); /* the frame-own rotational terms, summed in pair order */
         for (i = 0; i < m->frame_count; i++) {
             frm_real cg[3], tg[3];
+            double Kg[9], h[6];
             frm__gravity_moment(m, i, cg);
             frm_cross(cg, m->gravity, tg);
             for (r = 0; r < 3; r++) {
                 m->lin_gravity[3 * i + r] = cg[r];
                 m->lin_torque[3 * i + r] = m->force[6 * i + 3 + r] + tg[r];
             }
+            frm__gravity_stiffness(m, i, Kg);
+            for (r = 0; r < 6; r++) h[r] = (double)m->lin_hrot[6 * i + r];
+            h[0] += Kg[0], h[1] += Kg[4], h[2] += Kg[8], h[3] += Kg[5], h[4] += Kg[2], h[5] += Kg[1];
+            if (linearize == 2) frm__positive_part3(h);
+            for (r = 0; r < 6; r++) m->lin_hrot[6 * i + r] = (frm_real)h[r];
         }
+        m->lin_definite = linearize == 2;
         m->lin_valid = 1;
     }
     return FRM_OK;
@@ -2412,17 +2768,30 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k;
-            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s];
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
+            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
             for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
             frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                           m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
+            if (m->s_stab[s]) {
+                frm_real cst = m->stab_beta * m->s_mu[s] * vol, dPx[9];
+                for (k = 0; k < n; k++) {
+                    int i = m->p_frame[b + k];
+                    if (!m->f_stab_on[i]) continue;
+                    frm_pair_stab_apply(m->lin_F + 9 * (size_t)s, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst,
+                                        m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3, m->lin_definite, dPx, stq + 3 * k);
+                    for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+                }
+            }
             for (k = b; k < b + n; k++)
-                frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_H + 6 * (size_t)k,
-                               v + 6 * m->p_frame[k] + 3, m->p_out + 6 * (size_t)k);
+                frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
+            if (m->s_stab[s])
+                for (k = 0; k < n; k++)
+                    if (m->f_stab_on[m->p_frame[b + k]])
+                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
-                frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->p_C + 3 * (size_t)b,
-                                          m->s_couple[s], v, m->p_out + 6 * (size_t)b);
+                frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->s_couple[s], v,
+                                          m->p_out + 6 * (size_t)b);
         }
     }
 }
@@ -2478,7 +2847,7 @@ static void frm__gravity_stiffness(const frm_model *m, int i, double K[9])
    internal plus gravity torque at the linearisation). */
 static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *out, int exact)
 {
-    int i, r, k;
+    int i, r;
     if (m->lin_mode == FRM_STIFFNESS_BLOCKS) {
         frm__gather_ctx g;
         g.m = m;
@@ -2492,14 +2861,11 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         a.v = v;
         frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
         frm__gather(m, m->p_out, out, NULL);
-        for (i = 0; i < m->frame_count; i++) {
-            double K[9];
-            frm__gravity_stiffness(m, i, K);
-            for (r = 0; r < 3; r++) {
-                double t = 0;
-                for (k = 0; k < 3; k++) t += K[3 * r + k] * v[6 * i + 3 + k];
-                out[6 * i + 3 + r] += (frm_real)t;
-            }
+        for (i = 0; i < m->frame_count; i++) { /* the frame-own rotational term (pairs' Hs + gravity) */
+            const frm_real *h = m->lin_hrot + 6 * i, *t = v + 6 * i + 3;
+            out[6 * i + 3] += h[0] * t[0] + h[5] * t[1] + h[4] * t[2];
+            out[6 * i + 4] += h[5] * t[0] + h[1] * t[1] + h[3] * t[2];
+            out[6 * i + 5] += h[4] * t[0] + h[3] * t[1] + h[2] * t[2];
         }
     }
     if (exact)
@@ -2525,6 +2891,34 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
     D[27] += H[5];
 }
 
+/* The stabilisation's part of the tangent columns of slot a of sample s (assembly): for
+   each unit dq_c of slot a's frame, adds dPx / v to cols[c] and writes the torque row of
+   every stabilised slot k into rows[18 k + 3 c + r] (the column (a, c) of K's rotational
+   rows of frame k, i.e. by symmetry row c of block (a, k), columns 3 + r). */
+static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54], frm_real *rows)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, c, k, r, pa = b + a;
+    frm_real vol = m->s_volume[s], cst = m->stab_beta * m->s_mu[s] * vol, zero[3] = {0, 0, 0};
+    const frm_real *F = m->lin_F + 9 * (size_t)s;
+    for (c = 0; c < 6; c++) {
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        dq[c] = 1;
+        frm_pair_dF(dq, m->p_grad + 3 * (size_t)pa, m->p_G + 9 * (size_t)pa, dF);
+        for (k = 0; k < n; k++) {
+            int i = m->p_frame[b + k];
+            frm_real dPx[9], tq[3];
+            if (!m->f_stab_on[i]) {
+                for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = 0;
+                continue;
+            }
+            frm_pair_stab_apply(F, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst, m->p_stab + 3 * (size_t)(b + k),
+                                k == a ? dq + 3 : zero, m->lin_definite, dPx, tq);
+            for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
+            for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[r];
+        }
+    }
+}
+
 /* The coupling's Gauss-Newton coefficient between slots a and b of sample s. */
 static frm_real frm__coupling_coef(const frm_model *m, int s, int a, int b)
 {
@@ -2548,26 +2942,27 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
         int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
         if (i1 > m->frame_count) i1 = m->frame_count;
         for (i = i0; i < i1; i++) {
-            double acc[36], Kg[9];
+            double acc[36];
             int e, k, r;
             memset(acc, 0, sizeof acc);
             for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
-                int p = m->rev_pair[e], s = m->p_sample[p];
-                frm_real cols[54], K[36];
+                int p = m->rev_pair[e], s = m->p_sample[p], a = p - m->s_start[s];
+                frm_real cols[54], K[36], rows[18 * FRM_MAX_NEIGHBORS];
                 for (k = 0; k < 36; k++) K[k] = 0;
                 frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
                                          m->p_G + 9 * (size_t)p, cols);
+                if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
+                if (m->s_stab[s] && m->f_stab_on[i])
+                    for (k = 0; k < 6; k++)
+                        for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * a + 3 * k + r];
                 frm__add_rotational(m->p_H + 6 * (size_t)p, K);
-                if (m->s_couple[s] != 0) {
-                    frm_pair_coupling_block(frm__coupling_coef(m, s, p - m->s_start[s], p - m->s_start[s]), m->p_A + 3 * (size_t)p,
-                                            m->p_A + 3 * (size_t)p, K);
-                    frm_pair_coupling_rotation(m->p_C + 3 * (size_t)p, m->p_A + 3 * (size_t)p, K);
-                }
+                if (m->s_couple[s] != 0)
+                    frm_pair_coupling_block(frm__coupling_coef(m, s, a, a), m->p_A + 3 * (size_t)p, m->p_A + 3 * (size_t)p, K);
                 for (k = 0; k < 36; k++) acc[k] += (double)K[k];
             }
-            (void)Kg; /* the rest blocks carry no gravity: the rotated ones get the current one */
+            /* the rest blocks carry no gravity: the rotated ones get the current frame-own term */
             for (r = 0; r < 6; r++)
                 for (k = 0; k < 6; k++) m->kdiag_rest[36 * (size_t)i + 6 * r + k] = (frm_real)(0.5 * (acc[6 * r + k] + acc[6 * k + r]));
         }
@@ -2589,8 +2984,9 @@ static void frm__rest_diagonal(frm_model *m)
 }
 
 /* Assembly over frame chunks: row i's blocks from the pairs of frame i (slot a of sample
-   s): K_{i, frame of slot b} += v B_a^T A B_b for every slot b, plus Hs on the diagonal
-   and the gravity stiffness. Rows are independent: no two tasks write the same block. */
+   s): K_{i, frame of slot b} += v B_a^T A B_b for every slot b (with the stabilisation's
+   columns and torque rows), plus the frame-own rotational term lin_hrot on the diagonal.
+   Rows are independent: no two tasks write the same block. */
 static void frm__assemble_chunks(void *vctx, int begin, int end)
 {
     frm__gather_ctx *ctx = (frm__gather_ctx *)vctx;
@@ -2602,27 +2998,26 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
         for (i = i0; i < i1; i++) {
             int e, k, r, diag = frm__find_block(m, i, i);
             frm_real *D = m->blocks + 36 * (size_t)diag;
-            double Kg[9];
             memset(m->blocks + 36 * (size_t)m->blk_start[i], 0,
                    sizeof(frm_real) * 36 * (size_t)(m->blk_start[i + 1] - m->blk_start[i]));
             for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
                 int p = m->rev_pair[e], s = m->p_sample[p], b = m->s_start[s], n = m->s_start[s + 1] - b, a = p - b, q;
-                frm_real cols[54];
+                frm_real cols[54], rows[18 * FRM_MAX_NEIGHBORS];
                 frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
                                          m->p_G + 9 * (size_t)p, cols);
+                if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 for (q = 0; q < n; q++) {
                     frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
                     frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q), K);
+                    if (m->s_stab[s] && m->f_stab_on[m->p_frame[b + q]])
+                        for (k = 0; k < 6; k++)
+                            for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * q + 3 * k + r];
                     if (m->s_couple[s] != 0)
                         frm_pair_coupling_block(frm__coupling_coef(m, s, a, q), m->p_A + 3 * (size_t)p, m->p_A + 3 * (size_t)(b + q), K);
                 }
-                frm__add_rotational(m->p_H + 6 * (size_t)p, D);
-                if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)p, m->p_A + 3 * (size_t)p, D);
             }
-            frm__gravity_stiffness(m, i, Kg);
-            for (r = 0; r < 3; r++)
-                for (k = 0; k < 3; k++) D[6 * (3 + r) + 3 + k] += (frm_real)Kg[3 * r + k];
+            frm__add_rotational(m->lin_hrot + 6 * (size_t)i, D);
             for (r = 0; r < 6; r++)
                 for (k = 0; k < 6; k++) m->kdiag[36 * (size_t)i + 6 * r + k] = (frm_real)0.5 * (D[6 * r + k] + D[6 * k + r]);
         }
@@ -2669,12 +3064,13 @@ static void frm__prepare_mode(frm_model *m, int mode)
         return;
     }
     /* pair mode: the block-Jacobi blocks are the rest ones turned with the frame,
-       T K_rest T^T with T = diag(Q, Q), plus the current gravity term: exact for a rigid
-       motion of the rest state, an approximation under strain (the preconditioner only) */
+       T K_rest T^T with T = diag(Q, Q), plus the current frame-own rotational term (its
+       pairs' Hs and gravity): exact for a rigid motion of the rest state, an approximation
+       under strain (the preconditioner only) */
     for (i = 0; i < m->frame_count; i++) {
         const frm_real *Q = m->rel + 9 * i, *K0 = m->kdiag_rest + 36 * (size_t)i;
         frm_real *K = m->kdiag + 36 * (size_t)i;
-        double T[36], KT[36], Kg[9];
+        double T[36], KT[36];
         memset(T, 0, sizeof T);
         for (r = 0; r < 3; r++)
             for (k = 0; k < 3; k++) T[6 * r + k] = T[6 * (r + 3) + k + 3] = Q[3 * r + k];
@@ -2684,14 +3080,13 @@ static void frm__prepare_mode(frm_model *m, int mode)
                 for (l = 0; l < 6; l++) t += (double)K0[6 * r + l] * T[6 * k + l];
                 KT[6 * r + k] = t; /* K0 T^T */
             }
-        frm__gravity_stiffness(m, i, Kg);
         for (r = 0; r < 6; r++)
             for (k = 0; k < 6; k++) {
                 double t = 0;
                 for (l = 0; l < 6; l++) t += T[6 * r + l] * KT[6 * l + k];
-                if (r >= 3 && k >= 3) t += Kg[3 * (r - 3) + k - 3];
                 K[6 * r + k] = (frm_real)t;
             }
+        frm__add_rotational(m->lin_hrot + 6 * (size_t)i, K);
     }
 }
 
@@ -2775,11 +3170,13 @@ static void frm__mass_apply(const frm_model *m, int i, const frm_real *v, double
 }
 
 /* Block-Jacobi preconditioner: the inverse of a_mass M_i + a_stiff K_ii per free frame (a
-   Cholesky inverse; if that block is not positive definite, the inverse of its absolute
-   diagonal), zero for fixed and driven frames. */
-static void frm__build_precond(frm_model *m, double a_mass, double a_stiff)
+   Cholesky inverse; if that block is not positive definite, V |Lambda|^-1 V^T from its
+   eigen-decomposition, eigenvalues of magnitude below 1e-9 of the largest raised to it),
+   zero for fixed and driven frames. Returns the number of blocks that needed the
+   eigen-decomposition (an indefinite linearisation). */
+static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
 {
-    int i, k;
+    int i, k, fixed = 0;
     for (i = 0; i < m->frame_count; i++) {
         frm_real *P = m->precond + 36 * (size_t)i;
         double A[36], M[36], inv[36];
@@ -2791,11 +3188,27 @@ static void frm__build_precond(frm_model *m, double a_mass, double a_stiff)
         for (k = 0; k < 36; k++) A[k] = a_mass * M[k] + a_stiff * (double)m->kdiag[36 * (size_t)i + k];
         for (k = 3; k < 6; k++) A[7 * k] += a_stiff * m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]);
         if (!frm__invert6(A, inv)) {
-            for (k = 0; k < 36; k++) inv[k] = 0;
-            for (k = 0; k < 6; k++) inv[7 * k] = fabs(A[7 * k]) > 0 ? 1.0 / fabs(A[7 * k]) : 0.0;
+            double V[36], ev[6], top = 0;
+            int r, c;
+            for (r = 0; r < 6; r++)
+                for (c = 0; c < r; c++) A[6 * r + c] = A[6 * c + r] = 0.5 * (A[6 * r + c] + A[6 * c + r]);
+            frm__jacobi(A, 6, V, ev);
+            for (k = 0; k < 6; k++) {
+                ev[k] = fabs(ev[k]);
+                if (ev[k] > top) top = ev[k];
+            }
+            for (k = 0; k < 6; k++) ev[k] = ev[k] > 1e-9 * top ? 1 / ev[k] : (top > 0 ? 1 / (1e-9 * top) : 0);
+            for (r = 0; r < 6; r++)
+                for (c = 0; c < 6; c++) {
+                    double t = 0;
+                    for (k = 0; k < 6; k++) t += V[6 * r + k] * ev[k] * V[6 * c + k];
+                    inv[6 * r + c] = t;
+                }
+            fixed++;
         }
         for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
     }
+    return fixed;
 }
 
 /* >>solver ----------------------------------------------------------------------------- */
@@ -2961,6 +3374,12 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
 }
 
 #define FRM__MAX_HALVINGS 12
+/* A static solve whose residual has not halved for this many Newton iterations stops with
+   FRM_ERR_STALLED (mechanisms make it wander, see LIMITS) instead of running to the cap. */
+#define FRM__STALL_ITERATIONS 10
+/* Least regularisation (fraction of |K_ii| on the rotational diagonal) of a static solve's
+   positive-definite attempt, whose K may be singular along rotations nothing holds. */
+#define FRM__DEFINITE_REGULARIZATION 1e-6
 
 /* One Newton iteration (sec. 3.6): K dq = f by CG, then a backtracking (Armijo) line
    search on the total potential along q(alpha) = q (+) alpha dq:
@@ -2971,9 +3390,9 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
    moves. *res gets |f| after. */
 static int frm__newton_iteration(frm_model *m, double *ref, int *converged, double *res)
 {
-    frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X];
+    frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X], *trial_f = m->vec[FRM__V_T];
     double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta;
-    int err, h, i, r, accepted = 0, first = *ref < 0;
+    int err, h, i, r, attempt, accepted = 0, first = *ref < 0;
     *converged = 0;
     err = frm__force_pass(m, 1, 0, &W0);
     if (err) return err;
@@ -2988,23 +3407,47 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
         if (norm > *ref) *ref = norm;
         m->stats.initial_residual = (frm_real)norm;
     }
-    if (norm <= (double)m->newton_tolerance * *ref || norm <= frm__round_off_floor(m)) {
+    if (norm <= (double)m->newton_tolerance * *ref) {
         *converged = 1;
         return FRM_OK;
     }
-    frm__prepare_mode(m, frm__choose_mode(m));
-    m->solve_regularization = m->regularization;
-    frm__build_precond(m, 0.0, 1.0);
-    memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    /* below the round-off floor the residual's 2-norm no longer tells how far the soft modes
+       are from equilibrium (a slender steel beam in float: the floor exceeds the load):
+       iterate while Newton still halves the residual, stop when it cannot */
+    if (norm <= frm__round_off_floor(m)) {
+        if (!first && m->floor_residual > 0 && norm > 0.5 * m->floor_residual) {
+            *converged = 1;
+            return FRM_OK;
+        }
+        m->floor_residual = norm;
+    } else
+        m->floor_residual = 0;
     /* inexact Newton (Eisenstat-Walker): solve as accurately as the step can use */
     eta = first ? 1e-3 : (norm / m->newton_previous) * (norm / m->newton_previous);
     if (eta > 1e-3) eta = 1e-3;
     if (eta < 0.1 * (double)m->newton_tolerance * *ref / norm) eta = 0.1 * (double)m->newton_tolerance * *ref / norm;
     if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
     m->newton_previous = norm;
-    frm__cg(m, 0.0, 1.0, eta, f, dq); /* a capped or truncated solve still gives a descent direction */
-    m->solve_regularization = 0;
-    slope = frm__dot(m, f, dq);
+    for (attempt = 0;; attempt++) {
+        int cg;
+        frm__prepare_mode(m, frm__choose_mode(m));
+        /* the definite attempt adds at least FRM__DEFINITE_REGULARIZATION: its K may be singular */
+        m->solve_regularization = attempt && m->regularization < FRM__DEFINITE_REGULARIZATION ? FRM__DEFINITE_REGULARIZATION
+                                                                                              : m->regularization;
+        frm__build_precond(m, 0.0, 1.0);
+        memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+        cg = frm__cg(m, 0.0, 1.0, eta, f, dq); /* a capped solve still gives a descent direction */
+        m->solve_regularization = 0;
+        slope = frm__dot(m, f, dq);
+        if (m->lin_definite || (cg != FRM__CG_NEGATIVE && slope > 0 && frm__all_finite(dq, 6 * (size_t)m->frame_count)))
+            break;
+        /* the linearisation is indefinite along the search (compressed samples, the rotations'
+           second-order terms, gravity): Newton's step may climb; solve with K's positive-definite
+           part instead (see SOLVERS) */
+        err = frm__force_pass(m, 2, 0, NULL);
+        if (err) return err;
+        m->stats.definite_solves++;
+    }
     if (!(slope > 0) || !frm__all_finite(dq, 6 * (size_t)m->frame_count)) { /* not a descent direction */
         frm__precond_apply(m, f, dq);
         slope = frm__dot(m, f, dq);
@@ -3031,8 +3474,17 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
                 dphi -= alpha * ((double)m->ext[6 * i + r] * dq[6 * i + r] + (double)m->ext[6 * i + 3 + r] * dq[6 * i + 3 + r]);
             }
         }
-        if (dphi <= -1e-4 * alpha * slope + noise) accepted = 1;
-        else if (dphi < best) {
+        if (dphi <= -1e-4 * alpha * slope && dphi < -noise) accepted = 1; /* a real decrease (Armijo) */
+        else if (dphi <= noise) { /* the energy cannot tell (round-off): the residual must fall */
+            double rn;
+            frm__total_force(m, trial_f);
+            rn = frm__norm_free(m, trial_f);
+            if (rn < norm) accepted = 1;
+            else if (dphi < best) {
+                best = dphi;
+                best_alpha = alpha;
+            }
+        } else if (dphi < best) {
             best = dphi;
             best_alpha = alpha;
         }
@@ -3087,8 +3539,8 @@ FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
 
 FRMDEF int frm_model_solve_static(frm_model *m)
 {
-    double ref = -1, res = 0;
-    int it, converged = 0, err = FRM_OK;
+    double ref = -1, res = 0, mark = 0;
+    int it, mark_it = 0, converged = 0, err = FRM_OK;
     if (!m) return FRM_ERR_ARG;
     frm__reset_stats(m);
     frm__save_state(m);
@@ -3097,6 +3549,13 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     for (it = 0;; it++) {
         err = frm__newton_iteration(m, &ref, &converged, &res);
         if (err || converged || it == m->newton_max_iterations) break;
+        if (it == 0 || res < mark) { /* progress: the residual halved since the last mark */
+            mark = 0.5 * res;
+            mark_it = it;
+        } else if (it - mark_it >= FRM__STALL_ITERATIONS) {
+            err = FRM_ERR_STALLED;
+            break;
+        }
     }
     if (!err && !converged) err = FRM_ERR_NO_CONVERGENCE;
     m->stats.residual = (frm_real)res;
@@ -3112,7 +3571,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
 
 /* >>integrator ------------------------------------------------------------------------- */
 
-static int frm__linearize(frm_model *m, double *energy);
+static int frm__linearize(frm_model *m, double *energy, int definite);
 
 /* The light check after a step of a model with Neo-Hookean samples: F of every such
    sample has det F > 0 (else the new state has infinite energy). */
@@ -3142,13 +3601,8 @@ static int frm__implicit_step(frm_model *m, double dt)
     frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
     frm_real *drive = m->vec[FRM__V_DRIVE];
     double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
-    int err, i, k, cg, any_driven = 0;
+    int err, i, k, cg, attempt, any_driven = 0;
     frm__save_state(m);
-    err = frm__linearize(m, NULL);
-    if (err) return err;
-    frm__mass_update(m);
-    frm__total_force(m, f);
-    frm__build_precond(m, a_mass, a_stiff);
     /* driven frames: the velocity that reaches the target in dt */
     for (i = 0; i < m->frame_count; i++) {
         for (k = 0; k < 6; k++) drive[6 * i + k] = 0;
@@ -3163,21 +3617,33 @@ static int frm__implicit_step(frm_model *m, double dt)
             any_driven = 1;
         }
     }
-    /* b = dt (f - (dt + beta) K v - alpha M v) - a_stiff K dv_driven */
-    frm__stiffness_product(m, m->vel, t, 0);
-    for (i = 0; i < m->frame_count; i++) {
-        double mv[6];
-        frm__mass_apply(m, i, m->vel + 6 * i, mv);
-        for (k = 0; k < 6; k++)
-            b[6 * i + k] = (frm_real)(dt * ((double)f[6 * i + k] - (dt + (double)m->stiffness_damping) * t[6 * i + k] -
-                                            (double)m->mass_damping * mv[k]));
+    for (attempt = 0;; attempt++) {
+        err = frm__linearize(m, NULL, attempt);
+        if (err) return err;
+        frm__mass_update(m);
+        frm__total_force(m, f);
+        frm__build_precond(m, a_mass, a_stiff);
+        /* b = dt (f - (dt + beta) K v - alpha M v) - a_stiff K dv_driven */
+        frm__stiffness_product(m, m->vel, t, 0);
+        for (i = 0; i < m->frame_count; i++) {
+            double mv[6];
+            frm__mass_apply(m, i, m->vel + 6 * i, mv);
+            for (k = 0; k < 6; k++)
+                b[6 * i + k] = (frm_real)(dt * ((double)f[6 * i + k] - (dt + (double)m->stiffness_damping) * t[6 * i + k] -
+                                                (double)m->mass_damping * mv[k]));
+        }
+        if (any_driven) {
+            frm__stiffness_product(m, drive, t, 0);
+            for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
+        }
+        memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
+        cg = frm__cg(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
+        if (attempt || cg != FRM__CG_NEGATIVE) break;
+        /* M + dt^2 K is indefinite here (compressed samples, the rotations' second-order terms,
+           gravity, at a large dt): the step uses K's positive-definite part instead, which
+           keeps the system positive definite at any dt */
+        m->stats.definite_solves++;
     }
-    if (any_driven) {
-        frm__stiffness_product(m, drive, t, 0);
-        for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
-    }
-    memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
-    cg = frm__cg(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
     if ((cg == FRM__CG_CAP && m->cg_fail_at_cap) || cg == FRM__CG_NEGATIVE) {
         frm__restore_state(m);
         return FRM_ERR_NO_CONVERGENCE;
@@ -3230,11 +3696,11 @@ FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt)
     return frm__implicit_step(m, (double)dt);
 }
 
-/* Linearises at the current state (force pass with the stiffness data), chooses the mode
-   and prepares it. */
-static int frm__linearize(frm_model *m, double *energy)
+/* Linearises at the current state (force pass with the stiffness data: the symmetric part
+   of K, or with definite its positive-definite part), chooses the mode and prepares it. */
+static int frm__linearize(frm_model *m, double *energy, int definite)
 {
-    int err = frm__force_pass(m, 1, 0, energy);
+    int err = frm__force_pass(m, definite ? 2 : 1, 0, energy);
     if (err) return err;
     frm__prepare_mode(m, frm__choose_mode(m));
     return FRM_OK;
@@ -3480,20 +3946,21 @@ FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36])
 }
 
 FRMDEF size_t frm_model_memory_bytes(const frm_model *m) { return m ? m->block_bytes : 0; }
+FRMDEF int frm_model_stabilized_frames(const frm_model *m) { return m ? m->stab_frames : 0; }
 
 /* >>stiffness-api ---------------------------------------------------------------------- */
 
 FRMDEF int frm_model_prepare_stiffness(frm_model *m)
 {
     if (!m) return FRM_ERR_ARG;
-    return frm__linearize(m, NULL);
+    return frm__linearize(m, NULL, 0);
 }
 
 FRMDEF int frm_model_apply_stiffness(frm_model *m, const frm_real *v, frm_real *out, int symmetric)
 {
     if (!m || !v || !out) return FRM_ERR_ARG;
-    if (!m->lin_valid) {
-        int err = frm__linearize(m, NULL);
+    if (!m->lin_valid || m->lin_definite) {
+        int err = frm__linearize(m, NULL, 0);
         if (err) return err;
     }
     frm__stiffness_product(m, v, out, !symmetric);
