@@ -55,6 +55,9 @@ typedef struct bench_model {
     const char *precision; /* "double" or "float" */
     unsigned integrators;  /* bit (1u << BENCH_x) set for each supported integrator/solver */
     int nonlinear;         /* 1: geometrically exact (large deformation) */
+    int primary;           /* 1: every scene; 0: a variant of a primary entry (another law)
+                              that runs only the static scenes and the smallest kernels,
+                              to keep `make bench` within its time */
     const char *element;   /* unit of the kernel counts: "tet", "pair" */
     /* 0 or the library's error code; *sim NULL on failure */
     int (*create)(const bench_body *b, void **sim);

@@ -248,10 +248,10 @@ static int fr_kernel(void *v, int kernel)
         fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL
 
 static const bench_model fr_models[] = {
-    {"frames", "svk hex8", "svk", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_svk_hex, FR_FUNCTIONS},
-    {"frames", "nh hex8", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_nh_hex, FR_FUNCTIONS},
-    {"frames", "svk tet4", "svk", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_svk_tet, FR_FUNCTIONS},
-    {"frames", "nh tet4", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, "pair", fr_create_nh_tet, FR_FUNCTIONS},
+    {"frames", "svk hex8", "svk", BENCH_PRECISION, FR_ALL, 1, 1, "pair", fr_create_svk_hex, FR_FUNCTIONS},
+    {"frames", "nh hex8", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, 0, "pair", fr_create_nh_hex, FR_FUNCTIONS},
+    {"frames", "svk tet4", "svk", BENCH_PRECISION, FR_ALL, 1, 1, "pair", fr_create_svk_tet, FR_FUNCTIONS},
+    {"frames", "nh tet4", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, 0, "pair", fr_create_nh_tet, FR_FUNCTIONS},
 };
 
 const bench_model *BENCH_TABLE(int *count);
