@@ -119,8 +119,10 @@
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
    A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
-   Neo-Hookean sample (FRM_ERR_INVERTED) or without convergence (FRM_ERR_NO_CONVERGENCE)
-   leaves positions, orientations and velocities exactly as they were.
+   Neo-Hookean sample (FRM_ERR_INVERTED), without convergence (FRM_ERR_NO_CONVERGENCE) or,
+   for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
+   iterations, see LIMITS) leaves positions, orientations and velocities exactly as they
+   were.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
    time, different models by different threads. The per-sample and per-frame passes run
@@ -174,6 +176,31 @@
        fields, it stiffens the rotations a trilinear grid cannot see (see LIMITS), at the
        price of bending stiffness on coarse, elongated cells.
 
+       Rotation stabilisation (desc.rotation_stabilization = beta, default 0.5; 0 = the
+       thesis's model exactly). A frame whose samples lie on a line (or are a single one)
+       has a rotation they do not see at first order: turning it about that line while
+       translating it by -dtheta x a_s leaves every sample's prediction d = x + R lbar in
+       place, and F changes only by the skew w [dtheta]x. The energy is flat along it, and
+       under stress its second-order term w (Q - I) relieves the samples' strain, so it
+       buckles: the thesis's model has no equilibrium near the natural one (with one sample
+       per tetrahedron every edge frame of a beam is such a frame, and Newton wandered to
+       FRM_ERR_NO_CONVERGENCE on every beam of the bench; measured: the energy minimum
+       sits at 0.04 rad of spurious rotation and 78 % more sag on R1 one cell across). For
+       those frames only (found at creation: the kernel of the samples' second moment
+       J = tr(L) I - L, projector N in rest axes, unless the whole neighbourhood is
+       collinear too, a rod whose torsion lives in that rotation) the model adds, per
+       (sample, frame),
+           E_r = beta mu v / 2  omega . N omega,   omega = axial(skew(Q^T F)),
+       the frame's rotation relative to the sample's, about the unseen axes only. Zero for
+       rigid motions and whenever the frame turns with its samples, so it does not touch
+       the first-order solution: it only picks the unseen rotation, and changes
+       equilibria through the difference of the material rotations at a frame's samples
+       (measured: beta 0.5 against 0.1 moves the tip by 0.44 % on R3 one cell across, by
+       0.06 % at two, by 0.02 % on R2 at three; tests/test_frames.c checks it). Forces:
+       T = beta mu v / 2 Q [N omega]x joins the sample's P, the frame's own torque is
+       sum_j f_j x t_j; its stiffness is exact (Gauss-Newton part and second-order part,
+       tested against finite differences). frm_model_stabilized_frames counts the frames.
+
    MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
    split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
    sees its shares as points rigidly attached to it: the kinetic energy
@@ -196,23 +223,44 @@
        relative residual (1e-3, then as fast as the residual falls, never below
        cg_tolerance, never tighter than the step can use), then a backtracking Armijo line
        search on the total potential (elastic + gravity - f_ext . dq; constant torques have
-       no potential, their work along the step is exact); a CG that meets non-positive
-       curvature returns its last iterate (a descent direction). Converged when
-       |f| <= newton_tolerance |load| or |f| falls below the round-off floor (64 eps times
-       the size of the partial forces it sums, plus K times one ulp of the displacements).
-       static_regularization (default 1e-6) adds that fraction of |K_ii| to each frame's
-       rotational diagonal inside CG only: the forces and the equilibrium are unchanged.
+       no potential, their work along the step is exact); where the potential's change is
+       below its round-off the trial must lower |f| instead. Indefinite linearisations
+       (compressed samples, the rotations' second-order terms, gravity's torque on frames
+       whose samples hang above them): when CG meets non-positive curvature, or its step
+       is not a descent direction, the iteration is solved again with K's positive-definite
+       part (below; frm_stats.definite_solves counts them), which always gives a descent
+       direction. Converged when |f| <= newton_tolerance |load|, or when |f| is below the
+       round-off floor (64 eps times the size of the partial forces it sums, plus K times
+       one ulp of the displacements) and a further Newton iteration no longer halves it
+       (below the floor the 2-norm does not tell how far the soft modes are: a slender
+       steel beam in float has a floor above its load). A solve whose residual has not
+       halved in 10 iterations stops with FRM_ERR_STALLED (mechanisms, see LIMITS).
+       static_regularization (default 1e-10; 1e-6 at least in the positive-definite
+       attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
+       only: the forces and the equilibrium are unchanged. Keep it small: a slender beam's
+       softest bending mode sits near 1e-7 of the diagonal, and 1e-6 made Newton linear.
        Implicit Euler (eq. 3.64) with Rayleigh damping, one linearisation per step:
            (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
        then v += dv, x += dt v, q = exp(dt omega) q renormalised (|q| = 1 to round-off for
        ever). Fixed frames do not move, driven frames reach their targets in the step and
-       enter the right-hand side through K. The CG starts from the previous step's dv.
+       enter the right-hand side through K. The CG starts from the previous step's dv. If
+       CG meets non-positive curvature (M + dt^2 K indefinite: large dt on a stressed
+       body), the step is linearised again with K's positive-definite part, with which the
+       system is positive definite at any dt (the scheme stays implicit Euler with an
+       approximate Jacobian: same equilibria, stable).
+       K's positive-definite part K+: the material term (positive for SVK; Neo-Hookean with
+       2 (mu - lambda ln J) kept >= 0), the geometric term dF S with the positive part of
+       S, each frame's own rotational term (its pairs' derivative of B through the frame's
+       rotation, gravity's torque, the coupling's and the stabilisation's second-order
+       parts, summed) replaced by its positive part, and the stabilisation's Gauss-Newton
+       part: a sum of positive semi-definite terms, equal to K on a stress-free state
+       without gravity.
        Preconditioner: 6x6 block Jacobi, the inverse of a_M M_i + a_K K_ii per frame
-       (Cholesky; the absolute diagonal if a block is not positive definite). In block
-       mode K_ii is exact; in pair mode it is the rest state's, turned with the frame
-       (T K_rest T^T, T = diag(Q, Q)), plus the current gravity term: exact for rigid
-       motions, an approximation under strain, and free where the exact blocks cost
-       about 25 CG iterations.
+       (Cholesky; V |Lambda|^-1 V^T from its eigen-decomposition if a block is not positive
+       definite). In block mode K_ii is exact; in pair mode it is the rest state's, turned
+       with the frame (T K_rest T^T, T = diag(Q, Q)), plus the current frame-own rotational
+       term: exact for rigid motions, an approximation under strain, and free where the
+       exact blocks cost about 25 CG iterations.
 
    SHAPE FUNCTIONS AND SAMPLING (sec. 4.1)
        frm_shape_tet: barycentric (4 neighbours). frm_shape_hex: trilinear (8), gradients
@@ -236,10 +284,12 @@
            force pass (frm_model_forces)         pass 1 reads 60 (index, weight,
                gradient, rest lever) and writes 48, pass 2 reads 52: 160; linearising
                (before a solve) writes 120 more (G, Hs), 168 with the coupling term.
-           K v, pair mode (matrix-free)           pass 1 reads 148 (index, gradient, G,
-               Hs) and writes 48, pass 2 reads 52: 248, plus the sample's F, S (and the
+           K v, pair mode (matrix-free)           pass 1 reads 100 (index, gradient,
+               G) and writes 48, pass 2 reads 52: 200, plus the sample's F, S (and the
                Neo-Hookean tangent) over its neighbours, 15 to 45 a pair; 48 more with
-               the coupling term. About 130 flops a pair.
+               the coupling term. About 120 flops a pair. The derivative of B through a
+               frame's own rotation (the pairs' Hs) is summed per frame at the
+               linearisation and applied in pass 2 (6 reals a frame).
            K v, block mode                        292 per 6x6 block (36 reals and a
                column index), about 0.5 block a pair with 8 neighbours (hexahedra), 0.2
                with 4 (tetrahedra).
@@ -361,10 +411,10 @@ typedef FRM_REAL frm_real;
 /* The least bytes each kernel streams per (sample, neighbour) pair (see PERFORMANCE), for
    bandwidth bounds: the force pass (pass 1 reads index, weight, gradient and rest lever,
    writes 6 reals; pass 2 reads them back with the pair index), the matrix-free K v (pass 1
-   reads index, gradient, G and Hs, then the same 6-real round trip), and one assembled
+   reads index, gradient and G, then the same 6-real round trip), and one assembled
    6x6 block with its column index (block mode). Sample data (F, S) comes on top. */
 #define FRM_FORCE_BYTES_PER_PAIR (2 * sizeof(int) + 19 * sizeof(frm_real))
-#define FRM_KV_BYTES_PER_PAIR (2 * sizeof(int) + 30 * sizeof(frm_real))
+#define FRM_KV_BYTES_PER_PAIR (2 * sizeof(int) + 24 * sizeof(frm_real))
 #define FRM_KV_BYTES_PER_BLOCK (sizeof(int) + 36 * sizeof(frm_real))
 
 /* Pairs (sample, neighbour) below which loops run serially (starting threads costs more
@@ -2194,15 +2244,18 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
 }
 
 /* Second moment J = tr(L) I - L of a set of points (L their covariance about the mean),
-   accumulated by frm__spread_add: sums in acc[0..2] (coordinates), acc[3..11] (products),
+   accumulated by frm__spread_add relative to a nearby origin o (far from the world origin
+   the raw products would cancel): sums in acc[0..2] (coordinates), acc[3..11] (products),
    acc[12] (count). A rotation dtheta moves some point relative to the others at first
    order iff dtheta . J dtheta > 0. */
-static void frm__spread_add(double acc[13], const frm_real *x)
+static void frm__spread_add(double acc[13], const frm_real *x, const frm_real *o)
 {
+    double y[3];
     int r, c;
+    for (r = 0; r < 3; r++) y[r] = (double)x[r] - (double)o[r];
     for (r = 0; r < 3; r++) {
-        acc[r] += (double)x[r];
-        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += (double)x[r] * x[c];
+        acc[r] += y[r];
+        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += y[r] * y[c];
     }
     acc[12] += 1;
 }
@@ -2241,7 +2294,7 @@ static int frm__invisible_rotations(const frm_desc *d, const int *rev_start, con
         int p = rev_pair[e], s = pair_sample[p];
         const frm_real *g = d->neighbor_gradients + 3 * (size_t)p;
         if (d->neighbor_weights[p] == 0 && g[0] == 0 && g[1] == 0 && g[2] == 0) continue;
-        frm__spread_add(acc, d->sample_positions + 3 * (size_t)s);
+        frm__spread_add(acc, d->sample_positions + 3 * (size_t)s, d->frame_positions + 3 * (size_t)i);
     }
     if (acc[12] == 0) return 0;
     frm__spread_J(acc, J);
@@ -2257,7 +2310,7 @@ static int frm__invisible_rotations(const frm_desc *d, const int *rev_start, con
         for (q = d->neighbor_start[s]; q < d->neighbor_start[s + 1]; q++) {
             int j = d->neighbor_frames[q], f;
             for (f = rev_start[j]; f < rev_start[j + 1]; f++)
-                frm__spread_add(acc2, d->sample_positions + 3 * (size_t)pair_sample[rev_pair[f]]);
+                frm__spread_add(acc2, d->sample_positions + 3 * (size_t)pair_sample[rev_pair[f]], d->frame_positions + 3 * (size_t)i);
         }
     }
     frm__spread_J(acc2, J2);
