@@ -121,7 +121,7 @@
    A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
    Neo-Hookean sample (FRM_ERR_INVERTED), without convergence (FRM_ERR_NO_CONVERGENCE) or,
    for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
-   iterations, see LIMITS) leaves positions, orientations and velocities exactly as they
+   iterations or rose in 3 in a row, see LIMITS) leaves positions, orientations and velocities exactly as they
    were.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
@@ -234,7 +234,8 @@
        one ulp of the displacements) and a further Newton iteration no longer halves it
        (below the floor the 2-norm does not tell how far the soft modes are: a slender
        steel beam in float has a floor above its load). A solve whose residual has not
-       halved in 10 iterations stops with FRM_ERR_STALLED (mechanisms, see LIMITS).
+       halved in 10 iterations, or rose in 3 in a row, stops with FRM_ERR_STALLED
+       (mechanisms, see LIMITS).
        static_regularization (default 1e-10; 1e-6 at least in the positive-definite
        attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
        only: the forces and the equilibrium are unchanged. Keep it small: a slender beam's
@@ -313,7 +314,12 @@
 
    ACCURACY (tests/test_frames.c prints these)
        R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.39 % of Timoshenko
-       (0.82 % in float); with Gauss points -1.7 % (Poisson locking of 4 cells across).
+       (+0.16 % in float); with Gauss points -1.7 % (Poisson locking of 4 cells across).
+       Tetrahedral frames with one sample per tetrahedron (the bench's tet4 body, 5
+       tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +33 %,
+       +5.9 %, +2.3 %, +1.1 %, +0.28 % for k = 1, 2, 3, 4, 6, float within 2e-4 of double;
+       the R3 beam's static sag +30 % and +4.9 % at one and two cells across (soft at one
+       cell: the frames' rotations let a single tetrahedron bend).
        R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.289,
        6.132, 6.327 m, order 1.6, limit 6.54 m, about 40,000 DoF for 1 % of it.
        R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.96 %.
@@ -321,21 +327,37 @@
        to within 3.5 degrees; a coplanar Shepard sheet under 300 N (fig. 4.10) converges.
 
    LIMITS
-       - Invisible rotations: on tensor-product (extruded) hexahedral grids, a layer of
-         frames normal to an axis turning about that axis moves no sample at all (the
-         bilinear face interpolation reproduces the in-plane coordinates), so the energy
-         is flat along those directions. Small deformations solve well (the static
-         regularisation picks an orientation); under large deformation and compression
-         they turn into soft, unstable modes and Newton or the implicit step can fail:
-         use tetrahedral or meshless frames there, or frame_coupling = 1e-2 (which makes
-         coarse, elongated cells stiffer in bending: R1 at 25 x 5 x 5 becomes 31 % too
-         stiff). One cell across a hexahedral beam is too few (spurious distortion of the
-         section): use two or more.
+       - Invisible rotations. (a) A frame whose samples are collinear (or a single one) has
+         a rotation they do not see at first order; under stress it buckles (see MODEL).
+         With one sample per tetrahedron every edge frame of a mesh is such a frame. The
+         default rotation_stabilization (0.5) holds exactly those; with 0 (the thesis's
+         model) static solves of stressed bodies fail or end in the buckled minimum (R1
+         one cell across: 0.04 rad of spurious rotation, 78 % too much sag). (b) On
+         tensor-product (extruded) hexahedral grids a layer of frames normal to an axis,
+         turning about that axis, moves no sample at all (the bilinear face interpolation
+         reproduces the in-plane coordinates): a collective mode no single frame shows, so
+         the stabilisation does not see it (stabilising every hexahedral frame's rotation
+         makes bending 30 % too stiff). Small deformations on two or more cells across
+         solve well (R1, R3); one cell across, or large deformation (R2), the mode buckles
+         and the static solve stops with FRM_ERR_STALLED (0.2-0.5 s on the bench's beams)
+         rather than running to the cap. Use tetrahedral or meshless frames there, or
+         frame_coupling = 1e-2 (which makes coarse, elongated cells stiffer in bending: R1
+         at 25 x 5 x 5 becomes 31 % too stiff). Implicit steps stay stable at any time step
+         (the positive-definite fallback), the mode then moves dynamically.
+       - Indefinite linearisations (compression, buckling, the invisible rotations above)
+         make the static Newton fall back to K's positive-definite part, which converges
+         linearly, not quadratically, while K stays indefinite.
        - Hexahedral frames with Gauss points lock in bending near incompressibility, like
          trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
-         across); sub-cell samples lock less. Tetrahedral frames converge slowly (R2).
+         across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
+         beam, and no convergence at 0.499). Tetrahedral frames with one sample each lock
+         less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2).
        - St Venant-Kirchhoff softens and can collapse under strong compression; a
-         Neo-Hookean sample cannot invert (steps refuse with FRM_ERR_INVERTED).
+         Neo-Hookean sample cannot invert: its energy is infinite at det F <= 0, and a step
+         or solve that would reach it refuses with FRM_ERR_INVERTED and keeps the last
+         valid state (the bench's squash test: a corner driven through the opposite face).
+         There is no inversion-safe continuation (as heml.h's linearised volumetric term
+         below J0): use St Venant-Kirchhoff for scenes that push the body through itself.
        - Shepard functions are zero-order (no linear reproduction): meshless Shepard
          bodies are stiffer and less accurate than MLS ones, but take any point layout
          (coplanar, collinear); MLS needs 3D spread and may give negative weights (the
@@ -344,8 +366,10 @@
          and taken at the start of each step; gyroscopic terms are neglected.
        - Constant external torques have no potential: with them the static Newton's
          symmetric Jacobian converges linearly, not quadratically.
-       - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m);
-         steel-like stiffness needs the round-off floor to stop Newton (R1 float +0.82 %).
+       - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m; at
+         1e6 m a mesh of centimetres degenerates, FRM_ERR_SHAPE_DEGENERATE); steel-like
+         stiffness needs the round-off floor to stop Newton, which it does only once
+         Newton no longer halves the residual (R1 float +0.16 %).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
@@ -353,6 +377,14 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
+       unreleased: rotation stabilisation for frames with collinear samples (default on:
+             changes tetrahedral one-sample models); static and implicit solvers fall back
+             to K's positive-definite part on indefinite linearisations; static line search
+             judged by the residual below the energy's round-off; the round-off floor stops
+             Newton only without progress; FRM_ERR_STALLED; static_regularization default
+             1e-10 (was 1e-6); frm_stats.definite_solves, frm_model_stabilized_frames; the
+             frame-own rotational term applied per frame (frm_pair_apply and
+             frm_sample_coupling_apply lost their Hs / g arguments).
 
    Licence at the end of the file. */
 #ifndef FRAMES_H
@@ -579,9 +611,11 @@ typedef struct frm_desc {
     int newton_max_iterations; /* default 30 */
     frm_real static_regularization; /* static solves add this times |K_ii| to each frame's
                                        rotational diagonal inside CG (not to the forces: the
-                                       equilibrium is unchanged), default 1e-6. It fixes the
-                                       orientations the energy leaves free (see LIMITS:
-                                       invisible rotations); 0 gives the plain Newton step */
+                                       equilibrium is unchanged), default 1e-10 (at least 1e-6
+                                       in the positive-definite fallback). Larger values slow
+                                       Newton on slender bodies, whose softest bending modes
+                                       sit near 1e-7 of the diagonal; 0 gives the plain
+                                       Newton step */
     frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
 
     /* environment */
@@ -3430,6 +3464,9 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
 /* A static solve whose residual has not halved for this many Newton iterations stops with
    FRM_ERR_STALLED (mechanisms make it wander, see LIMITS) instead of running to the cap. */
 #define FRM__STALL_ITERATIONS 10
+/* ... or whose residual rose in this many consecutive iterations (energy descent walking
+   into a mechanism). */
+#define FRM__STALL_RISES 3
 /* Least regularisation (fraction of |K_ii| on the rotational diagonal) of a static solve's
    positive-definite attempt, whose K may be singular along rotations nothing holds. */
 #define FRM__DEFINITE_REGULARIZATION 1e-6
@@ -3592,8 +3629,8 @@ FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
 
 FRMDEF int frm_model_solve_static(frm_model *m)
 {
-    double ref = -1, res = 0, mark = 0;
-    int it, mark_it = 0, converged = 0, err = FRM_OK;
+    double ref = -1, res = 0, mark = 0, previous = 0;
+    int it, mark_it = 0, rises = 0, converged = 0, err = FRM_OK;
     if (!m) return FRM_ERR_ARG;
     frm__reset_stats(m);
     frm__save_state(m);
@@ -3602,10 +3639,12 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     for (it = 0;; it++) {
         err = frm__newton_iteration(m, &ref, &converged, &res);
         if (err || converged || it == m->newton_max_iterations) break;
+        rises = it > 0 && res > previous ? rises + 1 : 0;
+        previous = res;
         if (it == 0 || res < mark) { /* progress: the residual halved since the last mark */
             mark = 0.5 * res;
             mark_it = it;
-        } else if (it - mark_it >= FRM__STALL_ITERATIONS) {
+        } else if (it - mark_it >= FRM__STALL_ITERATIONS || rises >= FRM__STALL_RISES) {
             err = FRM_ERR_STALLED;
             break;
         }
