@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef struct test_case {
     const char *name;
@@ -98,7 +99,8 @@ static inline void test__check_rel(double expected, double actual, double rel, c
         } \
     } while (0)
 
-/* True when the build asked for the reduced sizes (sanitizer builds, see Makefile):
+/* True when the build asked for the reduced sizes (g++, clang and sanitizer builds, see
+   the Makefile):
    heavy convergence studies shrink, every assertion stays. */
 #ifdef TEST_QUICK
 #define TEST_IS_QUICK 1
@@ -112,14 +114,17 @@ static int test_main(int argc, char **argv, const test_case *cases, int count)
     int passed = 0, failed = 0, i;
     for (i = 0; i < count; i++) {
         if (filter && !strstr(cases[i].name, filter)) continue;
+        clock_t start = clock();
+        double seconds;
         test__failed_checks = 0;
         cases[i].fn();
+        seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
         if (test__failed_checks == 0) {
             passed++;
-            printf("PASS %s\n", cases[i].name);
+            printf("PASS %s (%.2f s)\n", cases[i].name, seconds);
         } else {
             failed++;
-            printf("FAIL %s (%d checks)\n", cases[i].name, test__failed_checks);
+            printf("FAIL %s (%d checks, %.2f s)\n", cases[i].name, test__failed_checks, seconds);
         }
         fflush(stdout);
     }
