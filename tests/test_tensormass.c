@@ -625,6 +625,109 @@ static void test_cantilever_springs(void)
     CHECK(d > 0.0);
 }
 
+/* The spring model's static Newton on two hard cases, at the default tolerances.
+   (1) A steel cantilever (strains about 1e-6), in float as in double: each stretch
+   l - l0 is formed as (l^2 - l0^2) / (l + l0) from the displacements, so small strains
+   keep their digits (as a difference of two lengths, float lost them all and Newton
+   never converged). Checked by linearity: halving the load halves the tip deflection to
+   within 3e-4, in float as in double (the springs' geometric nonlinearity at a tip slope
+   of about 0.7 % accounts for 5e-5; before the fix float's answer was noise).
+   (2) A soft bar whose end is turned by 180 degrees in eight static increments:
+   compressed springs make the tangent indefinite and a full Newton step can overshoot;
+   the full tangent (its positive-definite part where CG finds it indefinite) and the line
+   search must converge every increment in a few Newton iterations.
+   Springs are rotation-invariant, so the mid-length section turns by about 90 degrees:
+   within 3 degrees and its corner radius within 3 % (what a coarse 2 x 2 section gives
+   springs; the exact torsion has no such freedom to check against). */
+static double spring_cantilever_tip(double gravity_scale, int *newton)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    double tip[3] = {16.0, 0.0, 0.0}, deflection;
+    tmass_real g[3] = {0, 0, 0};
+    int i, t, err;
+    tetmesh_beam(&mesh, 16.0, 0.5, 0.5, 32, 1, 1, TETMESH_SPLIT5);
+    m = make_model(&mesh, TMASS_MASS_SPRING, 200e9, 0.3, 7800.0);
+    CHECK(m != NULL);
+    *newton = 0;
+    if (!m) {
+        tetmesh_free(&mesh);
+        return NAN;
+    }
+    g[2] = (tmass_real)(-9.81 * gravity_scale);
+    tmass_set_gravity(m, g);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+    err = tmass_solve_static(m);
+    CHECK_INT(TMASS_OK, err);
+    *newton = tmass_last_stats(m)->newton_iterations;
+    t = tetmesh_nearest_node(&mesh, tip);
+    deflection = -((double)tmass_positions(m)[3 * t + 2] - mesh.nodes[3 * t + 2]);
+    tmass_destroy(m);
+    tetmesh_free(&mesh);
+    return deflection;
+}
+
+static void test_springs_static_hard_cases(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    tmass_real zero[3] = {0, 0, 0};
+    double full, half, angle = 0.0, radius = 0.0;
+    int newton_full, newton_half, i, inc, n = 0;
+    full = spring_cantilever_tip(1.0, &newton_full);
+    half = spring_cantilever_tip(0.5, &newton_half);
+    printf("    springs steel cantilever: tip %.6g m (%d Newton), half load %.6g m (%d Newton)\n", full,
+           newton_full, half, newton_half);
+    CHECK(full > 0.0);
+    CHECK_REL(0.5 * full, half, 3e-4);
+    CHECK(newton_full <= 10 && newton_half <= 10);
+
+    tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 20, 2, 2, TETMESH_SPLIT5); /* section centred on x */
+    m = make_model(&mesh, TMASS_MASS_SPRING, 1e5, 0.3, 1000.0);
+    REQUIRE(m != NULL);
+    tmass_set_gravity(m, zero);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+    for (inc = 1; inc <= 8; inc++) {
+        double a = 3.14159265358979323846 * inc / 8, c = cos(a), sn = sin(a);
+        int err;
+        for (i = 0; i < mesh.node_count; i++) {
+            const double *p = mesh.nodes + 3 * i;
+            tmass_real u[3];
+            if (p[0] < 1.0 - 1e-9) continue;
+            u[0] = 0;
+            u[1] = (tmass_real)(c * p[1] - sn * p[2] - p[1]);
+            u[2] = (tmass_real)(sn * p[1] + c * p[2] - p[2]);
+            tmass_set_displacement(m, i, u);
+        }
+        err = tmass_solve_static(m);
+        CHECK_INT(TMASS_OK, err);
+        /* full-tangent Newton: 6 iterations here (the positive-definite part alone
+           converged linearly, in 48) */
+        CHECK(tmass_last_stats(m)->newton_iterations <= 15);
+        if (err) break;
+    }
+    for (i = 0; i < mesh.node_count; i++) {
+        const double *p0 = mesh.nodes + 3 * i;
+        const tmass_real *p = tmass_positions(m) + 3 * i;
+        if (fabs(p0[0] - 0.5) > 1e-9 || fabs(fabs(p0[1]) - 0.05) > 1e-9 || fabs(fabs(p0[2]) - 0.05) > 1e-9)
+            continue;
+        angle += atan2(p0[1] * p[2] - p0[2] * p[1], p0[1] * p[1] + p0[2] * p[2]);
+        radius += sqrt((double)p[1] * p[1] + (double)p[2] * p[2]) / sqrt(2 * 0.05 * 0.05);
+        n++;
+    }
+    REQUIRE(n == 4);
+    angle *= 180 / 3.14159265358979323846 / n;
+    radius /= n;
+    printf("    springs 180-degree twist: mid-length turned %.2f degrees, corner radius ratio %.4f\n", angle,
+           radius);
+    CHECK_NEAR(90.0, angle, 3.0);
+    CHECK_NEAR(1.0, radius, 0.03);
+    tmass_destroy(m);
+    tetmesh_free(&mesh);
+}
+
 /* ---- dynamics --------------------------------------------------------------------- */
 
 /* A small clamped beam deflected by a static load and released (no gravity, no damping);
@@ -1243,6 +1346,7 @@ static const test_case cases[] = {
     TEST(test_masses),
     TEST(test_cantilever_r1),
     TEST(test_cantilever_springs),
+    TEST(test_springs_static_hard_cases),
     TEST(test_semi_implicit_energy_bounded),
     TEST(test_explicit_euler_grows_rk4_decays),
     TEST(test_implicit_large_steps),
