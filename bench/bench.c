@@ -760,7 +760,7 @@ static const char *classify(int code, int finite, double error)
 }
 
 /* A 1 x 0.1 x 0.1 m cantilever released from rest under a load that would deflect it by
-   about 1 % of its length; stable when `steps` steps (1000, 100 when quick) stay finite,
+   about 1 % of its length; stable when `steps` steps (1000, 50 when quick) stay finite,
    raise no error and keep the tip within 10 deflections (an undamped unstable mode grows
    past that). */
 static int stable_at(const bench_model *m, const bench_body *b, int integrator, double dt, int steps, int *code)
@@ -784,7 +784,7 @@ static int stable_at(const bench_model *m, const bench_body *b, int integrator, 
 
 static void stability_time_step(const bench_model *m, const options *o)
 {
-    int steps = o->quick ? 100 : 1000, halvings = o->quick ? 6 : 12;
+    int steps = o->quick ? 50 : 1000, halvings = o->quick ? 5 : 12;
     static const double youngs[3] = {1e3, 1e5, 1e7};
     int e, it;
     for (it = 0; it < BENCH_STATIC; it++) {
@@ -1085,7 +1085,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
     static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk"};
     double bandwidth[3];
-    int i, s, th, kern, sizes = o->quick ? 2 : 4, max_threads = o->threads;
+    int i, s, th, kern, sizes = o->quick ? 1 : 4, max_threads = o->threads;
     FILE *f;
     printf("\n== 3. kernel throughput ==\n");
     for (th = 1; th <= max_threads; th++) {
@@ -1099,7 +1099,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
            "elements", "ns/elem", "bytes/elem", "bound ns", "ratio");
     for (i = 0; i < count; i++) {
         const bench_model *m = models[i];
-        for (s = 0; s < (m->primary ? sizes : 2); s++) {
+        for (s = 0; s < (m->primary || o->quick ? sizes : 2); s++) {
             /* a cube of n^3 cells; adapters report the elements they built */
             int n = (int)ceil(cbrt(targets[s] / 6.0)), code;
             bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
