@@ -87,7 +87,7 @@ build/examples/%: examples/%.c $(HEADERS)
 BENCH_CFLAGS := -std=c99 -O3 -march=native -ffp-contract=fast -fopenmp
 BENCH_MODELS := $(basename $(notdir $(wildcard bench/model_*.c)))
 BENCH_OBJS := $(foreach m,$(BENCH_MODELS),build/bench/$(m)_double.o build/bench/$(m)_float.o)
-BENCH_GIT := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- 2>/dev/null || echo -dirty)
+BENCH_GIT := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- . ':!bench/results' 2>/dev/null || echo -dirty)
 BENCH_DEFS := -DBENCH_FLAGS='"$(BENCH_CFLAGS)"' -DBENCH_GIT='"$(BENCH_GIT)"'
 
 build/bench/%_double.o: bench/%.c bench/bench.h bench/body_mesh.h $(HEADERS)
