@@ -4,7 +4,10 @@
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
    build/bench/bench [--quick] [--out DIR] [--parts trade,stability,kernels]
-                     [--filter TEXT] [--repeats N] [--threads N]
+                     [--filter TEXT] [--repeats N] [--threads N] [--budget SECONDS]
+
+   --budget: a refinement series stops at the first level whose answer takes longer
+   (default 2 s; law variants get a quarter). Raise it to see finer levels.
 
    1. trade: scenes with known answers (REFERENCES.md R1-R5 and a cutting scene), for every
       model entry x resolution x integrator: DoF, seconds per step, seconds to the answer,
@@ -875,7 +878,7 @@ static void stability_poisson(const bench_model *m, const options *o)
         r.m = m;
         r.parameter = nus[i];
         snprintf(r.setting, sizeof r.setting, "static nu=%g", nus[i]);
-        beam_static(m, nus[i], zero, o->quick ? 2 : 4, &r.value, &r.error, &r.code, &finite);
+        beam_static(m, nus[i], zero, o->quick ? 2 : 3, &r.value, &r.error, &r.code, &finite);
         r.outcome = classify(r.code, finite, r.error);
         stability_out(&r);
     }
@@ -962,7 +965,7 @@ static void stability_squash(const bench_model *m)
    and |corner radius / rest radius - 1|. */
 static void stability_twist(const bench_model *m, const options *o)
 {
-    int k = o->quick ? 2 : 4;
+    int k = o->quick ? 2 : 3;
     bench_body b = make_body(1, 0.1, 0.1, 10 * k, k, k, 1e5, 0.3, 1000);
     stability_row r;
     void *sim = NULL;
@@ -1136,7 +1139,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                 for (th = 1; th <= max_threads; th++) {
                     double sec, elems = m->elements(sim), bytes = m->kernel_bytes(sim, kern), bound, ns;
                     set_threads(th);
-                    sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.05, &code);
+                    sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.02, &code);
                     if (code) break;
                     ns = 1e9 * sec / elems;
                     bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
@@ -1176,7 +1179,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
 static void usage(void)
 {
     fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,kernels] [--filter TEXT] "
-                    "[--repeats N] [--threads N]\n");
+                    "[--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
 
@@ -1191,12 +1194,13 @@ int main(int argc, char **argv)
     o.threads = 2;
     o.out = "bench/results";
     o.parts = 7;
-    o.budget = 3;
+    o.budget = 2;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else if (!strcmp(argv[i], "--filter") && i + 1 < argc) o.filter = argv[++i];
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--budget") && i + 1 < argc) o.budget = atof(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--parts") && i + 1 < argc) {
             const char *p = argv[++i];
@@ -1204,7 +1208,6 @@ int main(int argc, char **argv)
         } else usage();
     }
     if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
-    if (o.quick) o.budget = 2;
     mkdir(o.out, 0755); /* may exist already; open_csv reports a real failure */
     read_environment();
     for (i = 0; i < (int)(sizeof registry / sizeof registry[0]); i++) {
