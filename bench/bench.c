@@ -1096,8 +1096,33 @@ static double time_kernel(const bench_model *m, void *sim, int kernel, double mi
     return median(t, 5);
 }
 
+/* Each model's single-thread cost per element at its smallest and largest size, for the
+   cache-to-memory summary. */
+typedef struct kernel_span {
+    const bench_model *m;
+    int kernel;
+    double small_elems, small_ns, large_elems, large_ns;
+} kernel_span;
+
+static void print_kernel_spans(const kernel_span *spans, int count, const char *const *kernel_name)
+{
+    int i, any = 0;
+    for (i = 0; i < count; i++) any |= spans[i].large_elems > spans[i].small_elems;
+    if (!any) return; /* one size per model (quick) */
+    printf("\ncost per element from the smallest to the largest size, 1 thread (cache to memory):\n");
+    for (i = 0; i < count; i++) {
+        const kernel_span *k = spans + i;
+        if (k->large_elems <= k->small_elems) continue;
+        printf("  %-10s %-12s %-6s %-7s %9.0f -> %9.0f elements: %7.2f -> %7.2f ns (x %.2f)\n", k->m->model,
+               k->m->variant, k->m->precision, kernel_name[k->kernel], k->small_elems, k->large_elems, k->small_ns,
+               k->large_ns, k->large_ns / k->small_ns);
+    }
+}
+
 static void run_kernels(const options *o, const bench_model *const *models, int count)
 {
+    static kernel_span spans[256 * BENCH_KERNEL_COUNT]; /* 256 model entries at most (main) */
+    int span_count = 0;
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
     static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk"};
     double bandwidth[3];
@@ -1142,6 +1167,17 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                     sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.02, &code);
                     if (code) break;
                     ns = 1e9 * sec / elems;
+                    if (th == 1 && span_count < (int)(sizeof spans / sizeof spans[0])) {
+                        kernel_span *k = NULL;
+                        int j;
+                        for (j = 0; j < span_count; j++)
+                            if (spans[j].m == m && spans[j].kernel == kern) k = spans + j;
+                        if (!k) {
+                            k = spans + span_count++;
+                            k->m = m, k->kernel = kern, k->small_elems = elems, k->small_ns = ns;
+                        }
+                        k->large_elems = elems, k->large_ns = ns;
+                    }
                     bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
                     printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
                            m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
@@ -1154,6 +1190,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
             m->destroy(sim);
         }
     }
+    print_kernel_spans(spans, span_count, kernel_name);
     /* haptic scenes: precomputed contact models */
     for (i = 0; i < count; i++) {
         double upd[3], pre = 0, mem = 0;
