@@ -206,8 +206,8 @@
    (1.2 to 1.4 times when the vertex traffic is counted too). In ISO mode (-std=c99) gcc
    does not contract multiply-adds into FMAs and the loop is about 8 % slower. The spring
    force reads less (40 bytes per edge) but computes a square root and a division per
-   edge (k (l - l0) / l = k (l^2 - l0^2) / ((l + l0) l); damping adds one): in blocks of 32 edges a vectorised loop forms the force factors, a second one
-   scatters them; about 1.4 times the tensor pass per edge (9 ns against 6.4 ns on a
+   edge (k (l - l0) / l = k (l^2 - l0^2) / ((l + l0) l); damping adds one): in blocks of
+   32 edges a vectorised loop forms the force factors, a second one scatters them; about 1.4 times the tensor pass per edge (9 ns against 6.4 ns on a
    25,600-tet beam in one run), compute-bound, not memory-bound. Removing a
    tetrahedron is constant work (ten tensor updates, its edges, faces and boundary
    triangles): 0.26 us per tetrahedron on a 6,000-tet mesh, 1.4 us on a 1.3-million-tet
