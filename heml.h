@@ -103,11 +103,15 @@
    time, different models by different threads. Loops run in parallel through desc.
    parallel_for (an engine's job system) when given, through OpenMP when compiled with
    -fopenmp, serially otherwise; meshes under HEML_PARALLEL_MIN_TETS tetrahedra run
-   serially. Tetrahedra are cut into fixed chunks of up to 256 (16 blocks of 16) that do
-   not depend on the thread count; chunks are coloured so that no two chunks of a colour
-   share a node, colours run in a fixed order and each chunk adds into the node forces in
-   a fixed order, so every node receives its contributions in the same order whatever the
-   threads (element colouring, no per-element buffer, no atomics). Reductions (energy, CG
+   serially. Tetrahedra are cut into fixed chunks of up to 256 (16 blocks of 16) and the
+   chunks, in mesh order, into groups of up to 16 consecutive chunks (fewer per group on
+   small meshes, so that there are at least 64 groups), none of which depends on the
+   thread count; groups are coloured so that no two groups of a colour share a node,
+   colours run in a fixed order, a group is run by one thread chunk after chunk and each
+   chunk adds into the node forces in a fixed order, so every node receives its
+   contributions in the same order whatever the threads (element colouring, no
+   per-element buffer, no atomics). A group sweeps a compact piece of the mesh, so its
+   nodes stay in cache. Reductions (energy, CG
    dot products) add fixed block partial sums in a fixed order. Results are bit-identical
    for any number of threads. The colouring was chosen over a two-pass gather by
    measurement (see PERFORMANCE).
@@ -820,7 +824,9 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__COOKIE 0x48454D4Cu /* "HEML" */
 #define HEML__ALIGN 64
 #define HEML__W 16          /* tetrahedra per block: the SIMD width of the kernels' loops */
-#define HEML__CHUNK 16      /* blocks per chunk: the unit of threading and colouring */
+#define HEML__CHUNK 16      /* blocks per chunk: the unit of the per-chunk sums */
+#define HEML__GROUP 16      /* chunks per group at most: the unit of threading and colouring */
+#define HEML__GROUPS_MIN 64 /* groups are made smaller until there are this many (or one chunk each) */
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
@@ -864,7 +870,7 @@ typedef struct heml__mat {
 } heml__mat;
 
 struct heml_model {
-    int node_count, tet_count, block_count, slot_count, chunk_count, colour_count;
+    int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     int agg_count;                         /* aggregates of the coarse space (0: none) */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
@@ -894,8 +900,10 @@ struct heml_model {
     size_t *blk_prony;    /* offset of the block's Prony state, reals */
     int *slot_tet, *tet_slot;
 
-    /* chunks of consecutive blocks of one material, listed colour by colour */
-    int *chunk_begin, *chunk_end, *chunk_material, *colour_start;
+    /* chunks of consecutive blocks of one material; groups of consecutive chunks (group g:
+       chunks group_start[g] .. group_start[g + 1] - 1), listed colour by colour (colour c:
+       groups colour_start[c] .. colour_start[c + 1] - 1) */
+    int *chunk_begin, *chunk_end, *chunk_material, *group_start, *colour_start;
     double *chunk_energy;
     int *chunk_below, *chunk_inverted;
 
@@ -1643,11 +1651,11 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         heml_real L = heml__log_jc(Jc, jc1, iJ);
         heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
         heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
-        heml_real sv = s0 * vol, mv = mu * vol, wv = (s0 - p0) * vol, tw = wv * tr;
+        heml_real mv = mu * vol, wv = (s0 - p0) * vol, dv = s0 * vol + wv * tr, ev = mv - wv;
         b->jm1[k] = jm1;
-        b->K[0][k] = sv + mv * H00 + wv * (c00 - H00) + tw;
-        b->K[4][k] = sv + mv * H11 + wv * (c11 - H11) + tw;
-        b->K[8][k] = sv + mv * H22 + wv * (c22 - H22) + tw;
+        b->K[0][k] = dv + ev * H00 + wv * c00;
+        b->K[4][k] = dv + ev * H11 + wv * c11;
+        b->K[8][k] = dv + ev * H22 + wv * c22;
         b->K[1][k] = mv * H01 + wv * (c01 - H10);
         b->K[2][k] = mv * H02 + wv * (c02 - H20);
         b->K[3][k] = mv * H10 + wv * (c10 - H01);
@@ -1998,7 +2006,7 @@ static void heml__run(const heml_model *m, int count, heml__range_fn fn, void *c
 #endif
 }
 
-/* One pass over the tetrahedra, chunk by chunk, colour by colour. */
+/* One pass over the tetrahedra, colour by colour, group by group, chunk by chunk. */
 typedef struct heml__pass {
     heml_model *m;
     int mode, prony_write, colour;
@@ -2012,8 +2020,9 @@ static void heml__chunks(void *vctx, int begin, int end)
     const heml__pass *p = (const heml__pass *)vctx;
     heml_model *m = p->m;
     heml__blk b;
-    int ci, blk, k;
-    for (ci = m->colour_start[p->colour] + begin; ci < m->colour_start[p->colour] + end; ci++) {
+    const heml_real jm1_0 = m->jm1_0;
+    int g0 = m->colour_start[p->colour] + begin, g1 = m->colour_start[p->colour] + end, ci, blk, k;
+    for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++) {
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         double energy = 0.0;
         int below = 0, inverted = 0;
@@ -2026,8 +2035,8 @@ static void heml__chunks(void *vctx, int begin, int end)
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
                 heml__scatter(idx, b.f, p->out);
-                for (k = 0; k < valid; k++) {
-                    below += b.jm1[k] < m->jm1_0;
+                for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
+                    below += b.jm1[k] < jm1_0;
                     inverted += b.jm1[k] <= -1;
                 }
                 break;
@@ -2200,6 +2209,7 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->chunk_begin, int, C);
     HEML__CARVE(c, m->chunk_end, int, C);
     HEML__CARVE(c, m->chunk_material, int, C);
+    HEML__CARVE(c, m->group_start, int, C + 1);
     HEML__CARVE(c, m->colour_start, int, C + 1);
     HEML__CARVE(c, m->chunk_energy, double, C);
     HEML__CARVE(c, m->chunk_below, int, C);
@@ -2478,22 +2488,31 @@ static int heml__validate(const heml_desc *d)
 
 /* >>precomputation -------------------------------------------------------------------- */
 
-/* Greedy colouring of the chunks (in their original order) so that no two chunks of a
-   colour share a node; the chunk arrays are then reordered colour by colour. stamp is n
+/* Groups of consecutive chunks (in their original, mesh order), then a greedy colouring
+   of the groups so that no two groups of a colour share a node; the chunk arrays are
+   reordered group by group, colour by colour. A group is the unit a thread runs, so its
+   chunks sweep a compact piece of the mesh one after the other (its nodes stay in cache);
+   colouring single chunks instead spread each colour over the whole mesh (measured: 40
+   against 24 ns per tetrahedron for the Neo-Hookean force at 1e6 tetrahedra). stamp is n
    ints of scratch, colour_of C ints, order 3 C ints. */
-static void heml__colour_chunks(heml_model *m, int *stamp, int *colour_of, int *order)
+static void heml__colour_groups(heml_model *m, int *stamp, int *colour_of, int *order)
 {
-    int c, colour = 0, done = 0, pos = 0, i, C = m->chunk_count;
-    for (c = 0; c < C; c++) colour_of[c] = -1;
+    int g, c, colour = 0, done = 0, pos = 0, i, C = m->chunk_count, per = C / HEML__GROUPS_MIN, G;
+    if (per < 1) per = 1;
+    if (per > HEML__GROUP) per = HEML__GROUP;
+    G = (C + per - 1) / per;
+    m->group_count = G;
+    for (g = 0; g < G; g++) colour_of[g] = -1;
     for (i = 0; i < m->node_count; i++) stamp[i] = -1;
-    while (done < C) {
-        for (c = 0; c < C; c++) {
-            int b0 = m->chunk_begin[c] * 4 * HEML__W, b1 = m->chunk_end[c] * 4 * HEML__W, ok = 1;
-            if (colour_of[c] >= 0) continue;
+    while (done < G) {
+        for (g = 0; g < G; g++) {
+            int c1 = (g + 1) * per < C ? (g + 1) * per : C, ok = 1;
+            int b0 = m->chunk_begin[g * per] * 4 * HEML__W, b1 = m->chunk_end[c1 - 1] * 4 * HEML__W;
+            if (colour_of[g] >= 0) continue;
             for (i = b0; i < b1 && ok; i++)
                 if (stamp[m->blk_idx[i]] == colour) ok = 0;
             if (!ok) continue;
-            colour_of[c] = colour;
+            colour_of[g] = colour;
             done++;
             for (i = b0; i < b1; i++) stamp[m->blk_idx[i]] = colour;
         }
@@ -2505,17 +2524,21 @@ static void heml__colour_chunks(heml_model *m, int *stamp, int *colour_of, int *
         order[C + c] = m->chunk_end[c];
         order[2 * C + c] = m->chunk_material[c];
     }
-    for (colour = 0; colour < m->colour_count; colour++) {
-        m->colour_start[colour] = pos;
-        for (c = 0; c < C; c++)
-            if (colour_of[c] == colour) {
+    for (colour = 0, g = 0; colour < m->colour_count; colour++) {
+        int h;
+        m->colour_start[colour] = g;
+        for (h = 0; h < G; h++) {
+            if (colour_of[h] != colour) continue;
+            m->group_start[g++] = pos;
+            for (c = h * per; c < (h + 1) * per && c < C; c++, pos++) {
                 m->chunk_begin[pos] = order[c];
                 m->chunk_end[pos] = order[C + c];
                 m->chunk_material[pos] = order[2 * C + c];
-                pos++;
             }
+        }
     }
-    m->colour_start[m->colour_count] = pos;
+    m->colour_start[m->colour_count] = g;
+    m->group_start[G] = pos;
 }
 
 static void heml__set_masks(heml_model *m, int i)
@@ -2997,7 +3020,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     }
     if (m->agg_count) memcpy(m->node_agg, stamp, sizeof(int) * (size_t)n);
     heml__aggregate_centres(m);
-    heml__colour_chunks(m, stamp, colour_of, order);
+    heml__colour_groups(m, stamp, colour_of, order);
     for (i = 0; i < n; i++) heml__set_masks(m, i);
     m->coarse_version = m->pin_version - 1;
     heml__prony_coefficients(m, (double)m->time_step);
