@@ -2488,6 +2488,42 @@ static int heml__validate(const heml_desc *d)
 
 /* >>precomputation -------------------------------------------------------------------- */
 
+/* The order tetrahedra take in the blocks: by material, then by their lowest node index
+   (ties by index), so that the passes walk the node arrays in order whatever the order
+   the tetrahedra came in: neighbouring tetrahedra share blocks, chunks and groups, the
+   gathers and scatters stream through memory and groups of a colour are few. Measured on
+   a beam of 1e6 tetrahedra with nodes numbered row by row: given in random order, a
+   Neo-Hookean force pass took 160 ns per tetrahedron unsorted and 40 ns sorted (30 to 35
+   for the mesh's own cell-by-cell order, which the sort keeps within noise). Rejected: a
+   Morton order of the centroids and the sum of the node indices (40 to 60 % slower on
+   that beam: they interleave tetrahedra many rows apart). Node numbering with locality
+   (row by row, a space-filling curve, reverse Cuthill-McKee) is left to the mesh. */
+typedef struct heml__order {
+    unsigned long long key;
+    int material, tet;
+} heml__order;
+
+static int heml__order_cmp(const void *pa, const void *pb)
+{
+    const heml__order *a = (const heml__order *)pa, *b = (const heml__order *)pb;
+    if (a->material != b->material) return a->material < b->material ? -1 : 1;
+    if (a->key != b->key) return a->key < b->key ? -1 : 1;
+    return (a->tet > b->tet) - (a->tet < b->tet);
+}
+
+static void heml__node_order(const heml_desc *d, heml__order *o)
+{
+    int t, j;
+    for (t = 0; t < d->tet_count; t++) {
+        int lo = d->tets[4 * t];
+        for (j = 1; j < 4; j++) lo = d->tets[4 * t + j] < lo ? d->tets[4 * t + j] : lo;
+        o[t].key = (unsigned long long)lo;
+        o[t].material = d->tet_material ? d->tet_material[t] : 0;
+        o[t].tet = t;
+    }
+    qsort(o, (size_t)d->tet_count, sizeof *o, heml__order_cmp);
+}
+
 /* Groups of consecutive chunks (in their original, mesh order), then a greedy colouring
    of the groups so that no two groups of a colour share a node; the chunk arrays are
    reordered group by group, colour by colour. A group is the unit a thread runs, so its
@@ -2892,6 +2928,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     heml__carver carver;
     const heml_material *src;
     int err, i, t, M, T, n, C_max, *counts, *fill, *bstart, *stamp, *colour_of, *order;
+    heml__order *order_of;
     size_t tmp_bytes;
     void *tmp_block;
     double *mass_acc, *diag_acc;
@@ -2907,14 +2944,16 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     n = d->node_count;
     alloc = d->allocator;
     C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
-    /* temporary: per-material counters, node stamps, chunk colours and reorder space,
-       mass and diagonal accumulators */
-    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+    /* temporary: mass and diagonal accumulators, the tetrahedra's order, per-material
+       counters, node stamps, chunk colours and reorder space */
+    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
+                sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
     tmp_block = heml__alloc(&alloc, tmp_bytes);
     if (!tmp_block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
     mass_acc = (double *)tmp_block;
     diag_acc = mass_acc + n;
-    counts = (int *)(diag_acc + 3 * (size_t)n);
+    order_of = (heml__order *)(diag_acc + 3 * (size_t)n);
+    counts = (int *)(order_of + T);
     fill = counts + M;
     bstart = fill + M;
     stamp = bstart + M;
@@ -2991,11 +3030,13 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
     }
-    /* slots: tetrahedra grouped by material (stable), each group padded to whole blocks */
+    /* slots: tetrahedra grouped by material, in node order (heml__node_order), each
+       material padded to whole blocks */
+    heml__node_order(d, order_of);
     for (i = 0; i < m->slot_count; i++) m->slot_tet[i] = -1;
-    for (t = 0; t < T; t++) {
-        int mi = d->tet_material ? d->tet_material[t] : 0;
-        int slot = bstart[mi] * HEML__W + fill[mi]++;
+    for (i = 0; i < T; i++) {
+        int mi = order_of[i].material, slot = bstart[mi] * HEML__W + fill[mi]++;
+        t = order_of[i].tet;
         m->slot_tet[slot] = t;
         m->tet_slot[t] = slot;
     }
