@@ -338,9 +338,13 @@
    (medians at 975,560: 48 / 61 against 32 / 49). Where the time goes (0.2.1, 20,480
    tetrahedra, the same loops run apart): the vectorised Neo-Hookean arithmetic alone 12
    to 13 ns, the gather and scatter alone 10 to 11 ns (about 85 scalar instructions per
-   tetrahedron). The 15 ns target would need both cut by about a third: the scatter and
-   gather only through explicit SIMD transposes (AVX2 has no scatter; not done), the
-   arithmetic by fewer register spills (about 80 of its 260 instructions per 4 lanes are
+   tetrahedron). The 15 ns target would need both cut by about a third. Tried for the
+   gather and scatter: AVX2 intrinsics with explicit transposes (128-bit loads and stores
+   of x, y per node, 4 lanes at a time) took them from 9.6 to 8.1 ns and the force from
+   22.4 to 20.8 ns on the 12,000-tetrahedron beam, not enough for a second, non-portable
+   code path, so not kept (the scalar loops are bound by the chains of updates to nodes
+   shared by neighbouring lanes more than by their instruction count). The arithmetic
+   would need fewer register spills (about 80 of its 260 instructions per 4 lanes are
    moves).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
