@@ -329,24 +329,27 @@
    than scalar loads (4 against 3 ns), so the gather loop is kept scalar
    (HEML__SCALAR_FN).
    0.2.1 colours groups of up to 16 chunks instead of single chunks (a colour of single
-   chunks spread over the whole mesh, so each colour swept all the node arrays again) and
-   orders the tetrahedra by their lowest node. Same method, 0.2.0 and 0.2.1 interleaved,
-   min of 3 rounds, double, ns per tetrahedron, force / differential:
-       12,000 tetrahedra (n = 20 above)          23.3 / 33.3      22.6 / 28.4
-       975,560 (58^3 cubes of 5, nodes row by row) 34.0 / 60.8    31.8 / 41.4
-       the same, tetrahedra in random order      97.8 / 189      29.3 / 41.4
-   (medians at 975,560: 48 / 61 against 32 / 49). Where the time goes (0.2.1, 20,480
-   tetrahedra, the same loops run apart): the vectorised Neo-Hookean arithmetic alone 12
-   to 13 ns, the gather and scatter alone 10 to 11 ns (about 85 scalar instructions per
-   tetrahedron). The 15 ns target would need both cut by about a third. Tried for the
-   gather and scatter: AVX2 intrinsics with explicit transposes (128-bit loads and stores
-   of x, y per node, 4 lanes at a time) took them from 9.6 to 8.1 ns and the force from
-   22.4 to 20.8 ns on the 12,000-tetrahedron beam, not enough for a second, non-portable
-   code path, so not kept. Nor are the scalar loops slowed by lanes that update the same
-   node one after the other: with no node shared inside a block they run no faster; they
-   are about 90 scalar instructions per tetrahedron at about 3 per cycle. The arithmetic
-   would need fewer register spills (about 80 of its 260 instructions per 4 lanes are
-   moves).
+   chunks spread over the whole mesh, so each colour swept all the node arrays again),
+   orders the tetrahedra by their lowest node and runs the Neo-Hookean force in short
+   stage loops (heml__forces_nh). Same method, 0.2.0 and 0.2.1 interleaved, min of 6
+   rounds (3 for random order), double, ns per tetrahedron, force / differential; figures
+   move by 15 % between rounds on this machine:
+                                                   0.2.0            0.2.1
+       12,000 tetrahedra (n = 20 above)            23.6 / 29.5      19.9 / 33.5 (*)
+       975,560 (58^3 cubes of 5, nodes row by row) 36.1 / 54.3      32.2 / 42.5
+       the same, tetrahedra in random order        141 / 195        26.5 / 44.6
+   (*) the differential's code and this mesh's order did not change: noise. Where the
+   time goes (0.2.1, the same loops run apart, 12,000 tetrahedra): the vectorised
+   Neo-Hookean arithmetic 10.5 to 11 ns (14 as one loop up to the stress and one for the
+   product, as in 0.2.0), the gather and scatter 9.5 to 10 ns (about 85 scalar
+   instructions per tetrahedron at about 3 per cycle; with no node shared inside a block
+   they run no faster, so it is not the chains of updates to shared nodes). The 15 ns
+   target needs the sum cut by a quarter. Tried for the gather and scatter: AVX2
+   intrinsics with explicit transposes (128-bit loads and stores of x, y per node, 4
+   lanes at a time) took them from 9.6 to 8.1 ns and the force from 22.4 to 20.8 ns on
+   the 12,000-tetrahedron beam: not enough for a second, non-portable code path, so not
+   kept. For the differential, splitting its volumetric scalars into a loop of their own
+   gained 3 % (14.7 to 14.3 ns of arithmetic): not kept either.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -398,7 +401,8 @@
    HISTORY
        0.2.1 (2026-12-01) passes colour groups of consecutive chunks (compact pieces of
              the mesh) and the tetrahedra are ordered by their lowest node: large and
-             randomly ordered meshes run 1.3 to 4 times faster; results change in their
+             randomly ordered meshes run 1.3 to 5 times faster; the Neo-Hookean force
+             runs in short stage loops (about 15 % faster); results change in their
              last digits (the order of the sums changed), still bit-identical across
              thread counts.
        0.2.0 (2026-12-01) displacements as the state (heml_displacements,
