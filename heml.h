@@ -2550,8 +2550,7 @@ static int heml__validate(const heml_desc *d)
    that beam: they interleave tetrahedra many rows apart). Node numbering with locality
    (row by row, a space-filling curve, reverse Cuthill-McKee) is left to the mesh. */
 typedef struct heml__order {
-    unsigned long long key;
-    int material, tet;
+    int material, key, tet; /* sorted in this order */
 } heml__order;
 
 static int heml__order_cmp(const void *pa, const void *pb)
@@ -2568,7 +2567,7 @@ static void heml__node_order(const heml_desc *d, heml__order *o)
     for (t = 0; t < d->tet_count; t++) {
         int lo = d->tets[4 * t];
         for (j = 1; j < 4; j++) lo = d->tets[4 * t + j] < lo ? d->tets[4 * t + j] : lo;
-        o[t].key = (unsigned long long)lo;
+        o[t].key = lo;
         o[t].material = d->tet_material ? d->tet_material[t] : 0;
         o[t].tet = t;
     }
