@@ -853,9 +853,17 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__COOKIE 0x48454D4Cu /* "HEML" */
 #define HEML__ALIGN 64
 #define HEML__W 16          /* tetrahedra per block: the SIMD width of the kernels' loops */
+/* Work units (overridable so that tests reach groups of several chunks on small meshes;
+   results never depend on the thread count, whatever their values). */
+#ifndef HEML__CHUNK
 #define HEML__CHUNK 16      /* blocks per chunk: the unit of the per-chunk sums */
+#endif
+#ifndef HEML__GROUP
 #define HEML__GROUP 16      /* chunks per group at most: the unit of threading and colouring */
+#endif
+#ifndef HEML__GROUPS_MIN
 #define HEML__GROUPS_MIN 64 /* groups are made smaller until there are this many (or one chunk each) */
+#endif
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients

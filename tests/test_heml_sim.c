@@ -5,6 +5,8 @@
    job systems, allocation discipline, and every error code. The laws and forces are
    tested in test_heml.c. */
 #define HEML_PARALLEL_MIN_TETS 64 /* exercise the chunked parallel path on small meshes */
+#define HEML__CHUNK 1                /* chunks of one block and groups of several chunks, */
+#define HEML__GROUPS_MIN 4           /* so threads run multi-chunk groups here too */
 #define HEML_IMPLEMENTATION
 #include "../heml.h"
 #define TETMESH_IMPLEMENTATION
