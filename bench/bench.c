@@ -1124,7 +1124,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
     static kernel_span spans[256 * BENCH_KERNEL_COUNT]; /* 256 model entries at most (main) */
     int span_count = 0;
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
-    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk"};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move"};
     double bandwidth[3];
     int i, s, th, kern, sizes = o->quick ? 1 : 4, max_threads = o->threads;
     FILE *f;

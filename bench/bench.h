@@ -28,7 +28,10 @@ enum {
     BENCH_KERNEL_FORCE = 0,     /* the internal force */
     BENCH_KERNEL_KV = 1,        /* K * v, matrix-free (the force differential) */
     BENCH_KERNEL_KV_BLOCKS = 2, /* K * v by assembled blocks, where a model has them */
-    BENCH_KERNEL_COUNT = 3
+    BENCH_KERNEL_MOVE = 3,      /* the force pass with its arithmetic taken out (gather the
+                                   nodes, stream the per-element data, scatter): the floor
+                                   under the force, where a model can time it */
+    BENCH_KERNEL_COUNT = 4
 };
 
 typedef struct bench_body {

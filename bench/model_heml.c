@@ -17,6 +17,7 @@
 #include "bench.h"
 #include "body_mesh.h"
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct hm_sim {
     heml_model *m;
@@ -159,16 +160,57 @@ static double hm_elements(void *v) { return (double)((hm_sim *)v)->tets; }
 static double hm_kernel_bytes(void *v, int kernel)
 {
     size_t r = 0, w = 0;
-    heml_kernel_bytes(((hm_sim *)v)->m, kernel, &r, &w);
+    heml_kernel_bytes(((hm_sim *)v)->m, kernel == BENCH_KERNEL_MOVE ? BENCH_KERNEL_FORCE : kernel, &r, &w);
     return (double)(r + w);
+}
+
+/* The move kernel: the force pass of heml.h (its colours, groups and blocks, its gather
+   and scatter, reached through the implementation this file includes) with the law's
+   arithmetic replaced by one multiply-add per link component, so that it still reads
+   every rest constant. What is left is the data movement the force cannot avoid. */
+typedef struct hm_move {
+    heml_model *m;
+    int colour;
+    heml_real *out;
+} hm_move;
+
+static void hm_move_links(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
+{
+    int r, k;
+    for (r = 0; r < 9; r++)
+        for (k = 0; k < HEML__W; k++) b->f[r][k] = b->e[r][k] * R[r * HEML__W + k] + R[9 * HEML__W + k];
+}
+
+static void hm_move_groups(void *ctx, int begin, int end)
+{
+    const hm_move *p = (const hm_move *)ctx;
+    const heml_model *m = p->m;
+    heml__blk b;
+    int g0 = m->colour_start[p->colour] + begin, g1 = m->colour_start[p->colour] + end, ci, blk;
+    for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++)
+        for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
+            const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+            heml__gather(idx, m->disp, b.e);
+            hm_move_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
+            heml__scatter(idx, b.f, p->out);
+        }
 }
 
 static int hm_kernel(void *v, int kernel)
 {
     hm_sim *s = (hm_sim *)v;
     if (kernel == BENCH_KERNEL_FORCE) return heml_compute_forces(s->m) ? 0 : HEML_ERR_ARG;
-    if (kernel != BENCH_KERNEL_KV) return BENCH_UNSUPPORTED;
-    return heml_apply_stiffness(s->m, s->dx, s->out);
+    if (kernel == BENCH_KERNEL_KV) return heml_apply_stiffness(s->m, s->dx, s->out);
+    if (kernel == BENCH_KERNEL_MOVE) {
+        hm_move p;
+        p.m = s->m;
+        p.out = s->out;
+        memset(s->out, 0, sizeof(heml_real) * 3 * (size_t)s->nodes);
+        for (p.colour = 0; p.colour < s->m->colour_count; p.colour++)
+            heml__run(s->m, s->m->colour_start[p.colour + 1] - s->m->colour_start[p.colour], hm_move_groups, &p);
+        return 0;
+    }
+    return BENCH_UNSUPPORTED;
 }
 
 #define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
