@@ -233,6 +233,7 @@ static int fr_kernel(void *v, int kernel)
     const frm_real *g;
     int err = 0;
     if (kernel == BENCH_KERNEL_FORCE) return frm_model_forces(s->m, &g);
+    if (kernel != BENCH_KERNEL_KV && kernel != BENCH_KERNEL_KV_BLOCKS) return BENCH_UNSUPPORTED;
     if (s->prepared != kernel) {
         err = frm_model_set_stiffness_mode(s->m, kernel == BENCH_KERNEL_KV ? FRM_STIFFNESS_PAIRS : FRM_STIFFNESS_BLOCKS);
         if (!err) err = kernel == BENCH_KERNEL_KV ? frm_model_prepare_stiffness(s->m) : frm_model_assemble_stiffness(s->m);

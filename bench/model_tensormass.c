@@ -190,7 +190,7 @@ static double tm_bytes_springs(void *v, int kernel)
    -K u), so both kernels time the same loop. Springs have no public K * v. */
 static int tm_kernel_tensor(void *v, int kernel)
 {
-    if (kernel == BENCH_KERNEL_KV_BLOCKS) return BENCH_UNSUPPORTED;
+    if (kernel != BENCH_KERNEL_FORCE && kernel != BENCH_KERNEL_KV) return BENCH_UNSUPPORTED;
     return tmass_forces(((tm_sim *)v)->m) ? 0 : TMASS_ERR_ARG;
 }
 
