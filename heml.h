@@ -287,9 +287,10 @@
    150 calls of heml_compute_forces / heml_apply_stiffness (400 for the small beam),
    0.1.0 and 0.2.0 built and run interleaved in the same session, min over 3 to 5 rounds;
    gcc -O3 -march=native (FMA contraction on) unless stated. Machine: this project's AMD
-   EPYC (Zen 5) virtual machine with AVX2, two vCPUs shared with other jobs (figures move
-   by 20 % between runs; compare within a row), an effective clock of 3.1 GHz by a
-   dependent add chain, triad 18.8 GB/s, both measured in the same session.
+   EPYC virtual machine (family 25, model 1: Zen 3, AVX2 without AVX-512; not the Zen 5
+   with AVX-512 at 4.2 GHz and 40 GB/s of REFERENCES.md), two vCPUs shared with other
+   jobs (figures move by 20 % between runs; compare within a row), an effective clock of
+   3.1 GHz by a dependent add chain, triad 18.8 GB/s, both measured in the same session.
                                            0.1.0            0.2.0
        n = 20: 12,000 tetrahedra (1.2 MB, cache-resident)
        Neo-Hookean force                   15.8 ns          19.9 ns
@@ -314,7 +315,7 @@
    this work was designed for: the gather and scatter alone (62 scalar memory operations:
    a kernel doing only them and the stream reads runs at 10 ns on the small beam) and the
    vectorised arithmetic (about 10 ns) each exceed the bound. For comparison REFERENCES lists Bullet's Neo-Hookean at 181 ns and
-   Vega's at 377 ns per tetrahedron on this machine kind. Mooney-Rivlin (split) costs
+   Vega's at 377 ns per tetrahedron on its Zen 5 machine. Mooney-Rivlin (split) costs
    about 2.6 times Neo-Hookean (J^-2/3 by libm's cbrt, a call), springs about 2.3 times
    (six square roots, calls under errno semantics). Rejected after measurement: one fused
    loop for the Neo-Hookean force or differential (it spills the 16 AVX2 registers: 10 %
@@ -350,6 +351,27 @@
    the 12,000-tetrahedron beam: not enough for a second, non-portable code path, so not
    kept. For the differential, splitting its volumetric scalars into a loop of their own
    gained 3 % (14.7 to 14.3 ns of arithmetic): not kept either.
+   The two floors under the target. Data movement: bench/ times a `move` kernel, this force
+   pass itself (colours, groups, heml__gather, heml__scatter) with the law's arithmetic
+   replaced by one multiply-add per link component, so that it still streams every rest
+   constant. In the committed run (bench/results, git 2ac37d3, double, one thread,
+   5-tetrahedron cubes, triad 19.5 GB/s) it costs 10 to 12 ns per tetrahedron at 1e3
+   tetrahedra and 18 to 26 ns at 1e6, 3.3 to 4.8 times the bound, against the Neo-Hookean
+   force's 21 and 41 ns: on large meshes the movement alone is above twice the bound,
+   whatever the arithmetic costs. (Run apart in an ad-hoc harness, gather and scatter
+   without the rest constants cost the same 9 to 10 ns at 1e6 as on a cache-resident mesh;
+   streaming the constants adds about their own transfer time, 5 to 6 ns: the stream does
+   not overlap the scalar gather and scatter.) Arithmetic: the compiled Neo-Hookean loops
+   issue about 135 multiplies and fused multiply-adds and 2 divisions per 4 lanes, on the 2
+   pipes that run them: at least 6 ns per tetrahedron at 3.1 GHz; they run in 9 to 11. For
+   comparison tensor-mass's edge kernel is within 1.7 times its bound at 1e6: it makes about
+   5 node accesses per tetrahedron (about 1.2 edges of 2 nodes, each read and written)
+   against these 8, for as many streamed bytes. Meeting the target would take hardware
+   scatter (AVX-512) or a traversal that keeps a node's data in registers between its
+   tetrahedra (whole cells per lane), and an arithmetic near its floor; not done. The target
+   was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); every
+   heml figure here comes from the Zen 3 above. There the clock alone would bring 20 ns near
+   15, and the bound halves with the bandwidth; neither is measured.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
