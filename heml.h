@@ -355,7 +355,7 @@
    pass itself (colours, groups, heml__gather, heml__scatter) with the law's arithmetic
    replaced by one multiply-add per link component, so that it still streams every rest
    constant. In the committed run (bench/results, git 2ac37d3, double, one thread,
-   5-tetrahedron cubes, triad 19.5 GB/s) it costs 10 to 12 ns per tetrahedron at 1e3
+   5-tetrahedron cubes, triad 19.5 GB/s) it costs 10 to 14 ns per tetrahedron at 1e3
    tetrahedra and 18 to 26 ns at 1e6, 3.3 to 4.8 times the bound, against the Neo-Hookean
    force's 21 and 41 ns: on large meshes the movement alone is above twice the bound,
    whatever the arithmetic costs. (Run apart in an ad-hoc harness, gather and scatter
