@@ -369,9 +369,9 @@
    against these 8, for as many streamed bytes. Meeting the target would take hardware
    scatter (AVX-512) or a traversal that keeps a node's data in registers between its
    tetrahedra (whole cells per lane), and an arithmetic near its floor; not done. The target
-   was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); every
-   heml figure here comes from the Zen 3 above. There the clock alone would bring 20 ns near
-   15, and the bound halves with the bandwidth; neither is measured.
+   was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); the
+   kernel figures above come from the Zen 3 named earlier. There the clock alone would bring
+   20 ns near 15, and the bound halves with the bandwidth; neither is measured.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
