@@ -261,16 +261,83 @@ typedef TMASS_REAL tmass_real;
 #define TMASSDEF extern
 #endif
 
-/* Float builds rename the constructors so that a float and a double translation unit
-   cannot be linked together by mistake. TMASS_REAL must be the single token float or
-   double. */
+/* Float builds rename every public entry point (..._f32) so that a float and a double
+   translation unit cannot be linked together by mistake (a float program calling any
+   tmass_ function fails to link against a double build). TMASS_REAL must be the single
+   token float or double. tests/test_tensormass.c lists every name and checks it. */
 #define TMASS__IS_float 1
 #define TMASS__IS_double 0
 #define TMASS__CAT2(a, b) a##b
 #define TMASS__CAT(a, b) TMASS__CAT2(a, b)
 #if TMASS__CAT(TMASS__IS_, TMASS_REAL)
-#define tmass_create tmass_create_f32
+#define tmass_version tmass_version_f32
+#define tmass_error_string tmass_error_string_f32
 #define tmass_default_desc tmass_default_desc_f32
+#define tmass_create tmass_create_f32
+#define tmass_destroy tmass_destroy_f32
+#define tmass_fix_node tmass_fix_node_f32
+#define tmass_set_displacement tmass_set_displacement_f32
+#define tmass_release_node tmass_release_node_f32
+#define tmass_node_pinned tmass_node_pinned_f32
+#define tmass_set_external_force tmass_set_external_force_f32
+#define tmass_clear_external_forces tmass_clear_external_forces_f32
+#define tmass_set_gravity tmass_set_gravity_f32
+#define tmass_set_solver tmass_set_solver_f32
+#define tmass_step tmass_step_f32
+#define tmass_step_ex tmass_step_ex_f32
+#define tmass_solve_static tmass_solve_static_f32
+#define tmass_node_count tmass_node_count_f32
+#define tmass_tet_count tmass_tet_count_f32
+#define tmass_live_tet_count tmass_live_tet_count_f32
+#define tmass_edge_count tmass_edge_count_f32
+#define tmass_positions tmass_positions_f32
+#define tmass_velocities tmass_velocities_f32
+#define tmass_rest_positions tmass_rest_positions_f32
+#define tmass_masses tmass_masses_f32
+#define tmass_forces tmass_forces_f32
+#define tmass_set_positions tmass_set_positions_f32
+#define tmass_set_velocities tmass_set_velocities_f32
+#define tmass_last_stats tmass_last_stats_f32
+#define tmass_energy tmass_energy_f32
+#define tmass_remove_tets tmass_remove_tets_f32
+#define tmass_default_tear_criteria tmass_default_tear_criteria_f32
+#define tmass_tear tmass_tear_f32
+#define tmass_tet_deformation tmass_tet_deformation_f32
+#define tmass_tet_alive tmass_tet_alive_f32
+#define tmass_node_active tmass_node_active_f32
+#define tmass_boundary_triangles tmass_boundary_triangles_f32
+#define tmass_vertex_tensor tmass_vertex_tensor_f32
+#define tmass_edge_tensor tmass_edge_tensor_f32
+#define tmass_memory_bytes tmass_memory_bytes_f32
+#define tmass_qs_default_desc tmass_qs_default_desc_f32
+#define tmass_qs_create tmass_qs_create_f32
+#define tmass_qs_destroy tmass_qs_destroy_f32
+#define tmass_qs_update tmass_qs_update_f32
+#define tmass_qs_displacements tmass_qs_displacements_f32
+#define tmass_qs_positions tmass_qs_positions_f32
+#define tmass_qs_nodes tmass_qs_nodes_f32
+#define tmass_qs_memory_bytes tmass_qs_memory_bytes_f32
+#define tmass_qs_remove_tets tmass_qs_remove_tets_f32
+#define tmass_qs_save tmass_qs_save_f32
+#define tmass_qs_load tmass_qs_load_f32
+#define tmass_qs_save_memory tmass_qs_save_memory_f32
+#define tmass_qs_load_memory tmass_qs_load_memory_f32
+#define tmass_hybrid_default_desc tmass_hybrid_default_desc_f32
+#define tmass_hybrid_create tmass_hybrid_create_f32
+#define tmass_hybrid_destroy tmass_hybrid_destroy_f32
+#define tmass_hybrid_step tmass_hybrid_step_f32
+#define tmass_hybrid_step_ex tmass_hybrid_step_ex_f32
+#define tmass_hybrid_solve_static tmass_hybrid_solve_static_f32
+#define tmass_hybrid_set_displacement tmass_hybrid_set_displacement_f32
+#define tmass_hybrid_release_node tmass_hybrid_release_node_f32
+#define tmass_hybrid_contact_force tmass_hybrid_contact_force_f32
+#define tmass_hybrid_remove_tets tmass_hybrid_remove_tets_f32
+#define tmass_hybrid_tear tmass_hybrid_tear_f32
+#define tmass_hybrid_positions tmass_hybrid_positions_f32
+#define tmass_hybrid_boundary_triangles tmass_hybrid_boundary_triangles_f32
+#define tmass_hybrid_dynamic_part tmass_hybrid_dynamic_part_f32
+#define tmass_hybrid_precomputed_part tmass_hybrid_precomputed_part_f32
+#define tmass_hybrid_connection_count tmass_hybrid_connection_count_f32
 #endif
 
 /* Edges below which loops run serially (parallel start-up costs more than it saves). */
@@ -326,13 +393,16 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_FILE_FORMAT, -33, "not a precomputation file, or its contents are corrupted") \
     X(TMASS_ERR_FILE_VERSION, -34, "precomputation file of another format version or real type") \
     X(TMASS_ERR_FILE_MISMATCH, -35, "precomputation file made for another mesh, material or setting") \
-    X(TMASS_ERR_FILE_TRUNCATED, -36, "precomputation file or buffer is truncated")
+    X(TMASS_ERR_FILE_TRUNCATED, -36, "precomputation file or buffer is truncated") \
+    X(TMASS_ERR_TET_DUPLICATE, -37, "the same tetrahedron (same four nodes, any order) is listed twice") \
+    X(TMASS_ERR_DIVERGED, -38, "explicit step diverged (an edge stretched past divergence_strain); the last valid state was kept") \
+    X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -37
+    TMASS_ERR_LAST_ = -40
 };
 
 typedef enum tmass_model_kind {
@@ -344,7 +414,8 @@ typedef enum tmass_integrator {
     TMASS_EXPLICIT_EULER = 0,
     TMASS_SEMI_IMPLICIT_EULER = 1,
     TMASS_RK4 = 2,
-    TMASS_IMPLICIT_EULER = 3
+    TMASS_IMPLICIT_EULER = 3,           /* springs: Newton on the incremental potential */
+    TMASS_IMPLICIT_EULER_LINEARIZED = 4 /* one linearised Newton iteration (see INTEGRATORS) */
 } tmass_integrator;
 
 /* Custom allocator: alloc(size, align, user) returns memory aligned to `align` (a power
@@ -387,6 +458,21 @@ typedef struct tmass_desc {
     tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-6 (1e-5 float) */
     int cg_max_iterations;       /* default 2000 */
 
+    /* Newton solves: the springs' implicit Euler step (TMASS_IMPLICIT_EULER) and static
+       solve; the tensor model is linear and needs one linear solve */
+    int newton_iterations;       /* cap per implicit step (static: 50 per increment), default 20 */
+    tmass_real newton_tolerance; /* residual over its reference scale, default 1e-6 (1e-5
+                                    float); a residual at its round-off floor is accepted too
+                                    (see SOLVERS) */
+
+    /* failure checks (see ERRORS and LIMITS) */
+    tmass_real divergence_strain; /* explicit integrators: a step that stretches any edge by
+                                     more than this relative elongation fails with
+                                     TMASS_ERR_DIVERGED, default 1 (100 %); 0 disables */
+    tmass_real precision_limit;   /* steps and static solves fail with TMASS_ERR_PRECISION when
+                                     eps(tmass_real) * max|u| > precision_limit * shortest rest
+                                     edge (u = x - X), default 1e-4; 0 disables */
+
     /* environment */
     tmass_allocator allocator;          /* all NULL: TMASS_MALLOC / TMASS_FREE */
     tmass_parallel_for_fn parallel_for; /* NULL: OpenMP if compiled with it, else serial */
@@ -399,10 +485,20 @@ typedef struct tmass_desc {
 
 /* Statistics of the last step or solve (read with tmass_last_stats). */
 typedef struct tmass_stats {
-    int cg_iterations;      /* CG iterations (implicit step or static solve), summed over Newton */
-    tmass_real cg_residual; /* final relative residual |r| / |b| */
-    int newton_iterations;  /* static solve of the spring model; 1 otherwise */
-    int force_evaluations;  /* force (or K times vector) evaluations in the step */
+    int newton_iterations;  /* Newton iterations, summed over increments (1 for a linear
+                               solve or a linearised step, 0 for an explicit step) */
+    int cg_iterations;      /* CG iterations, summed over every linear solve of the call */
+    tmass_real cg_residual; /* relative residual |r| / |b| of the last linear solve */
+    tmass_real residual;    /* final nonlinear residual |f| over its reference scale (the
+                               springs' static solve: |f| / |f_0|, f_0 the residual at the
+                               start); 0 where there is none (linear model, steps) */
+    int increments;         /* load increments accepted (1: the whole load at once) */
+    int increment_cuts;     /* increments cut back after a failed attempt */
+    int line_search_cuts;   /* line-search step halvings, summed */
+    int negative_curvature; /* linear solves that met a direction with p . A p <= 0 */
+    int inverted;           /* live tetrahedra with non-positive volume at the end */
+    int force_evaluations;  /* force passes (elastic force or spring force + tangent) */
+    int stiffness_products; /* K times vector products (CG iterations and setup) */
 } tmass_stats;
 
 /* Energies of the current state (tmass_energy). */
@@ -711,6 +807,10 @@ struct tmass_model {
     tmass_integrator integrator;
     tmass_real time_step, mass_damping, stiffness_damping, gravity[3], cg_tolerance;
     int cg_max_iterations;
+    double divergence_strain, precision_limit, newton_tolerance;
+    int newton_iterations;
+    double load_scale; /* springs' static continuation: fraction of the loads applied (1) */
+    double shortest_edge; /* shortest rest edge at creation, m */
     int parallel;
     double density; /* kg/m^3, uniform */
 
@@ -757,6 +857,7 @@ struct tmass_model {
     tmass_real *dv_prev; /* implicit warm start */
     double *partials; /* 2 * partial_count block sums */
     int cg_indefinite; /* the last CG stopped on p . A p <= 0 */
+    int cg_last_iterations; /* iterations of the last CG */
     int partial_count;
     int *tear_list;
 
@@ -992,8 +1093,9 @@ static int tmass__validate(const tmass_desc *d)
 {
     char msg[160];
     int i, t, err;
-    if (d->internal_cookie != TMASS__COOKIE)
-        return tmass__fail(d, TMASS_ERR_DESC, "start from tmass_default_desc()");
+    /* a desc without the cookie was not made by tmass_default_desc: nothing in it can be
+       trusted, its log callback least of all (issue 18) */
+    if (d->internal_cookie != TMASS__COOKIE) return TMASS_ERR_DESC;
     if (d->kind != TMASS_TENSOR_MASS && d->kind != TMASS_MASS_SPRING)
         return tmass__fail(d, TMASS_ERR_MODEL_KIND, "kind");
     if (d->node_count < 4 || d->node_count > 200000000 || !d->rest_positions)
@@ -1007,10 +1109,15 @@ static int tmass__validate(const tmass_desc *d)
     if (!(tmass__finite(d->mass_damping) && d->mass_damping >= 0) ||
         !(tmass__finite(d->stiffness_damping) && d->stiffness_damping >= 0))
         return tmass__fail(d, TMASS_ERR_DAMPING, "damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 3)
+    if ((int)d->integrator < 0 || (int)d->integrator > 4)
         return tmass__fail(d, TMASS_ERR_INTEGRATOR, "integrator");
     if (!(tmass__finite(d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
         return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
+    if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
+    if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
+        !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
+        return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
     for (i = 0; i < 3; i++)
         if (!tmass__finite(d->gravity[i])) return tmass__fail(d, TMASS_ERR_ARG, "gravity");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -1119,7 +1226,8 @@ static int tmass__build_edges(const int *tets, int tet_count, int node_count, in
     return count;
 }
 
-/* Face neighbours: returns TMASS_ERR_NONMANIFOLD if a face has more than two tets. */
+/* Face neighbours: returns TMASS_ERR_TET_DUPLICATE if two tets have the same four nodes,
+   TMASS_ERR_NONMANIFOLD if a face has more than two tets. */
 static int tmass__build_neighbors(tmass_model *m, int *start, int *key, int *payload)
 {
     int t, f, v, i, n = m->node_count, T = m->tet_count;
@@ -1174,6 +1282,8 @@ static int tmass__build_neighbors(tmass_model *m, int *start, int *key, int *pay
                         if (x != v && x != key[b]) hb = x;
                     }
                     if (ha == hb) {
+                        /* the same face with the same opposite node: the same tet twice */
+                        if (tets[4 * ta + fa % 4] == tets[4 * tb + fb % 4]) return TMASS_ERR_TET_DUPLICATE;
                         matches++;
                         m->tet_neighbors[fa] = tb;
                     }
@@ -1299,6 +1409,10 @@ TMASSDEF tmass_desc tmass_default_desc(void)
     d.integrator = TMASS_IMPLICIT_EULER;
     d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-6);
     d.cg_max_iterations = 2000;
+    d.newton_iterations = 20;
+    d.newton_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-6);
+    d.divergence_strain = (tmass_real)1;
+    d.precision_limit = (tmass_real)1e-4;
     d.internal_cookie = TMASS__COOKIE;
     return d;
 }
@@ -1385,6 +1499,11 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
     for (i = 0; i < 3; i++) m->gravity[i] = d->gravity[i];
     m->cg_tolerance = d->cg_tolerance;
     m->cg_max_iterations = d->cg_max_iterations;
+    m->divergence_strain = (double)d->divergence_strain;
+    m->newton_tolerance = (double)d->newton_tolerance;
+    m->newton_iterations = d->newton_iterations;
+    m->load_scale = 1.0;
+    m->precision_limit = (double)d->precision_limit;
     m->density = (double)d->density;
     m->allocator = alloc;
     m->parallel_for = d->parallel_for;
@@ -1418,6 +1537,8 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         const tmass_real *pa = m->rest + 3 * m->edge_a[i], *pb = m->rest + 3 * m->edge_b[i];
         double dx = (double)pb[0] - pa[0], dy = (double)pb[1] - pa[1], dz = (double)pb[2] - pa[2];
         m->edge_rest_length[i] = (tmass_real)sqrt(dx * dx + dy * dy + dz * dz);
+        if (i == 0 || (double)m->edge_rest_length[i] < m->shortest_edge)
+            m->shortest_edge = (double)m->edge_rest_length[i];
     }
     for (t = 0; t < T; t++) tmass__apply_tet(m, t, 1.0);
     for (i = 0; i < n; i++) {
@@ -1434,7 +1555,8 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
     tmass__free(&alloc, tmp_block, tmp_bytes);
     if (err) {
         tmass__free(&alloc, m->block, m->block_bytes);
-        return tmass__fail(d, err, "a triangle is shared by three or more tetrahedra");
+        return tmass__fail(d, err, err == TMASS_ERR_TET_DUPLICATE ? "a tetrahedron is listed twice"
+                                   : "a triangle is shared by three or more tetrahedra");
     }
     tmass__init_boundary(m);
     m->stats.newton_iterations = 1;
@@ -1838,7 +1960,10 @@ static double tmass__sum_partials(const tmass_model *m, int offset)
 /* Solves (D + c K) x = b on the free degrees of freedom by Jacobi-preconditioned CG
    (diag: D per degree of freedom, or NULL). x holds the initial guess; pinned and
    inactive entries are held at 0. Stops when |r| <= cg_tolerance |b| or after
-   cg_max_iterations. Scratch s[0..4]. Returns TMASS_OK or TMASS_ERR_NO_CONVERGENCE. */
+   cg_max_iterations. Scratch s[0..4]. Returns TMASS_OK, TMASS_ERR_NOT_FINITE (|b|^2 or the
+   residual not finite) or TMASS_ERR_NO_CONVERGENCE (the cap reached above the tolerance,
+   or a direction of non-positive curvature: the caller fails, issue 18's policy). Adds
+   its iterations to the stats and sets stats.cg_residual. */
 static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b,
                      tmass_real *x, tmass_real **s)
 {
@@ -1872,9 +1997,12 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             pinv[dof] = (tmass_real)(m->free_mask[dof] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
         }
     }
-    m->stats.cg_iterations = 0;
     m->stats.cg_residual = 0;
     m->cg_indefinite = 0;
+    m->cg_last_iterations = 0;
+    /* |b|^2 overflowing (or a non-finite load) would make the tolerance infinite and pass
+       any iterate: a failure, never a pass (issue 18 item 13) */
+    if (!tmass__finite(bb)) return TMASS_ERR_NOT_FINITE;
     if (bb == 0.0) {
         memset(x, 0, sizeof(tmass_real) * (size_t)n3);
         return TMASS_OK;
@@ -1896,6 +2024,11 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         tmass__matvec(m, k.p, k.q);
         tmass__run(m, blocks, tmass__cg_apply, &k);
         pq = tmass__sum_partials(m, 0);
+        if (!tmass__finite(pq)) { /* overflow in K p */
+            it++;
+            rr = HUGE_VAL;
+            break;
+        }
         if (!(pq > 0.0)) { /* not positive definite along p: singular or indefinite */
             m->cg_indefinite = 1;
             break;
@@ -1904,21 +2037,30 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         tmass__run(m, blocks, tmass__cg_update, &k);
         rr = tmass__sum_partials(m, 0);
         rz_new = tmass__sum_partials(m, blocks);
+        if (!tmass__finite(rr) || !tmass__finite(rz_new)) {
+            it++;
+            rr = HUGE_VAL;
+            break;
+        }
         k.beta = rz_new / rz;
         rz = rz_new;
         tmass__run(m, blocks, tmass__cg_direction, &k);
     }
-    m->stats.cg_iterations = it;
+    m->cg_last_iterations = it;
+    m->stats.cg_iterations += it;
     m->stats.cg_residual = (tmass_real)sqrt(rr / bb);
-    m->stats.force_evaluations += it + 1;
-    return rr <= tol2 ? TMASS_OK : TMASS_ERR_NO_CONVERGENCE;
+    m->stats.stiffness_products += it + 1;
+    m->stats.negative_curvature += m->cg_indefinite;
+    if (rr <= tol2) return TMASS_OK;
+    return tmass__finite(rr) ? TMASS_ERR_NO_CONVERGENCE : TMASS_ERR_NOT_FINITE;
 }
 
 /* >>integrators ----------------------------------------------------------------------- */
 
-static int tmass__all_finite(const tmass_real *a, int count)
+static int tmass__all_finite(const tmass_real *a, size_t count)
 {
-    int i, ok = 1;
+    size_t i;
+    int ok = 1;
     for (i = 0; i < count; i++) ok &= tmass__finite((double)a[i]);
     return ok;
 }
@@ -1999,15 +2141,17 @@ static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, cons
 }
 
 /* Backward Euler, linearised once (exact for the linear tensor model):
-       (M (1 + dt alpha) + dt^2 K + dt D) dv = dt (f(x0, v0) - dt K v0 + f_ext + M g
+       (M (1 + dt alpha) + dt^2 K + dt D) dv = dt (f(x0, v0) - dt K v0_free + f_ext + M g
                                                   - alpha M v0),
-   x1 = x0 + dt (v0 + dv), where D = beta K (tensor) or the axial spring damping. The
-   real-time step accepts the CG iterate when the iteration cap is reached (the stats
-   say so). */
+   x1 = x0 + dt (v0 + dv) on the free nodes, where D = beta K (tensor) or the axial spring
+   damping. x0 already holds the pinned nodes at their targets (tmass__begin_step) and v0
+   their velocity (target - u) / dt: that velocity enters the damping forces only, never
+   the elastic prediction x0 + dt v0 (which would count the pinned move twice, issue 18
+   item 6). A CG that does not reach its tolerance fails the step (issue 18 item 9). */
 static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
                                  const tmass_real *v0, tmass_real *x1, tmass_real *v1)
 {
-    int i, r, n = m->node_count, n3 = 3 * n;
+    int i, r, n = m->node_count, n3 = 3 * n, err;
     tmass_real *f = m->scratch[4], *dmass = m->scratch[5], *dv = m->scratch[6], *w = m->scratch[7];
     tmass_real *cg_scratch[5];
     tmass_real alpha = m->mass_damping;
@@ -2020,16 +2164,18 @@ static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real
     cg_scratch[4] = w;
     for (i = 0; i < n3; i++) dmass[i] = (tmass_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
     if (m->kind == TMASS_TENSOR_MASS) {
-        /* f(x0, v0) - dt K v0 = -K (u0 + (beta + dt) v0) */
-        tmass_real k = m->stiffness_damping + dt;
-        for (i = 0; i < n3; i++) w[i] = x0[i] + k * v0[i];
+        /* f(x0, v0) - dt K v0_free = -K (u0 + beta v0 + dt v0_free) */
+        tmass_real beta = m->stiffness_damping;
+        for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
         tmass__matvec(m, w, f);
         for (i = 0; i < n3; i++) f[i] = -f[i];
         m->stats.force_evaluations++;
         c = (double)dt * dt + (double)dt * m->stiffness_damping;
     } else {
-        /* spring force, tangent S = dt^2 K + dt D into the tensors (c = 1), and K v0 */
-        tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, v0, w, 0);
+        /* spring force (damping with the full v0), tangent S = dt^2 K + dt D into the
+           tensors (c = 1), and K v0_free (x1 lends its memory to v0_free) */
+        for (i = 0; i < n3; i++) x1[i] = v0[i] * m->free_mask[i];
+        tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, x1, w, 0);
         for (i = 0; i < n3; i++) f[i] -= dt * w[i];
         c = 1.0;
     }
@@ -2039,7 +2185,8 @@ static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real
             f[j] = dt * (f[j] + m->ext[j] + m->mass[i] * (m->gravity[r] - alpha * v0[j]));
         }
     memcpy(dv, m->dv_prev, sizeof(tmass_real) * (size_t)n3);
-    (void)tmass__cg(m, dmass, c, f, dv, cg_scratch);
+    err = tmass__cg(m, dmass, c, f, dv, cg_scratch);
+    if (err) return err;
     for (i = 0; i < n3; i++) {
         tmass_real fm = m->free_mask[i];
         v1[i] = v0[i] + dv[i] * fm;
@@ -2049,31 +2196,221 @@ static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real
     return TMASS_OK;
 }
 
+/* Implicit Euler of the spring model as the minimisation of the incremental potential
+   (issue 18): x1 solves, on the free nodes, with v(x) = (x - x0) / dt (pinned nodes keep
+   x0, their targets, and v0, their velocity)
+       R(x) = dt^2 (f_spring(x, v(x)) + f_ext + M g - alpha M v(x)) - M (x - x0 - dt v0) = 0,
+   by Newton: (M (1 + dt alpha) + dt^2 K_t(x) + dt D(x)) dx = R(x), K_t the tangent with
+   compressed springs' negative geometric term clamped (positive definite), D the axial
+   damping. A backtracking line search (up to 10 halvings) accepts a step that lowers the
+   incremental potential
+       Phi(x) = dt^2 (E(x) - (f_ext + M g) . x) + 1/2 |x - x0 - dt v0|_M^2 + dt alpha / 2 |x - x0|_M^2
+   (the axial damping, dissipative, is left out of Phi) or the residual. Converged when
+   |R| <= newton_tolerance * max(|R(x0 + dt v0)|, dt^2 |f_ext + M g|); the cap
+   newton_iterations or a failed linear solve fails the step, state kept. */
+static double tmass__spring_energy(const tmass_model *m, const tmass_real *u);
+
+/* Round-off floor of a spring residual at displacement u (squared): a displacement is
+   rounded to eps |u_i|, which moves the residual by about eps |u_i| A_ii, A the system's
+   diagonal (diag, or none, plus the tangent built by the last residual evaluation in the
+   vertex tensors). A Newton solve cannot get below it whatever its tolerance: in float it
+   is often 1e-4 of the load on stiff meshes. */
+static double tmass__roundoff_floor2(const tmass_model *m, const tmass_real *u, const tmass_real *diag)
+{
+    double eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON, s = 0.0;
+    int i, n3 = 3 * m->node_count;
+    for (i = 0; i < n3; i++) {
+        double a = (diag ? (double)diag[i] : 0.0) + (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)];
+        double e = eps * fabs((double)u[i]) * a * m->free_mask[i];
+        s += e * e;
+    }
+    return s;
+}
+
+static double tmass__spring_dyn_residual(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, const tmass_real *x, tmass_real *R,
+                                         tmass_real *v)
+{
+    int i, n3 = 3 * m->node_count;
+    double rr = 0.0, h2 = (double)dt * dt, alpha = m->mass_damping;
+    for (i = 0; i < n3; i++) v[i] = m->free_mask[i] > 0 ? (x[i] - x0[i]) / dt : v0[i];
+    tmass__spring_forces(m, x, v, R, h2, (double)dt, NULL, NULL, 0);
+    for (i = 0; i < n3; i++) {
+        double mi = (double)m->mass[i / 3];
+        double r = h2 * ((double)R[i] + m->ext[i] + mi * (m->gravity[i % 3] - alpha * v[i])) -
+                   mi * ((double)x[i] - x0[i] - (double)dt * v0[i]);
+        R[i] = (tmass_real)(r * m->free_mask[i]);
+        rr += (double)R[i] * R[i];
+    }
+    return rr;
+}
+
+static double tmass__spring_incremental_potential(const tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                                  const tmass_real *v0, const tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count;
+    double h2 = (double)dt * dt, work = 0.0, inertia = 0.0;
+    for (i = 0; i < n3; i++) {
+        double mi = (double)m->mass[i / 3], fm = m->free_mask[i];
+        double dx = (double)x[i] - x0[i], pred = dx - (double)dt * v0[i];
+        work += fm * ((double)m->ext[i] + mi * m->gravity[i % 3]) * x[i];
+        inertia += fm * 0.5 * mi * (pred * pred + (double)dt * m->mass_damping * dx * dx);
+    }
+    return h2 * (tmass__spring_energy(m, x) - work) + inertia;
+}
+
+static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+{
+    int i, n3 = 3 * m->node_count, it, err, halvings;
+    tmass_real *R = m->scratch[4], *dmass = m->scratch[5], *dx = m->scratch[6], *xt = m->scratch[7];
+    tmass_real *cg_scratch[5];
+    double rr, ref2, load2 = 0.0, tol2, h2 = (double)dt * dt;
+    /* CG scratch: scratch[8] and [9], the warm-start vector (unused by this integrator),
+       the force output array (recomputed by tmass_forces) and xt (free until the line
+       search); v1 holds v(x) */
+    cg_scratch[0] = m->scratch[8];
+    cg_scratch[1] = m->scratch[9];
+    cg_scratch[2] = m->dv_prev;
+    cg_scratch[3] = m->force;
+    cg_scratch[4] = xt;
+    for (i = 0; i < n3; i++) {
+        dmass[i] = (tmass_real)((1.0 + (double)dt * m->mass_damping) * (double)m->mass[i / 3]);
+        x1[i] = x0[i] + dt * v0[i] * m->free_mask[i]; /* the predictor */
+        load2 += m->free_mask[i] * h2 * h2 *
+                 ((double)m->ext[i] + (double)m->mass[i / 3] * m->gravity[i % 3]) *
+                 ((double)m->ext[i] + (double)m->mass[i / 3] * m->gravity[i % 3]);
+    }
+    rr = tmass__spring_dyn_residual(m, dt, x0, v0, x1, R, v1);
+    if (!tmass__finite(rr) || !tmass__finite(load2)) return TMASS_ERR_NOT_FINITE;
+    ref2 = rr > load2 ? rr : load2;
+    tol2 = m->newton_tolerance * m->newton_tolerance * ref2;
+    for (it = 0;; it++) {
+        double slope = 0.0, phi, rt = 0.0, alpha = 1.0;
+        m->stats.residual = (tmass_real)(ref2 > 0 ? sqrt(rr / ref2) : 0.0);
+        if (rr <= tol2 || rr <= tmass__roundoff_floor2(m, x1, dmass)) break;
+        if (it >= m->newton_iterations) return TMASS_ERR_NO_CONVERGENCE;
+        m->stats.newton_iterations++;
+        memset(dx, 0, sizeof(tmass_real) * (size_t)n3);
+        err = tmass__cg(m, dmass, 1.0, R, dx, cg_scratch);
+        if (err) return err;
+        for (i = 0; i < n3; i++) slope += (double)R[i] * dx[i];
+        phi = tmass__spring_incremental_potential(m, dt, x0, v0, x1);
+        for (halvings = 0; halvings <= 10; halvings++, alpha *= 0.5) {
+            for (i = 0; i < n3; i++) xt[i] = x1[i] + (tmass_real)alpha * dx[i];
+            rt = tmass__spring_dyn_residual(m, dt, x0, v0, xt, R, v1);
+            if (rt < rr || tmass__spring_incremental_potential(m, dt, x0, v0, xt) <= phi - 1e-4 * alpha * slope)
+                break;
+            m->stats.line_search_cuts++;
+        }
+        memcpy(x1, xt, sizeof(tmass_real) * (size_t)n3); /* R and v1 are at xt */
+        rr = rt;
+        if (!tmass__finite(rr)) return TMASS_ERR_NOT_FINITE;
+    }
+    memset(m->dv_prev, 0, sizeof(tmass_real) * (size_t)n3);
+    for (i = 0; i < n3; i++) v1[i] = m->free_mask[i] > 0 ? (x1[i] - x0[i]) / dt : v0[i];
+    return TMASS_OK;
+}
+
+/* Divergence check of the explicit integrators (issue 18 item 15): 1 if a live edge is
+   stretched past divergence_strain at displacement u, i.e. l^2 - l0^2 =
+   (2 d0 + du) . du > s (2 + s) l0^2 (no square root). An unstable explicit step grows
+   the highest mesh modes, which are edge stretches, geometrically: the check trips within
+   a few steps of a blow-up, long before anything overflows. */
+static int tmass__stretched_past(const tmass_model *m, const tmass_real *u)
+{
+    double s = m->divergence_strain, k = s * (2.0 + s);
+    int c, e;
+    if (s <= 0.0) return 0;
+    for (c = 0; c < m->chunk_total; c++)
+        for (e = m->chunk_start[c]; e < m->chunk_start[c] + m->chunk_live[c]; e++) {
+            int a = m->edge_a[e], b = m->edge_b[e], r;
+            double dl2 = 0.0, l0 = (double)m->edge_rest_length[e];
+            for (r = 0; r < 3; r++) {
+                double d0 = (double)m->rest[3 * b + r] - (double)m->rest[3 * a + r];
+                double du = (double)u[3 * b + r] - (double)u[3 * a + r];
+                dl2 += (2.0 * d0 + du) * du;
+            }
+            if (!(dl2 <= k * l0 * l0)) return 1;
+        }
+    return 0;
+}
+
+/* Precision check (issue 18 item 10): the model works on displacements u = x - X, so rest
+   positions far from the origin cost nothing, but a displacement of size |u| is rounded
+   to eps |u|, and differences of rounded displacements fake strains of eps |u| / h on an
+   edge of length h. 1 if eps(tmass_real) * max|u| > precision_limit * shortest edge. */
+static int tmass__imprecise(const tmass_model *m, const tmass_real *u)
+{
+    double eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON, big = 0.0;
+    int i, n3 = 3 * m->node_count;
+    if (m->precision_limit <= 0.0) return 0;
+    for (i = 0; i < n3; i++) {
+        double a = fabs((double)u[i]);
+        if (a > big) big = a;
+    }
+    return eps * big > m->precision_limit * m->shortest_edge;
+}
+
+/* Live tetrahedra with non-positive volume at displacement u (O(tets)). */
+static int tmass__count_inverted(const tmass_model *m, const tmass_real *u)
+{
+    int t, count = 0;
+    for (t = 0; t < m->tet_count; t++) {
+        const int *q = m->tet_nodes + 4 * t;
+        double e[3][3], det;
+        int j, r;
+        if (!m->tet_alive[t]) continue;
+        for (j = 0; j < 3; j++)
+            for (r = 0; r < 3; r++)
+                e[j][r] = ((double)m->rest[3 * q[j + 1] + r] - (double)m->rest[3 * q[0] + r]) +
+                          ((double)u[3 * q[j + 1] + r] - (double)u[3 * q[0] + r]);
+        det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+              e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+              e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+        count += !(det > 0.0);
+    }
+    return count;
+}
+
 TMASSDEF int tmass_step_ex(tmass_model *m, tmass_real dt, tmass_integrator integrator)
 {
     tmass_real *x0, *v0, *x1, *v1;
-    int n3;
+    int n3, err = TMASS_OK, implicit;
     if (!m) return TMASS_ERR_ARG;
     if (!(tmass__finite((double)dt) && dt > 0)) return TMASS_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 3) return TMASS_ERR_INTEGRATOR;
+    if ((int)integrator < 0 || (int)integrator > 4) return TMASS_ERR_INTEGRATOR;
     n3 = 3 * m->node_count;
     x0 = m->scratch[0];
     v0 = m->scratch[1];
     x1 = m->scratch[2];
     v1 = m->scratch[3];
     memset(&m->stats, 0, sizeof m->stats);
-    m->stats.newton_iterations = 1;
     tmass__begin_step(m, dt, x0, v0);
     switch (integrator) {
     case TMASS_EXPLICIT_EULER: tmass__explicit_euler(m, dt, x0, v0, x1, v1); break;
     case TMASS_SEMI_IMPLICIT_EULER: tmass__semi_implicit_euler(m, dt, x0, v0, x1, v1); break;
     case TMASS_RK4: tmass__rk4(m, dt, x0, v0, x1, v1); break;
-    case TMASS_IMPLICIT_EULER: tmass__implicit_euler(m, dt, x0, v0, x1, v1); break;
+    case TMASS_IMPLICIT_EULER:
+    case TMASS_IMPLICIT_EULER_LINEARIZED:
+        m->stats.increments = 1;
+        if (m->kind == TMASS_MASS_SPRING && integrator == TMASS_IMPLICIT_EULER) {
+            err = tmass__spring_implicit_newton(m, dt, x0, v0, x1, v1);
+        } else {
+            m->stats.newton_iterations = 1;
+            err = tmass__implicit_euler(m, dt, x0, v0, x1, v1);
+        }
+        break;
     }
-    if (!tmass__all_finite(x1, n3) || !tmass__all_finite(v1, n3)) {
+    if (!err && (!tmass__all_finite(x1, (size_t)n3) || !tmass__all_finite(v1, (size_t)n3))) err = TMASS_ERR_NOT_FINITE;
+    implicit = integrator == TMASS_IMPLICIT_EULER || integrator == TMASS_IMPLICIT_EULER_LINEARIZED;
+    if (!err && !implicit && tmass__stretched_past(m, x1)) err = TMASS_ERR_DIVERGED;
+    if (!err && tmass__imprecise(m, x1)) err = TMASS_ERR_PRECISION;
+    if (err) {
         memset(m->dv_prev, 0, sizeof(tmass_real) * (size_t)n3);
-        return TMASS_ERR_NOT_FINITE;
+        return err;
     }
+    if (implicit) m->stats.inverted = tmass__count_inverted(m, x1);
     tmass__commit(m, x1, v1);
     return TMASS_OK;
 }
@@ -2093,7 +2430,8 @@ static double tmass__spring_residual(tmass_model *m, const tmass_real *x, tmass_
     double ff = 0.0;
     tmass__spring_forces(m, x, NULL, f, 1.0, 0.0, NULL, NULL, full_tangent);
     for (i = 0; i < n3; i++) {
-        f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
+        f[i] = (f[i] + (tmass_real)m->load_scale * (m->ext[i] + m->mass[i / 3] * m->gravity[i % 3])) *
+               m->free_mask[i];
         ff += (double)f[i] * f[i];
     }
     return ff;
@@ -2129,42 +2467,46 @@ static double tmass__spring_potential(const tmass_model *m, const tmass_real *x)
     int i, n3 = 3 * m->node_count;
     double work = 0.0;
     for (i = 0; i < n3; i++)
-        work += ((double)m->ext[i] + (double)m->mass[i / 3] * m->gravity[i % 3]) * x[i] * m->free_mask[i];
+        work += m->load_scale * ((double)m->ext[i] + (double)m->mass[i / 3] * m->gravity[i % 3]) * x[i] *
+                m->free_mask[i];
     return tmass__spring_energy(m, x) - work;
 }
 
-/* Static equilibrium of the spring model: Newton on f(x) = 0 over the free nodes. Each
-   iteration solves K_t du = f by CG with the full tangent (quadratic convergence); where
-   compressed springs make K_t indefinite (CG meets p . K_t p <= 0, or du is no descent
-   direction) it solves again with their negative geometric term dropped, which is
-   positive definite, so du descends the potential. A backtracking line search (up to 10
-   halvings) accepts a step that lowers the potential (Armijo) or the residual: the
-   potential guards large load increments on stiff, bending-dominated meshes (where the
-   right Newton step raises |f| at first), the residual decides below the potential's
-   round-off. Converged when the step is below cg_tolerance |x|, or the residual below
-   cg_tolerance times the first one. */
-static int tmass__spring_static(tmass_model *m, tmass_real *x, int *cg_total)
+/* Newton for the static equilibrium of the spring model at the current load_scale, from
+   x (pinned entries already placed). Each iteration solves K_t du = f by CG with the full
+   tangent (quadratic convergence); where compressed springs make K_t indefinite (CG meets
+   p . K_t p <= 0, or du is no descent direction) it solves again with their negative
+   geometric term dropped, which is positive definite, so du descends the potential. A
+   backtracking line search (up to 10 halvings) accepts a step that lowers the potential
+   (Armijo) or the residual: the potential guards large load increments on stiff,
+   bending-dominated meshes (where the right Newton step raises |f| at first), the
+   residual decides below the potential's round-off. Converged only when the residual
+   |f| <= newton_tolerance * reference (ref2 = reference^2); a step that cannot move x any
+   more, or the iteration cap, end the attempt with TMASS_ERR_NO_CONVERGENCE (the caller
+   cuts the load increment back). */
+static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int cap)
 {
     int i, n3 = 3 * m->node_count, it, err = TMASS_OK;
     tmass_real *f = m->scratch[1], *du = m->scratch[2], *xt = m->scratch[8], *cg_scratch[5];
-    double ff, ff0, tol = (double)m->cg_tolerance;
+    double ff, tol = m->newton_tolerance, tol2 = tol * tol * ref2;
+    double eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
     for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
-    ff = ff0 = tmass__spring_residual(m, x, f, 1);
-    for (it = 0; it < 50; it++) {
+    ff = tmass__spring_residual(m, x, f, 1);
+    for (it = 0; it < cap; it++) {
         double dn = 0.0, xn = 0.0, alpha = 1.0, fft = 0.0, slope, potential;
         int halvings;
-        m->stats.newton_iterations = it + 1;
-        if (ff <= tol * tol * ff0) return TMASS_OK;
+        m->stats.residual = (tmass_real)sqrt(ff / ref2);
+        if (!tmass__finite(ff)) return TMASS_ERR_NOT_FINITE;
+        if (ff <= tol2 || ff <= tmass__roundoff_floor2(m, x, NULL)) return TMASS_OK;
+        m->stats.newton_iterations++;
         memset(du, 0, sizeof(tmass_real) * (size_t)n3);
         err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
-        *cg_total += m->stats.cg_iterations;
         slope = 0.0; /* f . du = minus the potential's slope along du */
         for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         if ((err && m->cg_indefinite) || (!err && !(slope > 0))) { /* on the PD part */
             tmass__spring_residual(m, x, f, 0);
             memset(du, 0, sizeof(tmass_real) * (size_t)n3);
             err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
-            *cg_total += m->stats.cg_iterations;
             slope = 0.0;
             for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         }
@@ -2174,9 +2516,10 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x, int *cg_total)
             for (i = 0; i < n3; i++) xt[i] = x[i] + (tmass_real)alpha * du[i];
             fft = tmass__spring_residual(m, xt, f, 1);
             if (fft < ff || tmass__spring_potential(m, xt) <= potential - 1e-4 * alpha * slope) break;
+            m->stats.line_search_cuts++;
         }
         /* no decrease even at 1/1024 of the step: take it anyway (f and the tangent are
-           at xt); the iteration cap ends a solve that cannot progress */
+           at xt); the iteration cap ends an attempt that cannot progress */
         for (i = 0; i < n3; i++) {
             double step = (double)xt[i] - x[i];
             x[i] = xt[i];
@@ -2184,19 +2527,73 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x, int *cg_total)
             xn += (double)x[i] * x[i];
         }
         ff = fft;
-        if (dn <= tol * tol * (xn > 0 ? xn : 1.0)) {
-            m->stats.newton_iterations = it + 1;
-            return TMASS_OK;
+        if (ff <= tol2 || ff <= tmass__roundoff_floor2(m, x, NULL)) continue; /* accepted above */
+        if (dn <= 16.0 * eps * eps * (xn > 0 ? xn : 1.0)) { /* stalled */
+            m->stats.residual = (tmass_real)sqrt(ff / ref2);
+            return TMASS_ERR_NO_CONVERGENCE;
         }
     }
-    return TMASS_ERR_NO_CONVERGENCE;
+    m->stats.residual = (tmass_real)sqrt(ff / ref2);
+    if (!tmass__finite(ff)) return TMASS_ERR_NOT_FINITE;
+    return ff <= tol2 || ff <= tmass__roundoff_floor2(m, x, NULL) ? TMASS_OK : TMASS_ERR_NO_CONVERGENCE;
+}
+
+/* Static equilibrium of the spring model with load continuation (issue 18): the load
+   fraction s goes from 0 to 1, scaling gravity and the external forces and moving each
+   pinned node from where it is to its target; each increment is a Newton solve
+   (tmass__spring_newton) from the last accepted state. The whole load is tried first; a
+   failed increment is cut to a quarter, an accepted one lets the next double. Gives up
+   with the last error (state kept) below an increment of TMASS__MIN_INCREMENT or past
+   TMASS__MAX_INCREMENTS attempts. The residual reference is the residual with the free
+   nodes at rest and the pinned nodes at their targets under the whole load (the scale of
+   the problem, whatever the starting state). */
+#define TMASS__MAX_INCREMENTS 64
+#define TMASS__MIN_INCREMENT 1e-4
+static int tmass__spring_static(tmass_model *m, tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count, err = TMASS_OK, attempts = 0;
+    tmass_real *accepted = m->scratch[9], *f = m->scratch[1];
+    double s = 0.0, ds = 1.0, ref2;
+    for (i = 0; i < n3; i++) accepted[i] = m->pin_mask[i] * m->target[i];
+    m->load_scale = 1.0;
+    ref2 = tmass__spring_residual(m, accepted, f, 1);
+    if (!tmass__finite(ref2)) return TMASS_ERR_NOT_FINITE;
+    if (ref2 == 0.0) ref2 = tmass__spring_residual(m, x, f, 1);
+    if (ref2 == 0.0) return TMASS_OK; /* at rest, unloaded: nothing to do */
+    memcpy(accepted, m->disp, sizeof(tmass_real) * (size_t)n3);
+    while (s < 1.0) {
+        double next = s + ds < 1.0 ? s + ds : 1.0;
+        if (++attempts > TMASS__MAX_INCREMENTS) break;
+        for (i = 0; i < n3; i++) {
+            tmass_real pin = m->pin_mask[i];
+            x[i] = pin > 0 ? m->disp[i] + (tmass_real)next * (m->target[i] - m->disp[i]) : accepted[i];
+        }
+        m->load_scale = next;
+        err = tmass__spring_newton(m, x, ref2, 50);
+        if (err == TMASS_OK) {
+            memcpy(accepted, x, sizeof(tmass_real) * (size_t)n3);
+            s = next;
+            m->stats.increments++;
+            ds *= 2.0;
+        } else {
+            m->stats.increment_cuts++;
+            ds *= 0.25;
+            if (ds < TMASS__MIN_INCREMENT) break;
+        }
+    }
+    m->load_scale = 1.0;
+    if (s < 1.0) return err ? err : TMASS_ERR_NO_CONVERGENCE;
+    memcpy(x, accepted, sizeof(tmass_real) * (size_t)n3);
+    return TMASS_OK;
 }
 
 /* Static equilibrium: one CG solve K u = f_ext + M g for the tensor model (it is
-   linear), Newton (tmass__spring_static) for the spring model. */
+   linear: a converged, finite solve is exact for the model), the continuation of
+   tmass__spring_static for the spring model. Accepted only with finite values inside
+   the precision limit; the state is kept otherwise. */
 TMASSDEF int tmass_solve_static(tmass_model *m)
 {
-    int i, n3, cg_total = 0, err = TMASS_OK;
+    int i, n3, err = TMASS_OK;
     tmass_real *x, *f, *cg_scratch[5];
     if (!m) return TMASS_ERR_ARG;
     n3 = 3 * m->node_count;
@@ -2204,26 +2601,27 @@ TMASSDEF int tmass_solve_static(tmass_model *m)
     f = m->scratch[1];
     for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
     memset(&m->stats, 0, sizeof m->stats);
-    m->stats.newton_iterations = 1;
     for (i = 0; i < n3; i++) {
         tmass_real pin = m->pin_mask[i];
         x[i] = m->disp[i] + pin * (m->target[i] - m->disp[i]);
     }
     if (m->kind == TMASS_TENSOR_MASS) {
         tmass_real *du = m->scratch[2];
+        m->stats.newton_iterations = 1;
+        m->stats.increments = 1;
         tmass__internal_force(m, x, NULL, f, m->scratch[8]);
         for (i = 0; i < n3; i++)
             f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
         memset(du, 0, sizeof(tmass_real) * (size_t)n3);
         err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
-        cg_total = m->stats.cg_iterations;
         for (i = 0; i < n3; i++) x[i] += du[i];
     } else {
-        err = tmass__spring_static(m, x, &cg_total);
+        err = tmass__spring_static(m, x);
     }
-    m->stats.cg_iterations = cg_total;
     if (err) return err;
     if (!tmass__all_finite(x, n3)) return TMASS_ERR_NOT_FINITE;
+    if (tmass__imprecise(m, x)) return TMASS_ERR_PRECISION;
+    m->stats.inverted = tmass__count_inverted(m, x);
     tmass__commit(m, x, NULL);
     return TMASS_OK;
 }
@@ -2915,6 +3313,7 @@ static int tmass__cg_block(tmass_model *m, const tmass_real *B, tmass_real *X, t
                 q[i * R + r] *= m->free_mask[i];
                 pq[r] += (double)p[i * R + r] * q[i * R + r];
             }
+        for (r = 0; r < R; r++) m->stats.negative_curvature += rr[r] > tol2[r] && !(pq[r] > 0.0);
         for (r = 0; r < R; r++) { /* a converged (or empty) column stops moving */
             active[r] = rr[r] > tol2[r] && pq[r] > 0.0;
             alpha[r] = active[r] ? rz[r] / pq[r] : 0.0;
@@ -2933,11 +3332,15 @@ static int tmass__cg_block(tmass_model *m, const tmass_real *B, tmass_real *X, t
         for (r = 0; r < R; r++) beta[r] = active[r] && beta[r] > 0.0 ? rz[r] / beta[r] : 0.0;
         for (i = 0; i < n3; i++)
             for (r = 0; r < R; r++) p[i * R + r] = z[i * R + r] + (tmass_real)beta[r] * p[i * R + r];
-        m->stats.force_evaluations++;
     }
     m->stats.cg_iterations += it;
+    m->stats.stiffness_products += it;
+    for (r = 0; r < R; r++)
+        if (!tmass__finite(rr[r])) return TMASS_ERR_NOT_FINITE;
     for (r = 0; r < R; r++)
         if (!(rr[r] <= tol2[r])) return TMASS_ERR_NO_CONVERGENCE;
+    for (i = 0; i < n3 * R; i++)
+        if (!tmass__finite((double)X[i])) return TMASS_ERR_NOT_FINITE;
     return TMASS_OK;
 }
 
@@ -2957,7 +3360,9 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     o3 = 3 * q->out_count;
     p3 = 3 * q->pre_count;
     total = p3 + 1;
-    /* the preload: K g = f_ext + M g_vec on the free nodes (one CG) */
+    /* the preload: K g = f_ext + M g_vec - K u_pinned on the free nodes (one CG), the
+       pinned nodes at their targets (pinned nodes away from rest are boundary conditions
+       too, issue 18 item 7) */
     b = m->scratch[0];
     x = m->scratch[1];
     for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[2 + i];
@@ -2965,13 +3370,18 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     saved_iter = m->cg_max_iterations;
     m->cg_tolerance = d->cg_tolerance;
     m->cg_max_iterations = d->cg_max_iterations;
+    memset(&m->stats, 0, sizeof m->stats);
+    for (i = 0; i < n3; i++) x[i] = m->pin_mask[i] * m->target[i];
+    tmass__matvec(m, x, b); /* K u_pinned */
     for (i = 0; i < n3; i++) {
-        b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3];
+        b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3] - b[i];
         x[i] = 0;
     }
     err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
     m->cg_tolerance = saved_tol;
     m->cg_max_iterations = saved_iter;
+    for (i = 0; i < n3; i++) x[i] += m->pin_mask[i] * m->target[i];
+    if (!err && !tmass__all_finite(x, n3)) err = TMASS_ERR_NOT_FINITE;
     memcpy(q->preload, x, sizeof(tmass_real) * (size_t)n3);
     if (!err && d->progress && d->progress(1, total, d->progress_user)) err = TMASS_ERR_CANCELLED;
     /* the compliance columns, TMASS__RHS at a time (temporary block: six interleaved
@@ -2989,7 +3399,6 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
             double dgl = (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)];
             pinv[i] = (tmass_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
         }
-        m->stats.cg_iterations = 0;
         for (j0 = 0; j0 < p3 && !err; j0 += R) {
             memset(B, 0, sizeof(tmass_real) * vec);
             for (r = 0; r < R && j0 + r < p3; r++)
@@ -3212,6 +3621,13 @@ TMASSDEF int tmass_qs_load_memory(const tmass_model *m, const tmass_qs_desc *d, 
     memcpy(q->preload, p + TMASS__QS_HEADER_BYTES, sizeof(tmass_real) * 3 * (size_t)q->node_count);
     memcpy(q->compliance, p + TMASS__QS_HEADER_BYTES + sizeof(tmass_real) * 3 * (size_t)q->node_count,
            (size_t)payload - sizeof(tmass_real) * 3 * (size_t)q->node_count);
+    /* a valid checksum only says the bytes are those written: a NaN or an infinity in
+       them (written by another tool, or a checksum recomputed by hand) is refused too */
+    if (!tmass__all_finite(q->preload, 3 * q->node_count) ||
+        !tmass__all_finite(q->compliance, 9 * (size_t)q->pre_count * (size_t)q->out_count)) {
+        tmass_qs_destroy(q);
+        return TMASS_ERR_FILE_FORMAT;
+    }
     tmass__qs_set_preload_state(q);
     *out = q;
     return TMASS_OK;

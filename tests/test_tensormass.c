@@ -819,14 +819,20 @@ static void test_explicit_euler_grows_rk4_decays(void)
     REQUIRE(m != NULL);
     e0 = prev = total_energy(m);
     for (s = 0; s < 500; s++) {
-        CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)dt, TMASS_EXPLICIT_EULER));
+        int err = tmass_step_ex(m, (tmass_real)dt, TMASS_EXPLICIT_EULER);
+        if (err) { /* the divergence check ends the growth (issue 18), state kept */
+            CHECK_INT(TMASS_ERR_DIVERGED, err);
+            CHECK(total_energy(m) == prev);
+            break;
+        }
         e = total_energy(m);
         if (!(e > prev)) monotone = 0;
         prev = e;
     }
-    printf("    explicit Euler: E/E0 = %.4f after 500 steps\n", prev / e0);
+    printf("    explicit Euler: E/E0 = %.4f after %d steps, then TMASS_ERR_DIVERGED\n", prev / e0, s);
     CHECK(monotone);
-    CHECK(prev > e0);
+    CHECK(prev > 10 * e0);
+    CHECK(s > 20 && s < 500);
     tmass_destroy(m);
     tetmesh_free(&mesh);
 
@@ -958,7 +964,7 @@ static void test_failed_step_keeps_state(void)
         memcpy(v, tmass_velocities(m), sizeof(tmass_real) * n3);
         err = tmass_step_ex(m, (tmass_real)0.01, TMASS_EXPLICIT_EULER);
     }
-    CHECK_INT(TMASS_ERR_NOT_FINITE, err);
+    CHECK_INT(TMASS_ERR_DIVERGED, err); /* the divergence check, long before overflow */
     for (i = 0; i < n3; i++) same &= x[i] == tmass_positions(m)[i] && v[i] == tmass_velocities(m)[i];
     CHECK(same);
     printf("    blew up at step %d; state kept\n", s);
@@ -1240,7 +1246,7 @@ static void test_validation_errors(void)
     d = base; d.tets = bad;                         CHECK_INT(TMASS_ERR_INDEX_REPEATED, try_create(&d));
     memcpy(bad, tets, sizeof tets); bad[6] = 1; bad[7] = 5;
     memcpy(bad + 4, tets, 4 * sizeof(int)); /* tet 1 = 0,1,3,7 duplicated: shares 4 faces */
-    d = base; d.tets = bad;                         CHECK_INT(TMASS_ERR_NONMANIFOLD, try_create(&d));
+    d = base; d.tets = bad;                         CHECK_INT(TMASS_ERR_TET_DUPLICATE, try_create(&d));
     memcpy(bad, tets, sizeof tets); bad[2] = 7; bad[3] = 3; /* swap: inverted */
     d = base; d.tets = bad;                         CHECK_INT(TMASS_ERR_TET_INVERTED, try_create(&d));
     memcpy(badn, nodes, sizeof nodes); /* flatten the cube: z = 0 for all */
@@ -1336,6 +1342,250 @@ static void test_error_strings(void)
     }
 }
 
+
+/* ---- issue 18: no silent wrong answers ---------------------------------------------- */
+
+static double max_diff_positions(const tmass_model *a, const tmass_model *b, int n3)
+{
+    double worst = 0.0;
+    int i;
+    for (i = 0; i < n3; i++) {
+        double d = fabs((double)tmass_positions(a)[i] - (double)tmass_positions(b)[i]);
+        if (d > worst) worst = d;
+    }
+    return worst;
+}
+
+/* Item 6: one implicit step of dt = 1e4 s (far past every vibration period, heavily
+   damped) after driving a node 1 cm lands on the static answer with that node driven;
+   the driven node's move must be counted once. Both models. */
+static void test_driven_node_implicit_matches_static(void)
+{
+    tetmesh mesh;
+    tmass_real u[3] = {0.0f, 0.0f, 0.01f}, g[3] = {0, 0, 0};
+    int kind;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        tmass_model *a = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+        tmass_model *b = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+        int i, n3 = 3 * mesh.node_count, top = -1;
+        double worst, moved = 0.0;
+        REQUIRE(a != NULL && b != NULL);
+        tmass_set_solver(a, (tmass_real)(IS_FLOAT ? 1e-6 : 1e-12), 5000);
+        tmass_set_solver(b, (tmass_real)(IS_FLOAT ? 1e-6 : 1e-12), 5000);
+        tmass_set_gravity(a, g);
+        tmass_set_gravity(b, g);
+        for (i = 0; i < mesh.node_count; i++) {
+            if (mesh.nodes[3 * i + 2] == 0.0) {
+                tmass_fix_node(a, i);
+                tmass_fix_node(b, i);
+            }
+            if (mesh.nodes[3 * i] == 0.5 && mesh.nodes[3 * i + 1] == 0.5 && mesh.nodes[3 * i + 2] == 1.0) top = i;
+        }
+        REQUIRE(top >= 0);
+        tmass_set_displacement(a, top, u);
+        tmass_set_displacement(b, top, u);
+        CHECK_INT(TMASS_OK, tmass_step_ex(a, (tmass_real)1e4, TMASS_IMPLICIT_EULER));
+        CHECK_INT(TMASS_OK, tmass_solve_static(b));
+        worst = max_diff_positions(a, b, n3);
+        for (i = 0; i < n3; i++) {
+            double d = fabs((double)tmass_positions(b)[i] - mesh.nodes[i]);
+            if (i / 3 != top && d > moved) moved = d;
+        }
+        printf("    %s: free nodes' static move %.3e m, implicit step off by %.2e of it\n",
+               kind ? "springs" : "tensor", moved, worst / moved);
+        CHECK(moved > 1e-4);
+        CHECK(worst < (IS_FLOAT ? 1e-3 : 1e-6) * moved);
+        tmass_destroy(a);
+        tmass_destroy(b);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* Item 9: a linear solve stopped by its iteration cap fails the step or the solve with
+   TMASS_ERR_NO_CONVERGENCE and keeps the state; stats.cg_residual says how far it got. */
+static void test_cg_cap_fails(void)
+{
+    tetmesh mesh;
+    int kind;
+    tetmesh_beam(&mesh, 1.0, 0.2, 0.2, 8, 2, 2, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        tmass_model *m = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+        tmass_real *x;
+        int i, n3 = 3 * mesh.node_count, same = 1;
+        REQUIRE(m != NULL);
+        for (i = 0; i < mesh.node_count; i++)
+            if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+        x = alloc_reals(n3);
+        CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)0.01, TMASS_IMPLICIT_EULER));
+        memcpy(x, tmass_positions(m), sizeof(tmass_real) * n3);
+        tmass_set_solver(m, (tmass_real)1e-6, 2);
+        CHECK_INT(TMASS_ERR_NO_CONVERGENCE, tmass_step_ex(m, (tmass_real)1.0, TMASS_IMPLICIT_EULER));
+        for (i = 0; i < n3; i++) same &= x[i] == tmass_positions(m)[i];
+        CHECK(same);
+        CHECK(tmass_last_stats(m)->cg_residual > (tmass_real)1e-6);
+        CHECK_INT(TMASS_ERR_NO_CONVERGENCE, tmass_solve_static(m));
+        for (i = 0; i < n3; i++) same &= x[i] == tmass_positions(m)[i];
+        CHECK(same);
+        free(x);
+        tmass_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* Item 12: a description that tmass_default_desc did not make (0xA5 bytes everywhere, so
+   its log pointer is wild) is refused with TMASS_ERR_DESC without a crash. */
+static void test_garbage_desc_refused(void)
+{
+    tmass_desc d;
+    tmass_model *m = (tmass_model *)&d;
+    memset(&d, 0xA5, sizeof d);
+    CHECK_INT(TMASS_ERR_DESC, tmass_create(&d, &m));
+    CHECK(m == NULL);
+}
+
+/* Item 13: a load whose |b|^2 overflows (1e156 N in double; the largest float in float)
+   fails with TMASS_ERR_NOT_FINITE instead of passing a tolerance of infinity; state kept. */
+static void test_huge_load_not_finite(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    tmass_real f[3] = {0, 0, 0};
+    int k, i, n3, same = 1, kind, err;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++)
+        for (k = 0; k < 2; k++) {
+            m = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+            REQUIRE(m != NULL);
+            n3 = 3 * mesh.node_count;
+            for (i = 0; i < mesh.node_count; i++)
+                if (mesh.nodes[3 * i + 2] == 0.0) tmass_fix_node(m, i);
+            f[2] = IS_FLOAT ? (tmass_real)(k ? 3e38 : 1e38) : (tmass_real)(k ? 1e200 : 1e156);
+            CHECK_INT(TMASS_OK, tmass_set_external_force(m, mesh.node_count - 1, f));
+            err = tmass_solve_static(m);
+            if (IS_FLOAT) /* float loads cannot overflow |b|^2 in double: the answer is refused */
+                CHECK(err == TMASS_ERR_NOT_FINITE || err == TMASS_ERR_PRECISION);
+            else
+                CHECK_INT(TMASS_ERR_NOT_FINITE, err);
+            /* the step's right-hand side is dt times smaller: |b|^2 may stay finite, and
+               the answer, metres beyond anything the precision can hold, is refused */
+            err = tmass_step_ex(m, (tmass_real)0.01, TMASS_IMPLICIT_EULER);
+            CHECK(err == TMASS_ERR_NOT_FINITE || err == TMASS_ERR_PRECISION);
+            if (!(err == TMASS_ERR_NOT_FINITE || err == TMASS_ERR_PRECISION))
+                printf("    kind %d load %g: step code %d\n", kind, (double)f[2], err);
+            for (i = 0; i < n3; i++) same &= tmass_positions(m)[i] == (tmass_real)mesh.nodes[i];
+            CHECK(same);
+            tmass_destroy(m);
+        }
+    tetmesh_free(&mesh);
+}
+
+/* Item 15: the same tetrahedron listed twice (any node order) is refused with its own
+   code instead of doubling its mass and stiffness. */
+static void test_duplicate_tet_refused(void)
+{
+    tmass_real nodes[5 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+    int twice[8] = {0, 1, 2, 3, 0, 1, 2, 3};
+    int reordered[8] = {0, 1, 2, 3, 1, 0, 3, 2}; /* two swaps: same orientation */
+    int fine[8] = {0, 1, 2, 3, 1, 2, 3, 4};
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    int err;
+    d.rest_positions = nodes;
+    d.node_count = 5;
+    d.tet_count = 2;
+    d.tets = fine;
+    err = tmass_create(&d, &m);
+    CHECK_INT(TMASS_OK, err);
+    tmass_destroy(m);
+    m = NULL;
+    d.tets = twice;
+    err = tmass_create(&d, &m);
+    CHECK_INT(TMASS_ERR_TET_DUPLICATE, err);
+    tmass_destroy(m);
+    m = NULL;
+    d.tets = reordered;
+    err = tmass_create(&d, &m);
+    CHECK_INT(TMASS_ERR_TET_DUPLICATE, err);
+    tmass_destroy(m);
+}
+
+/* Item 15: explicit Euler at dt = 10 s on a stiff clamped block blows up; the
+   divergence check stops it before anything is far off (no step reports success with a
+   body metres out), keeping the last valid state. */
+static void test_explicit_divergence_caught(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    int s, n3, err = TMASS_OK, i, integ;
+    static const tmass_integrator explicit_ones[3] = {TMASS_EXPLICIT_EULER, TMASS_SEMI_IMPLICIT_EULER, TMASS_RK4};
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
+    for (integ = 0; integ < 3; integ++) {
+        double worst = 0.0;
+        m = make_model(&mesh, TMASS_TENSOR_MASS, 1e9, 0.3, 1000);
+        REQUIRE(m != NULL);
+        n3 = 3 * mesh.node_count;
+        for (i = 0; i < mesh.node_count; i++)
+            if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+        for (s = 0; s < 400 && err == TMASS_OK; s++) {
+            err = tmass_step_ex(m, (tmass_real)10.0, explicit_ones[integ]);
+            for (i = 0; i < n3; i++) {
+                double d = fabs((double)tmass_positions(m)[i] - mesh.nodes[i]);
+                if (d > worst) worst = d;
+            }
+        }
+        printf("    integrator %d at dt = 10 s: code %d after %d steps, largest displacement %.3g m\n",
+               (int)explicit_ones[integ], err, s, worst);
+        CHECK_INT(TMASS_ERR_DIVERGED, err);
+        CHECK(worst < 10.0); /* a 1 m block: caught before it is metres off */
+        err = TMASS_OK;
+        tmass_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* Item 8: in float builds every public entry point is renamed (_f32) so that a float
+   and a double translation unit cannot be linked together. The list is every function
+   declared in tensormass.h. */
+#define NAME_STR2(x) #x
+#define NAME_STR(x) NAME_STR2(x)
+static void test_float_renames_every_entry_point(void)
+{
+    static const char *const names[][2] = {
+#define N(f) {#f, NAME_STR(f)}
+        N(tmass_version), N(tmass_error_string), N(tmass_default_desc), N(tmass_create),
+        N(tmass_destroy), N(tmass_fix_node), N(tmass_set_displacement), N(tmass_release_node),
+        N(tmass_node_pinned), N(tmass_set_external_force), N(tmass_clear_external_forces),
+        N(tmass_set_gravity), N(tmass_set_solver), N(tmass_step), N(tmass_step_ex),
+        N(tmass_solve_static), N(tmass_node_count), N(tmass_tet_count), N(tmass_live_tet_count),
+        N(tmass_edge_count), N(tmass_positions), N(tmass_velocities), N(tmass_rest_positions),
+        N(tmass_masses), N(tmass_forces), N(tmass_set_positions), N(tmass_set_velocities),
+        N(tmass_last_stats), N(tmass_energy), N(tmass_remove_tets), N(tmass_default_tear_criteria),
+        N(tmass_tear), N(tmass_tet_deformation), N(tmass_tet_alive), N(tmass_node_active),
+        N(tmass_boundary_triangles), N(tmass_vertex_tensor), N(tmass_edge_tensor),
+        N(tmass_memory_bytes), N(tmass_qs_default_desc), N(tmass_qs_create), N(tmass_qs_destroy),
+        N(tmass_qs_update), N(tmass_qs_displacements), N(tmass_qs_positions), N(tmass_qs_nodes),
+        N(tmass_qs_memory_bytes), N(tmass_qs_remove_tets), N(tmass_qs_save), N(tmass_qs_load),
+        N(tmass_qs_save_memory), N(tmass_qs_load_memory), N(tmass_hybrid_default_desc),
+        N(tmass_hybrid_create), N(tmass_hybrid_destroy), N(tmass_hybrid_step), N(tmass_hybrid_step_ex),
+        N(tmass_hybrid_solve_static), N(tmass_hybrid_set_displacement), N(tmass_hybrid_release_node),
+        N(tmass_hybrid_contact_force), N(tmass_hybrid_remove_tets), N(tmass_hybrid_tear),
+        N(tmass_hybrid_positions), N(tmass_hybrid_boundary_triangles), N(tmass_hybrid_dynamic_part),
+        N(tmass_hybrid_precomputed_part), N(tmass_hybrid_connection_count),
+#undef N
+    };
+    int i, count = (int)(sizeof names / sizeof names[0]);
+    for (i = 0; i < count; i++) {
+        char want[96];
+        snprintf(want, sizeof want, "%s%s", names[i][0], IS_FLOAT ? "_f32" : "");
+        if (strcmp(want, names[i][1]) != 0) {
+            fprintf(stderr, "    %s is linked as %s\n", names[i][0], names[i][1]);
+            CHECK(0);
+        }
+    }
+    printf("    %d entry points checked (%s build)\n", count, IS_FLOAT ? "float" : "double");
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_force_is_minus_energy_gradient),
@@ -1359,6 +1609,13 @@ static const test_case cases[] = {
     TEST(test_no_allocation_after_create),
     TEST(test_validation_errors),
     TEST(test_error_strings),
+    TEST(test_driven_node_implicit_matches_static),
+    TEST(test_cg_cap_fails),
+    TEST(test_garbage_desc_refused),
+    TEST(test_huge_load_not_finite),
+    TEST(test_duplicate_tet_refused),
+    TEST(test_explicit_divergence_caught),
+    TEST(test_float_renames_every_entry_point),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }

@@ -659,6 +659,155 @@ static void test_hybrid_validation(void)
     tetmesh_free(&mesh);
 }
 
+
+/* ---- issue 18 ---------------------------------------------------------------------- */
+
+/* Issue 18 item 7: pinned nodes that are not at rest (driven by tmass_set_displacement)
+   are boundary conditions of the precomputation: the preload with no contact equals the
+   direct static solve with those targets, at every node. */
+static void test_qs_pinned_not_at_rest(void)
+{
+    tetmesh mesh;
+    tmass_real *rest, drive[3] = {0.004f, -0.002f, 0.01f};
+    tmass_model *m, *direct;
+    tmass_qs *qs = NULL;
+    tmass_qs_desc qd = tmass_qs_default_desc();
+    int i, r, driven = 0;
+    double worst = 0.0;
+    beam_mesh(&mesh);
+    rest = alloc_reals(3 * mesh.node_count);
+    m = beam_model(&mesh, rest);
+    direct = beam_model(&mesh, rest);
+    REQUIRE(m != NULL && direct != NULL);
+    for (i = 0; i < mesh.node_count; i++) /* the clamped face is driven */
+        if (mesh.nodes[3 * i] == 0.0) {
+            tmass_set_displacement(m, i, drive);
+            tmass_set_displacement(direct, i, drive);
+            driven++;
+        }
+    REQUIRE(driven > 0);
+    qd.all_nodes = 1;
+    CHECK_INT(TMASS_OK, tmass_qs_create(m, &qd, &qs));
+    REQUIRE(qs != NULL);
+    CHECK_INT(TMASS_OK, tmass_qs_update(qs, NULL, NULL, 0, NULL));
+    CHECK_INT(TMASS_OK, tmass_solve_static(direct));
+    for (i = 0; i < mesh.node_count; i++)
+        for (r = 0; r < 3; r++) {
+            double d = fabs((double)tmass_qs_displacements(qs)[3 * i + r] -
+                            ((double)tmass_positions(direct)[3 * i + r] - (double)rest[3 * i + r]));
+            if (d > worst) worst = d;
+        }
+    printf("    driven clamp: max |u_qs - u_static| / |u_drive| = %.2e\n", worst / 0.01);
+    CHECK(worst <= SOLVE_TOL * 0.01 + (IS_FLOAT ? 1e-6 : 0));
+    tmass_qs_destroy(qs);
+    tmass_destroy(direct);
+    tmass_destroy(m);
+    free(rest);
+    tetmesh_free(&mesh);
+}
+
+static unsigned long long fnv1a(const unsigned char *p, size_t n)
+{
+    unsigned long long h = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i < n; i++) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+/* Issue 18 item 15: a file with a NaN (or an infinity) in its payload and a recomputed,
+   valid checksum is refused, in the preload and in the compliance. */
+static void test_qs_load_refuses_non_finite(void)
+{
+    tetmesh mesh;
+    tmass_real *rest, bad[2];
+    tmass_model *m;
+    tmass_qs *qs, *back;
+    tmass_qs_desc qd = tmass_qs_default_desc();
+    unsigned char *buf;
+    size_t size = 0, payload, where[2];
+    unsigned long long sum;
+    int k, w;
+    beam_mesh(&mesh);
+    rest = alloc_reals(3 * mesh.node_count);
+    m = beam_model(&mesh, rest);
+    REQUIRE(m != NULL);
+    REQUIRE(tmass_qs_create(m, &qd, &qs) == TMASS_OK);
+    tmass_qs_save_memory(qs, NULL, 0, &size);
+    buf = (unsigned char *)malloc(size);
+    REQUIRE(tmass_qs_save_memory(qs, buf, size, &size) == TMASS_OK);
+    payload = size - TMASS__QS_HEADER_BYTES - 8;
+    bad[0] = (tmass_real)NAN;
+    bad[1] = (tmass_real)INFINITY;
+    where[0] = TMASS__QS_HEADER_BYTES + sizeof(tmass_real) * 7;                         /* preload */
+    where[1] = TMASS__QS_HEADER_BYTES + sizeof(tmass_real) * (3 * (size_t)mesh.node_count + 5); /* compliance */
+    for (k = 0; k < 2; k++)
+        for (w = 0; w < 2; w++) {
+            unsigned char *copy = (unsigned char *)malloc(size);
+            memcpy(copy, buf, size);
+            memcpy(copy + where[w], &bad[k], sizeof(tmass_real));
+            sum = fnv1a(copy + TMASS__QS_HEADER_BYTES, payload);
+            memcpy(copy + TMASS__QS_HEADER_BYTES + payload, &sum, 8);
+            back = NULL;
+            CHECK_INT(TMASS_ERR_FILE_FORMAT, tmass_qs_load_memory(m, &qd, copy, size, &back));
+            CHECK(back == NULL);
+            if (back) tmass_qs_destroy(back);
+            free(copy);
+        }
+    free(buf);
+    tmass_qs_destroy(qs);
+    tmass_destroy(m);
+    free(rest);
+    tetmesh_free(&mesh);
+}
+
+static void count_log(int code, const char *message, void *user)
+{
+    (void)code;
+    (void)message;
+    ++*(int *)user;
+}
+
+/* Issue 18 item 12: descriptions not made by their default function (filled with 0xA5
+   bytes, so their log callback is a wild pointer) are refused with TMASS_ERR_DESC, never
+   called into. */
+static void test_garbage_descs_refused(void)
+{
+    tetmesh mesh;
+    tmass_real *rest;
+    tmass_model *m;
+    tmass_qs *qs = (tmass_qs *)&mesh;
+    tmass_hybrid *h = (tmass_hybrid *)&mesh;
+    tmass_qs_desc qd;
+    tmass_hybrid_desc hd;
+    unsigned char dynamic[1] = {1};
+    int calls = 0;
+    beam_mesh(&mesh);
+    rest = alloc_reals(3 * mesh.node_count);
+    m = beam_model(&mesh, rest);
+    REQUIRE(m != NULL);
+    memset(&qd, 0xA5, sizeof qd);
+    CHECK_INT(TMASS_ERR_DESC, tmass_qs_create(m, &qd, &qs));
+    CHECK(qs == NULL);
+    memset(&hd, 0xA5, sizeof hd);
+    CHECK_INT(TMASS_ERR_DESC, tmass_hybrid_create(&hd, &h));
+    CHECK(h == NULL);
+    /* a genuine hybrid desc around a garbage model desc */
+    hd = tmass_hybrid_default_desc();
+    memset(&hd.model, 0xA5, sizeof hd.model);
+    hd.tet_dynamic = dynamic;
+    h = (tmass_hybrid *)&mesh;
+    CHECK_INT(TMASS_ERR_DESC, tmass_hybrid_create(&hd, &h));
+    CHECK(h == NULL);
+    /* a garbage desc with a valid log: refused, and no callback is trusted */
+    memset(&hd.model, 0xA5, sizeof hd.model);
+    hd.model.log = count_log;
+    hd.model.log_user = &calls;
+    CHECK_INT(TMASS_ERR_DESC, tmass_hybrid_create(&hd, &h));
+    tmass_destroy(m);
+    free(rest);
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_qs_matches_direct_solve),
     TEST(test_qs_compliance_symmetric),
@@ -669,6 +818,9 @@ static const test_case cases[] = {
     TEST(test_hybrid_dynamics_settle),
     TEST(test_hybrid_topology),
     TEST(test_hybrid_validation),
+    TEST(test_qs_pinned_not_at_rest),
+    TEST(test_qs_load_refuses_non_finite),
+    TEST(test_garbage_descs_refused),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
