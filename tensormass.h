@@ -460,7 +460,7 @@ typedef struct tmass_desc {
 
     /* Newton solves: the springs' implicit Euler step (TMASS_IMPLICIT_EULER) and static
        solve; the tensor model is linear and needs one linear solve */
-    int newton_iterations;       /* cap per implicit step (static: 50 per increment), default 20 */
+    int newton_iterations;       /* cap per implicit step or static load increment, default 20 */
     tmass_real newton_tolerance; /* residual over its reference scale, default 1e-6 (1e-5
                                     float); a residual at its round-off floor is accepted too
                                     (see SOLVERS) */
@@ -2569,7 +2569,7 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
             x[i] = pin > 0 ? m->disp[i] + (tmass_real)next * (m->target[i] - m->disp[i]) : accepted[i];
         }
         m->load_scale = next;
-        err = tmass__spring_newton(m, x, ref2, 50);
+        err = tmass__spring_newton(m, x, ref2, m->newton_iterations);
         if (err == TMASS_OK) {
             memcpy(accepted, x, sizeof(tmass_real) * (size_t)n3);
             s = next;

@@ -1586,6 +1586,234 @@ static void test_float_renames_every_entry_point(void)
     printf("    %d entry points checked (%s build)\n", count, IS_FLOAT ? "float" : "double");
 }
 
+/* Item 10: the model works on u = x - X, so a body whose rest mesh lies 1e6 m out is as
+   exact as one at the origin; a body that has travelled far from its rest position holds
+   a large u whose rounding fakes strains: steps and static solves refuse it with
+   TMASS_ERR_PRECISION (state kept). With the check disabled (precision_limit = 0) the
+   forces of a 1 % stretch are visibly wrong: the reason the check exists. */
+static void test_precision_far_from_origin(void)
+{
+    tetmesh mesh;
+    tmass_desc d;
+    tmass_model *near_m = NULL, *far_m = NULL;
+    tmass_real *x;
+    double shift = IS_FLOAT ? 1e4 : 1e12, worst = 0.0, scale = 0.0, off = 1e6;
+    int i, n3, pass;
+    box_mesh(&mesh, 4, 4, 4, 1, 1, 1, TETMESH_SPLIT6); /* edges of 0.25 m, exact at 1e6 in float */
+    n3 = 3 * mesh.node_count;
+    x = alloc_reals(n3);
+    d = tmass_default_desc();
+    d.node_count = mesh.node_count;
+    d.tets = mesh.tets;
+    d.tet_count = mesh.tet_count;
+    d.young_modulus = (tmass_real)1e5;
+    d.cg_tolerance = (tmass_real)(IS_FLOAT ? 1e-6 : 1e-12);
+    for (i = 0; i < n3; i++) x[i] = (tmass_real)mesh.nodes[i];
+    d.rest_positions = x;
+    REQUIRE(tmass_create(&d, &near_m) == TMASS_OK);
+    for (i = 0; i < n3; i++) x[i] = (tmass_real)(mesh.nodes[i] + off);
+    REQUIRE(tmass_create(&d, &far_m) == TMASS_OK);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i + 2] == 0.0) {
+            tmass_fix_node(near_m, i);
+            tmass_fix_node(far_m, i);
+        }
+    /* far rest mesh: the same static answer, in displacements */
+    CHECK_INT(TMASS_OK, tmass_solve_static(near_m));
+    CHECK_INT(TMASS_OK, tmass_solve_static(far_m));
+    for (i = 0; i < n3; i++) {
+        double un = (double)tmass_positions(near_m)[i] - mesh.nodes[i];
+        double uf = (double)far_m->disp[i];
+        if (fabs(un - uf) > worst) worst = fabs(un - uf);
+        if (fabs(un) > scale) scale = fabs(un);
+    }
+    printf("    rest mesh 1e6 m out: static displacements differ by %.2e of the largest\n", worst / scale);
+    CHECK(worst <= (IS_FLOAT ? 1e-5 : 1e-12) * scale);
+    /* travelled far: u = shift + 1 % stretch along x */
+    for (pass = 0; pass < 2; pass++) {
+        const tmass_real *f;
+        double ferr = 0.0, fscale = 0.0;
+        tmass_model *m = near_m;
+        tmass_model *ref = NULL;
+        int err;
+        d.rest_positions = (tmass_real *)NULL;
+        for (i = 0; i < n3; i++) x[i] = (tmass_real)mesh.nodes[i];
+        d.rest_positions = x;
+        d.precision_limit = pass == 0 ? (tmass_real)0 : (tmass_real)1e-4;
+        tmass_destroy(near_m);
+        near_m = NULL;
+        REQUIRE(tmass_create(&d, &near_m) == TMASS_OK);
+        REQUIRE(tmass_create(&d, &ref) == TMASS_OK);
+        m = near_m;
+        for (i = 0; i < mesh.node_count; i++) {
+            x[3 * i] = (tmass_real)(mesh.nodes[3 * i] * 1.01);
+            x[3 * i + 1] = (tmass_real)mesh.nodes[3 * i + 1];
+            x[3 * i + 2] = (tmass_real)mesh.nodes[3 * i + 2];
+        }
+        tmass_set_positions(ref, x);
+        for (i = 0; i < n3; i++) x[i] = (tmass_real)((double)x[i] + shift);
+        tmass_set_positions(m, x);
+        for (i = 0; i < mesh.node_count; i++) /* pinned where they are now */
+            if (mesh.nodes[3 * i + 2] == 0.0) tmass_fix_node(m, i);
+        f = tmass_forces(ref);
+        for (i = 0; i < n3; i++) fscale = fabs(f[i]) > fscale ? fabs(f[i]) : fscale;
+        f = tmass_forces(m);
+        for (i = 0; i < n3; i++) {
+            double e = fabs((double)f[i] - (double)tmass_forces(ref)[i]);
+            if (e > ferr) ferr = e;
+            f = tmass_forces(m);
+        }
+        memcpy(x, tmass_positions(m), sizeof(tmass_real) * n3);
+        err = tmass_step_ex(m, (tmass_real)1e-3, TMASS_SEMI_IMPLICIT_EULER);
+        if (pass == 0) {
+            printf("    travelled %.0e m, check disabled: force error %.2g x the 1 %% stretch's, code %d\n",
+                   shift, ferr / fscale, err);
+            CHECK(ferr > 0.01 * fscale); /* the silent wrong answer the check prevents */
+            CHECK_INT(TMASS_OK, err);
+        } else {
+            int same = 1;
+            CHECK_INT(TMASS_ERR_PRECISION, err);
+            for (i = 0; i < n3; i++) same &= x[i] == tmass_positions(m)[i];
+            CHECK(same);
+            CHECK_INT(TMASS_ERR_PRECISION, tmass_step_ex(m, (tmass_real)1e-3, TMASS_IMPLICIT_EULER));
+            CHECK_INT(TMASS_ERR_PRECISION, tmass_solve_static(m));
+        }
+        tmass_destroy(ref);
+    }
+    tmass_destroy(near_m);
+    tmass_destroy(far_m);
+    free(x);
+    tetmesh_free(&mesh);
+}
+
+/* Common statistics: every solver fills them. Tensor static: one linear solve; springs
+   static: Newton increments with a residual under the tolerance; springs implicit:
+   Newton; explicit: no linear solve. A linear static answer with an inverted tet is
+   returned (exact for the linear model) and the tet counted. */
+static void test_stats_filled(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    const tmass_stats *st;
+    tmass_real big[3] = {0, 0, 0};
+    int i, kind;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        m = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+        REQUIRE(m != NULL);
+        for (i = 0; i < mesh.node_count; i++)
+            if (mesh.nodes[3 * i + 2] == 0.0) tmass_fix_node(m, i);
+        CHECK_INT(TMASS_OK, tmass_solve_static(m));
+        st = tmass_last_stats(m);
+        printf("    %s static: newton %d, cg %d, cg residual %.2g, residual %.2g, increments %d, cuts %d, "
+               "line-search cuts %d, inverted %d, forces %d, K products %d\n",
+               kind ? "springs" : "tensor", st->newton_iterations, st->cg_iterations, (double)st->cg_residual,
+               (double)st->residual, st->increments, st->increment_cuts, st->line_search_cuts, st->inverted,
+               st->force_evaluations, st->stiffness_products);
+        CHECK(st->newton_iterations >= 1 && st->cg_iterations >= 1 && st->increments >= 1);
+        CHECK(st->stiffness_products >= st->cg_iterations);
+        CHECK(st->cg_residual <= (tmass_real)1e-5 && st->cg_residual >= 0);
+        CHECK(st->residual <= (tmass_real)(IS_FLOAT ? 1e-5 : 1e-6));
+        CHECK_INT(0, st->inverted);
+        if (kind == 0) {
+            CHECK_INT(1, st->newton_iterations);
+            CHECK(st->residual == 0);
+        } else {
+            CHECK(st->force_evaluations >= st->newton_iterations);
+        }
+        CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)0.01, TMASS_IMPLICIT_EULER));
+        st = tmass_last_stats(m);
+        CHECK(st->increments == 1); /* from equilibrium: no CG or Newton iteration may be needed */
+        CHECK(kind == 0 ? st->newton_iterations == 1 : st->newton_iterations >= 0);
+        CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)1e-4, TMASS_RK4));
+        st = tmass_last_stats(m);
+        CHECK_INT(0, st->newton_iterations);
+        CHECK_INT(0, st->cg_iterations);
+        CHECK_INT(4, st->force_evaluations);
+        tmass_destroy(m);
+    }
+    /* the linear model: a load that inverts a tet is solved and the tet counted */
+    m = make_model(&mesh, TMASS_TENSOR_MASS, 1e3, 0.3, 1000);
+    REQUIRE(m != NULL);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i + 2] == 0.0) tmass_fix_node(m, i);
+    big[2] = (tmass_real)-5e3;
+    tmass_set_external_force(m, mesh.node_count - 1, big);
+    CHECK_INT(TMASS_OK, tmass_solve_static(m));
+    printf("    tensor, 5 kN on a corner of a 1 kPa cube: %d inverted tets (reported, not refused)\n",
+           tmass_last_stats(m)->inverted);
+    CHECK(tmass_last_stats(m)->inverted > 0);
+    tmass_destroy(m);
+    tetmesh_free(&mesh);
+}
+
+#define TWIST (3.14159265358979323846 * 5 / 6)
+/* Spring static continuation: a 150 degree twist of a soft beam's free end in one call,
+   with at most 4 Newton iterations per increment, converges (increments and cuts in the
+   stats) to the answer of six manual increments. */
+static void test_springs_static_continuation(void)
+{
+    tetmesh mesh;
+    tmass_model *one, *steps;
+    tmass_real zero[3] = {0, 0, 0};
+    double worst = 0.0;
+    int i, inc, n3;
+    tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 20, 2, 2, TETMESH_SPLIT5);
+    {   /* a Newton cap of 4 per increment: the whole twist at once cannot make it */
+        tmass_desc d = tmass_default_desc();
+        tmass_real *x = to_real(mesh.nodes, 3 * mesh.node_count);
+        d.rest_positions = x;
+        d.node_count = mesh.node_count;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        d.kind = TMASS_MASS_SPRING;
+        d.young_modulus = (tmass_real)1e5;
+        d.newton_iterations = 4;
+        one = NULL;
+        tmass_create(&d, &one);
+        free(x);
+    }
+    steps = make_model(&mesh, TMASS_MASS_SPRING, 1e5, 0.3, 1000.0);
+    REQUIRE(one != NULL && steps != NULL);
+    n3 = 3 * mesh.node_count;
+    tmass_set_gravity(one, zero);
+    tmass_set_gravity(steps, zero);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i] == 0.0) {
+            tmass_fix_node(one, i);
+            tmass_fix_node(steps, i);
+        }
+    for (inc = 1; inc <= 6; inc++) {
+        double a = TWIST * inc / 6, c = cos(a), sn = sin(a);
+        for (i = 0; i < mesh.node_count; i++) {
+            const double *p = mesh.nodes + 3 * i;
+            tmass_real u[3];
+            if (p[0] < 1.0 - 1e-9) continue;
+            u[0] = 0;
+            u[1] = (tmass_real)(c * p[1] - sn * p[2] - p[1]);
+            u[2] = (tmass_real)(sn * p[1] + c * p[2] - p[2]);
+            tmass_set_displacement(steps, i, u);
+            if (inc == 6) tmass_set_displacement(one, i, u);
+        }
+        CHECK_INT(TMASS_OK, tmass_solve_static(steps));
+    }
+    CHECK_INT(TMASS_OK, tmass_solve_static(one));
+    printf("    150 degree twist in one call, 4 Newton per increment at most: %d increments, %d cuts, %d Newton, "
+           "%d line-search cuts\n",
+           tmass_last_stats(one)->increments, tmass_last_stats(one)->increment_cuts,
+           tmass_last_stats(one)->newton_iterations, tmass_last_stats(one)->line_search_cuts);
+    for (i = 0; i < n3; i++) {
+        double e = fabs((double)tmass_positions(one)[i] - (double)tmass_positions(steps)[i]);
+        if (e > worst) worst = e;
+    }
+    printf("    one call vs six increments: max difference %.2e m\n", worst);
+    CHECK(worst < (IS_FLOAT ? 1e-4 : 1e-7));
+    CHECK(tmass_last_stats(one)->increments > 1 && tmass_last_stats(one)->increment_cuts > 0);
+    tmass_destroy(one);
+    tmass_destroy(steps);
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_force_is_minus_energy_gradient),
@@ -1616,6 +1844,9 @@ static const test_case cases[] = {
     TEST(test_duplicate_tet_refused),
     TEST(test_explicit_divergence_caught),
     TEST(test_float_renames_every_entry_point),
+    TEST(test_precision_far_from_origin),
+    TEST(test_stats_filled),
+    TEST(test_springs_static_continuation),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
