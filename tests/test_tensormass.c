@@ -2028,6 +2028,211 @@ static void test_implicit_damped_recurrence(void)
     tmass_destroy(m);
 }
 
+/* ---- stress sweep (issue 18): no success with a wrong answer -------------------------- */
+
+/* Dense K (3n x 3n, block (a, b) = K_ab) assembled from the model's tensors. */
+static void dense_stiffness(const tmass_model *m, const tetmesh *mesh, double *K)
+{
+    int n3 = 3 * mesh->node_count, i, t, j, k, r, c;
+    tmass_real T[9];
+    memset(K, 0, sizeof(double) * (size_t)n3 * n3);
+    for (i = 0; i < mesh->node_count; i++) {
+        tmass_vertex_tensor(m, i, T);
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) K[(size_t)(3 * i + r) * n3 + 3 * i + c] = T[3 * r + c];
+    }
+    for (t = 0; t < mesh->tet_count; t++)
+        for (j = 0; j < 4; j++)
+            for (k = 0; k < 4; k++) {
+                int a = mesh->tets[4 * t + j], b = mesh->tets[4 * t + k];
+                if (a == b) continue;
+                tmass_edge_tensor(m, a, b, T);
+                for (r = 0; r < 3; r++)
+                    for (c = 0; c < 3; c++) K[(size_t)(3 * a + r) * n3 + 3 * b + c] = T[3 * r + c];
+            }
+}
+
+/* Solves A x = b on the free degrees of freedom (free[i] != 0) by dense Cholesky in
+   double; the other entries of x are left alone. Returns 0, or -1 if not positive
+   definite. */
+static int dense_solve(double *A, const double *b, double *x, const int *is_free, int n)
+{
+    int i, j, k, nf = 0, *map = (int *)malloc(sizeof(int) * n);
+    double *L, *y;
+    for (i = 0; i < n; i++)
+        if (is_free[i]) map[nf++] = i;
+    L = (double *)calloc((size_t)nf * nf + 1, sizeof(double));
+    y = (double *)calloc((size_t)nf + 1, sizeof(double));
+    for (i = 0; i < nf; i++)
+        for (j = 0; j < nf; j++) L[(size_t)i * nf + j] = A[(size_t)map[i] * n + map[j]];
+    for (j = 0; j < nf; j++) {
+        double d = L[(size_t)j * nf + j];
+        for (k = 0; k < j; k++) d -= L[(size_t)j * nf + k] * L[(size_t)j * nf + k];
+        if (!(d > 0)) {
+            free(map); free(L); free(y);
+            return -1;
+        }
+        d = sqrt(d);
+        L[(size_t)j * nf + j] = d;
+        for (i = j + 1; i < nf; i++) {
+            double v = L[(size_t)i * nf + j];
+            for (k = 0; k < j; k++) v -= L[(size_t)i * nf + k] * L[(size_t)j * nf + k];
+            L[(size_t)i * nf + j] = v / d;
+        }
+    }
+    for (i = 0; i < nf; i++) {
+        double v = b[map[i]];
+        for (k = 0; k < i; k++) v -= L[(size_t)i * nf + k] * y[k];
+        y[i] = v / L[(size_t)i * nf + i];
+    }
+    for (i = nf - 1; i >= 0; i--) {
+        double v = y[i];
+        for (k = i + 1; k < nf; k++) v -= L[(size_t)k * nf + i] * y[k];
+        y[i] = v / L[(size_t)i * nf + i];
+    }
+    for (i = 0; i < nf; i++) x[map[i]] = y[i];
+    free(map); free(L); free(y);
+    return 0;
+}
+
+/* One sweep case on the tensor model: the beam (clamped at x = 0, under gravity) or the
+   squashed cube (bottom fixed, top driven down 10 %, gravity). dt = 0: static solve;
+   else three implicit steps. The answer is checked against the test's own dense solve
+   of the same discrete problem (the static equations, or the backward Euler recurrence
+   (M + dt^2 K) v1 = M v0 + dt (f_ext + M g - K (u0 + dt v0_free)) with the driven
+   nodes' velocity, u1 = u0 + dt v1): returns 1 when the library reported success and
+   matched, 0 when it returned an error code, -1 for a success with a wrong answer.
+   (Unknown v1 on the free entries: (M + dt^2 K) v1 = M v0 + dt (M g - K u0), u0 with the
+   driven nodes at their targets.) */
+static int sweep_case(const tetmesh *mesh, int cube, double E, double nu, double dt, double *err_out)
+{
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = to_real(mesh->nodes, 3 * mesh->node_count);
+    int n = mesh->node_count, n3 = 3 * n, i, s, steps = dt > 0 ? 3 : 1, code = TMASS_OK, *freedof;
+    double *K, *A, *b, *u, *v, *u1, worst = 0.0, scale = 0.0, size = 0.0, tol;
+    d.rest_positions = x;
+    d.node_count = n;
+    d.tets = mesh->tets;
+    d.tet_count = mesh->tet_count;
+    d.young_modulus = (tmass_real)E;
+    d.poisson_ratio = (tmass_real)nu;
+    if (tmass_create(&d, &m)) {
+        free(x);
+        return 0;
+    }
+    free(x);
+    freedof = (int *)calloc((size_t)n3, sizeof(int));
+    K = (double *)malloc(sizeof(double) * (size_t)n3 * n3);
+    A = (double *)malloc(sizeof(double) * (size_t)n3 * n3);
+    b = (double *)calloc((size_t)n3, sizeof(double));
+    u = (double *)calloc((size_t)n3, sizeof(double));
+    v = (double *)calloc((size_t)n3, sizeof(double));
+    u1 = (double *)calloc((size_t)n3, sizeof(double));
+    for (i = 0; i < n; i++) {
+        const double *p = mesh->nodes + 3 * i;
+        int pinned = cube ? (p[2] == 0.0 || p[2] == 1.0) : p[0] == 0.0;
+        freedof[3 * i] = freedof[3 * i + 1] = freedof[3 * i + 2] = !pinned;
+        if (cube && p[2] == 1.0) {
+            tmass_real du[3] = {0, 0, (tmass_real)-0.1};
+            tmass_set_displacement(m, i, du);
+        } else if (pinned) {
+            tmass_fix_node(m, i);
+        }
+    }
+    dense_stiffness(m, mesh, K);
+    for (s = 0; s < steps && code == TMASS_OK; s++) {
+        int r, c;
+        /* the reference step (dense, double) from the model's current state */
+        for (i = 0; i < n3; i++) {
+            u[i] = (double)m->disp[i]; /* u itself: positions round to eps |X| */
+            v[i] = (double)tmass_velocities(m)[i];
+        }
+        for (i = 0; i < n; i++)
+            if (cube && mesh->nodes[3 * i + 2] == 1.0) { /* driven: at the target this step */
+                double target = -0.1;
+                if (dt > 0) v[3 * i + 2] = (target - u[3 * i + 2]) / dt, v[3 * i] = v[3 * i + 1] = 0;
+                u[3 * i + 2] = target;
+            }
+        for (r = 0; r < n3; r++) {
+            double ku = 0.0, mass = (double)tmass_masses(m)[r / 3], grav = r % 3 == 2 ? -9.81 : 0.0;
+            for (c = 0; c < n3; c++) ku += K[(size_t)r * n3 + c] * u[c];
+            if (dt > 0) {
+                b[r] = mass * v[r] + dt * (mass * grav - ku);
+                for (c = 0; c < n3; c++)
+                    A[(size_t)r * n3 + c] = dt * dt * K[(size_t)r * n3 + c] + (r == c ? mass : 0.0);
+            } else {
+                b[r] = mass * grav - ku;
+                for (c = 0; c < n3; c++) A[(size_t)r * n3 + c] = K[(size_t)r * n3 + c];
+            }
+        }
+        for (i = 0; i < n3; i++) u1[i] = 0.0;
+        if (dense_solve(A, b, u1, freedof, n3)) {
+            code = -99;
+            break;
+        }
+        for (i = 0; i < n3; i++) /* u1 holds v1 (static: du) on the free entries */
+            u1[i] = freedof[i] ? (dt > 0 ? u[i] + dt * u1[i] : u[i] + u1[i]) : u[i];
+        code = dt > 0 ? tmass_step_ex(m, (tmass_real)dt, TMASS_IMPLICIT_EULER) : tmass_solve_static(m);
+        if (code) break;
+        for (i = 0; i < n3; i++) {
+            double e = fabs((double)m->disp[i] - u1[i]);
+            if (e > worst) worst = e;
+            if (fabs(u1[i] - u[i]) > scale) scale = fabs(u1[i] - u[i]);
+            if (fabs(u1[i]) > size) size = fabs(u1[i]);
+        }
+    }
+    /* matched: the error is within what the CG tolerance allows for this conditioning;
+       judged against the step's own displacement (an error of the size of the move
+       itself is a wrong answer) */
+    tol = IS_FLOAT ? 5e-2 : 1e-3; /* float CG stops at 1e-5 of |b|; at nu = 0.4999 the
+                                     condition number (about 1e4) lets 2 % through */
+    worst -= 8 * EPS * size; /* below the rounding of u itself nothing can be judged (in
+                                float a step of 1e-6 s moves less than u's last digit) */
+    if (worst < 0) worst = 0;
+    *err_out = scale > 0 ? worst / scale : worst;
+    tmass_destroy(m);
+    free(freedof); free(K); free(A); free(b); free(u); free(v); free(u1);
+    if (code == -99) return 0;
+    if (code) return 0;
+    if (!(scale > 0)) return worst == 0.0 ? 1 : -1;
+    return worst <= tol * scale ? 1 : -1;
+}
+
+static void test_stress_sweep(void)
+{
+    static const double Es[4] = {1.0, 1e3, 1e6, 2e11}, nus[4] = {0.0, 0.3, 0.49, 0.4999};
+    static const double dts[4] = {0.0, 1e-6, 1e-3, 1.0};
+    tetmesh beam, cube;
+    int shape, ie, inu, idt, ok = 0, refused = 0, wrong = 0;
+    double worst_ok = 0.0;
+    tetmesh_beam(&beam, 1.0, 0.2, 0.2, TEST_IS_QUICK ? 3 : 5, 1, 1, TETMESH_SPLIT6);
+    box_mesh(&cube, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (shape = 0; shape < 2; shape++)
+        for (ie = 0; ie < 4; ie++)
+            for (inu = 0; inu < 4; inu++)
+                for (idt = 0; idt < 4; idt++) {
+                    double e = 0.0;
+                    int r = sweep_case(shape ? &cube : &beam, shape, Es[ie], nus[inu], dts[idt], &e);
+                    if (r > 0) {
+                        ok++;
+                        if (e > worst_ok) worst_ok = e;
+                    } else if (r == 0) {
+                        refused++;
+                    } else {
+                        wrong++;
+                        printf("    WRONG: %s E %g nu %g dt %g: error %.3g of the move\n", shape ? "cube" : "beam",
+                               Es[ie], nus[inu], dts[idt], e);
+                    }
+                }
+    printf("    sweep: %d matched (worst %.2e of the move), %d refused with a code, %d wrong\n", ok, worst_ok,
+           refused, wrong);
+    CHECK_INT(0, wrong);
+    CHECK(ok > 100);
+    tetmesh_free(&beam);
+    tetmesh_free(&cube);
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_force_is_minus_energy_gradient),
@@ -2063,6 +2268,7 @@ static const test_case cases[] = {
     TEST(test_springs_static_continuation),
     TEST(test_integrator_order),
     TEST(test_implicit_damped_recurrence),
+    TEST(test_stress_sweep),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
