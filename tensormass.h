@@ -3164,7 +3164,7 @@ static unsigned long long tmass__hash(unsigned long long h, const void *data, si
 /* >>quasi-static ---------------------------------------------------------------------- */
 
 #define TMASS__QS_COOKIE 0x514D4153u /* "TMSQ" */
-#define TMASS__QS_VERSION 1u
+#define TMASS__QS_VERSION 2u /* 2: the preload includes driven pinned nodes (issue 18) */
 #define TMASS__FNV_BASIS 14695981039346656037ull
 
 struct tmass_qs {
