@@ -153,7 +153,9 @@
        is |f| over the reference. newton_iterations caps each increment (default 20).
        Springs implicit Euler (TMASS_IMPLICIT_EULER): Newton on the incremental potential
        (see INTEGRATORS) to the same kind of tolerance, at most newton_iterations, then
-       fails. TMASS_IMPLICIT_EULER_LINEARIZED keeps the single linearised iteration (no
+       fails. The spring model, like the tensor model, counts inverted tetrahedra in
+       stats.inverted and does not refuse them (springs have no volume term: a spring
+       network can pass through an inverted configuration and come back). TMASS_IMPLICIT_EULER_LINEARIZED keeps the single linearised iteration (no
        tolerance on the nonlinear residual: its error is the linearisation's, about the
        square of the step's strain increment; fine for small steps, wrong for large
        deformations within one step).
@@ -197,7 +199,8 @@
        displacements, so a strain of 1e-6 keeps its digits in float (the difference of two
        lengths would lose them all). The static solve is Newton on the full tangent (its
        positive-definite part where compressed springs make it indefinite) with a
-       backtracking line search on the potential or the residual.
+       backtracking line search on the potential or the residual, in load increments
+       (SOLVERS).
 
    INTEGRATORS (the desc picks a default, tmass_step_ex picks per call)
        TMASS_EXPLICIT_EULER        x1 = x + dt v, v1 = v + dt a(x, v). Unstable without
