@@ -2199,6 +2199,73 @@ static int sweep_case(const tetmesh *mesh, int cube, double E, double nu, double
     return worst <= tol * scale ? 1 : -1;
 }
 
+/* The spring model on the same cases: nonlinear, so the reference is a fine-tolerance run
+   of the same step or solve (Newton to 1e-10 of the scale, CG to 1e-12; float 1e-6 and
+   1e-7, at most 200 Newton iterations). Returns 1 matched, 0 error code, -1 success with
+   a wrong answer, -2 success that cannot be judged (the reference itself failed). */
+static tmass_model *spring_sweep_model(const tetmesh *mesh, int cube, double E, int fine)
+{
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = to_real(mesh->nodes, 3 * mesh->node_count);
+    int i;
+    d.rest_positions = x;
+    d.node_count = mesh->node_count;
+    d.tets = mesh->tets;
+    d.tet_count = mesh->tet_count;
+    d.kind = TMASS_MASS_SPRING;
+    d.young_modulus = (tmass_real)E;
+    if (fine) {
+        d.newton_tolerance = (tmass_real)(IS_FLOAT ? 1e-6 : 1e-10);
+        d.cg_tolerance = (tmass_real)(IS_FLOAT ? 1e-7 : 1e-12);
+        d.newton_iterations = 200;
+        d.cg_max_iterations = 20000;
+    }
+    i = tmass_create(&d, &m);
+    free(x);
+    if (i) return NULL;
+    for (i = 0; i < mesh->node_count; i++) {
+        const double *p = mesh->nodes + 3 * i;
+        if (cube && p[2] == 1.0) {
+            tmass_real du[3] = {0, 0, (tmass_real)-0.1};
+            tmass_set_displacement(m, i, du);
+        } else if (cube ? p[2] == 0.0 : p[0] == 0.0) {
+            tmass_fix_node(m, i);
+        }
+    }
+    return m;
+}
+
+static int sweep_springs_case(const tetmesh *mesh, int cube, double E, double dt, double *err_out)
+{
+    tmass_model *m = spring_sweep_model(mesh, cube, E, 0), *ref = spring_sweep_model(mesh, cube, E, 1);
+    int s, i, n3 = 3 * mesh->node_count, code = TMASS_OK, rcode = TMASS_OK, result;
+    double worst = 0.0, scale = 0.0;
+    if (!m || !ref) {
+        tmass_destroy(m);
+        tmass_destroy(ref);
+        return 0;
+    }
+    for (s = 0; s < (dt > 0 ? 3 : 1) && !code && !rcode; s++) {
+        code = dt > 0 ? tmass_step_ex(m, (tmass_real)dt, TMASS_IMPLICIT_EULER) : tmass_solve_static(m);
+        rcode = dt > 0 ? tmass_step_ex(ref, (tmass_real)dt, TMASS_IMPLICIT_EULER) : tmass_solve_static(ref);
+    }
+    for (i = 0; i < n3; i++) {
+        double e = fabs((double)m->disp[i] - (double)ref->disp[i]);
+        if (e > worst) worst = e;
+        if (fabs((double)ref->disp[i]) > scale) scale = fabs((double)ref->disp[i]);
+    }
+    worst -= 8 * EPS * scale;
+    if (worst < 0) worst = 0;
+    *err_out = scale > 0 ? worst / scale : worst;
+    if (code) result = 0;
+    else if (rcode) result = -2;
+    else result = worst <= (IS_FLOAT ? 1e-3 : 1e-4) * scale ? 1 : -1;
+    tmass_destroy(m);
+    tmass_destroy(ref);
+    return result;
+}
+
 static void test_stress_sweep(void)
 {
     static const double Es[4] = {1.0, 1e3, 1e6, 2e11}, nus[4] = {0.0, 0.3, 0.49, 0.4999};
@@ -2219,16 +2286,46 @@ static void test_stress_sweep(void)
                         if (e > worst_ok) worst_ok = e;
                     } else if (r == 0) {
                         refused++;
+                        printf("    refused: %s E %g nu %g dt %g\n", shape ? "cube" : "beam", Es[ie], nus[inu],
+                               dts[idt]);
                     } else {
                         wrong++;
                         printf("    WRONG: %s E %g nu %g dt %g: error %.3g of the move\n", shape ? "cube" : "beam",
                                Es[ie], nus[inu], dts[idt], e);
                     }
                 }
-    printf("    sweep: %d matched (worst %.2e of the move), %d refused with a code, %d wrong\n", ok, worst_ok,
-           refused, wrong);
+    printf("    tensor sweep: %d matched (worst %.2e of the move), %d refused with a code, %d wrong\n", ok,
+           worst_ok, refused, wrong);
     CHECK_INT(0, wrong);
     CHECK(ok > 100);
+    { /* springs: E x (static, three dt), nu plays no part */
+        int unjudged = 0;
+        ok = refused = wrong = 0;
+        worst_ok = 0.0;
+        for (shape = 0; shape < 2; shape++)
+            for (ie = 0; ie < 4; ie++)
+                for (idt = 0; idt < 4; idt++) {
+                    double e = 0.0;
+                    int r = sweep_springs_case(shape ? &cube : &beam, shape, Es[ie], dts[idt], &e);
+                    if (r == 1) {
+                        ok++;
+                        if (e > worst_ok) worst_ok = e;
+                    } else if (r == 0) {
+                        refused++;
+                        printf("    refused springs: %s E %g dt %g\n", shape ? "cube" : "beam", Es[ie], dts[idt]);
+                    } else if (r == -2) {
+                        unjudged++;
+                    } else {
+                        wrong++;
+                        printf("    WRONG springs: %s E %g dt %g: error %.3g of |u|\n", shape ? "cube" : "beam",
+                               Es[ie], dts[idt], e);
+                    }
+                }
+        printf("    springs sweep: %d matched the fine-tolerance run (worst %.2e of |u|), %d refused with a "
+               "code, %d unjudged (the fine run failed), %d wrong\n", ok, worst_ok, refused, unjudged, wrong);
+        CHECK_INT(0, wrong);
+        CHECK(ok >= 16);
+    }
     tetmesh_free(&beam);
     tetmesh_free(&cube);
 }
