@@ -2028,6 +2028,67 @@ static void test_implicit_damped_recurrence(void)
     tmass_destroy(m);
 }
 
+/* The springs' implicit Euler residual is minus the gradient of its incremental
+   potential, R(x) = -dPhi/dx (no axial damping, which Phi leaves out), by central finite
+   differences at a random state, with gravity and mass damping. */
+static void test_spring_incremental_potential_gradient(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    tmass_real *x0, *v0, *x, *R, *v;
+    unsigned seed = 7;
+    double dt = 0.02, worst = 0.0, scale = 0.0, h = IS_FLOAT ? 1e-3 : 1e-6;
+    int i, n3, k;
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
+    {
+        tmass_desc d = tmass_default_desc();
+        tmass_real *rest = to_real(mesh.nodes, 3 * mesh.node_count);
+        d.rest_positions = rest;
+        d.node_count = mesh.node_count;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        d.kind = TMASS_MASS_SPRING;
+        d.young_modulus = (tmass_real)1e4;
+        d.mass_damping = (tmass_real)0.8;
+        m = NULL;
+        tmass_create(&d, &m);
+        free(rest);
+    }
+    REQUIRE(m != NULL);
+    n3 = 3 * mesh.node_count;
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+    x0 = alloc_reals(n3);
+    v0 = alloc_reals(n3);
+    x = alloc_reals(n3);
+    R = alloc_reals(n3);
+    v = alloc_reals(n3);
+    for (i = 0; i < n3; i++) {
+        x0[i] = (tmass_real)(0.05 * rnd(&seed));
+        v0[i] = (tmass_real)(0.3 * rnd(&seed));
+        x[i] = (tmass_real)(x0[i] + 0.05 * rnd(&seed));
+    }
+    tmass__spring_dyn_residual(m, (tmass_real)dt, x0, v0, x, R, v);
+    for (k = 0; k < n3; k++) {
+        double plus, minus, fd;
+        tmass_real keep = x[k];
+        if (m->free_mask[k] == 0) continue;
+        x[k] = (tmass_real)(keep + h);
+        plus = tmass__spring_incremental_potential(m, (tmass_real)dt, x0, v0, x);
+        x[k] = (tmass_real)(keep - h);
+        minus = tmass__spring_incremental_potential(m, (tmass_real)dt, x0, v0, x);
+        x[k] = keep;
+        fd = -(plus - minus) / (2 * h);
+        if (fabs(fd - (double)R[k]) > worst) worst = fabs(fd - (double)R[k]);
+        if (fabs((double)R[k]) > scale) scale = fabs((double)R[k]);
+    }
+    printf("    max |R + dPhi/dx| / max |R| = %.2e\n", worst / scale);
+    CHECK(worst < (IS_FLOAT ? 2e-2 : 1e-6) * scale);
+    free(x0); free(v0); free(x); free(R); free(v);
+    tmass_destroy(m);
+    tetmesh_free(&mesh);
+}
+
 /* ---- stress sweep (issue 18): no success with a wrong answer -------------------------- */
 
 /* Dense K (3n x 3n, block (a, b) = K_ab) assembled from the model's tensors. */
@@ -2365,6 +2426,7 @@ static const test_case cases[] = {
     TEST(test_springs_static_continuation),
     TEST(test_integrator_order),
     TEST(test_implicit_damped_recurrence),
+    TEST(test_spring_incremental_potential_gradient),
     TEST(test_stress_sweep),
 };
 
