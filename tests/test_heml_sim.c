@@ -705,7 +705,7 @@ static void test_failed_step_keeps_state(void)
     printf("    blew up at step %d; state kept\n", s);
     err = heml_step_ex(m, (heml_real)1e-9, HEML_IMPLICIT_EULER);
     if (heml__all_finite(heml_compute_forces(m), (size_t)n3)) { /* (not the case on this mesh) */
-        CHECK_INT(HEML_OK, err);
+        CHECK(err == HEML_OK || err == HEML_ERR_ROUND_OFF); /* (float: at its round-off) */
     } else {
         CHECK_INT(HEML_ERR_NOT_FINITE, err);
         for (i = 0; i < n3; i++) same &= x[i] == heml_positions(m)[i] && v[i] == heml_velocities(m)[i];
