@@ -3701,7 +3701,7 @@ static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_re
 
 #define HEML__HALVINGS 12   /* line search: steps down to 2^-12 */
 #define HEML__STALL 4       /* Newton iterations without progress that end a solve */
-#define HEML__SHIFT_MIN 1e-3 /* Levenberg-Marquardt shift after negative curvature, times the */
+#define HEML__SHIFT_MIN 1e-6 /* Levenberg-Marquardt shift after negative curvature, times the */
 #define HEML__SHIFT_MAX 1e3  /* small-strain stiffness diagonal: first and largest */
 
 /* Newton minimisation of the objective from u (pinned axes already placed), in place.
