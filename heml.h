@@ -1,4 +1,4 @@
-/* heml.h - v0.2.0 - hyper-elastic mass links (hyperelastic tetrahedra) - MIT or public domain
+/* heml.h - v0.3.0 - hyper-elastic mass links (hyperelastic tetrahedra) - MIT or public domain
 
    A drop-in soft-body model after Goulette & Chen, "Fast computation of soft tissue
    deformations in real-time simulation with Hyper-Elastic Mass Links" (CMAME 2015): P1
@@ -7,8 +7,10 @@
    Any isotropic hyperelastic law plugs in (St Venant-Kirchhoff, Neo-Hookean, Mooney-
    Rivlin, a mass-spring network as the degenerate case, or your own law through
    callbacks), flat and inverted tetrahedra stay finite and restoring, and a Prony series
-   adds viscosity. Semi-explicit Euler (the paper's scheme) and implicit Euler with the
-   exact force differential inside matrix-free conjugate gradient; a static solve.
+   adds viscosity. Semi-explicit Euler (the paper's scheme, with a divergence check),
+   implicit Euler as the Newton minimisation of the incremental potential with the exact
+   force differential inside matrix-free conjugate gradient, and a static solve by
+   continuation; none reports success with an answer it has not converged.
 
    DO THIS in exactly one C or C++ file:
 
@@ -52,9 +54,10 @@
    OVERRIDES (define before including the implementation)
 
        HEML_REAL       float or double (default double): storage and kernels. Creation
-                       computes the rest constants in double. In float builds the public
-                       entry points are renamed (..._f32), so mixing float and double
-                       translation units fails at link time, not at run time.
+                       computes the rest constants in double. In float builds every
+                       public function is renamed (heml_create -> heml_create_f32, ...),
+                       so mixing float and double translation units fails at link time,
+                       not at run time.
        HEML_MALLOC(size, user) / HEML_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
        HEML_ASSERT(x)  internal sanity checks (default: assert from <assert.h>).
@@ -92,12 +95,41 @@
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
-   message for validation failures (the library never prints). A step whose result is not
-   finite returns HEML_ERR_NOT_FINITE and leaves positions, velocities and the viscous
-   state exactly as they were, so the caller may retry with a smaller time step or the
-   implicit integrator; so does an implicit step whose linear solve does not converge
-   (HEML_ERR_NO_CONVERGENCE). A static solve that fails leaves the state unchanged too. No
-   solver reports success with an answer it has not converged (see STATIC SOLVE).
+   message for validation failures (the library never prints; a description not made by
+   heml_default_desc is refused with HEML_ERR_DESC before its log callback, which is
+   garbage too, is touched). Every step and solve that fails leaves positions, velocities
+   and the viscous state exactly as they were, so the caller may retry (smaller time step,
+   the implicit integrator, a looser tolerance, more iterations). No solver reports success
+   with an answer it has not converged, and an unconverged linear solve never passes:
+       HEML_ERR_NOT_FINITE      a non-finite value anywhere, including a load or residual
+                                whose squared norm overflows (a 1e162 N force: |b|^2 = inf
+                                would have made every tolerance pass).
+       HEML_ERR_NO_CONVERGENCE  a Newton solve (static, HEML_IMPLICIT_EULER) did not reach
+                                its tolerance within its caps, the static continuation ran
+                                out of increments, or the linearised step's CG hit
+                                cg_max_iterations; stats.residual / stats.cg_residual say
+                                how far it got.
+       HEML_ERR_ROUND_OFF       a Newton solve stalled at the round-off level of its
+                                forces above its tolerance (loosen it or use double).
+       HEML_ERR_INVERTED        the answer of a static solve or implicit step has more
+                                inverted tetrahedra (J <= 0) than its start, and
+                                allow_inversion is 0 (also: a Cauchy stress asked of an
+                                inverted tetrahedron).
+       HEML_ERR_DIVERGED        a semi-explicit step failed its divergence check (see
+                                INTEGRATORS): the time step is beyond the stability limit
+                                of the current state.
+       HEML_ERR_PRECISION       eps(heml_real) max|u| > precision_limit h_min (h_min the
+                                shortest rest edge, precision_limit default 1e-4): the
+                                rounding of the displacements would fake strains above
+                                0.01 %. Checked on the state before every step and solve
+                                and on a static solve's answer. Only the displacement
+                                counts (the state is u = x - X, and the rest constants come
+                                from double), so a body created far from the origin is
+                                fine; one moved 1e6 m in float is not (its rounding is
+                                0.06 m). Move the rest mesh with the body, use double, or
+                                set precision_limit = 0 to accept the rounding.
+   Inside Newton, a Krylov solve that stops at its cap still gives a search direction;
+   only the nonlinear residual decides success.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
    time, different models by different threads. Loops run in parallel through desc.
@@ -221,50 +253,97 @@
                              h the smallest tetrahedron altitude (heml_stable_time_step
                              returns half of that). Use it for soft tissue with small steps
                              (haptics at 1 kHz), or when the step is small anyway.
-       HEML_IMPLICIT_EULER   backward Euler by Newton (desc.newton_iterations, default 1:
-                             the linearly implicit step), each iteration solving
-                             (M (1 + dt alpha) - dt^2 df/du) du = dt^2 r by Jacobi-
-                             preconditioned CG with the exact force differential applied
-                             matrix-free (beyond the paper), to cg_tolerance. Stable at
-                             large steps and for stiff materials (E = 1 MPa at dt = 10 ms,
-                             where the explicit limit is far below a millisecond); it costs
-                             one force evaluation plus one differential per CG iteration,
-                             and damps high frequencies. Use it for stiff materials, large
-                             steps, or scenes where robustness matters more than the last
-                             percent of dynamic accuracy. The exact differential is not
-                             positive definite under strong compression: where CG meets
-                             negative curvature (stats.negative_curvature) the solve is
-                             redone by MINRES. A solve that does not reach cg_tolerance in
-                             cg_max_iterations fails the step (HEML_ERR_NO_CONVERGENCE, the
-                             state kept): raise the cap or shorten the step.
-   STATIC SOLVE (heml_solve_static): Newton on R(u) = f(u) + f_ext + M g = 0 over the free
-       axes. Each iteration solves K delta = R (K = -df/du, the exact tangent, matrix-free)
-       by CG, by MINRES where CG meets negative curvature (its rounding errors grow with the
-       square of the condition number, so in float only CG resolves a slender body), to an
-       Eisenstat-Walker relative residual (1e-3, then 0.9 (|R_k| / |R_k-1|)^2, never
-       tighter than the tolerance needs). The preconditioner is Jacobi plus a coarse
+                             Divergence check (cheap: no extra force pass): the energy
+                             of the free degrees of freedom, kinetic plus the trapezoidal
+                             potential -sum (F_n-1 + F_n) / 2 . du of every force (exact for
+                             linear forces), may not grow beyond twice the energy the body
+                             was given (kinetic and elastic energy at its reference state
+                             plus the magnitudes of the loads' work and the driven axes'
+                             work since), and a step's result may not carry more kinetic
+                             energy than that: HEML_ERR_DIVERGED, state kept. The reference
+                             is reset by heml_set_positions / displacements / velocities, a
+                             change of the pinned axes, a static solve or an implicit step.
+                             Stable runs stay far below the bound (the energy of symplectic
+                             Euler oscillates by about omega dt / 2 of itself); a blow-up
+                             grows exponentially and is caught within a few steps, before
+                             anything overflows (a released inverted tetrahedron at half the
+                             estimated stable step: caught at its first step, where 0.2.1
+                             ran Mooney-Rivlin to |u| = 1e17 m with success). Not checked
+                             for user laws without an energy callback.
+       HEML_IMPLICIT_EULER   backward Euler as a minimisation: u1 minimises the incremental
+                             potential
+                                 W(u) - (f_ext + M g) . u + sum m |u - u0 - dt v0|^2 / (2 dt^2)
+                                      + alpha sum m |u - u0|^2 / (2 dt)
+                             (mass damping alpha enters as its dissipation potential), whose
+                             stationarity is backward Euler, by Newton iterations (cap
+                             desc.newton_iterations, default 20) to desc.newton_tolerance
+                             (default 1e-6, float 1e-4) on the residual relative to its
+                             largest force term, each solving (M (1 + dt alpha) / dt^2 -
+                             df/du) delta = R by Jacobi-preconditioned CG with the exact
+                             force differential applied matrix-free (an Eisenstat-Walker
+                             tolerance), then an energy line search (backtracking until the
+                             potential decreases; with a Prony series the force has no
+                             potential and the residual must decrease instead). Where CG
+                             meets negative curvature (stats.negative_curvature) a
+                             Levenberg-Marquardt shift is added, so every iteration
+                             descends. So a step lowers its own objective at any dt, E and
+                             nu: 1e-6 to 1 s, 1 Pa to 200 GPa, nu up to 0.4999 (the test
+                             sweep). Cost: one force and energy pass per line-search trial
+                             plus one differential per CG iteration; 1 to 3 Newton
+                             iterations on mild steps, about 15 on a soft beam falling at
+                             dt = 1 s (1 m, E = 100 kPa, nu = 0.45), about 140 at nu =
+                             0.4999 (then raise newton_iterations: with the default cap the
+                             step returns HEML_ERR_NO_CONVERGENCE). The answer must also
+                             not invert more tetrahedra than its start (allow_inversion).
+       HEML_IMPLICIT_EULER_LINEARIZED  one Newton iteration of backward Euler from u0 (the
+                             Baraff-Witkin linearly implicit step; 0.2.x's default): one
+                             linear solve, no line search, no check of the nonlinear
+                             equations. Stable, cheap and accurate while the step is nearly
+                             linear (small strain increments: dt well below the period of
+                             the motion that matters); wrong, with success, beyond: a soft
+                             nearly incompressible beam (E = 100 kPa, nu >= 0.45) at
+                             dt = 1 s accepted steps 40 to 50 % off, and with a raised CG
+                             cap its tip at -4.6 m or 0.88 m above its clamp. Its CG switches
+                             to MINRES under negative curvature and fails the step
+                             (HEML_ERR_NO_CONVERGENCE) at cg_max_iterations.
+   STATIC SOLVE (heml_solve_static): the minimum of the potential W(u) - (f_ext + M g) . u
+       over the free axes (the fully relaxed Prony response), by continuation and Newton.
+       Continuation: the loads and the pinned axes' moves to their targets are applied with
+       a factor lambda from 0 to 1, first in one increment; a failed increment is cut in
+       half from the last converged state (stats.increment_cuts), a converged one doubles
+       the next; it stops after desc.max_increments attempts (default 64) or below an
+       increment of desc.min_increment (default 1e-4) with HEML_ERR_NO_CONVERGENCE. Each
+       increment starts from a tangent predictor: the pinned axes move by their share and
+       the free ones by the small-strain response to it (one Krylov solve of K delta =
+       R + df/du dpin), so a boundary layer moves with the pins instead of being crushed by
+       them (0.2.1 moved only the pins: a 1 m cube squashed to s = 0.5 in one call returned
+       success with a tetrahedron inverted, the field 0.83 m off the affine one and 2060 J
+       against the minimum's 1823 J; now it is the affine field to 2e-10 m in one
+       increment). Newton: each iteration solves K delta = R (K = -df/du, the exact tangent,
+       matrix-free) by CG to an Eisenstat-Walker relative residual (1e-3, then 0.9 (|R_k| /
+       |R_k-1|)^2, never tighter than the tolerance needs), with a Levenberg-Marquardt
+       shift where CG meets negative curvature; the preconditioner is Jacobi plus a coarse
        correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
        small-strain stiffness projected on their rigid motions (6 per aggregate) is solved
-       exactly; slender bodies bend by rotating their sections, which Jacobi alone resolves
-       slowest (15 times fewer iterations on R1). A backtracking line search
-       accepts the step when it lowers the residual (so Newton also converges to unstable
-       equilibria it is started near, e.g. St Venant-Kirchhoff compressed beyond the
-       softening point) or the potential W - f . u (Armijo, up to its round-off: the first
-       Newton step of a slender beam raises the residual a hundredfold by stretching it
-       along its axis, then the next lands). Adaptive load stepping (loads and pinned
-       moves scaled by a factor raised from 0 to 1, the increment halved on failure) is the
-       fallback when the full load fails. Success means
-           |R| <= static_tolerance max(|f_ext + M g| (free), |f| (all, reactions included)).
-       Where the residual stops falling (no progress in 4 iterations, no acceptable step,
-       or static_max_iterations) within 100 times its round-off floor (eps times the terms
-       each degree of freedom sums, and the stiffness times one ulp of the displacements),
-       the answer is accepted only if it is converged in energy: the last Newton
-       correction's energy R . K^-1 R below static_tolerance^2 times the answer's
-       max(|f . u|, 2 W) (an energy-norm error below static_tolerance); otherwise
-       HEML_ERR_ROUND_OFF. Elsewhere it fails with HEML_ERR_NO_CONVERGENCE. On the steel
-       cantilever R1 (a nearly linear problem) Newton takes 3 or 4 iterations in double;
-       in float, 7 or 8, the energy criterion ending them (see LIMITS for what float
-       resolves). Drive large motions in increments from the last solution.
+       exactly (slender bodies bend by rotating their sections, which Jacobi alone resolves
+       slowest: 15 times fewer iterations on R1). A backtracking line search accepts a step
+       only when it lowers the potential (Armijo, up to its round-off), so Newton descends
+       to minima and does not converge to the unstable equilibria it may start near (St
+       Venant-Kirchhoff compressed beyond its softening point settles in its lower, sheared
+       state). Acceptance of an increment:
+           |R| <= static_tolerance max(|f_ext + M g| (free), |f| (all, reactions included)),
+       and (allow_inversion = 0) no more tetrahedra inverted (J <= 0) than at the start
+       (else HEML_ERR_INVERTED, counted in stats.inverted). Where the residual stops
+       falling (no progress in 4 iterations, no acceptable step, or static_max_iterations)
+       within 100 times its round-off floor (eps times the terms each degree of freedom
+       sums, and the stiffness times one ulp of the displacements), the answer is accepted
+       only if it is converged in energy: the last Newton correction's energy R . K^-1 R
+       below static_tolerance^2 times the answer's max(|f . u|, 2 W) (an energy-norm error
+       below static_tolerance); otherwise HEML_ERR_ROUND_OFF. Elsewhere it fails with
+       HEML_ERR_NO_CONVERGENCE. On the steel cantilever R1 (a nearly linear problem) Newton
+       takes 3 or 4 iterations in double; in float, 7 or 8, the energy criterion ending them
+       (see LIMITS for what float resolves). stats.below_threshold counts the tetrahedra of
+       the answer below J0, whose stress is the continuation's (LIMITS).
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
@@ -380,12 +459,31 @@
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
          to 0.5 or a stiff penalty): refine the mesh across thin parts.
-       - The semi-explicit integrator is conditionally stable; a step that goes non-finite
-         returns HEML_ERR_NOT_FINITE and keeps the last state, but a step below the
-         non-finite blow-up can still grow slowly: respect the time-step estimate.
-       - The implicit step's linear solve must converge: under strong compression or
-         inversion CG meets negative curvature and MINRES takes over (slower); a solve
-         capped by cg_max_iterations fails the step rather than return an unconverged one.
+       - The semi-explicit integrator is conditionally stable. The divergence check
+         (HEML_ERR_DIVERGED) catches growth of more than twice the energy the body was
+         given, so slower growth below that still passes: respect the time-step estimate.
+         heml_stable_time_step is a rest-state estimate: below J0 the volumetric tangent
+         of the continuation is (lambda (1 - ln J0) + mu) / J0^2 for Neo-Hookean, about 12
+         lambda at J0 = 0.4 instead of lambda + 2 mu, and a flattened tetrahedron's
+         altitude shrinks with J, so while tetrahedra are inverted the stable step is
+         about 3 times smaller or less: use a third of the estimate, or the implicit
+         integrator, to recover inverted meshes (a released inverted tetrahedron at half
+         the estimate: HEML_ERR_DIVERGED at its first step).
+       - HEML_IMPLICIT_EULER at large steps on nearly incompressible P1 meshes needs many
+         Newton iterations (about 140 for a 1 m beam at nu = 0.4999, dt = 1 s) and the
+         static solve of the same beam from rest, a large rotation of a locked mesh, does
+         not converge within its caps (HEML_ERR_NO_CONVERGENCE; from the state the damped
+         dynamics reach, 1 increment): both say so rather than return a wrong answer.
+       - St Venant-Kirchhoff has no uniaxial state beyond a stretch where its lateral
+         contraction would take J below zero (s = 2 at nu = 0.4): there, and wherever a
+         tetrahedron ends below J0, the answer's stress is that of the J0 guard (our
+         continuation), not the law's; heml_solve_static and the steps still succeed (the
+         guarded law is a valid hyperelastic law) and report those tetrahedra in
+         stats.below_threshold: check it when the law's own answer matters.
+       - The linearised implicit step's linear solve must converge: under strong
+         compression or inversion CG meets negative curvature and MINRES takes over
+         (slower); a solve capped by cg_max_iterations fails the step rather than return an
+         unconverged one.
        - The implicit step's CG is Jacobi-preconditioned only (the coarse space serves the
          static solve): slender stiff bodies at large time steps need hundreds of
          iterations per step (R3 at 40 x 4 x 4 cells, dt = T/100: about 20 ms a step).
@@ -421,6 +519,18 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       0.3.0 (2026-12-02) no silent wrong answers (issue 18): the static solve is a
+             continuation with a tangent predictor, an energy line search, a
+             Levenberg-Marquardt shift at negative curvature and an inversion acceptance
+             test (allow_inversion, max_increments, min_increment); HEML_IMPLICIT_EULER is
+             the Newton minimisation of the incremental potential (newton_iterations is
+             its cap, default 20, newton_tolerance new) and HEML_IMPLICIT_EULER_LINEARIZED
+             the old single iteration; the semi-explicit step has a divergence check
+             (HEML_ERR_DIVERGED); HEML_ERR_PRECISION (precision_limit); every public
+             function is renamed in float builds; a garbage description no longer crashes
+             heml_create; a load whose squared norm overflows fails; the stats have the
+             names shared with tensormass.h and frames.h (residual, increments,
+             increment_cuts, line_search_cuts, first eleven fields in a common order).
        0.2.1 (2026-12-01) passes colour groups of consecutive chunks (compact pieces of
              the mesh) and the tetrahedra are ordered by their lowest node: large and
              randomly ordered meshes run 1.3 to 5 times faster; the Neo-Hookean force
@@ -445,8 +555,8 @@
 #include <stddef.h>
 
 #define HEML_VERSION_MAJOR 0
-#define HEML_VERSION_MINOR 2
-#define HEML_VERSION_PATCH 1
+#define HEML_VERSION_MINOR 3
+#define HEML_VERSION_PATCH 0
 
 #ifndef HEML_REAL
 #define HEML_REAL double
@@ -782,9 +892,10 @@ HEMLDEF void heml_clear_external_forces(heml_model *m);
 HEMLDEF int heml_set_gravity(heml_model *m, const heml_real g[3]);
 /* Mass damping coefficient (1/s, >= 0): damping force -alpha m v. */
 HEMLDEF int heml_set_mass_damping(heml_model *m, heml_real alpha);
-/* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves. */
+/* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves (the
+   linearised step fails at the cap; Newton solves use the cap per Krylov solve). */
 HEMLDEF int heml_set_solver(heml_model *m, heml_real tolerance, int max_iterations);
-/* Newton iterations per implicit step (>= 1). */
+/* Cap of Newton iterations per HEML_IMPLICIT_EULER step (>= 1; default 20). */
 HEMLDEF int heml_set_newton_iterations(heml_model *m, int iterations);
 /* The inversion threshold J0 (in (0, 1)) for later evaluations. */
 HEMLDEF int heml_set_inversion_threshold(heml_model *m, heml_real J0);
@@ -798,15 +909,16 @@ HEMLDEF int heml_step(heml_model *m);
 /* One step of dt seconds with the given integrator. */
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator);
 /* Moves the free degrees of freedom to the static equilibrium under gravity, external
-   forces and the pinned axes (inexact Newton with MINRES, a backtracking line search on
-   the residual or the potential energy, and adaptive load stepping when the full load
-   fails; the fully relaxed Prony response), sets velocities to zero and the viscous state
-   to its relaxed value. Returns HEML_OK only when the residual is below static_tolerance
-   (see STATIC SOLVE). On failure the state is unchanged: HEML_ERR_NO_CONVERGENCE
-   (static_max_iterations Newton iterations per load step were not enough even with steps
-   of 1/1024 of the load), HEML_ERR_ROUND_OFF (the residual stopped falling at the
+   forces and the pinned axes: the minimum of the potential, by continuation (loads and
+   pin moves in adaptive increments, each from a tangent predictor) and Newton with
+   preconditioned CG and an energy line search (the fully relaxed Prony response); sets
+   velocities to zero and the viscous state to its relaxed value. Returns HEML_OK only
+   when the residual is below static_tolerance and (allow_inversion = 0) no more
+   tetrahedra are inverted than at the start (see STATIC SOLVE). On failure the state is
+   unchanged: HEML_ERR_NO_CONVERGENCE (caps reached: static_max_iterations per increment,
+   max_increments, min_increment), HEML_ERR_ROUND_OFF (the residual stopped falling at the
    round-off level of the forces, above the tolerance: loosen it or use double),
-   HEML_ERR_NOT_FINITE. */
+   HEML_ERR_INVERTED, HEML_ERR_PRECISION, HEML_ERR_NOT_FINITE. */
 HEMLDEF int heml_solve_static(heml_model *m);
 
 /* ---- kernels (for benchmarks and custom solvers) ---- */
@@ -859,9 +971,10 @@ HEMLDEF int heml_tet_stresses(heml_model *m, heml_stress_kind kind, heml_real *o
 /* The same for one tetrahedron (costs a block of 16). */
 HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_real out[9]);
 /* Estimate of the largest stable semi-explicit time step, s: half the smallest over the
-   tetrahedra of altitude / sqrt((lambda + 2 mu) / rho) with small-strain moduli. A CFL
-   heuristic with a safety factor of about 2 (on box meshes the scheme blew up at 1.7 to
-   2.8 times it), not a guarantee: large deformations stiffen most laws. */
+   tetrahedra of altitude / sqrt((lambda + 2 mu) / rho) with small-strain moduli, at rest.
+   A CFL heuristic with a safety factor of about 2 (on box meshes the scheme blew up at 1.7
+   to 2.8 times it), not a guarantee: large deformations stiffen most laws, and inverted or
+   flattened tetrahedra (below J0) need about a third of it or less (LIMITS). */
 HEMLDEF double heml_stable_time_step(const heml_model *m);
 /* Bytes held by the model. */
 HEMLDEF size_t heml_memory_bytes(const heml_model *m);
@@ -3029,7 +3142,7 @@ static double heml__shortest_edge(const heml_desc *d)
     return sqrt(best);
 }
 
-HEMLDEF const char *heml_version(void) { return "0.2.1"; }
+HEMLDEF const char *heml_version(void) { return "0.3.0"; }
 
 HEMLDEF const char *heml_error_string(int code)
 {

@@ -100,8 +100,9 @@ static double max_abs(const heml_real *a, int n)
 
 /* A 1 m cube of the Kuhn split stretched to s = 1.5 or squashed to s = 0.5 in one
    heml_solve_static from rest: the answer is the homogeneous field x = t X, y = t Y,
-   z = s Z, and the energy Vol w(s, t). (0.2.1 returned success with a tetrahedron at
-   J = 0.001 and twice the energy: the first guess moved only the pinned faces.) */
+   z = s Z, and the energy Vol w(s, t). (0.2.1, s = 0.5 on 4 x 4 x 4 cells: success with a
+   tetrahedron at J = -0.007, the field 0.83 m off and 2060 J against 1823 J: its first
+   guess moved only the pinned faces.) */
 static void test_static_large_imposed_displacement(void)
 {
     tetmesh mesh;
