@@ -263,6 +263,44 @@ static void test_incremental_potential_gradient(void)
     tetmesh_free(&mesh);
 }
 
+/* The same acceptance in implicit Euler: a single tetrahedron, three nodes pinned, the
+   fourth pushed through the opposite face by a force far above what the volumetric
+   stiffness holds (1e7 N on a 10 kPa unit tetrahedron, dt = 1 s): HEML_ERR_INVERTED and
+   the state kept; with allow_inversion = 1 the step succeeds and counts it. */
+static void test_implicit_inversion_refused(void)
+{
+    static const int tet[4] = {0, 1, 2, 3};
+    static const double nodes[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.3, 1};
+    heml_real X[12], push[3] = {0, 0, (heml_real)-1e7};
+    int k, i, err;
+    for (i = 0; i < 12; i++) X[i] = (heml_real)nodes[i];
+    for (k = 0; k < 2; k++) {
+        heml_desc d = heml_default_desc();
+        heml_model *m;
+        d.rest_positions = X;
+        d.node_count = 4;
+        d.tets = tet;
+        d.tet_count = 1;
+        d.gravity[2] = 0;
+        d.allow_inversion = k;
+        REQUIRE(heml_create(&d, &m) == HEML_OK);
+        for (i = 0; i < 3; i++) heml_fix_node(m, i);
+        heml_set_external_force(m, 3, push);
+        err = heml_step_ex(m, 1, HEML_IMPLICIT_EULER);
+        printf("    allow_inversion %d: %s, node 3 at z = %.3g m, %d inverted\n", k, heml_error_string(err),
+               (double)heml_positions(m)[11], heml_last_stats(m)->inverted);
+        if (k == 0) {
+            CHECK_INT(HEML_ERR_INVERTED, err);
+            CHECK((double)heml_positions(m)[11] == 1.0);
+        } else {
+            CHECK_INT(HEML_OK, err);
+            CHECK_INT(1, heml_last_stats(m)->inverted);
+            CHECK((double)heml_positions(m)[11] < 0.0);
+        }
+        heml_destroy(m);
+    }
+}
+
 /* ---- item 2: implicit Euler at large steps ------------------------------------------- */
 
 /* The backward-Euler residual of the last step, computed here from heml_compute_forces
@@ -967,6 +1005,7 @@ static void test_stress_sweep(void)
 static const test_case cases[] = {
     TEST(test_static_large_imposed_displacement),
     TEST(test_static_inversion_refused),
+    TEST(test_implicit_inversion_refused),
     TEST(test_incremental_potential_gradient),
     TEST(test_implicit_large_step_soft),
     TEST(test_implicit_linearized_option),
