@@ -929,10 +929,13 @@ static void test_stress_sweep(void)
                     ok++;
                 } else {
                     codes++;
+                    printf("    implicit E %g nu %g dt %g: %s\n", Es[ie], nus[in], dts[id], heml_error_string(err));
                 }
                 heml_destroy(m);
             }
-            { /* static: the beam under gravity, against a tighter run */
+            if (!(TEST_IS_QUICK && ie == 0)) { /* static: the beam under gravity, against a tighter run
+                                                  (at 1 Pa it collapses: about 1000 Newton
+                                                  iterations; left to the full-size builds) */
                 heml_desc d = heml_default_desc();
                 heml_model *m = make_model_ex(&beam, mt, -9.81, NULL), *t;
                 int et;
@@ -962,6 +965,7 @@ static void test_stress_sweep(void)
                     }
                 } else {
                     codes++;
+                    printf("    static beam E %g nu %g: %s\n", Es[ie], nus[in], heml_error_string(err));
                 }
                 heml_destroy(m);
                 heml_destroy(t);
