@@ -126,8 +126,9 @@
                                 counts (the state is u = x - X, and the rest constants come
                                 from double), so a body created far from the origin is
                                 fine; one moved 1e6 m in float is not (its rounding is
-                                0.06 m). Move the rest mesh with the body, use double, or
-                                set precision_limit = 0 to accept the rounding.
+                                0.06 m). Create the body near where it works, use
+                                double, or set precision_limit = 0 to accept the
+                                rounding.
    Inside Newton, a Krylov solve that stops at its cap still gives a search direction;
    only the nonlinear residual decides success.
 
@@ -301,11 +302,13 @@
                              equations. Stable, cheap and accurate while the step is nearly
                              linear (small strain increments: dt well below the period of
                              the motion that matters); wrong, with success, beyond: a soft
-                             nearly incompressible beam (E = 100 kPa, nu >= 0.45) at
-                             dt = 1 s accepted steps 40 to 50 % off, and with a raised CG
-                             cap its tip at -4.6 m or 0.88 m above its clamp. Its CG switches
-                             to MINRES under negative curvature and fails the step
-                             (HEML_ERR_NO_CONVERGENCE) at cg_max_iterations.
+                             beam (1 m, 10 cells, E = 100 kPa, nu = 0.45) falling at
+                             dt = 1 s took steps whose backward-Euler residual was 1e7
+                             times its weight, its tip swinging to -1.37 m (issue 18 saw
+                             steps 40 to 50 % off, and with a raised CG cap a tip at -4.6 m
+                             or 0.88 m above its clamp). Its CG switches to MINRES under
+                             negative curvature and fails the step (HEML_ERR_NO_CONVERGENCE)
+                             at cg_max_iterations.
    STATIC SOLVE (heml_solve_static): the minimum of the potential W(u) - (f_ext + M g) . u
        over the free axes (the fully relaxed Prony response), by continuation and Newton.
        Continuation: the loads and the pinned axes' moves to their targets are applied with
@@ -320,11 +323,11 @@
        stretched to s = 1.5 in one call returned success with the field 0.37 m off the
        affine one, a tetrahedron at J = -0.01 and 2684 J against the minimum's 986 J; now
        the affine field to 1e-10 m in one increment of 7 Newton iterations, and likewise
-       squashed to s = 0.5). Newton: each iteration solves K delta = R (K = -df/du, the exact tangent,
-       matrix-free) by CG to an Eisenstat-Walker relative residual (1e-3, then 0.9 (|R_k| /
-       |R_k-1|)^2, never tighter than the tolerance needs), with a Levenberg-Marquardt
-       shift where CG meets negative curvature; the preconditioner is Jacobi plus a coarse
-       correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
+       squashed to s = 0.5). Newton: each iteration solves K delta = R (K = -df/du, the
+       exact tangent, matrix-free) by CG to an Eisenstat-Walker relative residual (1e-3,
+       then 0.9 (|R_k| / |R_k-1|)^2, never tighter than the tolerance needs), with a
+       Levenberg-Marquardt shift where CG meets negative curvature; the preconditioner is
+       Jacobi plus a coarse correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
        small-strain stiffness projected on their rigid motions (6 per aggregate) is solved
        exactly (slender bodies bend by rotating their sections, which Jacobi alone resolves
        slowest: 15 times fewer iterations on R1). A backtracking line search accepts a step
