@@ -1,4 +1,4 @@
-/* heml.h - v0.2.0 - hyper-elastic mass links (hyperelastic tetrahedra) - MIT or public domain
+/* heml.h - v0.3.0 - hyper-elastic mass links (hyperelastic tetrahedra) - MIT or public domain
 
    A drop-in soft-body model after Goulette & Chen, "Fast computation of soft tissue
    deformations in real-time simulation with Hyper-Elastic Mass Links" (CMAME 2015): P1
@@ -7,8 +7,10 @@
    Any isotropic hyperelastic law plugs in (St Venant-Kirchhoff, Neo-Hookean, Mooney-
    Rivlin, a mass-spring network as the degenerate case, or your own law through
    callbacks), flat and inverted tetrahedra stay finite and restoring, and a Prony series
-   adds viscosity. Semi-explicit Euler (the paper's scheme) and implicit Euler with the
-   exact force differential inside matrix-free conjugate gradient; a static solve.
+   adds viscosity. Semi-explicit Euler (the paper's scheme, with a divergence check),
+   implicit Euler as the Newton minimisation of the incremental potential with the exact
+   force differential inside matrix-free conjugate gradient, and a static solve by
+   continuation; none reports success with an answer it has not converged.
 
    DO THIS in exactly one C or C++ file:
 
@@ -52,9 +54,10 @@
    OVERRIDES (define before including the implementation)
 
        HEML_REAL       float or double (default double): storage and kernels. Creation
-                       computes the rest constants in double. In float builds the public
-                       entry points are renamed (..._f32), so mixing float and double
-                       translation units fails at link time, not at run time.
+                       computes the rest constants in double. In float builds every
+                       public function is renamed (heml_create -> heml_create_f32, ...),
+                       so mixing float and double translation units fails at link time,
+                       not at run time.
        HEML_MALLOC(size, user) / HEML_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
        HEML_ASSERT(x)  internal sanity checks (default: assert from <assert.h>).
@@ -92,12 +95,42 @@
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
-   message for validation failures (the library never prints). A step whose result is not
-   finite returns HEML_ERR_NOT_FINITE and leaves positions, velocities and the viscous
-   state exactly as they were, so the caller may retry with a smaller time step or the
-   implicit integrator; so does an implicit step whose linear solve does not converge
-   (HEML_ERR_NO_CONVERGENCE). A static solve that fails leaves the state unchanged too. No
-   solver reports success with an answer it has not converged (see STATIC SOLVE).
+   message for validation failures (the library never prints; a description not made by
+   heml_default_desc is refused with HEML_ERR_DESC before its log callback, which is
+   garbage too, is touched). Every step and solve that fails leaves positions, velocities
+   and the viscous state exactly as they were, so the caller may retry (smaller time step,
+   the implicit integrator, a looser tolerance, more iterations). No solver reports success
+   with an answer it has not converged, and an unconverged linear solve never passes:
+       HEML_ERR_NOT_FINITE      a non-finite value anywhere, including a load or residual
+                                whose squared norm overflows (a 1e162 N force: |b|^2 = inf
+                                would have made every tolerance pass).
+       HEML_ERR_NO_CONVERGENCE  a Newton solve (static, HEML_IMPLICIT_EULER) did not reach
+                                its tolerance within its caps, the static continuation ran
+                                out of increments, or the linearised step's CG hit
+                                cg_max_iterations; stats.residual / stats.cg_residual say
+                                how far it got.
+       HEML_ERR_ROUND_OFF       a Newton solve stalled at the round-off level of its
+                                forces above its tolerance (loosen it or use double).
+       HEML_ERR_INVERTED        the answer of a static solve or implicit step has more
+                                inverted tetrahedra (J <= 0) than its start, and
+                                allow_inversion is 0 (also: a Cauchy stress asked of an
+                                inverted tetrahedron).
+       HEML_ERR_DIVERGED        a semi-explicit step failed its divergence check (see
+                                INTEGRATORS): the time step is beyond the stability limit
+                                of the current state.
+       HEML_ERR_PRECISION       eps(heml_real) max|u| > precision_limit h_min (h_min the
+                                shortest rest edge, precision_limit default 1e-4): the
+                                rounding of the displacements would fake strains above
+                                0.01 %. Checked on the state before every step and solve
+                                and on a static solve's answer. Only the displacement
+                                counts (the state is u = x - X, and the rest constants come
+                                from double), so a body created far from the origin is
+                                fine; one moved 1e6 m in float is not (its rounding is
+                                0.06 m). Create the body near where it works, use
+                                double, or set precision_limit = 0 to accept the
+                                rounding.
+   Inside Newton, a Krylov solve that stops at its cap still gives a search direction;
+   only the nonlinear residual decides success.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
    time, different models by different threads. Loops run in parallel through desc.
@@ -221,50 +254,100 @@
                              h the smallest tetrahedron altitude (heml_stable_time_step
                              returns half of that). Use it for soft tissue with small steps
                              (haptics at 1 kHz), or when the step is small anyway.
-       HEML_IMPLICIT_EULER   backward Euler by Newton (desc.newton_iterations, default 1:
-                             the linearly implicit step), each iteration solving
-                             (M (1 + dt alpha) - dt^2 df/du) du = dt^2 r by Jacobi-
-                             preconditioned CG with the exact force differential applied
-                             matrix-free (beyond the paper), to cg_tolerance. Stable at
-                             large steps and for stiff materials (E = 1 MPa at dt = 10 ms,
-                             where the explicit limit is far below a millisecond); it costs
-                             one force evaluation plus one differential per CG iteration,
-                             and damps high frequencies. Use it for stiff materials, large
-                             steps, or scenes where robustness matters more than the last
-                             percent of dynamic accuracy. The exact differential is not
-                             positive definite under strong compression: where CG meets
-                             negative curvature (stats.negative_curvature) the solve is
-                             redone by MINRES. A solve that does not reach cg_tolerance in
-                             cg_max_iterations fails the step (HEML_ERR_NO_CONVERGENCE, the
-                             state kept): raise the cap or shorten the step.
-   STATIC SOLVE (heml_solve_static): Newton on R(u) = f(u) + f_ext + M g = 0 over the free
-       axes. Each iteration solves K delta = R (K = -df/du, the exact tangent, matrix-free)
-       by CG, by MINRES where CG meets negative curvature (its rounding errors grow with the
-       square of the condition number, so in float only CG resolves a slender body), to an
-       Eisenstat-Walker relative residual (1e-3, then 0.9 (|R_k| / |R_k-1|)^2, never
-       tighter than the tolerance needs). The preconditioner is Jacobi plus a coarse
-       correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
+                             Divergence check (cheap: no extra force pass): the energy
+                             of the free degrees of freedom, kinetic plus the trapezoidal
+                             potential -sum (F_n-1 + F_n) / 2 . du of every force (exact for
+                             linear forces), may not grow beyond twice the energy the body
+                             was given (kinetic and elastic energy at its reference state
+                             plus the magnitudes of the loads' work and the driven axes'
+                             work since), and a step's result may not carry more kinetic
+                             energy than that: HEML_ERR_DIVERGED, state kept. The reference
+                             is reset by heml_set_positions / displacements / velocities, a
+                             change of the pinned axes, a static solve or an implicit step.
+                             Stable runs stay far below the bound (the energy of symplectic
+                             Euler oscillates by about omega dt / 2 of itself); a blow-up
+                             grows exponentially and is caught within a few steps, before
+                             anything overflows (a released inverted tetrahedron at half the
+                             estimated stable step: caught at its first step, where 0.2.1
+                             ran Mooney-Rivlin to |u| = 1e17 m with success). Not checked
+                             for user laws without an energy callback.
+       HEML_IMPLICIT_EULER   backward Euler as a minimisation: u1 minimises the incremental
+                             potential
+                                 W(u) - (f_ext + M g) . u + sum m |u - u0 - dt v0|^2 / (2 dt^2)
+                                      + alpha sum m |u - u0|^2 / (2 dt)
+                             (mass damping alpha enters as its dissipation potential), whose
+                             stationarity is backward Euler, by Newton iterations (cap
+                             desc.newton_iterations, default 20) to desc.newton_tolerance
+                             (default 1e-6, float 1e-4) on the residual relative to its
+                             largest force term, each solving (M (1 + dt alpha) / dt^2 -
+                             df/du) delta = R by Jacobi-preconditioned CG with the exact
+                             force differential applied matrix-free (an Eisenstat-Walker
+                             tolerance), then an energy line search (backtracking until the
+                             potential decreases; with a Prony series the force has no
+                             potential and the residual must decrease instead). Where CG
+                             meets negative curvature (stats.negative_curvature) a
+                             Levenberg-Marquardt shift is added, so every iteration
+                             descends. So a step lowers its own objective at any dt, E and
+                             nu: 1e-6 to 1 s, 1 Pa to 200 GPa, nu up to 0.4999 (the test
+                             sweep). Cost: one force and energy pass per line-search trial
+                             plus one differential per CG iteration; 1 to 3 Newton
+                             iterations on mild steps, about 15 on a soft beam falling at
+                             dt = 1 s (1 m, E = 100 kPa, nu = 0.45), about 140 at nu =
+                             0.4999 (then raise newton_iterations: with the default cap the
+                             step returns HEML_ERR_NO_CONVERGENCE). The answer must also
+                             not invert more tetrahedra than its start (allow_inversion).
+       HEML_IMPLICIT_EULER_LINEARIZED  one Newton iteration of backward Euler from u0 (the
+                             Baraff-Witkin linearly implicit step; 0.2.x's default): one
+                             linear solve, no line search, no check of the nonlinear
+                             equations. Stable, cheap and accurate while the step is nearly
+                             linear (small strain increments: dt well below the period of
+                             the motion that matters); wrong, with success, beyond: a soft
+                             beam (1 m, 10 cells, E = 100 kPa, nu = 0.45) falling at
+                             dt = 1 s took steps whose backward-Euler residual was 1e7
+                             times its weight, its tip swinging to -1.37 m (issue 18 saw
+                             steps 40 to 50 % off, and with a raised CG cap a tip at -4.6 m
+                             or 0.88 m above its clamp). Its CG switches to MINRES under
+                             negative curvature and fails the step (HEML_ERR_NO_CONVERGENCE)
+                             at cg_max_iterations.
+   STATIC SOLVE (heml_solve_static): the minimum of the potential W(u) - (f_ext + M g) . u
+       over the free axes (the fully relaxed Prony response), by continuation and Newton.
+       Continuation: the loads and the pinned axes' moves to their targets are applied with
+       a factor lambda from 0 to 1, first in one increment; a failed increment is cut in
+       half from the last converged state (stats.increment_cuts), a converged one doubles
+       the next; it stops after desc.max_increments attempts (default 64) or below an
+       increment of desc.min_increment (default 1e-4) with HEML_ERR_NO_CONVERGENCE. Each
+       increment starts from a tangent predictor: the pinned axes move by their share and
+       the free ones by the small-strain response to it (one Krylov solve of K delta =
+       R + df/du dpin), so a boundary layer moves with the pins instead of being crushed by
+       them (0.2.1 moved only the pins: a 1 m Neo-Hookean cube, nu = 0.45, 4 x 4 x 4 cells,
+       stretched to s = 1.5 in one call returned success with the field 0.37 m off the
+       affine one, a tetrahedron at J = -0.01 and 2684 J against the minimum's 986 J; now
+       the affine field to 1e-10 m in one increment of 7 Newton iterations, and likewise
+       squashed to s = 0.5). Newton: each iteration solves K delta = R (K = -df/du, the
+       exact tangent, matrix-free) by CG to an Eisenstat-Walker relative residual (1e-3,
+       then 0.9 (|R_k| / |R_k-1|)^2, never tighter than the tolerance needs), with a
+       Levenberg-Marquardt shift where CG meets negative curvature; the preconditioner is
+       Jacobi plus a coarse correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
        small-strain stiffness projected on their rigid motions (6 per aggregate) is solved
-       exactly; slender bodies bend by rotating their sections, which Jacobi alone resolves
-       slowest (15 times fewer iterations on R1). A backtracking line search
-       accepts the step when it lowers the residual (so Newton also converges to unstable
-       equilibria it is started near, e.g. St Venant-Kirchhoff compressed beyond the
-       softening point) or the potential W - f . u (Armijo, up to its round-off: the first
-       Newton step of a slender beam raises the residual a hundredfold by stretching it
-       along its axis, then the next lands). Adaptive load stepping (loads and pinned
-       moves scaled by a factor raised from 0 to 1, the increment halved on failure) is the
-       fallback when the full load fails. Success means
-           |R| <= static_tolerance max(|f_ext + M g| (free), |f| (all, reactions included)).
-       Where the residual stops falling (no progress in 4 iterations, no acceptable step,
-       or static_max_iterations) within 100 times its round-off floor (eps times the terms
-       each degree of freedom sums, and the stiffness times one ulp of the displacements),
-       the answer is accepted only if it is converged in energy: the last Newton
-       correction's energy R . K^-1 R below static_tolerance^2 times the answer's
-       max(|f . u|, 2 W) (an energy-norm error below static_tolerance); otherwise
-       HEML_ERR_ROUND_OFF. Elsewhere it fails with HEML_ERR_NO_CONVERGENCE. On the steel
-       cantilever R1 (a nearly linear problem) Newton takes 3 or 4 iterations in double;
-       in float, 7 or 8, the energy criterion ending them (see LIMITS for what float
-       resolves). Drive large motions in increments from the last solution.
+       exactly (slender bodies bend by rotating their sections, which Jacobi alone resolves
+       slowest: 15 times fewer iterations on R1). A backtracking line search accepts a step
+       only when it lowers the potential (Armijo, up to its round-off), so Newton descends
+       to minima and does not converge to the unstable equilibria it may start near (St
+       Venant-Kirchhoff compressed beyond its softening point settles in its lower, sheared
+       state). Acceptance of an increment:
+           |R| <= static_tolerance max(|f_ext + M g| (free), |f| (all, reactions included)),
+       and (allow_inversion = 0) no more tetrahedra inverted (J <= 0) than at the start
+       (else HEML_ERR_INVERTED, counted in stats.inverted). Where the residual stops
+       falling (no progress in 4 iterations, no acceptable step, or static_max_iterations)
+       within 100 times its round-off floor (eps times the terms each degree of freedom
+       sums, and the stiffness times one ulp of the displacements), the answer is accepted
+       only if it is converged in energy: the last Newton correction's energy R . K^-1 R
+       below static_tolerance^2 times the answer's max(|f . u|, 2 W) (an energy-norm error
+       below static_tolerance); otherwise HEML_ERR_ROUND_OFF. Elsewhere it fails with
+       HEML_ERR_NO_CONVERGENCE. On the steel cantilever R1 (a nearly linear problem) Newton
+       takes 3 or 4 iterations in double; in float, 7 or 8, the energy criterion ending them
+       (see LIMITS for what float resolves). stats.below_threshold counts the tetrahedra of
+       the answer below J0, whose stress is the continuation's (LIMITS).
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
@@ -380,12 +463,31 @@
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
          to 0.5 or a stiff penalty): refine the mesh across thin parts.
-       - The semi-explicit integrator is conditionally stable; a step that goes non-finite
-         returns HEML_ERR_NOT_FINITE and keeps the last state, but a step below the
-         non-finite blow-up can still grow slowly: respect the time-step estimate.
-       - The implicit step's linear solve must converge: under strong compression or
-         inversion CG meets negative curvature and MINRES takes over (slower); a solve
-         capped by cg_max_iterations fails the step rather than return an unconverged one.
+       - The semi-explicit integrator is conditionally stable. The divergence check
+         (HEML_ERR_DIVERGED) catches growth of more than twice the energy the body was
+         given, so slower growth below that still passes: respect the time-step estimate.
+         heml_stable_time_step is a rest-state estimate: below J0 the volumetric tangent
+         of the continuation is (lambda (1 - ln J0) + mu) / J0^2 for Neo-Hookean, about 12
+         lambda at J0 = 0.4 instead of lambda + 2 mu, and a flattened tetrahedron's
+         altitude shrinks with J, so while tetrahedra are inverted the stable step is
+         about 3 times smaller or less: use a third of the estimate, or the implicit
+         integrator, to recover inverted meshes (a released inverted tetrahedron at half
+         the estimate: HEML_ERR_DIVERGED at its first step).
+       - HEML_IMPLICIT_EULER at large steps on nearly incompressible P1 meshes needs many
+         Newton iterations (about 140 for a 1 m beam at nu = 0.4999, dt = 1 s) and the
+         static solve of the same beam from rest, a large rotation of a locked mesh, does
+         not converge within its caps (HEML_ERR_NO_CONVERGENCE; from the state the damped
+         dynamics reach, 1 increment): both say so rather than return a wrong answer.
+       - St Venant-Kirchhoff has no uniaxial state beyond a stretch where its lateral
+         contraction would take J below zero (s = 2 at nu = 0.4): there, and wherever a
+         tetrahedron ends below J0, the answer's stress is that of the J0 guard (our
+         continuation), not the law's; heml_solve_static and the steps still succeed (the
+         guarded law is a valid hyperelastic law) and report those tetrahedra in
+         stats.below_threshold: check it when the law's own answer matters.
+       - The linearised implicit step's linear solve must converge: under strong
+         compression or inversion CG meets negative curvature and MINRES takes over
+         (slower); a solve capped by cg_max_iterations fails the step rather than return an
+         unconverged one.
        - The implicit step's CG is Jacobi-preconditioned only (the coarse space serves the
          static solve): slender stiff bodies at large time steps need hundreds of
          iterations per step (R3 at 40 x 4 x 4 cells, dt = T/100: about 20 ms a step).
@@ -421,6 +523,18 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       0.3.0 (2026-12-02) no silent wrong answers (issue 18): the static solve is a
+             continuation with a tangent predictor, an energy line search, a
+             Levenberg-Marquardt shift at negative curvature and an inversion acceptance
+             test (allow_inversion, max_increments, min_increment); HEML_IMPLICIT_EULER is
+             the Newton minimisation of the incremental potential (newton_iterations is
+             its cap, default 20, newton_tolerance new) and HEML_IMPLICIT_EULER_LINEARIZED
+             the old single iteration; the semi-explicit step has a divergence check
+             (HEML_ERR_DIVERGED); HEML_ERR_PRECISION (precision_limit); every public
+             function is renamed in float builds; a garbage description no longer crashes
+             heml_create; a load whose squared norm overflows fails; the stats have the
+             names shared with tensormass.h and frames.h (residual, increments,
+             increment_cuts, line_search_cuts, first eleven fields in a common order).
        0.2.1 (2026-12-01) passes colour groups of consecutive chunks (compact pieces of
              the mesh) and the tetrahedra are ordered by their lowest node: large and
              randomly ordered meshes run 1.3 to 5 times faster; the Neo-Hookean force
@@ -445,8 +559,8 @@
 #include <stddef.h>
 
 #define HEML_VERSION_MAJOR 0
-#define HEML_VERSION_MINOR 2
-#define HEML_VERSION_PATCH 1
+#define HEML_VERSION_MINOR 3
+#define HEML_VERSION_PATCH 0
 
 #ifndef HEML_REAL
 #define HEML_REAL double
@@ -459,7 +573,7 @@ typedef HEML_REAL heml_real;
 #define HEMLDEF extern
 #endif
 
-/* Float builds rename the public entry points so that a float and a double translation
+/* Float builds rename every public entry point so that a float and a double translation
    unit cannot be linked together by mistake. HEML_REAL must be the single token float or
    double. */
 #define HEML__IS_float 1
@@ -468,19 +582,48 @@ typedef HEML_REAL heml_real;
 #define HEML__CAT(a, b) HEML__CAT2(a, b)
 #if HEML__CAT(HEML__IS_, HEML_REAL)
 #define HEML__FLOAT 1
+#define heml_version heml_version_f32
+#define heml_error_string heml_error_string_f32
 #define heml_default_desc heml_default_desc_f32
 #define heml_material_from_young heml_material_from_young_f32
 #define heml_create heml_create_f32
+#define heml_destroy heml_destroy_f32
+#define heml_fix_node heml_fix_node_f32
+#define heml_set_displacement heml_set_displacement_f32
+#define heml_set_displacement_axes heml_set_displacement_axes_f32
+#define heml_release_node heml_release_node_f32
+#define heml_node_pinned heml_node_pinned_f32
+#define heml_set_external_force heml_set_external_force_f32
+#define heml_clear_external_forces heml_clear_external_forces_f32
+#define heml_set_gravity heml_set_gravity_f32
+#define heml_set_mass_damping heml_set_mass_damping_f32
+#define heml_set_solver heml_set_solver_f32
+#define heml_set_newton_iterations heml_set_newton_iterations_f32
+#define heml_set_inversion_threshold heml_set_inversion_threshold_f32
+#define heml_reset_viscous_state heml_reset_viscous_state_f32
 #define heml_step heml_step_f32
 #define heml_step_ex heml_step_ex_f32
 #define heml_solve_static heml_solve_static_f32
 #define heml_compute_forces heml_compute_forces_f32
 #define heml_apply_stiffness heml_apply_stiffness_f32
+#define heml_kernel_bytes heml_kernel_bytes_f32
+#define heml_node_count heml_node_count_f32
+#define heml_tet_count heml_tet_count_f32
 #define heml_positions heml_positions_f32
-#define heml_set_positions heml_set_positions_f32
 #define heml_displacements heml_displacements_f32
+#define heml_velocities heml_velocities_f32
+#define heml_rest_positions heml_rest_positions_f32
+#define heml_masses heml_masses_f32
+#define heml_set_positions heml_set_positions_f32
 #define heml_set_displacements heml_set_displacements_f32
+#define heml_set_velocities heml_set_velocities_f32
+#define heml_last_stats heml_last_stats_f32
 #define heml_energy heml_energy_f32
+#define heml_tet_volume_ratios heml_tet_volume_ratios_f32
+#define heml_tet_stresses heml_tet_stresses_f32
+#define heml_tet_stress heml_tet_stress_f32
+#define heml_stable_time_step heml_stable_time_step_f32
+#define heml_memory_bytes heml_memory_bytes_f32
 #else
 #define HEML__FLOAT 0
 #endif
@@ -524,14 +667,16 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_NODE_RANGE, -24, "node index out of range") \
     X(HEML_ERR_TET_RANGE, -25, "tetrahedron index out of range") \
     X(HEML_ERR_NO_SECOND_DERIVATIVES, -26, "the user law gives no second derivatives (needed for the force differential)") \
-    X(HEML_ERR_INVERTED, -27, "tetrahedron inverted or flat (J <= 0): Cauchy stress undefined") \
-    X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept")
+    X(HEML_ERR_INVERTED, -27, "tetrahedron inverted or flat (J <= 0): a static solve or implicit step would newly invert one (allow_inversion = 0), or a Cauchy stress is undefined; the last valid state was kept") \
+    X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept") \
+    X(HEML_ERR_DIVERGED, -29, "explicit step failed its divergence check (energy grew beyond the work done on the body); the last valid state was kept") \
+    X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
     HEML_ERROR_LIST(HEML__ENUM)
 #undef HEML__ENUM
-    HEML_ERR_LAST_ = -29
+    HEML_ERR_LAST_ = -31
 };
 
 typedef enum heml_law {
@@ -545,8 +690,11 @@ typedef enum heml_law {
 } heml_law;
 
 typedef enum heml_integrator {
-    HEML_SEMI_EXPLICIT_EULER = 0, /* eq. 32 (default) */
-    HEML_IMPLICIT_EULER = 1       /* Newton + matrix-free CG (beyond the paper) */
+    HEML_SEMI_EXPLICIT_EULER = 0,      /* eq. 32 (default) */
+    HEML_IMPLICIT_EULER = 1,           /* backward Euler: Newton minimisation of the incremental
+                                          potential to newton_tolerance, matrix-free CG, line search */
+    HEML_IMPLICIT_EULER_LINEARIZED = 2 /* one linearised Newton iteration, no line search (fast,
+                                          accurate only while the step is nearly linear) */
 } heml_integrator;
 
 typedef enum heml_stress_kind {
@@ -638,14 +786,28 @@ typedef struct heml_desc {
     heml_real gravity[3];            /* m/s^2, default (0, 0, -9.81) */
     heml_real time_step;             /* s, default 1e-3, used by heml_step */
     heml_integrator integrator;      /* default HEML_SEMI_EXPLICIT_EULER */
-    int newton_iterations;           /* implicit step, default 1 */
+    int newton_iterations;           /* HEML_IMPLICIT_EULER: cap of Newton iterations per step,
+                                        default 20 */
+    heml_real newton_tolerance;      /* HEML_IMPLICIT_EULER: residual of the step's equations
+                                        relative to its largest force term, default 1e-6 (1e-4 float) */
     heml_real cg_tolerance;          /* relative residual of the implicit step's CG, default 1e-6
                                         (1e-5 float) */
     int cg_max_iterations;           /* Krylov iterations per linear solve, default 1000 */
     int static_max_iterations;       /* Newton iterations of heml_solve_static per load step,
                                         default 50 */
     heml_real static_tolerance;      /* its residual relative to the larger of the loads and the
-                                        internal forces (see STATIC SOLVE), default 1e-9 (1e-5 float) */
+                                        internal forces (see STATIC SOLVE), default 1e-9 (1e-4 float) */
+    int max_increments;              /* heml_solve_static: continuation increments tried (accepted
+                                        and cut), default 64 */
+    heml_real min_increment;         /* heml_solve_static: smallest load fraction of an increment
+                                        before giving up, default 1e-4 */
+    int allow_inversion;             /* 0 (default): a static solve or implicit step that would
+                                        leave more tetrahedra inverted (J <= 0) than at its start
+                                        fails with HEML_ERR_INVERTED; 1: allowed (stats.inverted) */
+    heml_real precision_limit;       /* steps and solves fail with HEML_ERR_PRECISION when
+                                        eps(heml_real) max|u| > precision_limit h_min (h_min the
+                                        shortest rest edge): the rounding of the state may not fake
+                                        strains above it; default 1e-4, 0 disables the check */
 
     /* environment */
     heml_allocator allocator;          /* all NULL: HEML_MALLOC / HEML_FREE */
@@ -657,22 +819,28 @@ typedef struct heml_desc {
     unsigned int internal_cookie;      /* set by heml_default_desc; do not touch */
 } heml_desc;
 
-/* Statistics of the last step, solve or force evaluation (read with heml_last_stats). */
+/* Statistics of the last step, solve or force evaluation (read with heml_last_stats). The
+   first eleven fields have the same names and meanings in tensormass.h and frames.h. */
 typedef struct heml_stats {
-    int cg_iterations;         /* CG (implicit step) or MINRES (static solve, and the implicit
-                                  step after negative curvature) iterations, summed over Newton
-                                  iterations */
-    heml_real cg_residual;     /* final relative residual |r| / |b| of the last Krylov solve */
-    int newton_iterations;     /* Newton iterations done */
+    int newton_iterations;     /* Newton iterations, summed over increments (1 for the
+                                  linearised implicit step; 0 for a semi-explicit step) */
+    int cg_iterations;         /* CG (or MINRES) iterations, summed */
+    heml_real cg_residual;     /* relative residual |r| / |b| of the last Krylov solve */
+    heml_real residual;        /* final nonlinear residual over its reference scale (static
+                                  solve, HEML_IMPLICIT_EULER); 0 where there is none */
+    int increments;            /* heml_solve_static: continuation increments accepted (1: the
+                                  whole load at once) */
+    int increment_cuts;        /* heml_solve_static: increments cut back after a failed attempt */
+    int line_search_cuts;      /* line-search step reductions, summed */
+    int negative_curvature;    /* Krylov solves that met a direction of negative curvature (the
+                                  tangent was not positive definite there) */
+    int inverted;              /* tetrahedra with J <= 0 at the last force evaluation (the
+                                  answer's, after a successful solve or implicit step) */
     int force_evaluations;     /* force passes */
     int stiffness_products;    /* force-differential passes */
-    int negative_curvature;    /* CG solves stopped at a direction of negative curvature */
-    int below_threshold;       /* tetrahedra with J < J0 at the last force evaluation */
-    int inverted;              /* tetrahedra with J <= 0 at the last force evaluation */
-    heml_real static_residual; /* heml_solve_static: last |r| over its reference scale */
-    int load_steps;            /* heml_solve_static: load increments (1 when the full load
-                                  converged at once) */
-    int line_search_halvings;  /* heml_solve_static: halvings of the Newton step, summed */
+    int below_threshold;       /* tetrahedra with J < J0 at the last force evaluation: their
+                                  stress is the J0 continuation's, not the law's (for St
+                                  Venant-Kirchhoff: the inversion guard's; see LIMITS) */
 } heml_stats;
 
 /* Energies of the current state (heml_energy). */
@@ -728,9 +896,10 @@ HEMLDEF void heml_clear_external_forces(heml_model *m);
 HEMLDEF int heml_set_gravity(heml_model *m, const heml_real g[3]);
 /* Mass damping coefficient (1/s, >= 0): damping force -alpha m v. */
 HEMLDEF int heml_set_mass_damping(heml_model *m, heml_real alpha);
-/* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves. */
+/* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves (the
+   linearised step fails at the cap; Newton solves use the cap per Krylov solve). */
 HEMLDEF int heml_set_solver(heml_model *m, heml_real tolerance, int max_iterations);
-/* Newton iterations per implicit step (>= 1). */
+/* Cap of Newton iterations per HEML_IMPLICIT_EULER step (>= 1; default 20). */
 HEMLDEF int heml_set_newton_iterations(heml_model *m, int iterations);
 /* The inversion threshold J0 (in (0, 1)) for later evaluations. */
 HEMLDEF int heml_set_inversion_threshold(heml_model *m, heml_real J0);
@@ -744,15 +913,16 @@ HEMLDEF int heml_step(heml_model *m);
 /* One step of dt seconds with the given integrator. */
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator);
 /* Moves the free degrees of freedom to the static equilibrium under gravity, external
-   forces and the pinned axes (inexact Newton with MINRES, a backtracking line search on
-   the residual or the potential energy, and adaptive load stepping when the full load
-   fails; the fully relaxed Prony response), sets velocities to zero and the viscous state
-   to its relaxed value. Returns HEML_OK only when the residual is below static_tolerance
-   (see STATIC SOLVE). On failure the state is unchanged: HEML_ERR_NO_CONVERGENCE
-   (static_max_iterations Newton iterations per load step were not enough even with steps
-   of 1/1024 of the load), HEML_ERR_ROUND_OFF (the residual stopped falling at the
+   forces and the pinned axes: the minimum of the potential, by continuation (loads and
+   pin moves in adaptive increments, each from a tangent predictor) and Newton with
+   preconditioned CG and an energy line search (the fully relaxed Prony response); sets
+   velocities to zero and the viscous state to its relaxed value. Returns HEML_OK only
+   when the residual is below static_tolerance and (allow_inversion = 0) no more
+   tetrahedra are inverted than at the start (see STATIC SOLVE). On failure the state is
+   unchanged: HEML_ERR_NO_CONVERGENCE (caps reached: static_max_iterations per increment,
+   max_increments, min_increment), HEML_ERR_ROUND_OFF (the residual stopped falling at the
    round-off level of the forces, above the tolerance: loosen it or use double),
-   HEML_ERR_NOT_FINITE. */
+   HEML_ERR_INVERTED, HEML_ERR_PRECISION, HEML_ERR_NOT_FINITE. */
 HEMLDEF int heml_solve_static(heml_model *m);
 
 /* ---- kernels (for benchmarks and custom solvers) ---- */
@@ -805,9 +975,10 @@ HEMLDEF int heml_tet_stresses(heml_model *m, heml_stress_kind kind, heml_real *o
 /* The same for one tetrahedron (costs a block of 16). */
 HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_real out[9]);
 /* Estimate of the largest stable semi-explicit time step, s: half the smallest over the
-   tetrahedra of altitude / sqrt((lambda + 2 mu) / rho) with small-strain moduli. A CFL
-   heuristic with a safety factor of about 2 (on box meshes the scheme blew up at 1.7 to
-   2.8 times it), not a guarantee: large deformations stiffen most laws. */
+   tetrahedra of altitude / sqrt((lambda + 2 mu) / rho) with small-strain moduli, at rest.
+   A CFL heuristic with a safety factor of about 2 (on box meshes the scheme blew up at 1.7
+   to 2.8 times it), not a guarantee: large deformations stiffen most laws, and inverted or
+   flattened tetrahedra (below J0) need about a third of it or less (LIMITS). */
 HEMLDEF double heml_stable_time_step(const heml_model *m);
 /* Bytes held by the model. */
 HEMLDEF size_t heml_memory_bytes(const heml_model *m);
@@ -890,7 +1061,7 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
-#define HEML__SCRATCH 17    /* 3n scratch vectors */
+#define HEML__SCRATCH 22    /* 3n scratch vectors */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
@@ -935,7 +1106,16 @@ struct heml_model {
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
     heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
-    int cg_max_iterations, newton_iterations, static_max_iterations;
+    heml_real newton_tolerance, min_increment, precision_limit;
+    int cg_max_iterations, newton_iterations, static_max_iterations, max_increments, allow_inversion;
+    double h_min; /* shortest rest edge, m (the precision check) */
+    /* divergence check of the semi-explicit step (heml__diverged): valid, the energy H0 and
+       the energy scale at its reference state, the free degrees of freedom's potential
+       -int F . du so far, and the last step's displacements and forces */
+    int div_valid;
+    unsigned div_pin_version;
+    double div_H0, div_scale, div_phi;
+    heml_real *div_u, *div_f;
     int parallel;
 
     heml_allocator allocator;
@@ -2305,6 +2485,8 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->prony_q_next, heml_real, m->prony_reals);
     for (i = 0; i < HEML__SCRATCH; i++) HEML__CARVE(c, m->scratch[i], heml_real, 3 * n);
     HEML__CARVE(c, m->dv_prev, heml_real, 3 * n);
+    HEML__CARVE(c, m->div_u, heml_real, 3 * n);
+    HEML__CARVE(c, m->div_f, heml_real, 3 * n);
     HEML__CARVE(c, m->node_agg, int, m->agg_count ? n : 0);
     HEML__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
@@ -2488,8 +2670,8 @@ static int heml__validate(const heml_desc *d)
 {
     char msg[200];
     int i, t, err, M;
-    if (d->internal_cookie != HEML__COOKIE)
-        return heml__fail(d, HEML_ERR_DESC, "start from heml_default_desc()");
+    /* a description not made by heml_default_desc: its log callback is garbage too */
+    if (d->internal_cookie != HEML__COOKIE) return HEML_ERR_DESC;
     if (d->node_count < 4 || d->node_count > HEML__MAX_NODES || !d->rest_positions)
         return heml__fail(d, HEML_ERR_NODE_COUNT, "node_count must be >= 4 with positions");
     if (d->tet_count < 1 || d->tet_count > HEML__MAX_TETS || !d->tets)
@@ -2501,13 +2683,18 @@ static int heml__validate(const heml_desc *d)
         return heml__fail(d, HEML_ERR_TIME_STEP, "time_step");
     if (!(heml__finite((double)d->mass_damping) && d->mass_damping >= 0))
         return heml__fail(d, HEML_ERR_DAMPING, "mass_damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 1)
+    if ((int)d->integrator < 0 || (int)d->integrator > 2)
         return heml__fail(d, HEML_ERR_INTEGRATOR, "integrator");
     if (!(heml__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
         d->newton_iterations < 1 || d->static_max_iterations < 1 ||
-        !(heml__finite((double)d->static_tolerance) && d->static_tolerance > 0))
-        return heml__fail(d, HEML_ERR_SOLVER, "cg_tolerance, cg_max_iterations, newton_iterations, "
-                                              "static_max_iterations or static_tolerance");
+        !(heml__finite((double)d->static_tolerance) && d->static_tolerance > 0) ||
+        !(heml__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->max_increments < 1 ||
+        !(heml__finite((double)d->min_increment) && d->min_increment > 0 && d->min_increment <= 1) ||
+        !(heml__finite((double)d->precision_limit) && d->precision_limit >= 0) ||
+        (d->allow_inversion != 0 && d->allow_inversion != 1))
+        return heml__fail(d, HEML_ERR_SOLVER, "cg_tolerance, cg_max_iterations, newton_iterations, newton_tolerance, "
+                                              "static_max_iterations, static_tolerance, max_increments, "
+                                              "min_increment, precision_limit or allow_inversion");
     for (i = 0; i < 3; i++)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -2657,15 +2844,19 @@ static void heml__colour_groups(heml_model *m, int *stamp, int *colour_of, int *
     m->group_start[G] = pos;
 }
 
+/* The masks of node i from its pinned axes; pin_version counts changes of the masks (not
+   of the targets: a driven node moved every step keeps its coarse space and its
+   divergence reference). */
 static void heml__set_masks(heml_model *m, int i)
 {
-    int r;
-    m->pin_version++;
+    int r, changed = 0;
     for (r = 0; r < 3; r++) {
         int pinned = (m->axes[i] >> r) & 1, movable = m->mass[i] > 0;
+        changed |= m->pin_mask[3 * i + r] != (heml_real)pinned || m->free_mask[3 * i + r] != (heml_real)(!pinned && movable);
         m->pin_mask[3 * i + r] = (heml_real)pinned;
         m->free_mask[3 * i + r] = (heml_real)(!pinned && movable);
     }
+    m->pin_version += (unsigned)changed;
 }
 
 /* Fills the block arrays (constants of every slot, padding), the masses and the
@@ -2938,7 +3129,24 @@ static void heml__coarse_apply(heml_model *m, const heml_real *rv, heml_real *z)
 
 /* >>creation -------------------------------------------------------------------------- */
 
-HEMLDEF const char *heml_version(void) { return "0.2.1"; }
+/* The shortest rest edge of the mesh, m (the precision check's element size). */
+static double heml__shortest_edge(const heml_desc *d)
+{
+    static const int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
+    double best = INFINITY;
+    int t, e, r;
+    for (t = 0; t < d->tet_count; t++)
+        for (e = 0; e < 6; e++) {
+            const heml_real *a = d->rest_positions + 3 * d->tets[4 * t + ends[e][0]];
+            const heml_real *b = d->rest_positions + 3 * d->tets[4 * t + ends[e][1]];
+            double l2 = 0.0;
+            for (r = 0; r < 3; r++) l2 += ((double)a[r] - (double)b[r]) * ((double)a[r] - (double)b[r]);
+            if (l2 < best) best = l2;
+        }
+    return sqrt(best);
+}
+
+HEMLDEF const char *heml_version(void) { return "0.3.0"; }
 
 HEMLDEF const char *heml_error_string(int code)
 {
@@ -2993,7 +3201,12 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.gravity[2] = (heml_real)-9.81;
     d.time_step = (heml_real)1e-3;
     d.integrator = HEML_SEMI_EXPLICIT_EULER;
-    d.newton_iterations = 1;
+    d.newton_iterations = 20;
+    d.newton_tolerance = (heml_real)(HEML__FLOAT ? 1e-4 : 1e-6);
+    d.max_increments = 64;
+    d.min_increment = (heml_real)1e-4;
+    d.allow_inversion = 0;
+    d.precision_limit = (heml_real)1e-4;
     d.cg_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-6);
     d.cg_max_iterations = 1000;
     d.static_max_iterations = 50;
@@ -3087,6 +3300,11 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->newton_iterations = d->newton_iterations;
     m->static_max_iterations = d->static_max_iterations;
     m->static_tolerance = d->static_tolerance;
+    m->newton_tolerance = d->newton_tolerance;
+    m->max_increments = d->max_increments;
+    m->min_increment = d->min_increment;
+    m->allow_inversion = d->allow_inversion;
+    m->precision_limit = d->precision_limit;
     m->J0 = d->inversion_threshold;
     m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
     m->allocator = alloc;
@@ -3146,6 +3364,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->coarse_version = m->pin_version - 1;
     heml__prony_coefficients(m, (double)m->time_step);
     heml__free(&alloc, tmp_block, tmp_bytes);
+    m->h_min = heml__shortest_edge(d);
     m->stats.newton_iterations = 0;
     *out = m;
     return HEML_OK;
@@ -3228,6 +3447,7 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
     }
     bb = heml__dot(r, r, n3);
     m->stats.cg_residual = 0;
+    if (!heml__finite(bb)) return HEML_ERR_NOT_FINITE; /* |b|^2 overflowed: never a pass */
     if (bb == 0.0) {
         memset(x, 0, sizeof(heml_real) * (size_t)n3);
         return HEML_OK;
@@ -3262,6 +3482,7 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
     }
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (heml_real)sqrt(rr / bb);
+    if (!heml__finite(rr)) return HEML_ERR_NOT_FINITE;
     return rr <= tol2 ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
 }
 
@@ -3291,6 +3512,7 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     heml__precond(m, pinv, r1, y, coarse);
     beta1 = heml__dot(r1, y, n3);
     m->stats.cg_residual = 0;
+    if (!heml__finite(beta1)) return HEML_ERR_NOT_FINITE;
     if (!(beta1 > 0.0)) return HEML_OK;
     beta1 = sqrt(beta1);
     beta = phibar = beta1;
@@ -3373,13 +3595,75 @@ static void heml__commit(heml_model *m, const heml_real *u, const heml_real *v)
     }
 }
 
-/* eq. 32: v1 = v0 + dt a(u0, v0), u1 = u0 + dt v1; a = (f + f_ext)/m + g - alpha v0. */
-static void heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
-                                heml_real *u1, heml_real *v1)
+/* The divergence check of the semi-explicit step, on its start state (u0, v0) and forces f
+   at u0 (no extra force pass). It tracks the energy of the free degrees of freedom,
+       H = kinetic + Phi,   Phi = - sum over steps of (F_n-1 + F_n) / 2 . (u_n - u_n-1)
+   (F = f + f_ext + M g on the free degrees of freedom: the trapezoidal potential of every
+   force, exact for linear forces), from a reference state (the first semi-explicit step
+   after creation, heml_set_* of the state, a change of the pinned axes, a static solve or
+   an implicit step), where
+   H = H0. A stable run keeps H near H0 (damping and Prony lower it); an unstable one
+   grows it exponentially. The step fails when H - H0 exceeds twice the energy the body
+   was given: the kinetic and elastic energy at the reference state plus the magnitudes of
+   the work of the loads and of the pinned axes' moves since (a sum of absolute values, so
+   the bound only grows). Returns 1 when diverged; the first call costs one energy pass;
+   user laws without an energy callback are not checked. */
+#ifndef HEML__DIV_FACTOR
+#define HEML__DIV_FACTOR 2.0 /* energy growth allowed, times the energy the body was given */
+#endif
+static int heml__diverged(heml_model *m, const heml_real *u0, const heml_real *v0, const heml_real *f)
+{
+    int i, r, n = m->node_count, n3 = 3 * n;
+    double K = 0.0, dphi = 0.0, budget = 0.0, noise = 0.0, eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    for (i = 0; i < n3; i++)
+        if (m->free_mask[i] > 0) K += 0.5 * (double)m->mass[i / 3] * (double)v0[i] * (double)v0[i];
+    if (!m->div_valid || m->div_pin_version != m->pin_version) {
+        double W = heml__pass_run(m, HEML__ENERGY, u0, NULL, NULL, 0, HEML_STRESS_PK1);
+        m->div_valid = 1;
+        m->div_pin_version = m->pin_version;
+        m->div_H0 = K;
+        m->div_scale = heml__finite(W) ? K + fabs(W) : NAN;
+        m->div_phi = 0.0;
+        memcpy(m->div_u, u0, sizeof(heml_real) * (size_t)n3);
+        memcpy(m->div_f, f, sizeof(heml_real) * (size_t)n3);
+        return 0;
+    }
+    if (!heml__finite(m->div_scale)) return 0;
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            int j = 3 * i + r;
+            double du = (double)u0[j] - (double)m->div_u[j];
+            double load = (double)m->ext[j] + (double)m->mass[i] * (double)m->gravity[r];
+            double favg = 0.5 * ((double)f[j] + (double)m->div_f[j]);
+            if (m->free_mask[j] > 0) {
+                dphi -= (favg + load) * du;
+                budget += fabs(load * du);
+                noise += fabs(favg * du) + fabs(load * du);
+            } else {
+                budget += fabs(favg * du); /* the work of a driven axis */
+            }
+        }
+    m->div_phi += dphi;
+    m->div_scale += budget + 64.0 * eps * noise;
+    if (!(K + m->div_phi - m->div_H0 <= HEML__DIV_FACTOR * m->div_scale)) return 1;
+    memcpy(m->div_u, u0, sizeof(heml_real) * (size_t)n3);
+    memcpy(m->div_f, f, sizeof(heml_real) * (size_t)n3);
+    return 0;
+}
+
+/* eq. 32: v1 = v0 + dt a(u0, v0), u1 = u0 + dt v1; a = (f + f_ext)/m + g - alpha v0.
+   HEML_ERR_DIVERGED when heml__diverged flags the start state, or when the result's
+   kinetic energy exceeds twice the energy the body was given (heml__diverged's scale
+   plus the loads' work over this step; the elastic energy is never negative, so no stable
+   motion gets there): an overshoot is caught before it is accepted. */
+static int heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                               heml_real *u1, heml_real *v1)
 {
     int i, r, n = m->node_count;
     heml_real *f = m->scratch[4], alpha = m->mass_damping;
+    double K1 = 0.0, work = 0.0;
     heml__forces(m, u0, f, 1);
+    if (heml__all_finite(f, 3 * (size_t)n) && heml__diverged(m, u0, v0, f)) return HEML_ERR_DIVERGED;
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
@@ -3387,58 +3671,289 @@ static void heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0
             heml_real a = (f[j] + m->ext[j]) * m->inv_mass[i] + m->gravity[r] - alpha * v0[j];
             v1[j] = v0[j] + fm * dt * a;
             u1[j] = u0[j] + fm * dt * v1[j];
+            if (fm > 0) {
+                K1 += 0.5 * (double)m->mass[i] * (double)v1[j] * (double)v1[j];
+                work += fabs(((double)m->ext[j] + (double)m->mass[i] * (double)m->gravity[r]) *
+                             ((double)u1[j] - (double)u0[j]));
+            }
         }
+    /* the candidate's kinetic energy cannot exceed the energy the body was given */
+    if (heml__finite(m->div_scale) && !(K1 <= HEML__DIV_FACTOR * (m->div_scale + work))) return HEML_ERR_DIVERGED;
+    return HEML_OK;
 }
 
-/* Backward Euler by Newton on du = u1 - u0 from du = 0:
-       (M (1 + dt alpha) - dt^2 df/du(u0 + du)) delta = dt^2 R,
-       R = f(u0 + du) + f_ext + M g - alpha M du / dt - M (du - dt v0) / dt^2,
-   du += delta; the first iteration is the linearly implicit (Baraff-Witkin) step. Each
-   linear solve is CG, or MINRES when CG meets negative curvature; one that does not reach
+/* The linearised implicit step (HEML_IMPLICIT_EULER_LINEARIZED): one Newton iteration of
+   backward Euler from du = u1 - u0 = 0,
+       (M (1 + dt alpha) - dt^2 df/du(u0)) du = dt^2 R,
+       R = f(u0) + f_ext + M g + M v0 / dt,
+   the Baraff-Witkin step: no line search, no check of the nonlinear equations. The linear
+   solve is CG, or MINRES when CG meets negative curvature; one that does not reach
    cg_tolerance in cg_max_iterations fails the step (HEML_ERR_NO_CONVERGENCE). */
+static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                                     heml_real *u1, heml_real *v1)
+{
+    int i, r, err, n = m->node_count, n3 = 3 * n;
+    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *du = m->scratch[6], *rhs = m->scratch[7];
+    heml_real *krylov[8], alpha = m->mass_damping;
+    double dt2 = (double)dt * dt;
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[9 + i];
+    for (i = 0; i < n3; i++) dmass[i] = (heml_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
+    heml__forces(m, u0, f, 1);
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            int j = 3 * i + r;
+            double mi = (double)m->mass[i];
+            double R = (double)f[j] + (double)m->ext[j] + mi * (double)m->gravity[r] + mi * (double)v0[j] / (double)dt;
+            rhs[j] = (heml_real)(dt2 * R) * m->free_mask[j];
+            du[j] = dt * (v0[j] + m->dv_prev[j]);
+        }
+    if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
+    err = heml__cg(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+    if (err == HEML__NEGATIVE_CURVATURE)
+        err = heml__minres(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+    if (err) return err;
+    m->stats.newton_iterations = 1;
+    for (i = 0; i < n3; i++) {
+        heml_real fm = m->free_mask[i];
+        u1[i] = u0[i] + du[i] * fm;
+        v1[i] = fm > 0 ? du[i] / dt : v0[i];
+        m->dv_prev[i] = (v1[i] - v0[i]) * fm;
+    }
+    return HEML_OK;
+}
+
+/* >>minimisation: Newton on an energy (the static solve and implicit Euler) ------------ */
+
+/* The objective Phi(u) over the free degrees of freedom, minimised by heml__newton:
+       static:   Phi = W(u) - load . u
+       implicit: Phi = W(u) - load . u + sum m |u - u0 - dt v0|^2 / (2 dt^2)
+                                       + alpha sum m |u - u0|^2 / (2 dt)
+   (the incremental potential of backward Euler with mass damping: its stationarity is
+   M (u - u0 - dt v0) / dt^2 + alpha M (u - u0) / dt = f(u) + load). -grad Phi is the
+   residual R = f + load - M (u - u0 - dt v0) / dt^2 - alpha M (u - u0) / dt and its
+   Hessian D - df/du with D = M (1 + dt alpha) / dt^2 (0 static). */
+typedef struct heml__objective {
+    const heml_real *load;    /* 3n: f_ext + M g on the free degrees of freedom, scaled */
+    const heml_real *u0, *v0; /* implicit: the step's start; NULL: static */
+    const heml_real *dmass;   /* implicit: D per degree of freedom; NULL: static */
+    const heml_real *warm;    /* implicit: the first Krylov solve's initial guess, or NULL */
+    double dt, alpha, tol;
+    int max_iterations, coarse, energy_search, inverted_start;
+} heml__objective;
+
+/* One evaluation of the objective at u: f, R, |R|, the reference scale max(|load|, |f|
+   (all degrees of freedom, reactions included), |inertia|), Phi, its parts and its
+   round-off size. */
+typedef struct heml__point {
+    double res, scale, energy, work, kinetic, potential, noise;
+} heml__point;
+
+static void heml__eval(heml_model *m, const heml__objective *ob, const heml_real *u, heml_real *f, heml_real *R,
+                       heml__point *pt)
+{
+    int i, n3 = 3 * m->node_count;
+    double W = heml__pass_run(m, HEML__FORCE_ENERGY, u, NULL, f, 1, HEML_STRESS_PK1), ff, ll, ii = 0.0, kin = 0.0;
+    double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    for (i = 0; i < n3; i++) {
+        double Rj = (double)f[i] + (double)ob->load[i];
+        if (ob->u0 && m->free_mask[i] > 0) {
+            double mi = (double)m->mass[i / 3], d = (double)u[i] - (double)ob->u0[i];
+            double e = d - ob->dt * (double)ob->v0[i];
+            double in = mi * e / (ob->dt * ob->dt) + ob->alpha * mi * d / ob->dt;
+            Rj -= in;
+            ii += in * in;
+            kin += 0.5 * mi * (e * e / (ob->dt * ob->dt) + ob->alpha * d * d / ob->dt);
+        }
+        R[i] = (heml_real)Rj * m->free_mask[i];
+    }
+    ff = heml__dot(f, f, n3);
+    ll = heml__dot(ob->load, ob->load, n3);
+    pt->res = sqrt(heml__dot(R, R, n3));
+    pt->scale = sqrt(ff > ll ? (ff > ii ? ff : ii) : (ll > ii ? ll : ii));
+    pt->energy = W;
+    pt->work = heml__dot(ob->load, u, n3);
+    pt->kinetic = kin;
+    pt->potential = W - pt->work + kin;
+    pt->noise = 64.0 * eps * (fabs(W) + fabs(pt->work) + kin) + 4.0 * m->energy_noise;
+}
+
+/* The round-off level of the residual at u (one pass): per free degree of freedom the
+   unit round-off times the size of the terms its force sums, and the force that rounding
+   the displacements moves (the stiffness diagonal, plus D of implicit Euler, times one ulp
+   of the node's largest displacement component), in quadrature. */
+static double heml__round_off_floor(heml_model *m, const heml_real *u, const heml_real *dmass, heml_real *scratch)
+{
+    int i, r;
+    double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, sum = 0.0;
+    heml__pass_run(m, HEML__ABS, u, NULL, scratch, 0, HEML_STRESS_PK1);
+    for (i = 0; i < m->node_count; i++) {
+        double umax = 0.0;
+        for (r = 0; r < 3; r++)
+            if (fabs((double)u[3 * i + r]) > umax) umax = fabs((double)u[3 * i + r]);
+        for (r = 0; r < 3; r++) {
+            int j = 3 * i + r;
+            double a = (double)scratch[j], k = ((double)m->diag[j] + (dmass ? (double)dmass[j] : 0.0)) * umax;
+            if (m->free_mask[j] > 0) sum += eps * eps * (a * a + k * k);
+        }
+    }
+    return sqrt(sum);
+}
+
+/* Newton made no more progress at u (current point pt, direction with slope R . delta,
+   krylov_ok whether its solve reached its tolerance). Within 100 times the round-off
+   floor the answer is accepted (HEML_OK) only when it is converged in energy: the Newton
+   correction's energy R . K^-1 R (the slope) is below tol^2 times the energy of the
+   answer, max(|load . u|, 2 W, 2 kinetic), i.e. the energy-norm error is below tol;
+   otherwise HEML_ERR_ROUND_OFF. Above the floor: HEML_ERR_NO_CONVERGENCE. */
+static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_real *u, const heml__point *pt,
+                         double slope, int krylov_ok, heml_real *scratch)
+{
+    double tol = ob->tol, ref = fabs(pt->work);
+    if (heml__finite(pt->energy) && 2.0 * fabs(pt->energy) > ref) ref = 2.0 * fabs(pt->energy);
+    if (2.0 * pt->kinetic > ref) ref = 2.0 * pt->kinetic;
+    if (!(pt->res <= 100.0 * heml__round_off_floor(m, u, ob->dmass, scratch))) return HEML_ERR_NO_CONVERGENCE;
+    if (krylov_ok && slope > 0 && slope <= tol * tol * ref) return HEML_OK;
+    return HEML_ERR_ROUND_OFF;
+}
+
+#define HEML__HALVINGS 12   /* line search: steps down to 2^-12 */
+#define HEML__STALL 4       /* Newton iterations without progress that end a solve */
+#define HEML__SHIFT_MIN 1e-6 /* Levenberg-Marquardt shift after negative curvature, times the */
+#define HEML__SHIFT_MAX 1e3  /* small-strain stiffness diagonal: first and largest */
+
+/* Newton minimisation of the objective from u (pinned axes already placed), in place.
+   Each iteration solves (D - df/du) delta = R by preconditioned CG to an Eisenstat-Walker
+   relative residual (1e-3, then 0.9 (|R_k| / |R_k-1|)^2, never tighter than the
+   tolerance needs). Where CG meets negative curvature (the tangent is not positive
+   definite: stats.negative_curvature) the solve is repeated with a Levenberg-Marquardt
+   shift, shift times the small-strain stiffness diagonal added to the tangent (1e-3,
+   raised tenfold until CG meets no negative curvature, up to 1e3, and lowered tenfold
+   after each accepted step), so the direction descends and the iteration never steers
+   towards a saddle; where even the largest shift fails, the preconditioned residual. A
+   capped solve still gives a usable direction. The backtracking line search accepts a step that lowers Phi (Armijo, up to
+   its round-off); where Phi is not a potential of the forces (a Prony history in a
+   dynamic step, or a user law without an energy callback) a step that lowers |R|.
+   Converged when |R| <= tol max(|load|, |f|, |inertia|). When neither |R| nor Phi made
+   progress in HEML__STALL iterations, or the line search found no acceptable step, or
+   after max_iterations: heml__stalled decides. Scratch 4..17. */
+static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
+{
+    heml_real *f = m->scratch[4], *R = m->scratch[5], *delta = m->scratch[6], *ut = m->scratch[7];
+    heml_real *ft = m->scratch[8], *Rt = m->scratch[9], *reg = m->scratch[21], *krylov[8];
+    int i, it, n3 = 3 * m->node_count, quiet = 0;
+    double best, prev = 0.0, eta = 1e-3, tol = ob->tol, shift = 0.0;
+    heml__point pt, tp;
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
+    heml__eval(m, ob, u, f, R, &pt);
+    ob->inverted_start = m->stats.inverted;
+    best = pt.res;
+    for (it = 0;; it++) {
+        double step = 1.0, slope;
+        int ls, accepted = 0, krylov_ok, kerr, by_energy = ob->energy_search && heml__finite(pt.potential);
+        m->stats.residual = (heml_real)(pt.scale > 0 ? pt.res / pt.scale : 0.0);
+        if (!heml__finite(pt.res) || !heml__finite(pt.scale)) return HEML_ERR_NOT_FINITE;
+        if (pt.res <= tol * pt.scale) return HEML_OK;
+        if (it > 0) {
+            eta = 0.9 * (pt.res / prev) * (pt.res / prev);
+            if (eta > 1e-3) eta = 1e-3;
+        }
+        if (eta < 0.1 * tol * pt.scale / pt.res) eta = 0.1 * tol * pt.scale / pt.res;
+        if (eta > 1e-3) eta = 1e-3;
+        for (;;) { /* (D + shift diag K0 - df/du) delta = R: the shift only after negative curvature */
+            const heml_real *D = ob->dmass;
+            if (shift > 0) {
+                for (i = 0; i < n3; i++) reg[i] = (heml_real)((ob->dmass ? (double)ob->dmass[i] : 0.0) + shift * (double)m->diag[i]);
+                D = reg;
+            }
+            for (i = 0; i < n3; i++) delta[i] = it == 0 && ob->warm ? ob->warm[i] * m->free_mask[i] : 0;
+            kerr = heml__cg(m, u, D, 1.0, R, delta, eta, ob->coarse, krylov);
+            if (kerr != HEML__NEGATIVE_CURVATURE || shift >= HEML__SHIFT_MAX) break;
+            shift = shift > 0 ? 10.0 * shift : HEML__SHIFT_MIN;
+        }
+        if (kerr == HEML_ERR_NOT_FINITE) return kerr;
+        krylov_ok = kerr == HEML_OK && shift == 0.0;
+        slope = heml__dot(R, delta, n3);
+        if (!(slope > 0.0)) { /* still negative curvature, or a warm start that ascends */
+            const heml_real *pinv = krylov[4];
+            for (i = 0; i < n3; i++) delta[i] = pinv[i] * R[i];
+            slope = heml__dot(R, delta, n3);
+            krylov_ok = 0;
+        }
+        if (it == ob->max_iterations || quiet >= HEML__STALL) return heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+        m->stats.newton_iterations++;
+        for (ls = 0; ls <= HEML__HALVINGS && !accepted; ls++, step *= 0.5) {
+            heml_real t = (heml_real)step;
+            for (i = 0; i < n3; i++) ut[i] = u[i] + t * delta[i];
+            heml__eval(m, ob, ut, ft, Rt, &tp);
+            if (!heml__finite(tp.res)) {
+                m->stats.line_search_cuts++;
+                continue;
+            }
+            accepted = by_energy ? tp.potential - pt.potential <= -1e-4 * step * slope + pt.noise
+                                 : tp.res <= (1.0 - 1e-4 * step) * pt.res;
+            m->stats.line_search_cuts += !accepted;
+        }
+        if (!accepted) return heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+        shift = shift > HEML__SHIFT_MIN ? 0.1 * shift : 0.0;
+        quiet = tp.res < 0.9 * best || tp.potential < pt.potential - pt.noise ? 0 : quiet + 1;
+        if (tp.res < best) best = tp.res;
+        prev = pt.res;
+        pt = tp;
+        memcpy(u, ut, sizeof(heml_real) * (size_t)n3);
+        memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
+    }
+}
+
+/* eps(heml_real) max|u| <= precision_limit h_min: the rounding of the state cannot fake
+   strains above precision_limit (0 disables the check). */
+static int heml__precision_ok(const heml_model *m, const heml_real *u)
+{
+    double umax = 0.0, eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    int i, n3 = 3 * m->node_count;
+    if (!(m->precision_limit > 0)) return 1;
+    for (i = 0; i < n3; i++)
+        if (fabs((double)u[i]) > umax) umax = fabs((double)u[i]);
+    return eps * umax <= (double)m->precision_limit * m->h_min;
+}
+
+/* Backward Euler (HEML_IMPLICIT_EULER): u1 minimises the incremental potential (see
+   heml__objective) by heml__newton to newton_tolerance in at most newton_iterations
+   iterations, from u1 = u0 with the first Krylov solve warm-started at dt (v0 + the last
+   step's dv). Fails (state kept) with HEML_ERR_NO_CONVERGENCE / HEML_ERR_ROUND_OFF when
+   Newton does not get there, HEML_ERR_INVERTED when the answer has more inverted
+   tetrahedra than u0 and allow_inversion is 0. */
 static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
                           heml_real *u1, heml_real *v1)
 {
-    int i, r, it, err, n = m->node_count, n3 = 3 * n;
-    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *du = m->scratch[6], *rhs = m->scratch[7];
-    heml_real *delta = m->scratch[8], *krylov[8], alpha = m->mass_damping;
-    double dt2 = (double)dt * dt;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[9 + i];
-    for (i = 0; i < n3; i++) {
-        dmass[i] = (heml_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
-        du[i] = 0;
-    }
-    for (it = 0; it < m->newton_iterations; it++) {
-        double dd = 0.0, xx = 0.0;
-        for (i = 0; i < n3; i++) u1[i] = u0[i] + du[i];
-        heml__forces(m, u1, f, 1);
-        for (i = 0; i < n; i++)
-            for (r = 0; r < 3; r++) {
-                int j = 3 * i + r;
-                double mi = (double)m->mass[i];
-                double R = (double)f[j] + (double)m->ext[j] + mi * (double)m->gravity[r] -
-                           (double)alpha * mi * (double)du[j] / (double)dt -
-                           mi * ((double)du[j] - (double)dt * (double)v0[j]) / dt2;
-                rhs[j] = (heml_real)(dt2 * R) * m->free_mask[j];
-                delta[j] = it == 0 ? dt * (v0[j] + m->dv_prev[j]) : 0;
-            }
-        if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-        err = heml__cg(m, u1, dmass, dt2, rhs, delta, (double)m->cg_tolerance, 0, krylov);
-        if (err == HEML__NEGATIVE_CURVATURE)
-            err = heml__minres(m, u1, dmass, dt2, rhs, delta, (double)m->cg_tolerance, 0, krylov);
-        if (err) return err;
-        for (i = 0; i < n3; i++) {
-            du[i] += delta[i] * m->free_mask[i];
-            dd += (double)delta[i] * delta[i];
-            xx += (double)du[i] * du[i];
+    int i, r, err, n = m->node_count, n3 = 3 * n;
+    heml_real *dmass = m->scratch[19], *load = m->scratch[18], *warm = m->scratch[20];
+    heml__objective ob;
+    double cm = (1.0 + (double)dt * (double)m->mass_damping) / ((double)dt * (double)dt);
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            int j = 3 * i + r;
+            dmass[j] = (heml_real)(cm * (double)m->mass[i]);
+            load[j] = (m->ext[j] + m->mass[i] * m->gravity[r]) * m->free_mask[j];
+            warm[j] = dt * (v0[j] + m->dv_prev[j]);
         }
-        m->stats.newton_iterations = it + 1;
-        if (it > 0 && dd <= (double)m->cg_tolerance * m->cg_tolerance * xx) break;
-    }
+    memset(&ob, 0, sizeof ob);
+    ob.load = load;
+    ob.u0 = u0;
+    ob.v0 = v0;
+    ob.dmass = dmass;
+    ob.warm = warm;
+    ob.dt = (double)dt;
+    ob.alpha = (double)m->mass_damping;
+    ob.tol = (double)m->newton_tolerance;
+    ob.max_iterations = m->newton_iterations;
+    ob.energy_search = !m->has_prony; /* a Prony history's force has no potential */
+    memcpy(u1, u0, sizeof(heml_real) * (size_t)n3);
+    err = heml__newton(m, &ob, u1);
+    if (err) return err;
+    if (!m->allow_inversion && m->stats.inverted > ob.inverted_start) return HEML_ERR_INVERTED;
     for (i = 0; i < n3; i++) {
         heml_real fm = m->free_mask[i];
-        u1[i] = u0[i] + du[i];
-        v1[i] = fm > 0 ? du[i] / dt : v0[i];
+        v1[i] = fm > 0 ? (u1[i] - u0[i]) / dt : v0[i];
         m->dv_prev[i] = (v1[i] - v0[i]) * fm;
     }
     return HEML_OK;
@@ -3451,8 +3966,8 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
     int err = HEML_OK;
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)dt) && dt > 0)) return HEML_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 1) return HEML_ERR_INTEGRATOR;
-    if (integrator == HEML_IMPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
+    if ((int)integrator < 0 || (int)integrator > 2) return HEML_ERR_INTEGRATOR;
+    if (integrator != HEML_SEMI_EXPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * (size_t)m->node_count;
     u0 = m->scratch[0];
     v0 = m->scratch[1];
@@ -3461,14 +3976,17 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, (double)dt);
     heml__begin_step(m, dt, u0, v0);
-    if (integrator == HEML_SEMI_EXPLICIT_EULER) heml__semi_explicit(m, dt, u0, v0, u1, v1);
-    else err = heml__implicit(m, dt, u0, v0, u1, v1);
+    if (!heml__precision_ok(m, u0)) return HEML_ERR_PRECISION;
+    if (integrator == HEML_SEMI_EXPLICIT_EULER) err = heml__semi_explicit(m, dt, u0, v0, u1, v1);
+    else if (integrator == HEML_IMPLICIT_EULER) err = heml__implicit(m, dt, u0, v0, u1, v1);
+    else err = heml__implicit_linearized(m, dt, u0, v0, u1, v1);
     if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
     if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);
         return err;
     }
     heml__commit(m, u1, v1);
+    if (integrator != HEML_SEMI_EXPLICIT_EULER) m->div_valid = 0;
     return HEML_OK;
 }
 
@@ -3480,181 +3998,107 @@ HEMLDEF int heml_step(heml_model *m)
 
 /* >>static ---------------------------------------------------------------------------- */
 
-/* One evaluation of the static problem at u under the load vector `load` (free degrees of
-   freedom only): internal forces f, residual R = mask (f + load), its norm, the reference
-   scale max(|load|, |f|) (f over every degree of freedom, so the pinned ones' reactions
-   count), the elastic energy W of the relaxed response, the work load . u, the potential
-   W - load . u and its round-off size. */
-typedef struct heml__static_point {
-    double res, scale, energy, work, potential, noise;
-} heml__static_point;
-
-static void heml__static_eval(heml_model *m, const heml_real *u, const heml_real *load, heml_real *f,
-                              heml_real *R, heml__static_point *pt)
-{
-    int i, n3 = 3 * m->node_count;
-    double W = heml__pass_run(m, HEML__FORCE_ENERGY, u, NULL, f, 1, HEML_STRESS_PK1), ff, ll;
-    for (i = 0; i < n3; i++) R[i] = (f[i] + load[i]) * m->free_mask[i];
-    ff = heml__dot(f, f, n3);
-    ll = heml__dot(load, load, n3);
-    pt->res = sqrt(heml__dot(R, R, n3));
-    pt->scale = sqrt(ff > ll ? ff : ll);
-    pt->energy = W;
-    pt->work = heml__dot(load, u, n3);
-    pt->potential = W - pt->work;
-    pt->noise = 64.0 * (HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON) * (fabs(W) + fabs(pt->work)) + 4.0 * m->energy_noise;
-}
-
-/* The round-off level of the residual at u (one pass): per free degree of freedom the
-   unit round-off times the size of the terms its force sums, and the force that rounding
-   the displacements moves (the stiffness diagonal times one ulp of the node's largest
-   displacement component), in quadrature. */
-static double heml__round_off_floor(heml_model *m, const heml_real *u, heml_real *scratch)
-{
-    int i, r;
-    double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, sum = 0.0;
-    heml__pass_run(m, HEML__ABS, u, NULL, scratch, 0, HEML_STRESS_PK1);
-    for (i = 0; i < m->node_count; i++) {
-        double umax = 0.0;
-        for (r = 0; r < 3; r++)
-            if (fabs((double)u[3 * i + r]) > umax) umax = fabs((double)u[3 * i + r]);
-        for (r = 0; r < 3; r++) {
-            int j = 3 * i + r;
-            double a = (double)scratch[j], k = (double)m->diag[j] * umax;
-            if (m->free_mask[j] > 0) sum += eps * eps * (a * a + k * k);
-        }
-    }
-    return sqrt(sum);
-}
-
-/* Newton made no more progress at u (current point pt, direction delta with slope
-   R . delta, minres_ok whether MINRES reached its tolerance). Within 100 times the
-   round-off floor the answer is accepted (HEML_OK) only when it is converged in energy:
-   the Newton correction's energy R . K^-1 R (the slope) is below static_tolerance^2
-   times the energy of the answer, max(|load . u|, 2 W), i.e. the energy-norm error is
-   below static_tolerance; otherwise HEML_ERR_ROUND_OFF. Above the floor:
-   HEML_ERR_NO_CONVERGENCE. */
-static int heml__static_stalled(heml_model *m, const heml_real *u, const heml__static_point *pt, double slope,
-                                int minres_ok, heml_real *scratch)
-{
-    double tol = (double)m->static_tolerance, ref = fabs(pt->work);
-    if (heml__finite(pt->energy) && 2.0 * fabs(pt->energy) > ref) ref = 2.0 * fabs(pt->energy);
-    if (!(pt->res <= 100.0 * heml__round_off_floor(m, u, scratch))) return HEML_ERR_NO_CONVERGENCE;
-    if (minres_ok && slope > 0 && slope <= tol * tol * ref) return HEML_OK;
-    return HEML_ERR_ROUND_OFF;
-}
-
-#define HEML__HALVINGS 10   /* line search: steps down to 2^-10 */
-#define HEML__STALL 4       /* Newton iterations without progress that end a load step */
-
-/* Newton at one load (pinned axes already placed in u): K delta = R (K = -df/du) by
-   MINRES to the Eisenstat-Walker relative residual eta (1e-3, then (|R_k| / |R_k-1|)^2
-   times 0.9, never tighter than the tolerance needs), then a backtracking line search
-   that accepts a step when it lowers the residual (which also converges to unstable
-   equilibria) or the potential W - load . u (Armijo, up to its round-off: the Newton step
-   of a slender body often raises the residual on its way to the solution). Converged when
-   |R| <= static_tolerance max(|load|, |f|). When neither the residual nor the potential
-   made progress in HEML__STALL iterations, or the line search found no acceptable step,
-   or after static_max_iterations: heml__static_stalled decides. Scratch 1..14; u is
-   updated in place. */
-static int heml__static_newton(heml_model *m, const heml_real *load, heml_real *u)
-{
-    heml_real *f = m->scratch[1], *R = m->scratch[2], *delta = m->scratch[3], *ut = m->scratch[4];
-    heml_real *ft = m->scratch[5], *Rt = m->scratch[6], *krylov[8];
-    int i, it, n3 = 3 * m->node_count, quiet = 0;
-    double best, prev = 0.0, eta = 1e-3, tol = (double)m->static_tolerance;
-    heml__static_point pt, tp;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[7 + i];
-    heml__static_eval(m, u, load, f, R, &pt);
-    best = pt.res;
-    for (it = 0;; it++) {
-        double step = 1.0, slope;
-        int ls, accepted = 0, minres_ok, kerr;
-        m->stats.static_residual = (heml_real)(pt.scale > 0 ? pt.res / pt.scale : 0.0);
-        if (!heml__finite(pt.res)) return HEML_ERR_NOT_FINITE;
-        if (pt.res <= tol * pt.scale) return HEML_OK;
-        if (it > 0) {
-            eta = 0.9 * (pt.res / prev) * (pt.res / prev);
-            if (eta > 1e-3) eta = 1e-3;
-        }
-        if (eta < 0.1 * tol * pt.scale / pt.res) eta = 0.1 * tol * pt.scale / pt.res;
-        if (eta > 1e-3) eta = 1e-3; /* (at the round-off floor the smooth error needs it) */
-        /* CG (its rounding errors grow like the condition number, MINRES's like its square:
-           in float only CG resolves a slender body); MINRES where the tangent is indefinite.
-           A capped solve still gives a usable direction. */
-        memset(delta, 0, sizeof(heml_real) * (size_t)n3);
-        kerr = heml__cg(m, u, NULL, 1.0, R, delta, eta, 1, krylov);
-        if (kerr == HEML__NEGATIVE_CURVATURE) kerr = heml__minres(m, u, NULL, 1.0, R, delta, eta, 1, krylov);
-        minres_ok = kerr == HEML_OK;
-        slope = heml__dot(R, delta, n3);
-        if (it == m->static_max_iterations || quiet >= HEML__STALL)
-            return heml__static_stalled(m, u, &pt, slope, minres_ok, ft);
-        m->stats.newton_iterations++;
-        for (ls = 0; ls <= HEML__HALVINGS && !accepted; ls++, step *= 0.5) {
-            heml_real t = (heml_real)step;
-            for (i = 0; i < n3; i++) ut[i] = u[i] + t * delta[i];
-            heml__static_eval(m, ut, load, ft, Rt, &tp);
-            if (!heml__finite(tp.res)) continue;
-            accepted = tp.res <= (1.0 - 1e-4 * step) * pt.res ||
-                       (slope > 0 && tp.potential - pt.potential <= -1e-4 * step * slope + pt.noise);
-            m->stats.line_search_halvings += !accepted;
-        }
-        if (!accepted) return heml__static_stalled(m, u, &pt, slope, minres_ok, ft);
-        quiet = tp.res < 0.9 * best || tp.potential < pt.potential - pt.noise ? 0 : quiet + 1;
-        if (tp.res < best) best = tp.res;
-        prev = pt.res;
-        pt = tp;
-        memcpy(u, ut, sizeof(heml_real) * (size_t)n3);
-        memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
-    }
-}
-
-/* Equilibrium by load stepping: loads (gravity, external forces) and the pinned axes'
-   moves to their targets are applied with a factor lambda from 0 to 1, first in one
-   step; when Newton fails at a factor, the increment is halved from the last converged
-   one (down to 1/1024) and doubled again after a success. A round-off stall ends the
-   solve at once (a smaller load would not help). */
+/* Equilibrium by continuation: loads (gravity, external forces) and the pinned axes' moves
+   to their targets are applied with a factor lambda from 0 to 1, first in one increment;
+   a failed increment is cut in half (from the last converged state), a successful one
+   doubles the next. Each increment starts from a tangent predictor: the pinned axes moved
+   by their share and the free ones by the small-strain response to it and to the new
+   load, K delta = R(u; load) + df/du (u) dpin (one Krylov solve), so that the boundary
+   layer moves with the pins instead of being crushed by them; Newton (heml__newton, Phi =
+   W - load . u) takes it from there. An increment is accepted when Newton converged and
+   (allow_inversion = 0) no more tetrahedra are inverted than at the start; where the
+   predictor inverts more, Newton starts from the pinned axes' move alone. Stops: max_increments attempts, an
+   increment below min_increment, a round-off stall (HEML_ERR_ROUND_OFF: a smaller load
+   would not help), or a load whose norm is not finite (HEML_ERR_NOT_FINITE). Scratch: 0-4,
+   18-20 here, 4-17 Newton's. */
 HEMLDEF int heml_solve_static(heml_model *m)
 {
-    heml_real *u, *saved, *load;
-    int i, r, n3, err = HEML_OK;
+    heml_real *u, *saved, *dpin, *q, *load, *rhs, *pred, *f, *krylov[8];
+    int i, r, n3, err = HEML_OK, attempts = 0, inverted_start;
     double lambda = 0.0, increment = 1.0;
+    heml__objective ob;
     if (!m) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * m->node_count;
     u = m->scratch[0];
-    saved = m->scratch[15];
-    load = m->scratch[16];
+    saved = m->scratch[1];
+    dpin = m->scratch[2];
+    q = m->scratch[3];
+    f = m->scratch[4];
+    load = m->scratch[18];
+    rhs = m->scratch[19];
+    pred = m->scratch[20];
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
     memset(&m->stats, 0, sizeof m->stats);
+    if (!heml__precision_ok(m, m->disp) || !heml__precision_ok(m, m->target)) return HEML_ERR_PRECISION;
     heml__prony_coefficients(m, -1.0);
     memcpy(u, m->disp, sizeof(heml_real) * (size_t)n3);
+    heml__forces(m, u, f, 0);
+    inverted_start = m->stats.inverted;
+    memset(&ob, 0, sizeof ob);
+    ob.load = load;
+    ob.tol = (double)m->static_tolerance;
+    ob.max_iterations = m->static_max_iterations;
+    ob.coarse = 1;
+    ob.energy_search = 1; /* the relaxed Prony response is s f, of potential s W */
     while (lambda < 1.0) {
-        double trial = lambda + increment > 1.0 ? 1.0 : lambda + increment;
+        double trial = lambda + increment > 1.0 ? 1.0 : lambda + increment, slope;
         heml_real t = (heml_real)trial;
+        int kerr;
+        if (attempts++ >= m->max_increments) {
+            if (!err) err = HEML_ERR_NO_CONVERGENCE;
+            break;
+        }
         memcpy(saved, u, sizeof(heml_real) * (size_t)n3);
         for (i = 0; i < m->node_count; i++)
             for (r = 0; r < 3; r++) {
                 int j = 3 * i + r;
                 load[j] = t * (m->ext[j] + m->mass[i] * m->gravity[r]) * m->free_mask[j];
-                if (m->pin_mask[j] > 0) u[j] = m->disp[j] + t * (m->target[j] - m->disp[j]);
+                dpin[j] = m->pin_mask[j] > 0 ? m->disp[j] + t * (m->target[j] - m->disp[j]) - u[j] : 0;
             }
-        err = heml__static_newton(m, load, u);
+        if (!heml__finite(heml__dot(load, load, n3))) {
+            err = HEML_ERR_NOT_FINITE;
+            break;
+        }
+        /* the tangent predictor */
+        heml__forces(m, u, f, 0);
+        heml__pass_run(m, HEML__DIFF, u, dpin, q, 0, HEML_STRESS_PK1);
+        for (i = 0; i < n3; i++) {
+            rhs[i] = (f[i] + load[i] + q[i]) * m->free_mask[i];
+            pred[i] = 0;
+        }
+        kerr = heml__cg(m, u, NULL, 1.0, rhs, pred, 1e-3, 1, krylov);
+        if (kerr == HEML_ERR_NOT_FINITE) {
+            err = kerr;
+            break;
+        }
+        slope = heml__dot(rhs, pred, n3);
+        if (!(slope > 0 && heml__finite(slope))) memset(pred, 0, sizeof(heml_real) * (size_t)n3);
+        for (i = 0; i < n3; i++) u[i] += dpin[i] + pred[i] * m->free_mask[i];
+        heml__forces(m, u, f, 0);
+        if (!m->allow_inversion && m->stats.inverted > inverted_start) /* no prediction then */
+            for (i = 0; i < n3; i++) u[i] = saved[i] + dpin[i];
+        err = heml__newton(m, &ob, u);
+        if (!err && !m->allow_inversion && m->stats.inverted > inverted_start) err = HEML_ERR_INVERTED;
         if (err == HEML_OK) {
             lambda = trial;
             increment *= 2.0;
-            m->stats.load_steps++;
+            m->stats.increments++;
         } else {
             memcpy(u, saved, sizeof(heml_real) * (size_t)n3);
             increment *= 0.5;
-            if (err == HEML_ERR_ROUND_OFF || increment < 1.0 / 1024) break;
+            m->stats.increment_cuts++;
+            if (err == HEML_ERR_ROUND_OFF || err == HEML_ERR_NOT_FINITE || increment < (double)m->min_increment) break;
         }
     }
     if (lambda < 1.0) return err;
     if (!heml__all_finite(u, (size_t)n3)) return HEML_ERR_NOT_FINITE;
+    if (!heml__precision_ok(m, u)) return HEML_ERR_PRECISION;
     if (m->has_prony) { /* the Prony state of the last pass at u: make sure it is at u */
-        heml__forces(m, u, m->scratch[1], 1);
+        heml__forces(m, u, m->scratch[4], 1);
     }
     heml__commit(m, u, NULL);
+    m->div_valid = 0;
     memset(m->dv_prev, 0, sizeof(heml_real) * (size_t)n3);
     return HEML_OK;
 }
@@ -3794,6 +4238,7 @@ HEMLDEF int heml_set_positions(heml_model *m, const heml_real *positions)
     if (!heml__all_finite(positions, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
     for (i = 0; i < 3 * m->node_count; i++) m->disp[i] = positions[i] - m->rest[i];
     memcpy(m->pos, positions, sizeof(heml_real) * 3 * (size_t)m->node_count);
+    m->div_valid = 0;
     return HEML_OK;
 }
 
@@ -3803,6 +4248,7 @@ HEMLDEF int heml_set_displacements(heml_model *m, const heml_real *displacements
     if (!heml__all_finite(displacements, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
     memcpy(m->disp, displacements, sizeof(heml_real) * 3 * (size_t)m->node_count);
     heml__update_positions(m);
+    m->div_valid = 0;
     return HEML_OK;
 }
 
@@ -3812,6 +4258,7 @@ HEMLDEF int heml_set_velocities(heml_model *m, const heml_real *velocities)
     if (!m || !velocities) return HEML_ERR_ARG;
     if (!heml__all_finite(velocities, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
     for (i = 0; i < 3 * m->node_count; i++) m->vel[i] = velocities[i] * (m->mass[i / 3] > 0);
+    m->div_valid = 0;
     return HEML_OK;
 }
 

@@ -227,8 +227,8 @@ static void test_semi_explicit_energy_and_time_step(void)
         heml_set_velocities(m, v);
         for (s = 0; s < 400 && err == HEML_OK; s++) err = heml_step_ex(m, (heml_real)(4 * est), HEML_SEMI_EXPLICIT_EULER);
         E = total_energy(m);
-        printf("    at 4x the estimate: %s after %d steps\n", err ? "not finite" : "finite", s);
-        CHECK(err == HEML_ERR_NOT_FINITE || E > 100 * E0);
+        printf("    at 4x the estimate: %s after %d steps\n", heml_error_string(err), s);
+        CHECK(err == HEML_ERR_DIVERGED || err == HEML_ERR_NOT_FINITE); /* caught, never accepted */
         free(v);
         heml_destroy(m);
     }
@@ -268,13 +268,13 @@ static void test_implicit_stiff_tissue(void)
     REQUIRE(tip >= 0);
     printf("    explicit limit estimate %.3g s, step %.3g s\n", heml_stable_time_step(me), dt);
     for (s = 0; s < 100 && err == HEML_OK; s++) err = heml_step_ex(me, (heml_real)dt, HEML_SEMI_EXPLICIT_EULER);
-    CHECK_INT(HEML_ERR_NOT_FINITE, err);
+    CHECK(err == HEML_ERR_DIVERGED || err == HEML_ERR_NOT_FINITE);
     failed_at = s;
     for (s = 0; s < steps; s++) {
         CHECK_INT(HEML_OK, heml_step_ex(mi, (heml_real)dt, HEML_IMPLICIT_EULER));
         CHECK(heml_last_stats(mi)->negative_curvature == 0);
+        if (s == 0) CHECK(heml_last_stats(mi)->cg_iterations > 0);
     }
-    CHECK(heml_last_stats(mi)->cg_iterations > 0);
     CHECK_INT(HEML_OK, heml_solve_static(ms));
     z0 = mesh.nodes[3 * tip + 2];
     zi = (double)heml_positions(mi)[3 * tip + 2] - z0;
@@ -312,9 +312,9 @@ static void test_implicit_newton_iterations(void)
         heml_set_positions(m, x);
         memcpy(x0, x, sizeof(heml_real) * n3);
         heml_set_solver(m, (heml_real)(IS_FLOAT ? 1e-6 : 1e-10), 5000);
-        CHECK_INT(HEML_OK, heml_set_newton_iterations(m, k ? 6 : 1));
-        CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)dt, HEML_IMPLICIT_EULER));
-        if (k) /* up to 6 (fewer once the update is below the CG tolerance) */
+        CHECK_INT(HEML_OK, heml_set_newton_iterations(m, 6));
+        CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)dt, k ? HEML_IMPLICIT_EULER : HEML_IMPLICIT_EULER_LINEARIZED));
+        if (k) /* up to 6 (fewer once the residual is below newton_tolerance) */
             CHECK(heml_last_stats(m)->newton_iterations > 1 && heml_last_stats(m)->newton_iterations <= 6);
         else
             CHECK_INT(1, heml_last_stats(m)->newton_iterations);
@@ -572,9 +572,9 @@ static void test_static_r2_soft_beam(void)
                 }
             printf("    %-13s %2d x %d x %d cells: tip %.5f m, %d Newton iterations, %d load step(s), "
                    "largest free residual %.2g of the load\n", names[li], 16 * k, k, k, tip,
-                   heml_last_stats(m)->newton_iterations, heml_last_stats(m)->load_steps, worst / sqrt(load));
+                   heml_last_stats(m)->newton_iterations, heml_last_stats(m)->increments, worst / sqrt(load));
             CHECK_REL(ref[k - 1][li], tip, IS_FLOAT ? 1e-3 : 1e-5);
-            CHECK_INT(1, heml_last_stats(m)->load_steps);
+            CHECK_INT(1, heml_last_stats(m)->increments);
             CHECK(heml_last_stats(m)->newton_iterations <= 30);
             heml_destroy(m);
         }
@@ -697,7 +697,7 @@ static void test_failed_step_keeps_state(void)
         e_before = (double)heml_compute_forces(m)[n3 - 1];
         err = heml_step_ex(m, (heml_real)0.01, HEML_SEMI_EXPLICIT_EULER);
     }
-    CHECK_INT(HEML_ERR_NOT_FINITE, err);
+    CHECK(err == HEML_ERR_DIVERGED || err == HEML_ERR_NOT_FINITE); /* (the divergence check comes first) */
     for (i = 0; i < n3; i++) same &= x[i] == heml_positions(m)[i] && v[i] == heml_velocities(m)[i];
     CHECK(same);
     e_after = (double)heml_compute_forces(m)[n3 - 1]; /* same positions and Prony state: same force */
@@ -705,7 +705,7 @@ static void test_failed_step_keeps_state(void)
     printf("    blew up at step %d; state kept\n", s);
     err = heml_step_ex(m, (heml_real)1e-9, HEML_IMPLICIT_EULER);
     if (heml__all_finite(heml_compute_forces(m), (size_t)n3)) { /* (not the case on this mesh) */
-        CHECK_INT(HEML_OK, err);
+        CHECK(err == HEML_OK || err == HEML_ERR_ROUND_OFF); /* (float: at its round-off) */
     } else {
         CHECK_INT(HEML_ERR_NOT_FINITE, err);
         for (i = 0; i < n3; i++) same &= x[i] == heml_positions(m)[i] && v[i] == heml_velocities(m)[i];
@@ -1033,7 +1033,7 @@ static void test_validation_errors(void)
     /* one cube of 6 tets */
     heml_real nodes[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
     int tets[6 * 4] = {0, 1, 3, 7, 0, 5, 1, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 6, 4, 7};
-    int bad[6 * 4], tm[6] = {0, 1, 0, 1, 0, 1}, code;
+    int bad[6 * 4], tm[6] = {0, 1, 0, 1, 0, 1}, code, err;
     heml_real badn[8 * 3];
     heml_material mats[2];
     heml_prony_term terms[2];
@@ -1187,7 +1187,8 @@ static void test_validation_errors(void)
         heml_real before[24];
         int i, same = 1;
         memcpy(before, heml_positions(m), sizeof before);
-        CHECK_INT(HEML_ERR_NO_CONVERGENCE, note(heml_solve_static(m)));
+        err = note(heml_solve_static(m));
+        CHECK(err == HEML_ERR_NO_CONVERGENCE || err == HEML_ERR_ROUND_OFF);
         for (i = 0; i < 24; i++) same &= before[i] == heml_positions(m)[i];
         CHECK(same);
     }
@@ -1231,7 +1232,37 @@ static void test_validation_errors(void)
     {
         int s, err = HEML_OK;
         for (s = 0; s < 1000 && err == HEML_OK; s++) err = heml_step_ex(m, (heml_real)1, HEML_SEMI_EXPLICIT_EULER);
-        CHECK_INT(HEML_ERR_NOT_FINITE, note(err));
+        CHECK_INT(HEML_ERR_DIVERGED, note(err));
+    }
+    heml_destroy(m);
+    /* implicit Euler whose Newton cap is too small for its step */
+    d = base;
+    d.newton_iterations = 1;
+    d.material = heml_material_from_young(HEML_NEO_HOOKEAN, 1e3, 0.45);
+    REQUIRE(heml_create(&d, &m) == HEML_OK);
+    heml_fix_node(m, 0);
+    heml_fix_node(m, 1);
+    CHECK_INT(HEML_ERR_NO_CONVERGENCE, note(heml_step_ex(m, (heml_real)1, HEML_IMPLICIT_EULER)));
+    heml_destroy(m);
+    /* a load whose squared norm overflows (issue 18 item 13) */
+    REQUIRE(heml_create(&base, &m) == HEML_OK);
+    heml_fix_node(m, 0);
+    {
+        heml_real huge[3] = {0, 0, (heml_real)(IS_FLOAT ? 1e30 : 1e162)};
+        heml_set_external_force(m, 7, huge);
+        CHECK_INT(HEML_ERR_NOT_FINITE, note(heml_solve_static(m)));
+    }
+    heml_destroy(m);
+    /* a state too far from the origin for the precision asked for */
+    d = base;
+    d.precision_limit = (heml_real)1e-14;
+    REQUIRE(heml_create(&d, &m) == HEML_OK);
+    {
+        heml_real far[24];
+        int i;
+        for (i = 0; i < 24; i++) far[i] = (heml_real)1e3;
+        heml_set_displacements(m, far);
+        CHECK_INT(HEML_ERR_PRECISION, note(heml_step(m)));
     }
     heml_destroy(m);
     /* every error code was provoked above */
