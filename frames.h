@@ -65,9 +65,9 @@
 
        FRM_REAL        float or double (default double). Kernels and stored data are
                        FRM_REAL; creation, shape functions, sampling, dot products and
-                       energies run in double. In float builds the entry points that take
-                       or make FRM_REAL data are renamed (..._f32), so float and double
-                       translation units cannot be linked together.
+                       energies run in double. In float builds every public entry point
+                       is renamed (..._f32), so float and double translation units cannot
+                       be linked together.
        FRM_MALLOC(size, user) / FRM_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
        FRM_ASSERT(x)   internal sanity checks (default: assert from <assert.h>).
@@ -415,25 +415,68 @@ typedef FRM_REAL frm_real;
 #define FRM_HOSTDEV
 #endif
 
-/* Float builds rename the entry points that take or make frm_real data, so that a float
-   and a double translation unit cannot be linked together by mistake. FRM_REAL must be
-   the single token float or double. */
+/* Float builds rename every public entry point (every FRMDEF function, ..._f32), so that
+   a float and a double translation unit cannot be linked together by mistake, whichever
+   functions a program calls (tests/test_frames_elem.c reads this list back against the
+   declarations). FRM_REAL must be the single token float or double. */
 #define FRM__IS_float 1
 #define FRM__IS_double 0
 #define FRM__CAT2(a, b) a##b
 #define FRM__CAT(a, b) FRM__CAT2(a, b)
 #if FRM__CAT(FRM__IS_, FRM_REAL)
-#define frm_model_create frm_model_create_f32
-#define frm_model_default_desc frm_model_default_desc_f32
+#define frm_version frm_version_f32
+#define frm_error_string frm_error_string_f32
+#define frm_shape_tet frm_shape_tet_f32
+#define frm_shape_hex frm_shape_hex_f32
+#define frm_shape_shepard frm_shape_shepard_f32
+#define frm_shape_mls frm_shape_mls_f32
 #define frm_sampling_hexes frm_sampling_hexes_f32
 #define frm_sampling_tets frm_sampling_tets_f32
 #define frm_sampling_meshless frm_sampling_meshless_f32
 #define frm_sampling_box frm_sampling_box_f32
 #define frm_sampling_surface frm_sampling_surface_f32
-#define frm_shape_tet frm_shape_tet_f32
-#define frm_shape_hex frm_shape_hex_f32
-#define frm_shape_shepard frm_shape_shepard_f32
-#define frm_shape_mls frm_shape_mls_f32
+#define frm_sampling_apply frm_sampling_apply_f32
+#define frm_sampling_free frm_sampling_free_f32
+#define frm_shape_default_desc frm_shape_default_desc_f32
+#define frm_poisson_default_desc frm_poisson_default_desc_f32
+#define frm_model_default_desc frm_model_default_desc_f32
+#define frm_model_create frm_model_create_f32
+#define frm_model_destroy frm_model_destroy_f32
+#define frm_model_fix_frame frm_model_fix_frame_f32
+#define frm_model_drive_frame frm_model_drive_frame_f32
+#define frm_model_release_frame frm_model_release_frame_f32
+#define frm_model_frame_state frm_model_frame_state_f32
+#define frm_model_set_external frm_model_set_external_f32
+#define frm_model_clear_external frm_model_clear_external_f32
+#define frm_model_set_gravity frm_model_set_gravity_f32
+#define frm_model_set_solver frm_model_set_solver_f32
+#define frm_model_set_stiffness_mode frm_model_set_stiffness_mode_f32
+#define frm_model_step frm_model_step_f32
+#define frm_model_step_ex frm_model_step_ex_f32
+#define frm_model_solve_static frm_model_solve_static_f32
+#define frm_model_newton_step frm_model_newton_step_f32
+#define frm_model_frame_count frm_model_frame_count_f32
+#define frm_model_sample_count frm_model_sample_count_f32
+#define frm_model_pair_count frm_model_pair_count_f32
+#define frm_model_positions frm_model_positions_f32
+#define frm_model_orientations frm_model_orientations_f32
+#define frm_model_velocities frm_model_velocities_f32
+#define frm_model_set_poses frm_model_set_poses_f32
+#define frm_model_set_velocities frm_model_set_velocities_f32
+#define frm_model_sample_positions frm_model_sample_positions_f32
+#define frm_model_deformation_gradients frm_model_deformation_gradients_f32
+#define frm_model_forces frm_model_forces_f32
+#define frm_model_total_forces frm_model_total_forces_f32
+#define frm_model_energy frm_model_energy_f32
+#define frm_model_last_stats frm_model_last_stats_f32
+#define frm_model_mass_block frm_model_mass_block_f32
+#define frm_model_memory_bytes frm_model_memory_bytes_f32
+#define frm_model_stabilized_frames frm_model_stabilized_frames_f32
+#define frm_model_prepare_stiffness frm_model_prepare_stiffness_f32
+#define frm_model_apply_stiffness frm_model_apply_stiffness_f32
+#define frm_model_assemble_stiffness frm_model_assemble_stiffness_f32
+#define frm_model_stiffness_blocks frm_model_stiffness_blocks_f32
+#define frm_model_stiffness_block frm_model_stiffness_block_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
@@ -484,7 +527,7 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_STIFFNESS_MODE, -24, "unknown stiffness mode, or assembled blocks requested from a matrix-free model") \
     X(FRM_ERR_NOT_FINITE, -25, "result not finite; the last valid state was kept") \
     X(FRM_ERR_NO_CONVERGENCE, -26, "solver did not converge; the last valid state was kept") \
-    X(FRM_ERR_INVERTED, -27, "a Neo-Hookean sample would invert (det F <= 0); the last valid state was kept") \
+    X(FRM_ERR_INVERTED, -27, "a sample would invert or mirror (det F <= 0; Neo-Hookean and St Venant-Kirchhoff); the last valid state was kept") \
     X(FRM_ERR_FRAME_RANGE, -28, "frame index out of range") \
     X(FRM_ERR_NOT_NEIGHBORS, -29, "the two frames share no sample (no stiffness block between them)") \
     X(FRM_ERR_SHAPE_DEGENERATE, -30, "shape function undefined: flat or inverted element, coincident or coplanar frames") \
@@ -661,17 +704,19 @@ typedef struct frm_shape_desc {
     int nearest;         /* k for FRM_SUPPORT_NEAREST, 1..16 (MLS needs >= 4), default 8 */
     frm_real radius;     /* m: the support radius for FRM_SUPPORT_RADIUS; ignored otherwise */
     frm_real power;      /* Shepard exponent p of eq. 4.9, > 1, default 2 */
+    unsigned int internal_cookie; /* set by frm_shape_default_desc; do not touch */
 } frm_shape_desc;
 
 /* Poisson-disk sampling of a domain (thesis sec. 4.1, "Domain sampling", after Bridson
    2007): frames from a coarser distance than samples. */
 typedef struct frm_poisson_desc {
-    frm_real frame_spacing;  /* m, least distance between frames, > sample_spacing */
+    frm_real frame_spacing;  /* m, least distance between frames, >= sample_spacing */
     frm_real sample_spacing; /* m, least distance between samples */
     unsigned int seed;       /* same seed, same points, on every platform; default 1 */
     frm_real volume;         /* m^3 split evenly over the samples; <= 0 (default): the
                                 domain's own volume (needed for a flat or linear box) */
     int max_points;          /* refuse (FRM_ERR_SAMPLING) to make more points, default 1e6 */
+    unsigned int internal_cookie; /* set by frm_poisson_default_desc; do not touch */
 } frm_poisson_desc;
 
 /* Frames, samples and their neighbour table, owning its arrays: what frm_sampling_*
@@ -700,13 +745,14 @@ FRMDEF const char *frm_error_string(int code);
 
 /* Tetrahedral barycentric (linear) functions of the 4 corners (12 coordinates, m, any
    orientation) at point: weights[4], gradients[4 * 3] (1/m, constant in the element).
-   FRM_ERR_SHAPE_DEGENERATE for a flat tetrahedron. */
+   FRM_ERR_SHAPE_DEGENERATE for a flat tetrahedron; FRM_ERR_ARG for a non-finite corner or point. */
 FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], frm_real weights[4],
                          frm_real gradients[12]);
 /* Hexahedral trilinear functions of the 8 corners (corner (a, b, c), a, b, c in {0, 1}, is
    index a + 2 b + 4 c, as hexmesh_grid in examples/tetmesh.h) at the parametric point
    xi in [0, 1]^3: the physical point (may be NULL), weights[8], gradients[8 * 3] (1/m)
-   and det(dx/dxi) (m^3, may be NULL). FRM_ERR_SHAPE_DEGENERATE if det <= 0 there. */
+   and det(dx/dxi) (m^3, may be NULL). FRM_ERR_SHAPE_DEGENERATE if det <= 0 there;
+   FRM_ERR_ARG for a non-finite corner or xi. */
 FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_real point[3],
                          frm_real weights[8], frm_real gradients[24], frm_real *jacobian_det);
 /* Shepard inverse-distance functions (eqs. 4.8-4.9) of `count` frames (3 * count
@@ -714,14 +760,16 @@ FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_r
    form); radius > 0: w_i ~ ((R - d_i)+ / (R d_i))^p (Franke-Little, zero at the support's
    edge; frames beyond R get weight 0, at least one must be inside). A point on a frame
    gets that frame's weight 1 and zero gradients (the limit for p > 1). Coplanar and
-   collinear frames are fine. FRM_ERR_SHAPE_DEGENERATE if two frames coincide. */
+   collinear frames are fine. FRM_ERR_SHAPE_DEGENERATE if two frames coincide; FRM_ERR_ARG
+   for a non-finite frame or point, power <= 1 or not finite, radius not finite. */
 FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real point[3], frm_real power,
                              frm_real radius, frm_real *weights, frm_real *gradients);
 /* Linear moving least squares functions (eqs. 4.5-4.7 with p = [1 x y z]) of `count`
    frames at point, Wendland C2 kernel of support radius > 0 (m). First-order
    consistent: sum w_i x_i = point and sum x_i grad w_i^T = I. Weights may be negative.
    FRM_ERR_SHAPE_DEGENERATE if the frames inside the radius are fewer than 4 or (nearly)
-   coplanar: the moment matrix is singular (table 4.1). */
+   coplanar: the moment matrix is singular (table 4.1); FRM_ERR_ARG for a non-finite frame,
+   point or radius. */
 FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point[3], frm_real radius,
                          frm_real *weights, frm_real *gradients);
 
@@ -1083,8 +1131,12 @@ FRM_HOSTDEV static inline void frm_first_piola(const frm_real F[9], const frm_re
        SVK (eq. 3.53):  S = lambda tr(E) I + 2 mu E
        Neo-Hookean:     S = mu (I - C^-1) + lambda ln J C^-1 = 2 mu C^-1 E + lambda ln J C^-1
    (J - 1 by frm_det_minus_one, ln J by log1p: small strains keep their digits). Returns 0,
-   or FRM_ERR_INVERTED for a Neo-Hookean sample with J <= 0 (the energy is infinite
-   there). Room for more laws: add a case here and in frm_material_dstress. */
+   or FRM_ERR_INVERTED for a sample with J <= 0: Neo-Hookean's energy is infinite there
+   (S, psi not computed); St Venant-Kirchhoff's is finite and has a minimum of zero at
+   every mirror image of the rest state (F = diag(1, 1, -1): E = 0), so a solver would
+   happily settle a layer there; S and psi are computed, and a caller that accepts
+   mirrored SVK samples may use them. Room for more laws: add a case here and in
+   frm_material_dstress. */
 FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real lambda, const frm_real H[9],
                                                   frm_real S[6], frm_real *psi, frm_real *cache)
 {
@@ -1138,7 +1190,7 @@ FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real
     *psi = (frm_real)0.5 * lambda * tr * tr +
            mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
     (void)cache;
-    return 0;
+    return 1 + frm_det_minus_one(H) > 0 ? 0 : FRM_ERR_INVERTED;
 }
 
 /* dS for a strain variation dE (6) at the state frm_material_stress cached (eq. 3.68):
@@ -1562,7 +1614,9 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM_ASSERT(x) assert(x)
 #endif
 
-#define FRM__COOKIE 0x46524D53u /* "FRMS" */
+#define FRM__COOKIE 0x46524D53u         /* "FRMS" */
+#define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
+#define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
@@ -2390,7 +2444,9 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     if (!out) return FRM_ERR_ARG;
     *out = NULL;
     if (!d) return FRM_ERR_ARG;
-    if (d->internal_cookie != FRM__COOKIE) return frm__fail(d, FRM_ERR_DESC, "start from frm_model_default_desc()");
+    /* not made by frm_model_default_desc: every field, the log callback included, may be
+       garbage, so refuse without calling it */
+    if (d->internal_cookie != FRM__COOKIE) return FRM_ERR_DESC;
     if (d->frame_count < 1 || d->frame_count > 100000000 || !d->frame_positions)
         return frm__fail(d, FRM_ERR_FRAME_COUNT, "frame_count must be >= 1 with positions");
     if (d->sample_count < 1 || d->sample_count > 100000000 || !d->sample_positions || !d->sample_volumes)
@@ -4141,6 +4197,7 @@ FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], fr
     double X[4][3], p[3], w[4], g[4][3];
     int k, r;
     if (!corners || !point || !weights || !gradients) return FRM_ERR_ARG;
+    if (!frm__all_finite(corners, 12) || !frm__all_finite(point, 3)) return FRM_ERR_ARG;
     for (k = 0; k < 4; k++)
         for (r = 0; r < 3; r++) X[k][r] = (double)corners[3 * k + r];
     for (r = 0; r < 3; r++) p[r] = (double)point[r];
@@ -4199,6 +4256,7 @@ FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_r
     double X[8][3], x[3], p[3], w[8], g[8][3], det;
     int a, r;
     if (!corners || !xi || !weights || !gradients) return FRM_ERR_ARG;
+    if (!frm__all_finite(corners, 24) || !frm__all_finite(xi, 3)) return FRM_ERR_ARG;
     for (a = 0; a < 8; a++)
         for (r = 0; r < 3; r++) X[a][r] = (double)corners[3 * a + r];
     for (r = 0; r < 3; r++) x[r] = (double)xi[r];
@@ -4276,6 +4334,8 @@ FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real p
     double X[3 * 64], p[3], w[64], g[3 * 64];
     int i, err;
     if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    if (!frm__all_finite(frames, 3 * (size_t)count) || !frm__all_finite(point, 3)) return FRM_ERR_ARG;
+    if (!(frm__finite((double)power) && power > 1) || !frm__finite((double)radius)) return FRM_ERR_ARG;
     for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
     for (i = 0; i < 3; i++) p[i] = (double)point[i];
     err = frm__shepard_functions(X, count, p, (double)power, (double)radius, w, g);
@@ -4390,6 +4450,8 @@ FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point
     double X[3 * 64], p[3], w[64], g[3 * 64];
     int i, err;
     if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    if (!frm__all_finite(frames, 3 * (size_t)count) || !frm__all_finite(point, 3) || !frm__finite((double)radius))
+        return FRM_ERR_ARG;
     for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
     for (i = 0; i < 3; i++) p[i] = (double)point[i];
     err = frm__mls_functions(X, count, p, (double)radius, w, g);
@@ -4410,6 +4472,7 @@ FRMDEF frm_shape_desc frm_shape_default_desc(void)
     s.nearest = 8;
     s.radius = 0;
     s.power = 2;
+    s.internal_cookie = FRM__SHAPE_COOKIE;
     return s;
 }
 
@@ -4422,6 +4485,7 @@ FRMDEF frm_poisson_desc frm_poisson_default_desc(void)
     p.seed = 1;
     p.volume = 0;
     p.max_points = 1000000;
+    p.internal_cookie = FRM__POISSON_COOKIE;
     return p;
 }
 
@@ -4776,6 +4840,7 @@ static int frm__grid_query(const frm__grid *g, const double *X, const double *p,
 
 static int frm__check_shape(const frm_shape_desc *sh)
 {
+    if (sh->internal_cookie != FRM__SHAPE_COOKIE) return FRM_ERR_DESC;
     if ((int)sh->shape != FRM_SHAPE_SHEPARD && (int)sh->shape != FRM_SHAPE_MLS) return FRM_ERR_SAMPLING;
     if (sh->support == FRM_SUPPORT_NEAREST) {
         if (sh->nearest < 1 || sh->nearest > FRM_MAX_NEIGHBORS) return FRM_ERR_SAMPLING;
@@ -4784,7 +4849,7 @@ static int frm__check_shape(const frm_shape_desc *sh)
         if (!(frm__finite((double)sh->radius) && sh->radius > 0)) return FRM_ERR_SAMPLING;
     } else
         return FRM_ERR_SAMPLING;
-    if (sh->shape == FRM_SHAPE_SHEPARD && !(frm__finite((double)sh->power) && sh->power > 0)) return FRM_ERR_SAMPLING;
+    if (sh->shape == FRM_SHAPE_SHEPARD && !(frm__finite((double)sh->power) && sh->power > 1)) return FRM_ERR_SAMPLING;
     return FRM_OK;
 }
 
@@ -5210,13 +5275,15 @@ static int frm__poisson(const double lo[3], const double hi[3], const frm__surfa
     return err;
 }
 
-static int frm__check_poisson(const frm_poisson_desc *p)
+static int frm__check_poisson(const frm_poisson_desc *p, const frm_shape_desc *shape)
 {
     if (!p) return FRM_ERR_ARG;
+    if (p->internal_cookie != FRM__POISSON_COOKIE) return FRM_ERR_DESC;
     if (!(frm__finite((double)p->frame_spacing) && p->frame_spacing > 0) ||
         !(frm__finite((double)p->sample_spacing) && p->sample_spacing > 0) || !frm__finite((double)p->volume) ||
-        p->max_points < 1)
+        p->max_points < 1 || p->frame_spacing < p->sample_spacing) /* frames coarser than samples */
         return FRM_ERR_SAMPLING;
+    if (shape) return frm__check_shape(shape); /* before the points are made */
     return FRM_OK;
 }
 
@@ -5264,7 +5331,7 @@ FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_r
     if (!out) return FRM_ERR_ARG;
     memset(out, 0, sizeof *out);
     if (!lo || !hi || !frm__vec3_finite(lo) || !frm__vec3_finite(hi)) return FRM_ERR_ARG;
-    err = frm__check_poisson(p);
+    err = frm__check_poisson(p, shape);
     if (err) return err;
     memset(&alloc, 0, sizeof alloc);
     if (allocator) alloc = *allocator;
@@ -5289,7 +5356,7 @@ FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int
     int err;
     if (!out) return FRM_ERR_ARG;
     memset(out, 0, sizeof *out);
-    err = frm__check_poisson(p);
+    err = frm__check_poisson(p, shape);
     if (err) return err;
     memset(&alloc, 0, sizeof alloc);
     if (allocator) alloc = *allocator;
