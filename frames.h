@@ -1190,7 +1190,7 @@ FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real
     *psi = (frm_real)0.5 * lambda * tr * tr +
            mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
     (void)cache;
-    return 1 + frm_det_minus_one(H) > 0 ? 0 : FRM_ERR_INVERTED;
+    return 1 + frm_det_minus_one(H) <= 0 ? FRM_ERR_INVERTED : 0; /* NaN: left to the non-finite checks */
 }
 
 /* dS for a strain variation dE (6) at the state frm_material_stress cached (eq. 3.68):

@@ -2039,7 +2039,8 @@ static void test_validation_errors(void)
     d = base;
     d.internal_cookie = 0;
     CHECK_INT(FRM_ERR_DESC, try_create(&d));
-    CHECK_INT(FRM_ERR_DESC, lc.last_code); /* and the logger heard of it */
+    /* the logger is not called: a description not made by the default function may hold a
+       garbage callback (issue 18 item 12, tests/test_frames_elem.c) */
     d = base;
     d.frame_count = 0;
     CHECK_INT(FRM_ERR_FRAME_COUNT, try_create(&d));
