@@ -1466,30 +1466,64 @@ FRM_HOSTDEV static inline void frm_stab_stress(frm_real c, const frm_real Qm[9],
             T[3 * r + k] = h * (X[3 * r + k] + Qm[3 * r] * X[k] + Qm[3 * r + 1] * X[3 + k] + Qm[3 * r + 2] * X[6 + k]);
 }
 
-/* The rotation stabilisation of one (sample, frame) pair (see MODEL): with A = Q^T F the
-   sample's deformation seen in the frame's rest axes, omega = axial(skew A) its rotation
-   relative to the frame and m = N omega (N the frame's projector on the rotations its
-   samples do not see, rest axes, 6 Voigt),
-       E = c/2 omega . m,   T = c/2 Q [m]x,   dE = T : dF - dtheta . sum_j f_j x t_j
-   (f_j, t_j the columns of F, T; dtheta the frame's rotation). The caller adds T / v to
-   the sample's P (the T : dF part reaches every frame through B^T); the frame's own share
-   torque = sum_j f_j x t_j is returned with T, m and E. H = F - I and Qm = Q - I keep
-   small rotations' digits: skew(Q^T F) = skew(Qm^T + H + Qm^T H). */
-FRM_HOSTDEV static inline frm_real frm_pair_stab_force(const frm_real H[9], const frm_real F[9], const frm_real Qm[9],
-                                                       const frm_real N[6], frm_real c, frm_real T[9],
-                                                       frm_real torque[3], frm_real m[3])
+/* The rotation of a sample relative to one of its frames (see MODEL, rotation
+   stabilisation): with A = Q^T F the sample's deformation seen in the frame's rest axes,
+   omega = axial(skew A). H = F - I and Qm = Q - I keep small rotations' digits:
+   skew(Q^T F) = skew(Qm^T + H + Qm^T H). */
+FRM_HOSTDEV static inline void frm_pair_stab_omega(const frm_real H[9], const frm_real Qm[9], frm_real om[3])
 {
-    frm_real A[9], om[3], Nm[9];
+    frm_real A[9];
     int r, k;
     for (r = 0; r < 3; r++)
         for (k = 0; k < 3; k++)
             A[3 * r + k] = Qm[3 * k + r] + H[3 * r + k] + Qm[r] * H[k] + Qm[3 + r] * H[3 + k] + Qm[6 + r] * H[6 + k];
     frm_skew_axial(A, om);
-    frm_sym_to_matrix(N, Nm);
-    for (r = 0; r < 3; r++) m[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
-    frm_stab_stress(c, Qm, m, T);
-    frm_column_cross_sum(F, T, torque);
-    return (frm_real)0.5 * c * (om[0] * m[0] + om[1] * m[1] + om[2] * m[2]);
+}
+
+/* Its variation for the sample's dF and the frame's rotation dtheta (Q -> exp([dtheta]x) Q):
+   domega = axial(skew(Q^T (dF - [dtheta]x F))). dtheta may be NULL (zero). */
+FRM_HOSTDEV static inline void frm_pair_stab_domega(const frm_real F[9], const frm_real dF[9], const frm_real Qm[9],
+                                                    const frm_real *dtheta, frm_real om[3])
+{
+    frm_real D[9], A[9];
+    int r, k;
+    for (k = 0; k < 9; k++) D[k] = dF[k];
+    if (dtheta)
+        for (k = 0; k < 3; k++) { /* D = dF - [dtheta]x F, column by column */
+            D[k] -= dtheta[1] * F[6 + k] - dtheta[2] * F[3 + k];
+            D[3 + k] -= dtheta[2] * F[k] - dtheta[0] * F[6 + k];
+            D[6 + k] -= dtheta[0] * F[3 + k] - dtheta[1] * F[k];
+        }
+    for (r = 0; r < 3; r++) /* A = Q^T D */
+        for (k = 0; k < 3; k++)
+            A[3 * r + k] = D[3 * r + k] + Qm[r] * D[k] + Qm[3 + r] * D[3 + k] + Qm[6 + r] * D[6 + k];
+    frm_skew_axial(A, om);
+}
+
+/* The stabilisation's conjugate of each pair's relative rotation for one sample of n
+   neighbours (see MODEL): with omega_k the relative rotations (3 n), N_k the frames'
+   projectors on their unseen rotations (6 Voigt each, rest axes; zero for most frames) and
+   Omega = sum_j w_j omega_j (the frames' interpolated rotation less the material's),
+       m_k = N_k omega_k + w_k Omega,   Phi = sum_k omega_k . N_k omega_k + |Omega|^2,
+   so that the energy c/2 Phi has dE = c sum_k m_k . domega_k. Writes m (3 n), returns Phi.
+   The same map takes variations domega_k to the Gauss-Newton conjugates. */
+FRM_HOSTDEV static inline frm_real frm_sample_stab_moments(int n, const int *frame, const frm_real *weight,
+                                                           const frm_real *projector, const frm_real *om, frm_real *m)
+{
+    frm_real Om[3] = {0, 0, 0}, phi = 0;
+    int k, r;
+    for (k = 0; k < n; k++)
+        for (r = 0; r < 3; r++) Om[r] += weight[k] * om[3 * k + r];
+    for (k = 0; k < n; k++) {
+        const frm_real *N = projector + 6 * frame[k], *o = om + 3 * k;
+        frm_real *mk = m + 3 * k;
+        mk[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2];
+        mk[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2];
+        mk[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2];
+        phi += o[0] * mk[0] + o[1] * mk[1] + o[2] * mk[2];
+        for (r = 0; r < 3; r++) mk[r] += weight[k] * Om[r];
+    }
+    return phi + Om[0] * Om[0] + Om[1] * Om[1] + Om[2] * Om[2];
 }
 
 /* The frame-own second-order part of the stabilisation, X = sym(F T^T) - tr(F^T T) I (6,
@@ -1510,31 +1544,20 @@ FRM_HOSTDEV static inline void frm_pair_stab_rotation(const frm_real F[9], const
 }
 
 /* The stabilisation's stiffness (symmetric part, less the frame-own X above) for one pair:
-   for the sample's dF and the frame's dtheta,
-       omega1 = axial(skew(Q^T (dF - [dtheta]x F))),   Ta = c/2 Q [N omega1]x,
-       dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
+   for the sample's dF, the frame's dtheta and u the conjugate (frm_sample_stab_moments) of
+   the sample's domega_k (frm_pair_stab_domega),
+       Ta = c/2 Q [u]x,   dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
    dPx a stress-like term (absolute: the caller divides by the volume and adds it to dP,
-   which B^T takes to every frame), torque the frame's own row. definite = 1 keeps the
-   Gauss-Newton part only (Ta; -sum f_j x ta_j), which is positive semi-definite. m is
-   the linearisation's m = N omega. */
+   which B^T takes to every frame), torque the frame's own row, T = c/2 Q [m]x with m the
+   linearisation's conjugate. definite = 1 keeps the Gauss-Newton part only (Ta;
+   -sum f_j x ta_j), which is positive semi-definite. dtheta may be NULL (zero). */
 FRM_HOSTDEV static inline void frm_pair_stab_apply(const frm_real F[9], const frm_real dF[9], const frm_real Qm[9],
-                                                   const frm_real N[6], frm_real c, const frm_real m[3],
-                                                   const frm_real dtheta[3], int definite, frm_real dPx[9],
+                                                   frm_real c, const frm_real u[3], const frm_real m[3],
+                                                   const frm_real *dtheta, int definite, frm_real dPx[9],
                                                    frm_real torque[3])
 {
-    frm_real D[9], A[9], om[3], u[3], Nm[9], t[3];
+    frm_real t[3];
     int r, k;
-    for (k = 0; k < 3; k++) { /* D = dF - [dtheta]x F, column by column */
-        D[k] = dF[k] - (dtheta[1] * F[6 + k] - dtheta[2] * F[3 + k]);
-        D[3 + k] = dF[3 + k] - (dtheta[2] * F[k] - dtheta[0] * F[6 + k]);
-        D[6 + k] = dF[6 + k] - (dtheta[0] * F[3 + k] - dtheta[1] * F[k]);
-    }
-    for (r = 0; r < 3; r++) /* A = Q^T D */
-        for (k = 0; k < 3; k++)
-            A[3 * r + k] = D[3 * r + k] + Qm[r] * D[k] + Qm[3 + r] * D[3 + k] + Qm[6 + r] * D[6 + k];
-    frm_skew_axial(A, om);
-    frm_sym_to_matrix(N, Nm);
-    for (r = 0; r < 3; r++) u[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
     frm_stab_stress(c, Qm, u, dPx);
     frm_column_cross_sum(F, dPx, torque);
     for (r = 0; r < 3; r++) torque[r] = -torque[r];
@@ -1543,11 +1566,12 @@ FRM_HOSTDEV static inline void frm_pair_stab_apply(const frm_real F[9], const fr
         frm_stab_stress(c, Qm, m, T);
         frm_column_cross_sum(dF, T, t);
         for (r = 0; r < 3; r++) torque[r] -= t[r];
-        for (k = 0; k < 3; k++) { /* dPx += [dtheta]x T */
-            dPx[k] += dtheta[1] * T[6 + k] - dtheta[2] * T[3 + k];
-            dPx[3 + k] += dtheta[2] * T[k] - dtheta[0] * T[6 + k];
-            dPx[6 + k] += dtheta[0] * T[3 + k] - dtheta[1] * T[k];
-        }
+        if (dtheta)
+            for (k = 0; k < 3; k++) { /* dPx += [dtheta]x T */
+                dPx[k] += dtheta[1] * T[6 + k] - dtheta[2] * T[3 + k];
+                dPx[3 + k] += dtheta[2] * T[k] - dtheta[0] * T[6 + k];
+                dPx[6 + k] += dtheta[0] * T[3 + k] - dtheta[1] * T[k];
+            }
     }
 }
 
@@ -2012,7 +2036,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_A, frm_real, 3 * P);
     FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
-    if (m->stab_frames) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
+    if (m->stab_beta > 0) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
     for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
@@ -2554,13 +2578,14 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
     memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
     memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
-    if (m->stab_frames)
+    if (m->stab_beta > 0) { /* every sample: its frames' interpolated rotation is tied to its own */
         for (i = 0; i < n; i++) {
             double N[6];
             m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
             for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)N[k];
-            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
         }
+        for (s = 0; s < S; s++) m->s_stab[s] = 1;
+    }
 
     /* samples */
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
@@ -2699,23 +2724,22 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             energy += (double)v * (double)psi;
             frm_first_piola(F, S, P);
             if (stab) { /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                frm_real cst = m->stab_beta * m->s_mu[s] * v, mv[3];
+                frm_real cst = m->stab_beta * m->s_mu[s] * v, om[3 * FRM_MAX_NEIGHBORS], mm[3 * FRM_MAX_NEIGHBORS];
+                for (k = 0; k < n; k++) frm_pair_stab_omega(H, m->relm + 9 * m->p_frame[b + k], om + 3 * k);
+                energy += 0.5 * (double)cst * (double)frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, mm);
                 for (k = 0; k < n; k++) {
-                    int i = m->p_frame[b + k];
-                    if (!m->f_stab_on[i]) continue;
-                    energy += (double)frm_pair_stab_force(H, F, m->relm + 9 * i, m->f_stab + 6 * i, cst, sT + 9 * k,
-                                                          stq + 3 * k, mv);
-                    if (ctx->linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mv, sizeof mv);
+                    frm_stab_stress(cst, m->relm + 9 * m->p_frame[b + k], mm + 3 * k, sT + 9 * k);
+                    frm_column_cross_sum(F, sT + 9 * k, stq + 3 * k);
                     for (r = 0; r < 9; r++) P[r] += sT[9 * k + r] / v;
                 }
+                if (ctx->linearize) memcpy(m->p_stab + 3 * (size_t)b, mm, sizeof(frm_real) * 3 * (size_t)n);
             }
             for (k = 0; k < n; k++)
                 frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
             if (stab)
                 for (k = 0; k < n; k++)
-                    if (m->f_stab_on[m->p_frame[b + k]])
-                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
+                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
                 energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
                                                             m->p_out + 6 * (size_t)b,
@@ -2738,7 +2762,7 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                     frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                        m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k), Hs);
-                    if (stab && m->f_stab_on[m->p_frame[b + k]]) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
+                    if (stab) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
                     if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)(b + k), lever + 3 * k, Hs);
                 }
             }
@@ -2917,12 +2941,17 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                           m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
             if (m->s_stab[s]) {
-                frm_real cst = m->stab_beta * m->s_mu[s] * vol, dPx[9];
+                frm_real cst = m->stab_beta * m->s_mu[s] * vol, dPx[9], om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
+                const frm_real *Fl = m->lin_F + 9 * (size_t)s;
                 for (k = 0; k < n; k++) {
                     int i = m->p_frame[b + k];
-                    if (!m->f_stab_on[i]) continue;
-                    frm_pair_stab_apply(m->lin_F + 9 * (size_t)s, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst,
-                                        m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3, m->lin_definite, dPx, stq + 3 * k);
+                    frm_pair_stab_domega(Fl, dF, m->relm + 9 * i, v + 6 * i + 3, om + 3 * k);
+                }
+                frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, uu);
+                for (k = 0; k < n; k++) {
+                    int i = m->p_frame[b + k];
+                    frm_pair_stab_apply(Fl, dF, m->relm + 9 * i, cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3,
+                                        m->lin_definite, dPx, stq + 3 * k);
                     for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
                 }
             }
@@ -2930,8 +2959,7 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
                 frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
             if (m->s_stab[s])
                 for (k = 0; k < n; k++)
-                    if (m->f_stab_on[m->p_frame[b + k]])
-                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
+                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
                 frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->s_couple[s], v,
                                           m->p_out + 6 * (size_t)b);
@@ -3041,21 +3069,19 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
 static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54], frm_real *rows)
 {
     int b = m->s_start[s], n = m->s_start[s + 1] - b, c, k, r, pa = b + a;
-    frm_real vol = m->s_volume[s], cst = m->stab_beta * m->s_mu[s] * vol, zero[3] = {0, 0, 0};
+    frm_real vol = m->s_volume[s], cst = m->stab_beta * m->s_mu[s] * vol, om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
     const frm_real *F = m->lin_F + 9 * (size_t)s;
     for (c = 0; c < 6; c++) {
         frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
         dq[c] = 1;
         frm_pair_dF(dq, m->p_grad + 3 * (size_t)pa, m->p_G + 9 * (size_t)pa, dF);
+        for (k = 0; k < n; k++)
+            frm_pair_stab_domega(F, dF, m->relm + 9 * m->p_frame[b + k], k == a ? dq + 3 : NULL, om + 3 * k);
+        frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, uu);
         for (k = 0; k < n; k++) {
-            int i = m->p_frame[b + k];
             frm_real dPx[9], tq[3];
-            if (!m->f_stab_on[i]) {
-                for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = 0;
-                continue;
-            }
-            frm_pair_stab_apply(F, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst, m->p_stab + 3 * (size_t)(b + k),
-                                k == a ? dq + 3 : zero, m->lin_definite, dPx, tq);
+            frm_pair_stab_apply(F, dF, m->relm + 9 * m->p_frame[b + k], cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k),
+                                k == a ? dq + 3 : NULL, m->lin_definite, dPx, tq);
             for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
             for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[r];
         }
@@ -3097,7 +3123,7 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                                          m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
-                if (m->s_stab[s] && m->f_stab_on[i])
+                if (m->s_stab[s])
                     for (k = 0; k < 6; k++)
                         for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * a + 3 * k + r];
                 frm__add_rotational(m->p_H + 6 * (size_t)p, K);
@@ -3153,7 +3179,7 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
                 for (q = 0; q < n; q++) {
                     frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
                     frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q), K);
-                    if (m->s_stab[s] && m->f_stab_on[m->p_frame[b + q]])
+                    if (m->s_stab[s])
                         for (k = 0; k < 6; k++)
                             for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * q + 3 * k + r];
                     if (m->s_couple[s] != 0)
