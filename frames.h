@@ -630,6 +630,13 @@ typedef struct frm_desc {
                                         boundary frames of tetrahedra with one sample each) to
                                         the samples' rotation; frames whose samples spread in
                                         3D are not affected (see MODEL and LIMITS) */
+    frm_real rotation_divergence; /* dimensionless, default 4 (0: the thesis's model): ties the
+                                     divergence of the frames' rotation field to the
+                                     material's, which is zero (a rotation field half the curl
+                                     of the displacement has none). Removes the frames'
+                                     rotations that move no material (tetrahedral frames'
+                                     spurious low modes, hexahedral frames' layers turning about
+                                     their normal); of order h^2 for smooth fields (see MODEL) */
     frm_real frame_coupling; /* dimensionless, default 0 (the thesis's model exactly): weight
                                 of the coupling term that ties each frame's own prediction
                                 of a sample to the blended position (see MODEL); 1e-2
@@ -1502,18 +1509,23 @@ FRM_HOSTDEV static inline void frm_pair_stab_domega(const frm_real F[9], const f
 
 /* The stabilisation's conjugate of each pair's relative rotation for one sample of n
    neighbours (see MODEL): with omega_k the relative rotations (3 n), N_k the frames'
-   projectors on their unseen rotations (6 Voigt each, rest axes; zero for most frames) and
-   Omega = sum_j w_j omega_j (the frames' interpolated rotation less the material's),
-       m_k = N_k omega_k + w_k Omega,   Phi = sum_k omega_k . N_k omega_k + |Omega|^2,
-   so that the energy c/2 Phi has dE = c sum_k m_k . domega_k. Writes m (3 n), returns Phi.
-   The same map takes variations domega_k to the Gauss-Newton conjugates. */
-FRM_HOSTDEV static inline frm_real frm_sample_stab_moments(int n, const int *frame, const frm_real *weight,
-                                                           const frm_real *projector, const frm_real *om, frm_real *m)
+   projectors on their unseen rotations (6 Voigt each, rest axes; zero for most frames),
+   grad w_k the weight gradients (3 n) and D = sum_k grad w_k . omega_k (minus the
+   divergence of the frames' interpolated rotation field: a material rotation field, half
+   the curl of the displacement, has none),
+       m_k = N_k omega_k + g D grad w_k,   Phi = sum_k omega_k . N_k omega_k + g D^2,
+   so that the energy c/2 Phi has dE = c sum_k m_k . domega_k (g = gamma h^2, m^2). Writes
+   m (3 n), returns Phi. The same map takes variations domega_k to the Gauss-Newton
+   conjugates. */
+FRM_HOSTDEV static inline frm_real frm_sample_stab_moments(int n, const int *frame, const frm_real *grad,
+                                                           const frm_real *projector, frm_real g, const frm_real *om,
+                                                           frm_real *m)
 {
-    frm_real Om[3] = {0, 0, 0}, phi = 0;
+    frm_real D = 0, phi;
     int k, r;
-    for (k = 0; k < n; k++)
-        for (r = 0; r < 3; r++) Om[r] += weight[k] * om[3 * k + r];
+    for (k = 0; k < n; k++) D += grad[3 * k] * om[3 * k] + grad[3 * k + 1] * om[3 * k + 1] + grad[3 * k + 2] * om[3 * k + 2];
+    phi = g * D * D;
+    D *= g;
     for (k = 0; k < n; k++) {
         const frm_real *N = projector + 6 * frame[k], *o = om + 3 * k;
         frm_real *mk = m + 3 * k;
@@ -1521,9 +1533,9 @@ FRM_HOSTDEV static inline frm_real frm_sample_stab_moments(int n, const int *fra
         mk[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2];
         mk[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2];
         phi += o[0] * mk[0] + o[1] * mk[1] + o[2] * mk[2];
-        for (r = 0; r < 3; r++) mk[r] += weight[k] * Om[r];
+        for (r = 0; r < 3; r++) mk[r] += D * grad[3 * k + r];
     }
-    return phi + Om[0] * Om[0] + Om[1] * Om[1] + Om[2] * Om[2];
+    return phi;
 }
 
 /* The frame-own second-order part of the stabilisation, X = sym(F T^T) - tr(F^T T) I (6,
@@ -1686,6 +1698,8 @@ struct frm_model {
     int stiffness_mode, has_blocks;
     double regularization, solve_regularization; /* static solves: eps added to K's rotational diagonal */
     frm_real stab_beta;                          /* rotation_stabilization */
+    frm_real stab_gamma;                         /* rotation_divergence */
+    int stab_on;                                 /* the stabilisation has a term (beta with unseen rotations, or gamma) */
     int stab_frames;                             /* frames with a rotation their samples do not see */
     double newton_previous;                      /* |f| at the previous Newton iteration */
     double floor_residual;                       /* |f| of the last iteration below the round-off floor, or 0 */
@@ -1718,6 +1732,7 @@ struct frm_model {
 
     /* samples */
     frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_hstab; /* g = gamma h^2 of the stabilisation's divergence term (m^2) */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
@@ -2017,6 +2032,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_mu, frm_real, S);
     FRM__CARVE(c, m->s_lambda, frm_real, S);
     FRM__CARVE(c, m->s_couple, frm_real, S);
+    FRM__CARVE(c, m->s_hstab, frm_real, S);
     FRM__CARVE(c, m->s_law, unsigned char, S);
     FRM__CARVE(c, m->s_stab, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
@@ -2036,7 +2052,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_A, frm_real, 3 * P);
     FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
-    if (m->stab_beta > 0) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
+    if (m->stab_on) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
     for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
@@ -2091,6 +2107,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
     if (!(frm__finite((double)d->rotation_stabilization) && d->rotation_stabilization >= 0))
         return frm__fail(d, FRM_ERR_ARG, "rotation_stabilization must be finite and >= 0");
+    if (!(frm__finite((double)d->rotation_divergence) && d->rotation_divergence >= 0))
+        return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -2242,6 +2260,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.static_regularization = (frm_real)1e-10;
     d.frame_coupling = 0;
     d.rotation_stabilization = (frm_real)0.5;
+    d.rotation_divergence = (frm_real)4;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
@@ -2526,11 +2545,13 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         tmp.sq_total = (int)sq;
     }
     tmp.stab_beta = d->rotation_stabilization;
+    tmp.stab_gamma = d->rotation_divergence;
     if (tmp.stab_beta > 0)
         for (i = 0; i < n; i++) {
             double N[6];
             tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
         }
+    tmp.stab_on = tmp.stab_frames > 0 || tmp.stab_gamma > 0;
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
     frm__layout(&tmp, &carver);
@@ -2578,14 +2599,15 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
     memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
     memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
-    if (m->stab_beta > 0) { /* every sample: its frames' interpolated rotation is tied to its own */
+    if (m->stab_frames) /* beta N: the unseen rotations of frames with collinear samples */
         for (i = 0; i < n; i++) {
             double N[6];
             m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
-            for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)N[k];
+            for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)(N[k] * (double)m->stab_beta);
+            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
         }
+    if (m->stab_gamma > 0) /* the divergence term: every sample */
         for (s = 0; s < S; s++) m->s_stab[s] = 1;
-    }
 
     /* samples */
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
@@ -2625,6 +2647,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         }
         h2 = wsum > 0 ? h2 / wsum : 0;
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
+        m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
     }
     i = frm__compute_masses(m, d);
     if (i >= 0) {
@@ -2724,9 +2747,9 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             energy += (double)v * (double)psi;
             frm_first_piola(F, S, P);
             if (stab) { /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                frm_real cst = m->stab_beta * m->s_mu[s] * v, om[3 * FRM_MAX_NEIGHBORS], mm[3 * FRM_MAX_NEIGHBORS];
+                frm_real cst = m->s_mu[s] * v, om[3 * FRM_MAX_NEIGHBORS], mm[3 * FRM_MAX_NEIGHBORS];
                 for (k = 0; k < n; k++) frm_pair_stab_omega(H, m->relm + 9 * m->p_frame[b + k], om + 3 * k);
-                energy += 0.5 * (double)cst * (double)frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, mm);
+                energy += 0.5 * (double)cst * (double)frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, mm);
                 for (k = 0; k < n; k++) {
                     frm_stab_stress(cst, m->relm + 9 * m->p_frame[b + k], mm + 3 * k, sT + 9 * k);
                     frm_column_cross_sum(F, sT + 9 * k, stq + 3 * k);
@@ -2941,13 +2964,13 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                           m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
             if (m->s_stab[s]) {
-                frm_real cst = m->stab_beta * m->s_mu[s] * vol, dPx[9], om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
+                frm_real cst = m->s_mu[s] * vol, dPx[9], om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
                 const frm_real *Fl = m->lin_F + 9 * (size_t)s;
                 for (k = 0; k < n; k++) {
                     int i = m->p_frame[b + k];
                     frm_pair_stab_domega(Fl, dF, m->relm + 9 * i, v + 6 * i + 3, om + 3 * k);
                 }
-                frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, uu);
+                frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, uu);
                 for (k = 0; k < n; k++) {
                     int i = m->p_frame[b + k];
                     frm_pair_stab_apply(Fl, dF, m->relm + 9 * i, cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3,
@@ -3069,7 +3092,7 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
 static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54], frm_real *rows)
 {
     int b = m->s_start[s], n = m->s_start[s + 1] - b, c, k, r, pa = b + a;
-    frm_real vol = m->s_volume[s], cst = m->stab_beta * m->s_mu[s] * vol, om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
+    frm_real vol = m->s_volume[s], cst = m->s_mu[s] * vol, om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
     const frm_real *F = m->lin_F + 9 * (size_t)s;
     for (c = 0; c < 6; c++) {
         frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
@@ -3077,7 +3100,7 @@ static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54
         frm_pair_dF(dq, m->p_grad + 3 * (size_t)pa, m->p_G + 9 * (size_t)pa, dF);
         for (k = 0; k < n; k++)
             frm_pair_stab_domega(F, dF, m->relm + 9 * m->p_frame[b + k], k == a ? dq + 3 : NULL, om + 3 * k);
-        frm_sample_stab_moments(n, m->p_frame + b, m->p_weight + b, m->f_stab, om, uu);
+        frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, uu);
         for (k = 0; k < n; k++) {
             frm_real dPx[9], tq[3];
             frm_pair_stab_apply(F, dF, m->relm + 9 * m->p_frame[b + k], cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k),
