@@ -682,7 +682,7 @@ static int hex_beam(frm_sampling *s, frm_model **m, double L, double W, int nx, 
    linearisation, and static solves stalled. Their rotation field has a divergence, which
    the divergence term holds. The R3 beam of 10 x 1 x 1 cells: the thesis's model
    (rotation_divergence = 0) has generalized eigenvalues of (K, M) at zero (below 1e-6 of
-   the first bending mode's); with the default none lies below 0.8 x 0.5091 Hz (the bending
+   the first bending mode's; float's round-off of K puts them within 0.04 Hz); with the default none lies below 0.8 x 0.5091 Hz (the bending
    pair itself is 8 % low one cell across: the frames' rotations make one cell soft, see
    the R1 test below). */
 static void test_hex_beam_modes(void)
@@ -701,7 +701,7 @@ static void test_hex_beam_modes(void)
                pass == 0 ? "rotation_divergence 0" : "default");
         for (i = 0; i < 6; i++) printf(" %.4f (%.2f)", freq[i], rot[i]);
         printf("; highest %.1f\n", freq[n - 1]);
-        if (pass == 0) CHECK(fabs(freq[0]) < 1e-3 * 0.5091);
+        if (pass == 0) CHECK(fabs(freq[0]) < (IS_FLOAT ? 0.2 : 1e-3) * 0.5091); /* float: K's round-off, 0.04 Hz */
         else CHECK(freq[0] > 0.8 * 0.5091);
         free(freq);
         frm_model_destroy(m);
@@ -716,6 +716,7 @@ static double hex_r1_tip(int nx, int n, int *err, int *newton)
     frm_model *m;
     double L = 16, W = 0.5, tip = 0;
     int i, c = 0;
+    *newton = 0;
     *err = hex_beam(&s, &m, L, W, nx, n, 200e9, 31200 / (L * W * W), -1, 1);
     if (*err) return 0;
     *err = frm_model_set_solver(m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-10), 20000, (frm_real)(IS_FLOAT ? 1e-3 : 1e-6), 30);
