@@ -1507,35 +1507,23 @@ FRM_HOSTDEV static inline void frm_pair_stab_domega(const frm_real F[9], const f
     frm_skew_axial(A, om);
 }
 
-/* The stabilisation's conjugate of each pair's relative rotation for one sample of n
-   neighbours (see MODEL): with omega_k the relative rotations (3 n), N_k the frames'
-   projectors on their unseen rotations (6 Voigt each, rest axes; zero for most frames),
-   grad w_k the weight gradients (3 n) and D = sum_k grad w_k . omega_k (minus the
-   divergence of the frames' interpolated rotation field: a material rotation field, half
-   the curl of the displacement, has none),
-       m_k = N_k omega_k + g D grad w_k,   Phi = sum_k omega_k . N_k omega_k + g D^2,
-   so that the energy c/2 Phi has dE = c sum_k m_k . domega_k (g = gamma h^2, m^2). Writes
-   m (3 n), returns Phi. The same map takes variations domega_k to the Gauss-Newton
-   conjugates. */
-FRM_HOSTDEV static inline frm_real frm_sample_stab_moments(int n, const int *frame, const frm_real *grad,
-                                                           const frm_real *projector, frm_real g, const frm_real *om,
-                                                           frm_real *m)
+/* Z = Q [g]x = [g]x + Qm [g]x for a pair's weight gradient g: the divergence term's
+   direction, g . axial(skew(Q^T A)) = Z : A / 2 for any A (row r of Qm [g]x is qm_r x g). */
+FRM_HOSTDEV static inline void frm_stab_direction(const frm_real Qm[9], const frm_real g[3], frm_real Z[9])
 {
-    frm_real D = 0, phi;
-    int k, r;
-    for (k = 0; k < n; k++) D += grad[3 * k] * om[3 * k] + grad[3 * k + 1] * om[3 * k + 1] + grad[3 * k + 2] * om[3 * k + 2];
-    phi = g * D * D;
-    D *= g;
-    for (k = 0; k < n; k++) {
-        const frm_real *N = projector + 6 * frame[k], *o = om + 3 * k;
-        frm_real *mk = m + 3 * k;
-        mk[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2];
-        mk[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2];
-        mk[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2];
-        phi += o[0] * mk[0] + o[1] * mk[1] + o[2] * mk[2];
-        for (r = 0; r < 3; r++) mk[r] += D * grad[3 * k + r];
+    int r;
+    for (r = 0; r < 3; r++) {
+        const frm_real *q = Qm + 3 * r;
+        Z[3 * r] = q[1] * g[2] - q[2] * g[1];
+        Z[3 * r + 1] = q[2] * g[0] - q[0] * g[2];
+        Z[3 * r + 2] = q[0] * g[1] - q[1] * g[0];
     }
-    return phi;
+    Z[1] -= g[2];
+    Z[2] += g[1];
+    Z[3] += g[2];
+    Z[5] -= g[0];
+    Z[6] -= g[1];
+    Z[7] += g[0];
 }
 
 /* The frame-own second-order part of the stabilisation, X = sym(F T^T) - tr(F^T T) I (6,
@@ -1556,8 +1544,8 @@ FRM_HOSTDEV static inline void frm_pair_stab_rotation(const frm_real F[9], const
 }
 
 /* The stabilisation's stiffness (symmetric part, less the frame-own X above) for one pair:
-   for the sample's dF, the frame's dtheta and u the conjugate (frm_sample_stab_moments) of
-   the sample's domega_k (frm_pair_stab_domega),
+   for the sample's dF, the frame's dtheta and u = N domega + g dD grad w the Gauss-Newton
+   conjugate of the pair's domega (frm_pair_stab_domega; see frm__stab_sample_apply),
        Ta = c/2 Q [u]x,   dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
    dPx a stress-like term (absolute: the caller divides by the volume and adds it to dP,
    which B^T takes to every frame), torque the frame's own row, T = c/2 Q [m]x with m the
@@ -1733,6 +1721,8 @@ struct frm_model {
     /* samples */
     frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
     frm_real *s_hstab; /* g = gamma h^2 of the stabilisation's divergence term (m^2) */
+    frm_real *s_stabY; /* 9: Y = sum of Z_k over the pairs of frames without unseen rotations, at the linearisation */
+    frm_real *s_stabD; /* 1: D at the linearisation */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
@@ -1743,8 +1733,9 @@ struct frm_model {
     frm_real *p_weight, *p_grad, *p_local, *p_rlev; /* 1, 3, 3, 3: rest lever abar = Rbar lbar = pbar - xbar */
     frm_real *p_G, *p_H, *p_A, *p_C;       /* 9, 6, 3 (lever), 3 (coupling g) at the linearisation */
     frm_real *p_out;                       /* 6: pass-1 partial contributions */
-    frm_real *p_stab;                      /* 3: m = N omega of the stabilisation at the linearisation
-                                              (pairs of stabilised frames; NULL when there are none) */
+    frm_real *p_stab;                      /* 3: the stabilisation at the linearisation: pairs of frames with
+                                              unseen rotations m_k = N omega_k + g D grad w_k, the others
+                                              t_k = sum_j f_j x z_j (F, Z_k); NULL without stabilisation */
 
     /* per sample chunk: energy partial sums and errors of the last pass */
     double *chunk_energy;
@@ -2033,6 +2024,10 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_lambda, frm_real, S);
     FRM__CARVE(c, m->s_couple, frm_real, S);
     FRM__CARVE(c, m->s_hstab, frm_real, S);
+    if (m->stab_on) {
+        FRM__CARVE(c, m->s_stabY, frm_real, 9 * S);
+        FRM__CARVE(c, m->s_stabD, frm_real, S);
+    }
     FRM__CARVE(c, m->s_law, unsigned char, S);
     FRM__CARVE(c, m->s_stab, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
@@ -2708,6 +2703,122 @@ static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
     for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
 }
 
+/* The rotation stabilisation of sample s (see MODEL): its energy (returned), its stress
+   added to P (divided by the volume), each pair's T_k into T (9 n, for the frame-own
+   second-order term) and the frame-own torques into stq (3 n). With D = sum_k grad w_k .
+   omega_k = Y : F / 2, Y = sum_k Z_k: pairs of frames without unseen rotations have
+   T_k = c g D / 2 Z_k (no omega_k needed); those with them the general
+   T_k = c/2 Q_k [N_k omega_k + g D grad w_k]x. With linearize, the data K v needs. */
+static double frm__stab_sample_force(frm_model *m, int s, const frm_real H[9], const frm_real F[9], frm_real P[9],
+                                     frm_real *T, frm_real *stq, int linearize)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
+    frm_real v = m->s_volume[s], c = m->s_mu[s] * v, g = m->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
+    frm_real sD;
+    double energy = 0;
+    for (r = 0; r < 9; r++) Dall[r] = 0;
+    for (k = 0; k < n; k++) { /* Z_k into T, Y over the plain pairs, Dall over the others */
+        const frm_real *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        frm_stab_direction(m->relm + 9 * i, gk, T + 9 * k);
+        for (r = 0; r < 9; r++) {
+            if (m->f_stab_on[i]) Dall[r] += T[9 * k + r];
+            else Y[r] += T[9 * k + r];
+        }
+    }
+    for (r = 0; r < 9; r++) Dall[r] += Y[r];
+    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
+                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
+    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
+    sD = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
+    for (k = 0; k < n; k++) {
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            const frm_real *N = m->f_stab + 6 * i, *gk = m->p_grad + 3 * (size_t)(b + k);
+            frm_real om[3], mk[3];
+            frm_pair_stab_omega(H, m->relm + 9 * i, om);
+            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
+            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+            frm_stab_stress(c, m->relm + 9 * i, mk, T + 9 * k);
+            frm_column_cross_sum(F, T + 9 * k, stq + 3 * k);
+            for (r = 0; r < 9; r++) P[r] += T[9 * k + r] / v;
+            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mk, sizeof mk);
+        } else {
+            frm_real t[3];
+            frm_column_cross_sum(F, T + 9 * k, t);
+            for (r = 0; r < 3; r++) stq[3 * k + r] = sD * t[r];
+            for (r = 0; r < 9; r++) T[9 * k + r] *= sD;
+            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), t, sizeof t);
+        }
+    }
+    if (linearize) {
+        memcpy(m->s_stabY + 9 * (size_t)s, Y, sizeof Y);
+        m->s_stabD[s] = D;
+    }
+    return energy;
+}
+
+/* The stabilisation's part of K v for sample s (see frm__stab_sample_force): for the
+   sample's dF and each pair's frame rotation dth[k] (NULL: zero), the stress-like sum
+   dPx (absolute: divide by the volume) and each pair's frame-own torque row stq (3 n).
+   dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (+ g_k . domega_k for the general pairs), the
+   Gauss-Newton part c g dD Z_k / 2 (stress) and -c g dD t_k / 2 (torque), and unless
+   definite the second-order part of T_k = c g D Z_k / 2: [dtheta_k]x T_k and
+   -sum_j df_j x t_kj. */
+static void frm__stab_sample_apply(const frm_model *m, int s, const frm_real dF[9], const frm_real *const *dth,
+                                   int definite, frm_real dPx[9], frm_real *stq)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
+    const frm_real *F = m->lin_F + 9 * (size_t)s, *Y = m->s_stabY + 9 * (size_t)s;
+    frm_real c = m->s_mu[s] * m->s_volume[s], g = m->s_hstab[s], D = m->s_stabD[s], dD, s1, s2, om[3 * FRM_MAX_NEIGHBORS];
+    dD = (frm_real)0.5 * (Y[0] * dF[0] + Y[1] * dF[1] + Y[2] * dF[2] + Y[3] * dF[3] + Y[4] * dF[4] + Y[5] * dF[5] +
+                          Y[6] * dF[6] + Y[7] * dF[7] + Y[8] * dF[8]);
+    for (k = 0; k < n; k++) {
+        const frm_real *t = m->p_stab + 3 * (size_t)(b + k), *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            frm_pair_stab_domega(F, dF, m->relm + 9 * i, dth[k], om + 3 * k);
+            dD += gk[0] * om[3 * k] + gk[1] * om[3 * k + 1] + gk[2] * om[3 * k + 2];
+        } else if (dth[k])
+            dD -= (frm_real)0.5 * (dth[k][0] * t[0] + dth[k][1] * t[1] + dth[k][2] * t[2]);
+    }
+    s1 = (frm_real)0.5 * c * g * dD;
+    s2 = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) dPx[r] = s1 * Y[r];
+    for (k = 0; k < n; k++) {
+        const frm_real *t = m->p_stab + 3 * (size_t)(b + k), *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            const frm_real *N = m->f_stab + 6 * i, *o = om + 3 * k;
+            frm_real u[3], d[9];
+            u[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2] + g * dD * gk[0];
+            u[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2] + g * dD * gk[1];
+            u[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2] + g * dD * gk[2];
+            frm_pair_stab_apply(F, dF, m->relm + 9 * i, c, u, t, dth[k], definite, d, stq + 3 * k);
+            for (r = 0; r < 9; r++) dPx[r] += d[r];
+            continue;
+        }
+        for (r = 0; r < 3; r++) stq[3 * k + r] = -s1 * t[r];
+        if (!definite && s2 != 0) {
+            frm_real Z[9], w[3];
+            const frm_real *th = dth[k];
+            frm_stab_direction(m->relm + 9 * i, gk, Z);
+            frm_column_cross_sum(dF, Z, w);
+            for (r = 0; r < 3; r++) stq[3 * k + r] -= s2 * w[r];
+            if (th)
+                for (r = 0; r < 3; r++) { /* dPx += [dtheta]x T_k, column r */
+                    dPx[r] += s2 * (th[1] * Z[6 + r] - th[2] * Z[3 + r]);
+                    dPx[3 + r] += s2 * (th[2] * Z[r] - th[0] * Z[6 + r]);
+                    dPx[6 + r] += s2 * (th[0] * Z[3 + r] - th[1] * Z[r]);
+                }
+        }
+    }
+}
+
 typedef struct frm__force_ctx {
     frm_model *m;
     int linearize, outputs;
@@ -2746,17 +2857,8 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             }
             energy += (double)v * (double)psi;
             frm_first_piola(F, S, P);
-            if (stab) { /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                frm_real cst = m->s_mu[s] * v, om[3 * FRM_MAX_NEIGHBORS], mm[3 * FRM_MAX_NEIGHBORS];
-                for (k = 0; k < n; k++) frm_pair_stab_omega(H, m->relm + 9 * m->p_frame[b + k], om + 3 * k);
-                energy += 0.5 * (double)cst * (double)frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, mm);
-                for (k = 0; k < n; k++) {
-                    frm_stab_stress(cst, m->relm + 9 * m->p_frame[b + k], mm + 3 * k, sT + 9 * k);
-                    frm_column_cross_sum(F, sT + 9 * k, stq + 3 * k);
-                    for (r = 0; r < 9; r++) P[r] += sT[9 * k + r] / v;
-                }
-                if (ctx->linearize) memcpy(m->p_stab + 3 * (size_t)b, mm, sizeof(frm_real) * 3 * (size_t)n);
-            }
+            if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
+                energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
             for (k = 0; k < n; k++)
                 frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
@@ -2964,19 +3066,11 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                           m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
             if (m->s_stab[s]) {
-                frm_real cst = m->s_mu[s] * vol, dPx[9], om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
-                const frm_real *Fl = m->lin_F + 9 * (size_t)s;
-                for (k = 0; k < n; k++) {
-                    int i = m->p_frame[b + k];
-                    frm_pair_stab_domega(Fl, dF, m->relm + 9 * i, v + 6 * i + 3, om + 3 * k);
-                }
-                frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, uu);
-                for (k = 0; k < n; k++) {
-                    int i = m->p_frame[b + k];
-                    frm_pair_stab_apply(Fl, dF, m->relm + 9 * i, cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3,
-                                        m->lin_definite, dPx, stq + 3 * k);
-                    for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
-                }
+                frm_real dPx[9];
+                const frm_real *dth[FRM_MAX_NEIGHBORS];
+                for (k = 0; k < n; k++) dth[k] = v + 6 * m->p_frame[b + k] + 3;
+                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
+                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
             }
             for (k = b; k < b + n; k++)
                 frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
@@ -3092,22 +3186,17 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
 static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54], frm_real *rows)
 {
     int b = m->s_start[s], n = m->s_start[s + 1] - b, c, k, r, pa = b + a;
-    frm_real vol = m->s_volume[s], cst = m->s_mu[s] * vol, om[3 * FRM_MAX_NEIGHBORS], uu[3 * FRM_MAX_NEIGHBORS];
-    const frm_real *F = m->lin_F + 9 * (size_t)s;
+    frm_real vol = m->s_volume[s], tq[3 * FRM_MAX_NEIGHBORS];
+    const frm_real *dth[FRM_MAX_NEIGHBORS];
     for (c = 0; c < 6; c++) {
-        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dPx[9];
         dq[c] = 1;
         frm_pair_dF(dq, m->p_grad + 3 * (size_t)pa, m->p_G + 9 * (size_t)pa, dF);
+        for (k = 0; k < n; k++) dth[k] = k == a && c >= 3 ? dq + 3 : NULL;
+        frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, tq);
+        for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
         for (k = 0; k < n; k++)
-            frm_pair_stab_domega(F, dF, m->relm + 9 * m->p_frame[b + k], k == a ? dq + 3 : NULL, om + 3 * k);
-        frm_sample_stab_moments(n, m->p_frame + b, m->p_grad + 3 * (size_t)b, m->f_stab, m->s_hstab[s], om, uu);
-        for (k = 0; k < n; k++) {
-            frm_real dPx[9], tq[3];
-            frm_pair_stab_apply(F, dF, m->relm + 9 * m->p_frame[b + k], cst, uu + 3 * k, m->p_stab + 3 * (size_t)(b + k),
-                                k == a ? dq + 3 : NULL, m->lin_definite, dPx, tq);
-            for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
-            for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[r];
-        }
+            for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[3 * k + r];
     }
 }
 
@@ -3221,6 +3310,7 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
    its product every iteration, the block mode assembles once and then streams 288 bytes
    a block. With 8 neighbours blocks win beyond about 30 CG iterations a linearisation. */
 #define FRM__COST_PAIR_ITER 35.0      /* pair-mode K v, per pair per iteration */
+#define FRM__COST_PAIR_STAB 30.0      /* its rotation stabilisation's divergence term (hexahedra, 8 neighbours) */
 #define FRM__COST_BLOCK_ITER 8.0      /* block-mode K v, per block per iteration */
 #define FRM__COST_ASSEMBLE_PAIR 500.0 /* assembly: the tangent columns, per pair */
 #define FRM__COST_ASSEMBLE_SLOT 60.0  /* assembly: one slot-pair block, per (pair, slot) */
@@ -3233,7 +3323,7 @@ static int frm__choose_mode(const frm_model *m)
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
     it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
-    pairs = it * FRM__COST_PAIR_ITER * m->pair_count;
+    pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
