@@ -2601,8 +2601,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)(N[k] * (double)m->stab_beta);
             for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
         }
-    if (m->stab_gamma > 0) /* the divergence term: every sample */
-        for (s = 0; s < S; s++) m->s_stab[s] = 1;
+
 
     /* samples */
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
@@ -2643,6 +2642,17 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         h2 = wsum > 0 ? h2 / wsum : 0;
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
         m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
+        if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
+                                    sum_k xbar_k grad w_k^T = I, i.e. sum_k abar_k grad w_k^T = -I */
+            double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, err = 0;
+            int q, r;
+            for (p = m->s_start[s]; p < m->s_start[s + 1]; p++)
+                for (r = 0; r < 3; r++)
+                    for (q = 0; q < 3; q++) A[3 * r + q] += (double)m->p_rlev[3 * p + r] * (double)m->p_grad[3 * p + q];
+            for (r = 0; r < 9; r++) err += fabs(A[r]);
+            if (err <= 1e-3) m->s_stab[s] = 1;
+            else m->s_hstab[s] = 0; /* zero-order (Shepard): left to the thesis's model */
+        }
     }
     i = frm__compute_masses(m, d);
     if (i >= 0) {

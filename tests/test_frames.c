@@ -353,8 +353,17 @@ static double independent_energy(const scene *sc)
         }
         /* and the divergence of the frames' rotation field: 1/2 gamma mu v h^2 D^2,
            D = sum_k grad w_k . omega_k (issue 18) */
-        if (h2 > 0)
-            W += 0.5 * (double)sc->d.rotation_divergence * mu * (double)s->sample_volumes[smp] * (h2 / wabs) * Dv * Dv;
+        { /* only where the weights reproduce linear fields: sum_k lbar_k grad w_k^T = -I */
+            double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, lin = 0;
+            for (e = s->neighbor_start[smp]; e < s->neighbor_start[smp + 1]; e++)
+                for (r = 0; r < 3; r++)
+                    for (c = 0; c < 3; c++)
+                        A[3 * r + c] += ((double)s->sample_positions[3 * smp + r] - s->frame_positions[3 * s->neighbor_frames[e] + r]) *
+                                        (double)s->neighbor_gradients[3 * e + c];
+            for (r = 0; r < 9; r++) lin += fabs(A[r]);
+            if (h2 > 0 && lin <= 1e-3)
+                W += 0.5 * (double)sc->d.rotation_divergence * mu * (double)s->sample_volumes[smp] * (h2 / wabs) * Dv * Dv;
+        }
         for (r = 0; r < 3; r++)
             for (c = 0; c < 3; c++) C[3 * r + c] = F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c];
         J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
