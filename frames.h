@@ -52,7 +52,7 @@
            for (i = 0; i < 81; i += 9) frm_model_fix_frame(m, i); // clamp the face x = 0
            err = frm_model_solve_static(m);                       // sag under gravity
            printf("%s: the tip sagged %.4f m\n", frm_error_string(err),
-                  0.5 - (double)frm_model_positions(m)[3 * 44 + 2]); // 0.0401, beam theory 0.040
+                  0.5 - (double)frm_model_positions(m)[3 * 44 + 2]); // 0.0399, beam theory 0.040
            for (i = 0; i < 100; i++) frm_model_step(m); // then one second of implicit dynamics
            frm_model_destroy(m);
            return 0;
@@ -111,15 +111,21 @@
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
    names it, and the optional desc.log callback receives a detailed message for validation
-   failures (the library never prints). Creation refuses: counts out of range, non-finite
+   failures (the library never prints). A description not made by its default function
+   (frm_model_default_desc, frm_shape_default_desc, frm_poisson_default_desc: a private
+   cookie) is refused with FRM_ERR_DESC before anything in it is read, its log callback
+   included (it may be garbage). Shape functions refuse non-finite points, corners, frames
+   or radii and a Shepard exponent <= 1 (FRM_ERR_ARG); samplings refuse a Shepard exponent
+   <= 1 and frame_spacing < sample_spacing (FRM_ERR_SAMPLING). Creation refuses: counts out of range, non-finite
    positions, orientations that are not unit quaternions (|q|^2 off by more than 1e-5),
    zero, negative or non-finite sample volumes, samples without neighbours or with more
    than FRM_MAX_NEIGHBORS (16), frame indices out of range or repeated in a sample,
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
-   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
-   Neo-Hookean sample (FRM_ERR_INVERTED), without convergence (FRM_ERR_NO_CONVERGENCE) or,
+   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted or
+   mirrored sample (FRM_ERR_INVERTED: det F <= 0, Neo-Hookean and St Venant-Kirchhoff alike;
+   frm_model_forces and _energy refuse such a state too), without convergence (FRM_ERR_NO_CONVERGENCE) or,
    for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
    iterations or rose in 3 in a row, see LIMITS) leaves positions, orientations and velocities exactly as they
    were.
@@ -176,9 +182,12 @@
        fields, it stiffens the rotations a trilinear grid cannot see (see LIMITS), at the
        price of bending stiffness on coarse, elongated cells.
 
-       Rotation stabilisation (desc.rotation_stabilization = beta, default 0.5; 0 = the
-       thesis's model exactly). A frame whose samples lie on a line (or are a single one)
-       has a rotation they do not see at first order: turning it about that line while
+       Rotation stabilisation: two terms that give the frames' rotations the stiffness the
+       continuum has where the samples do not see them; both are zero for rigid motions and
+       whenever the frames turn with the material.
+       (1) Unseen rotations (desc.rotation_stabilization = beta, default 0.5; 0 = the
+       thesis's model). A frame whose samples lie on a line (or are a single one) has a
+       rotation they do not see at first order: turning it about that line while
        translating it by -dtheta x a_s leaves every sample's prediction d = x + R lbar in
        place, and F changes only by the skew w [dtheta]x. The energy is flat along it, and
        under stress its second-order term w (Q - I) relieves the samples' strain, so it
@@ -189,17 +198,61 @@
        those frames only (found at creation: the kernel of the samples' second moment
        J = tr(L) I - L, projector N in rest axes, unless the whole neighbourhood is
        collinear too, a rod whose torsion lives in that rotation) the model adds, per
-       (sample, frame),
-           E_r = beta mu v / 2  omega . N omega,   omega = axial(skew(Q^T F)),
-       the frame's rotation relative to the sample's, about the unseen axes only. Zero for
-       rigid motions and whenever the frame turns with its samples, so it does not touch
-       the first-order solution: it only picks the unseen rotation, and changes
-       equilibria through the difference of the material rotations at a frame's samples
-       (measured: beta 0.5 against 0.1 moves the tip by 0.44 % on R3 one cell across, by
-       0.06 % at two, by 0.02 % on R2 at three; tests/test_frames.c checks it). Forces:
-       T = beta mu v / 2 Q [N omega]x joins the sample's P, the frame's own torque is
-       sum_j f_j x t_j; its stiffness is exact (Gauss-Newton part and second-order part,
-       tested against finite differences). frm_model_stabilized_frames counts the frames.
+       (sample, frame), beta mu v / 2 omega . N omega with omega = axial(skew(Q^T F)), the
+       frame's rotation relative to the sample's, about the unseen axes only (measured:
+       beta 0.5 against 0.1 moves the tip by 0.49 % on R3 one cell across, by 0.09 % at
+       two; tests/test_frames.c checks it). frm_model_stabilized_frames counts the frames.
+       (2) Divergence (desc.rotation_divergence = gamma, default 4; 0 = the thesis's
+       model). Frame rotations can also move no material collectively: with weights that
+       reproduce linear fields, turning every frame by the same theta moves nothing
+       (sum_i w_i theta x (x - x_i) = 0), and on a tensor-product hexahedral grid neither
+       does a layer of frames normal to an axis turning about it (the bilinear face
+       interpolation reproduces the in-plane coordinates): zero-energy modes of the
+       linearisation, which stalled the static solves of hexahedral frames one cell across
+       and of R2. With one sample per tetrahedron the slowly varying version costs only
+       the under-integrated bubble energy mu h^2 |grad theta|^2: the R3 beam had modes at
+       0.39-0.42 Hz below its first bending mode (0.509 Hz) at every resolution and at
+       2.3-2.5 Hz below the second, the frames turning about the beam's axis while the
+       material hardly moves, which beta did not touch (0.4164 against 0.4168 Hz for 0.5
+       and 2). A tie of each frame's rotation to the material's (|omega|^2 per pair or per
+       sample) removes them but locks bending: the frames' natural rotation in bending is
+       not the material's (on R1 with 24 x 4 x 4 hexahedral cells it is half of it: the
+       rotation gradient makes the quadratic bubble through sum_i w_i (G d_i) x d_i with
+       G = omega'/2), so even gamma = 1e-2 put R1 31 % too stiff. What the continuum does
+       fix is the divergence: a material rotation field, half the curl of the
+       displacement, has none, and neither has the frames' natural field in bending
+       (theta_y varying along x), while every mode above has (theta_x varying along x,
+       a layer's jump). Per sample, with omega_k = axial(skew(Q_k^T F)) the sample's
+       rotation relative to frame k (rest axes) and, linearised, omega_k = omega_s - theta_k
+       and sum_k grad w_k = 0,
+           D = sum_k grad w_k . omega_k  (= -div theta, the frames' interpolated field)
+           E_d = gamma mu v h^2 / 2 D^2,
+       h^2 the sample's mean squared lever (sum |w| |lbar|^2 / sum |w|): of order h^2 for
+       smooth fields, so it vanishes under refinement, zero for rigid motions (omega_k = 0)
+       and for a uniform turn relative to the material. Only samples whose weights
+       reproduce linear fields (sum_k lbar_k grad w_k^T = -I to 1e-3: tetrahedra,
+       hexahedra, MLS) carry it; zero-order Shepard samples keep the thesis's model.
+       Forces: with Z_k = Q_k [grad w_k]x, grad w_k . omega_k = [grad w_k]x : Q_k^T F / 2
+       = Z_k : F / 2, so D = Y : F / 2 (Y = sum_k Z_k), the stress c g D / 2 Y joins
+       P (c = mu v, g = gamma h^2) and each frame's own torque is c g D / 2 sum_j f_j x z_kj.
+       Stiffness, exact: dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (t_k = sum_j f_j x z_kj),
+       the Gauss-Newton part c g dD (Y / 2, -t_k / 2) and the second-order part of
+       T_k = c g D / 2 Z_k ([dtheta_k]x T_k, -sum_j df_j x t_kj and the frame-own
+       sym(F T^T) - tr(F^T T) I), tested against finite differences of the force, which are
+       tested against an independent energy (tests/test_frames.c). Measured on the R3 beam
+       (generalized eigenvalues of (K, M), tests/test_frames_elem.c), tetrahedral frames
+       with one sample each, two cells across: lowest modes 0.4164 (spurious), 0.4976,
+       0.4976, 2.4879 (spurious), 2.9943 Hz with gamma = 0; 0.4982, 0.4982, 2.9982, 2.9982,
+       4.8506 (torsion, 3D 4.5101) Hz with gamma = 4; one cell across 0.3901 (spurious),
+       0.4447 against 0.4480, 0.4484 (bending), 2.69 (second bending) Hz; hexahedral frames
+       one cell across: six and more zero eigenvalues with gamma = 0, lowest 0.4681 Hz
+       (bending) with gamma = 4. gamma trades the hexahedral one-cell rotation mode (0.27,
+       0.35, 0.47, 0.64, 0.96 Hz for gamma = 0.5, 1, 2, 4, 10) against the tetrahedral
+       frames' torsion, which the term stiffens at coarse resolution (4.44 Hz at gamma 0,
+       4.67, 4.80, 4.85, 4.87 Hz at 0.5, 2, 4, 10 on two cells across; of order h^2).
+       Both terms: the stabilisation's stress joins the sample's P, the frame-own torques
+       apart; the unseen-rotations term's stiffness is exact too (Gauss-Newton part and
+       second-order part).
 
    MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
    split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
@@ -303,6 +356,10 @@
            force pass 42 ns a pair; K v pair mode 28-42 ns a pair (20.6 with -O3
            -march=native); K v block mode 7-8 ns a block, 3.6-4 ns a pair; assembly
            0.8-1.7 us a pair; so blocks pay off after 4 to 25 CG iterations.
+       The rotation stabilisation's divergence term (default on, issue 18) adds to these: on
+       the same beam, in one run on a loaded machine, force pass 82 against 48 ns a pair
+       and K v pair mode 59 against 28 ns with and without it (tetrahedra, one sample each,
+       4 neighbours: 93 against 74 and 48 against 41 ns); block products unchanged.
        On the reference machine of REFERENCES.md (4.2 GHz, 40 GB/s) expect about half.
        FRM_STIFFNESS_AUTO assembles when the previous solve's iteration count (50 before
        any) times the pair mode's cost exceeds the assembly plus the block products
@@ -313,16 +370,25 @@
        matrix-free, 139 ms by blocks (thesis: 3468 ms CPU, 66.1 ms on a GTX 570).
 
    ACCURACY (tests/test_frames.c prints these)
-       R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.39 % of Timoshenko
-       (+0.16 % in float); with Gauss points -1.7 % (Poisson locking of 4 cells across).
+       R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.21 % of Timoshenko,
+       +0.49 % of the 3D value 0.150169 m (before the divergence term: +0.39 % / +0.67 %;
+       float was +0.16 % of Timoshenko then); with Gauss points -1.7 % (Poisson locking of 4
+       cells across). Hexahedral frames one cell across (32 x 1 x 1 cells, which stalled
+       before): +20.4 % of the 3D value, two cells across (64 x 2 x 2) +4.1 %
+       (tests/test_frames_elem.c): one cell is soft, as with tetrahedral frames.
        Tetrahedral frames with one sample per tetrahedron (the bench's tet4 body, 5
-       tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +33 %,
-       +5.9 %, +2.3 %, +1.1 %, +0.28 % for k = 1, 2, 3, 4, 6, float within 2e-4 of double;
-       the R3 beam's static sag +30 % and +4.9 % at one and two cells across (soft at one
-       cell: the frames' rotations let a single tetrahedron bend).
-       R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.289,
-       6.132, 6.327 m, order 1.6, limit 6.54 m, about 40,000 DoF for 1 % of it.
-       R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.96 %.
+       tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +32.9 %,
+       +6.1 %, +2.5 %, +1.3 % of the 3D value for k = 1, 2, 3, 4 (+33.4, +6.2, +2.5, +1.4 %
+       before the divergence term), float within 1e-3 of double at k = 2;
+       the R3 beam's static sag +29 % and +4.6 % of beam theory at one and two cells
+       across (+30 % and +4.9 % before; soft at one cell: the frames' rotations let a
+       single tetrahedron bend). Its lowest modes: see MODEL, rotation stabilisation.
+       R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.225,
+       6.112, 6.319 m (5.289, 6.132, 6.327 before), order 1.6, limit 6.54 m, about 45,000 DoF
+       for 1 % of it. Hexahedral frames (stalled before at every resolution): 7.203, 6.656,
+       6.569 m at 16 x 1 x 1, 32 x 2 x 2, 48 x 3 x 3 cells.
+       R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.69 % of
+       Timoshenko (-0.96 % before).
        A 180 degree torsion of a 10-frame Shepard bar (thesis fig. 4.11) spreads linearly
        to within 3.5 degrees; a coplanar Shepard sheet under 300 N (fig. 4.10) converges.
 
@@ -332,18 +398,26 @@
          With one sample per tetrahedron every edge frame of a mesh is such a frame. The
          default rotation_stabilization (0.5) holds exactly those; with 0 (the thesis's
          model) static solves of stressed bodies fail or end in the buckled minimum (R1
-         one cell across: 0.04 rad of spurious rotation, 78 % too much sag). (b) On
-         tensor-product (extruded) hexahedral grids a layer of frames normal to an axis,
-         turning about that axis, moves no sample at all (the bilinear face interpolation
-         reproduces the in-plane coordinates): a collective mode no single frame shows, so
-         the stabilisation does not see it (stabilising every hexahedral frame's rotation
-         makes bending 30 % too stiff). Small deformations on two or more cells across
-         solve well (R1, R3); one cell across, or large deformation (R2), the mode buckles
-         and the static solve stops with FRM_ERR_STALLED (0.2-0.5 s on the bench's beams)
-         rather than running to the cap. Use tetrahedral or meshless frames there, or
-         frame_coupling = 1e-2 (which makes coarse, elongated cells stiffer in bending: R1
-         at 25 x 5 x 5 becomes 31 % too stiff). Implicit steps stay stable at any time step
-         (the positive-definite fallback), the mode then moves dynamically.
+         one cell across: 0.04 rad of spurious rotation, 78 % too much sag). (b) Rotations
+         that move no material collectively: on tensor-product hexahedral grids a layer of
+         frames normal to an axis turning about it (zero energy), with one sample per
+         tetrahedron the frames turning slowly about a beam's axis (spurious modes below
+         the first bending mode at every resolution). The default rotation_divergence (4)
+         holds them (see MODEL): hexahedral frames one cell across and R2 now solve, the
+         tetrahedral frames' R3 beam has no mode below its bending modes. What remains:
+         hexahedral frames one cell across keep frame-rotation modes above the first
+         bending mode but below the second (0.64 and 1.75 Hz on R3, bending 0.47 and
+         2.82 Hz; 1.75 Hz does not depend on gamma), and bend 20 % too soft on R1 (4 % at two
+         cells across); at coarse resolution the divergence term stiffens the tetrahedral
+         frames' torsion (R3 at two cells across: 4.85 Hz against 4.44 Hz without it, 3D
+         4.51 Hz; of order h^2). With rotation_divergence = 0 (the thesis's model) static
+         solves of hexahedral frames one cell across or in large deformation stop with
+         FRM_ERR_STALLED (0.2-0.5 s on the bench's beams). Shepard samples (zero order)
+         carry no divergence term (see MODEL).
+         The stabilisation costs: on every sample with linear weights its force pass
+         carries the term (measured +70 % on the hexahedral R1 beam, +26 % on tetrahedra)
+         and the matrix-free K v about twice the time on hexahedra (+20 % on tetrahedra);
+         assembled blocks are unchanged.
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
@@ -352,12 +426,16 @@
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
          beam, and no convergence at 0.499). Tetrahedral frames with one sample each lock
          less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2).
-       - St Venant-Kirchhoff softens and can collapse under strong compression; a
-         Neo-Hookean sample cannot invert: its energy is infinite at det F <= 0, and a step
-         or solve that would reach it refuses with FRM_ERR_INVERTED and keeps the last
-         valid state (the bench's squash test: a corner driven through the opposite face).
-         There is no inversion-safe continuation (as heml.h's linearised volumetric term
-         below J0): use St Venant-Kirchhoff for scenes that push the body through itself.
+       - St Venant-Kirchhoff softens and can collapse under strong compression, and its
+         energy has a minimum of zero at every mirror image of the rest state (F =
+         diag(1, 1, -1)): a solve once settled a compressed cube's top layer there, with
+         success and P_zz = 0. Both laws now refuse det F <= 0 (a Neo-Hookean sample's
+         energy is infinite there): a step or solve that would reach it returns
+         FRM_ERR_INVERTED and keeps the last valid state (the bench's squash test, a corner
+         driven through the opposite face, is refused with either law). There is no
+         inversion-safe continuation (as heml.h's linearised volumetric term below J0). The
+         kernel frm_material_stress still computes St Venant-Kirchhoff's S and energy of a
+         mirrored sample before returning FRM_ERR_INVERTED, for a caller that allows it.
        - Shepard functions are zero-order (no linear reproduction): meshless Shepard
          bodies are stiffer and less accurate than MLS ones, but take any point layout
          (coplanar, collinear); MLS needs 3D spread and may give negative weights (the
@@ -377,7 +455,16 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
-       unreleased: rotation stabilisation for frames with collinear samples (default on:
+       unreleased (issue 18): the divergence term of the rotation stabilisation
+             (desc.rotation_divergence, default 4: removes the tetrahedral frames' spurious
+             low modes and the hexahedral frames' zero-energy rotations; changes results
+             slightly, see ACCURACY); St Venant-Kirchhoff refuses det F <= 0
+             (FRM_ERR_INVERTED); descriptions without their cookie refused before their log
+             callback is called, frm_shape_desc and frm_poisson_desc gained cookies (start
+             them from their default functions); shape functions refuse non-finite input and
+             Shepard exponents <= 1, samplings frame_spacing < sample_spacing; every entry
+             point renamed in float builds.
+       earlier unreleased: rotation stabilisation for frames with collinear samples (default on:
              changes tetrahedral one-sample models); static and implicit solvers fall back
              to K's positive-definite part on indefinite linearisations; static line search
              judged by the residual below the energy's round-off; the round-off floor stops
