@@ -371,15 +371,16 @@
 
    ACCURACY (tests/test_frames.c prints these)
        R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.21 % of Timoshenko,
-       +0.49 % of the 3D value 0.150169 m (before the divergence term: +0.39 % / +0.67 %;
-       float was +0.16 % of Timoshenko then); with Gauss points -1.7 % (Poisson locking of 4
+       +0.49 % of the 3D value 0.150169 m (before the divergence term: +0.39 % / +0.67 %);
+       float +0.17 % of Timoshenko (+0.16 % before); with Gauss points -1.7 % (Poisson locking of 4
        cells across). Hexahedral frames one cell across (32 x 1 x 1 cells, which stalled
        before): +20.4 % of the 3D value, two cells across (64 x 2 x 2) +4.1 %
        (tests/test_frames_elem.c): one cell is soft, as with tetrahedral frames.
        Tetrahedral frames with one sample per tetrahedron (the bench's tet4 body, 5
        tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +32.9 %,
        +6.1 %, +2.5 %, +1.3 % of the 3D value for k = 1, 2, 3, 4 (+33.4, +6.2, +2.5, +1.4 %
-       before the divergence term), float within 1e-3 of double at k = 2;
+       before the divergence term), float within 8e-4 of double at k = 2 and 4e-4 at k = 4
+       (2e-4 before: float's Newton stops on the round-off floor a little earlier);
        the R3 beam's static sag +29 % and +4.6 % of beam theory at one and two cells
        across (+30 % and +4.9 % before; soft at one cell: the frames' rotations let a
        single tetrahedron bend). Its lowest modes: see MODEL, rotation stabilisation.
@@ -447,7 +448,7 @@
        - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m; at
          1e6 m a mesh of centimetres degenerates, FRM_ERR_SHAPE_DEGENERATE); steel-like
          stiffness needs the round-off floor to stop Newton, which it does only once
-         Newton no longer halves the residual (R1 float +0.16 %).
+         Newton no longer halves the residual (R1 float +0.17 %).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
