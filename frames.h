@@ -3958,8 +3958,8 @@ FRMDEF int frm_model_solve_static(frm_model *m)
 
 static int frm__linearize(frm_model *m, double *energy, int definite);
 
-/* The light check after a step of a model with Neo-Hookean samples: F of every such
-   sample has det F > 0 (else the new state has infinite energy). */
+/* The light check after a step: every sample has det F > 0 (a Neo-Hookean sample's energy
+   is infinite otherwise, a St Venant-Kirchhoff one's may sit in a mirrored minimum). */
 static int frm__check_inversion(frm_model *m)
 {
     int s;
@@ -3967,7 +3967,6 @@ static int frm__check_inversion(frm_model *m)
     for (s = 0; s < m->sample_count; s++) {
         int b = m->s_start[s];
         frm_real F[9], J;
-        if (m->s_law[s] != FRM_LAW_NEO_HOOKEAN) continue;
         frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
                                m->p_rlev + 3 * b, NULL, m->disp, m->relm, F, NULL, NULL, NULL);
         J = 1 + frm_det_minus_one(F); /* F holds H */
@@ -4056,7 +4055,7 @@ static int frm__implicit_step(frm_model *m, double dt)
         frm__restore_state(m);
         return FRM_ERR_NOT_FINITE;
     }
-    if (m->has_neo_hookean && frm__check_inversion(m)) {
+    if (frm__check_inversion(m)) { /* both laws (issue 18: SVK has minima at mirror images) */
         frm__restore_state(m);
         return FRM_ERR_INVERTED;
     }

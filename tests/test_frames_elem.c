@@ -286,6 +286,55 @@ static void test_svk_mirrored_compression(void)
 }
 
 
+/* The implicit step too: one St Venant-Kirchhoff cell (2^3 samples) with its bottom frames
+   fixed and a top corner driven through the bottom face in one step (the bench's squash):
+   the step returns FRM_ERR_INVERTED and keeps its state, or ends with every det F > 0. */
+static void test_svk_mirrored_step(void)
+{
+    hexmesh h;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    frm_real *x, q[4] = {0, 0, 0, 1}, target[3] = {-0.5f, -0.5f, -0.5f}, before[3];
+    const frm_real *F;
+    int i, err, corner = -1, minus = 0;
+    REQUIRE(hexmesh_grid(&h, lo, hi, 1, 1, 1) == TETMESH_OK);
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    REQUIRE(frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    d.material.law = FRM_LAW_SVK;
+    d.gravity[2] = 0;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    for (i = 0; i < h.node_count; i++) {
+        if (h.nodes[3 * i + 2] == 0) frm_model_fix_frame(m, i);
+        if (h.nodes[3 * i] == 1 && h.nodes[3 * i + 1] == 1 && h.nodes[3 * i + 2] == 1) corner = i;
+    }
+    REQUIRE(corner >= 0);
+    REQUIRE(frm_model_drive_frame(m, corner, target, q) == FRM_OK);
+    for (i = 0; i < 3; i++) before[i] = frm_model_positions(m)[3 * corner + i];
+    err = frm_model_step(m);
+    F = frm_model_deformation_gradients(m);
+    for (i = 0; i < s.sample_count; i++) {
+        const frm_real *f = F + 9 * i;
+        double det = f[0] * ((double)f[4] * f[8] - (double)f[5] * f[7]) - f[1] * ((double)f[3] * f[8] - (double)f[5] * f[6]) +
+                     f[2] * ((double)f[3] * f[7] - (double)f[4] * f[6]);
+        minus += !(det > 0);
+    }
+    printf("    SVK cell, a corner driven through the bottom in one implicit step: %s, %d mirrored samples\n",
+           frm_error_string(err), minus);
+    CHECK_INT(0, minus);
+    if (err) {
+        CHECK_INT(FRM_ERR_INVERTED, err);
+        for (i = 0; i < 3; i++) CHECK(frm_model_positions(m)[3 * corner + i] == before[i]);
+    }
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    free(x);
+    hexmesh_free(&h);
+}
+
 /* ---- item 18: modes of the linearised model ----------------------------------------- */
 
 /* Eigen-decomposition of a symmetric n x n matrix (row-major V in, eigenvectors out in its
@@ -797,6 +846,7 @@ static const test_case cases[] = {
     TEST(test_float_renames),
     TEST(test_shape_refusals),
     TEST(test_svk_mirrored_compression),
+    TEST(test_svk_mirrored_step),
     TEST(test_tet_beam_modes),
     TEST(test_hex_beam_modes),
     TEST(test_hex_one_cell_r1),
