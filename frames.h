@@ -104,9 +104,10 @@
    Nothing else allocates: forces, stiffness products and assembly, steps and solves
    reuse the block. Per (sample, neighbour) pair the model holds about 230 bytes in
    double (index, weight, gradient, levers, the linearisation's G and Hs, the pass-1
-   buffer), per block 292 when block storage is reserved (every stiffness mode but
-   FRM_STIFFNESS_PAIRS), per sample about 200, per frame about 1 kB; frm_model_memory_bytes
-   tells. The description's arrays are read during frm_model_create only. The samplings
+   buffer; 24 more with the rotation stabilisation's divergence term, the default), per
+   block 292 when block storage is reserved (every stiffness mode but
+   FRM_STIFFNESS_PAIRS), per sample about 200 (290 with the divergence term), per frame
+   about 1 kB; frm_model_memory_bytes tells. The description's arrays are read during frm_model_create only. The samplings
    allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
