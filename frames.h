@@ -52,7 +52,7 @@
            for (i = 0; i < 81; i += 9) frm_model_fix_frame(m, i); // clamp the face x = 0
            err = frm_model_solve_static(m);                       // sag under gravity
            printf("%s: the tip sagged %.4f m\n", frm_error_string(err),
-                  0.5 - (double)frm_model_positions(m)[3 * 44 + 2]); // 0.0401, beam theory 0.040
+                  0.5 - (double)frm_model_positions(m)[3 * 44 + 2]); // 0.0399, beam theory 0.040
            for (i = 0; i < 100; i++) frm_model_step(m); // then one second of implicit dynamics
            frm_model_destroy(m);
            return 0;
@@ -65,9 +65,9 @@
 
        FRM_REAL        float or double (default double). Kernels and stored data are
                        FRM_REAL; creation, shape functions, sampling, dot products and
-                       energies run in double. In float builds the entry points that take
-                       or make FRM_REAL data are renamed (..._f32), so float and double
-                       translation units cannot be linked together.
+                       energies run in double. In float builds every public entry point
+                       is renamed (..._f32), so float and double translation units cannot
+                       be linked together.
        FRM_MALLOC(size, user) / FRM_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
        FRM_ASSERT(x)   internal sanity checks (default: assert from <assert.h>).
@@ -104,22 +104,29 @@
    Nothing else allocates: forces, stiffness products and assembly, steps and solves
    reuse the block. Per (sample, neighbour) pair the model holds about 230 bytes in
    double (index, weight, gradient, levers, the linearisation's G and Hs, the pass-1
-   buffer), per block 292 when block storage is reserved (every stiffness mode but
-   FRM_STIFFNESS_PAIRS), per sample about 200, per frame about 1 kB; frm_model_memory_bytes
-   tells. The description's arrays are read during frm_model_create only. The samplings
+   buffer; 24 more with the rotation stabilisation's divergence term, the default), per
+   block 292 when block storage is reserved (every stiffness mode but
+   FRM_STIFFNESS_PAIRS), per sample about 200 (290 with the divergence term), per frame
+   about 1 kB; frm_model_memory_bytes tells. The description's arrays are read during frm_model_create only. The samplings
    allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
    names it, and the optional desc.log callback receives a detailed message for validation
-   failures (the library never prints). Creation refuses: counts out of range, non-finite
+   failures (the library never prints). A description not made by its default function
+   (frm_model_default_desc, frm_shape_default_desc, frm_poisson_default_desc: a private
+   cookie) is refused with FRM_ERR_DESC before anything in it is read, its log callback
+   included (it may be garbage). Shape functions refuse non-finite points, corners, frames
+   or radii and a Shepard exponent <= 1 (FRM_ERR_ARG); samplings refuse a Shepard exponent
+   <= 1 and frame_spacing < sample_spacing (FRM_ERR_SAMPLING). Creation refuses: counts out of range, non-finite
    positions, orientations that are not unit quaternions (|q|^2 off by more than 1e-5),
    zero, negative or non-finite sample volumes, samples without neighbours or with more
    than FRM_MAX_NEIGHBORS (16), frame indices out of range or repeated in a sample,
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
-   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
-   Neo-Hookean sample (FRM_ERR_INVERTED), without convergence (FRM_ERR_NO_CONVERGENCE) or,
+   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted or
+   mirrored sample (FRM_ERR_INVERTED: det F <= 0, Neo-Hookean and St Venant-Kirchhoff alike;
+   frm_model_forces and _energy refuse such a state too), without convergence (FRM_ERR_NO_CONVERGENCE) or,
    for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
    iterations or rose in 3 in a row, see LIMITS) leaves positions, orientations and velocities exactly as they
    were.
@@ -176,9 +183,12 @@
        fields, it stiffens the rotations a trilinear grid cannot see (see LIMITS), at the
        price of bending stiffness on coarse, elongated cells.
 
-       Rotation stabilisation (desc.rotation_stabilization = beta, default 0.5; 0 = the
-       thesis's model exactly). A frame whose samples lie on a line (or are a single one)
-       has a rotation they do not see at first order: turning it about that line while
+       Rotation stabilisation: two terms that give the frames' rotations the stiffness the
+       continuum has where the samples do not see them; both are zero for rigid motions and
+       whenever the frames turn with the material.
+       (1) Unseen rotations (desc.rotation_stabilization = beta, default 0.5; 0 = the
+       thesis's model). A frame whose samples lie on a line (or are a single one) has a
+       rotation they do not see at first order: turning it about that line while
        translating it by -dtheta x a_s leaves every sample's prediction d = x + R lbar in
        place, and F changes only by the skew w [dtheta]x. The energy is flat along it, and
        under stress its second-order term w (Q - I) relieves the samples' strain, so it
@@ -189,17 +199,61 @@
        those frames only (found at creation: the kernel of the samples' second moment
        J = tr(L) I - L, projector N in rest axes, unless the whole neighbourhood is
        collinear too, a rod whose torsion lives in that rotation) the model adds, per
-       (sample, frame),
-           E_r = beta mu v / 2  omega . N omega,   omega = axial(skew(Q^T F)),
-       the frame's rotation relative to the sample's, about the unseen axes only. Zero for
-       rigid motions and whenever the frame turns with its samples, so it does not touch
-       the first-order solution: it only picks the unseen rotation, and changes
-       equilibria through the difference of the material rotations at a frame's samples
-       (measured: beta 0.5 against 0.1 moves the tip by 0.44 % on R3 one cell across, by
-       0.06 % at two, by 0.02 % on R2 at three; tests/test_frames.c checks it). Forces:
-       T = beta mu v / 2 Q [N omega]x joins the sample's P, the frame's own torque is
-       sum_j f_j x t_j; its stiffness is exact (Gauss-Newton part and second-order part,
-       tested against finite differences). frm_model_stabilized_frames counts the frames.
+       (sample, frame), beta mu v / 2 omega . N omega with omega = axial(skew(Q^T F)), the
+       frame's rotation relative to the sample's, about the unseen axes only (measured:
+       beta 0.5 against 0.1 moves the tip by 0.49 % on R3 one cell across, by 0.09 % at
+       two; tests/test_frames.c checks it). frm_model_stabilized_frames counts the frames.
+       (2) Divergence (desc.rotation_divergence = gamma, default 4; 0 = the thesis's
+       model). Frame rotations can also move no material collectively: with weights that
+       reproduce linear fields, turning every frame by the same theta moves nothing
+       (sum_i w_i theta x (x - x_i) = 0), and on a tensor-product hexahedral grid neither
+       does a layer of frames normal to an axis turning about it (the bilinear face
+       interpolation reproduces the in-plane coordinates): zero-energy modes of the
+       linearisation, which stalled the static solves of hexahedral frames one cell across
+       and of R2. With one sample per tetrahedron the slowly varying version costs only
+       the under-integrated bubble energy mu h^2 |grad theta|^2: the R3 beam had modes at
+       0.39-0.42 Hz below its first bending mode (0.509 Hz) at every resolution and at
+       2.3-2.5 Hz below the second, the frames turning about the beam's axis while the
+       material hardly moves, which beta did not touch (0.4164 against 0.4168 Hz for 0.5
+       and 2). A tie of each frame's rotation to the material's (|omega|^2 per pair or per
+       sample) removes them but locks bending: the frames' natural rotation in bending is
+       not the material's (on R1 with 24 x 4 x 4 hexahedral cells it is half of it: the
+       rotation gradient makes the quadratic bubble through sum_i w_i (G d_i) x d_i with
+       G = omega'/2), so even gamma = 1e-2 put R1 31 % too stiff. What the continuum does
+       fix is the divergence: a material rotation field, half the curl of the
+       displacement, has none, and neither has the frames' natural field in bending
+       (theta_y varying along x), while every mode above has (theta_x varying along x,
+       a layer's jump). Per sample, with omega_k = axial(skew(Q_k^T F)) the sample's
+       rotation relative to frame k (rest axes) and, linearised, omega_k = omega_s - theta_k
+       and sum_k grad w_k = 0,
+           D = sum_k grad w_k . omega_k  (= -div theta, the frames' interpolated field)
+           E_d = gamma mu v h^2 / 2 D^2,
+       h^2 the sample's mean squared lever (sum |w| |lbar|^2 / sum |w|): of order h^2 for
+       smooth fields, so it vanishes under refinement, zero for rigid motions (omega_k = 0)
+       and for a uniform turn relative to the material. Only samples whose weights
+       reproduce linear fields (sum_k lbar_k grad w_k^T = -I to 1e-3: tetrahedra,
+       hexahedra, MLS) carry it; zero-order Shepard samples keep the thesis's model.
+       Forces: with Z_k = Q_k [grad w_k]x, grad w_k . omega_k = [grad w_k]x : Q_k^T F / 2
+       = Z_k : F / 2, so D = Y : F / 2 (Y = sum_k Z_k), the stress c g D / 2 Y joins
+       P (c = mu v, g = gamma h^2) and each frame's own torque is c g D / 2 sum_j f_j x z_kj.
+       Stiffness, exact: dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (t_k = sum_j f_j x z_kj),
+       the Gauss-Newton part c g dD (Y / 2, -t_k / 2) and the second-order part of
+       T_k = c g D / 2 Z_k ([dtheta_k]x T_k, -sum_j df_j x t_kj and the frame-own
+       sym(F T^T) - tr(F^T T) I), tested against finite differences of the force, which are
+       tested against an independent energy (tests/test_frames.c). Measured on the R3 beam
+       (generalized eigenvalues of (K, M), tests/test_frames_elem.c), tetrahedral frames
+       with one sample each, two cells across: lowest modes 0.4164 (spurious), 0.4976,
+       0.4976, 2.4879 (spurious), 2.9943 Hz with gamma = 0; 0.4982, 0.4982, 2.9982, 2.9982,
+       4.8506 (torsion, 3D 4.5101) Hz with gamma = 4; one cell across 0.3901 (spurious),
+       0.4447 against 0.4480, 0.4484 (bending), 2.69 (second bending) Hz; hexahedral frames
+       one cell across: six and more zero eigenvalues with gamma = 0, lowest 0.4681 Hz
+       (bending) with gamma = 4. gamma trades the hexahedral one-cell rotation mode (0.27,
+       0.35, 0.47, 0.64, 0.96 Hz for gamma = 0.5, 1, 2, 4, 10) against the tetrahedral
+       frames' torsion, which the term stiffens at coarse resolution (4.44 Hz at gamma 0,
+       4.67, 4.80, 4.85, 4.87 Hz at 0.5, 2, 4, 10 on two cells across; of order h^2).
+       Both terms: the stabilisation's stress joins the sample's P, the frame-own torques
+       apart; the unseen-rotations term's stiffness is exact too (Gauss-Newton part and
+       second-order part).
 
    MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
    split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
@@ -303,6 +357,10 @@
            force pass 42 ns a pair; K v pair mode 28-42 ns a pair (20.6 with -O3
            -march=native); K v block mode 7-8 ns a block, 3.6-4 ns a pair; assembly
            0.8-1.7 us a pair; so blocks pay off after 4 to 25 CG iterations.
+       The rotation stabilisation's divergence term (default on, issue 18) adds to these: on
+       the same beam, in one run on a loaded machine, force pass 82 against 48 ns a pair
+       and K v pair mode 59 against 28 ns with and without it (tetrahedra, one sample each,
+       4 neighbours: 93 against 74 and 48 against 41 ns); block products unchanged.
        On the reference machine of REFERENCES.md (4.2 GHz, 40 GB/s) expect about half.
        FRM_STIFFNESS_AUTO assembles when the previous solve's iteration count (50 before
        any) times the pair mode's cost exceeds the assembly plus the block products
@@ -313,16 +371,26 @@
        matrix-free, 139 ms by blocks (thesis: 3468 ms CPU, 66.1 ms on a GTX 570).
 
    ACCURACY (tests/test_frames.c prints these)
-       R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.39 % of Timoshenko
-       (+0.16 % in float); with Gauss points -1.7 % (Poisson locking of 4 cells across).
+       R1, steel cantilever, 25 x 5 x 5 frames, sub-cell samples: +0.21 % of Timoshenko,
+       +0.49 % of the 3D value 0.150169 m (before the divergence term: +0.39 % / +0.67 %);
+       float +0.17 % of Timoshenko (+0.16 % before); with Gauss points -1.7 % (Poisson locking of 4
+       cells across). Hexahedral frames one cell across (32 x 1 x 1 cells, which stalled
+       before): +20.4 % of the 3D value, two cells across (64 x 2 x 2) +4.1 %
+       (tests/test_frames_elem.c): one cell is soft, as with tetrahedral frames.
        Tetrahedral frames with one sample per tetrahedron (the bench's tet4 body, 5
-       tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +33 %,
-       +5.9 %, +2.3 %, +1.1 %, +0.28 % for k = 1, 2, 3, 4, 6, float within 2e-4 of double;
-       the R3 beam's static sag +30 % and +4.9 % at one and two cells across (soft at one
-       cell: the frames' rotations let a single tetrahedron bend).
-       R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.289,
-       6.132, 6.327 m, order 1.6, limit 6.54 m, about 40,000 DoF for 1 % of it.
-       R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.96 %.
+       tetrahedra a cube, rotation stabilisation on): R1 on 32k x k x k cells +32.9 %,
+       +6.1 %, +2.5 %, +1.3 % of the 3D value for k = 1, 2, 3, 4 (+33.4, +6.2, +2.5, +1.4 %
+       before the divergence term), float within 8e-4 of double at k = 2 and 4e-4 at k = 4
+       (2e-4 before: float's Newton stops on the round-off floor a little earlier);
+       the R3 beam's static sag +29 % and +4.6 % of beam theory at one and two cells
+       across (+30 % and +4.9 % before; soft at one cell: the frames' rotations let a
+       single tetrahedron bend). Its lowest modes: see MODEL, rotation stabilisation.
+       R2, soft cantilever, 4-neighbour frames (tetrahedra) at h = 1, 1/2, 1/3 m: 5.225,
+       6.112, 6.319 m (5.289, 6.132, 6.327 before), order 1.6, limit 6.54 m, about 45,000 DoF
+       for 1 % of it. Hexahedral frames (stalled before at every resolution): 7.203, 6.656,
+       6.569 m at 16 x 1 x 1, 32 x 2 x 2, 48 x 3 x 3 cells.
+       R3, beam frequency from the implicit dynamics, 11 x 3 x 3 frames: -0.69 % of
+       Timoshenko (-0.96 % before).
        A 180 degree torsion of a 10-frame Shepard bar (thesis fig. 4.11) spreads linearly
        to within 3.5 degrees; a coplanar Shepard sheet under 300 N (fig. 4.10) converges.
 
@@ -332,18 +400,26 @@
          With one sample per tetrahedron every edge frame of a mesh is such a frame. The
          default rotation_stabilization (0.5) holds exactly those; with 0 (the thesis's
          model) static solves of stressed bodies fail or end in the buckled minimum (R1
-         one cell across: 0.04 rad of spurious rotation, 78 % too much sag). (b) On
-         tensor-product (extruded) hexahedral grids a layer of frames normal to an axis,
-         turning about that axis, moves no sample at all (the bilinear face interpolation
-         reproduces the in-plane coordinates): a collective mode no single frame shows, so
-         the stabilisation does not see it (stabilising every hexahedral frame's rotation
-         makes bending 30 % too stiff). Small deformations on two or more cells across
-         solve well (R1, R3); one cell across, or large deformation (R2), the mode buckles
-         and the static solve stops with FRM_ERR_STALLED (0.2-0.5 s on the bench's beams)
-         rather than running to the cap. Use tetrahedral or meshless frames there, or
-         frame_coupling = 1e-2 (which makes coarse, elongated cells stiffer in bending: R1
-         at 25 x 5 x 5 becomes 31 % too stiff). Implicit steps stay stable at any time step
-         (the positive-definite fallback), the mode then moves dynamically.
+         one cell across: 0.04 rad of spurious rotation, 78 % too much sag). (b) Rotations
+         that move no material collectively: on tensor-product hexahedral grids a layer of
+         frames normal to an axis turning about it (zero energy), with one sample per
+         tetrahedron the frames turning slowly about a beam's axis (spurious modes below
+         the first bending mode at every resolution). The default rotation_divergence (4)
+         holds them (see MODEL): hexahedral frames one cell across and R2 now solve, the
+         tetrahedral frames' R3 beam has no mode below its bending modes. What remains:
+         hexahedral frames one cell across keep frame-rotation modes above the first
+         bending mode but below the second (0.64 and 1.75 Hz on R3, bending 0.47 and
+         2.82 Hz; 1.75 Hz does not depend on gamma), and bend 20 % too soft on R1 (4 % at two
+         cells across); at coarse resolution the divergence term stiffens the tetrahedral
+         frames' torsion (R3 at two cells across: 4.85 Hz against 4.44 Hz without it, 3D
+         4.51 Hz; of order h^2). With rotation_divergence = 0 (the thesis's model) static
+         solves of hexahedral frames one cell across or in large deformation stop with
+         FRM_ERR_STALLED (0.2-0.5 s on the bench's beams). Shepard samples (zero order)
+         carry no divergence term (see MODEL).
+         The stabilisation costs: on every sample with linear weights its force pass
+         carries the term (measured +70 % on the hexahedral R1 beam, +26 % on tetrahedra)
+         and the matrix-free K v about twice the time on hexahedra (+20 % on tetrahedra);
+         assembled blocks are unchanged.
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
@@ -352,12 +428,16 @@
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
          beam, and no convergence at 0.499). Tetrahedral frames with one sample each lock
          less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2).
-       - St Venant-Kirchhoff softens and can collapse under strong compression; a
-         Neo-Hookean sample cannot invert: its energy is infinite at det F <= 0, and a step
-         or solve that would reach it refuses with FRM_ERR_INVERTED and keeps the last
-         valid state (the bench's squash test: a corner driven through the opposite face).
-         There is no inversion-safe continuation (as heml.h's linearised volumetric term
-         below J0): use St Venant-Kirchhoff for scenes that push the body through itself.
+       - St Venant-Kirchhoff softens and can collapse under strong compression, and its
+         energy has a minimum of zero at every mirror image of the rest state (F =
+         diag(1, 1, -1)): a solve once settled a compressed cube's top layer there, with
+         success and P_zz = 0. Both laws now refuse det F <= 0 (a Neo-Hookean sample's
+         energy is infinite there): a step or solve that would reach it returns
+         FRM_ERR_INVERTED and keeps the last valid state (the bench's squash test, a corner
+         driven through the opposite face, is refused with either law). There is no
+         inversion-safe continuation (as heml.h's linearised volumetric term below J0). The
+         kernel frm_material_stress still computes St Venant-Kirchhoff's S and energy of a
+         mirrored sample before returning FRM_ERR_INVERTED, for a caller that allows it.
        - Shepard functions are zero-order (no linear reproduction): meshless Shepard
          bodies are stiffer and less accurate than MLS ones, but take any point layout
          (coplanar, collinear); MLS needs 3D spread and may give negative weights (the
@@ -369,7 +449,7 @@
        - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m; at
          1e6 m a mesh of centimetres degenerates, FRM_ERR_SHAPE_DEGENERATE); steel-like
          stiffness needs the round-off floor to stop Newton, which it does only once
-         Newton no longer halves the residual (R1 float +0.16 %).
+         Newton no longer halves the residual (R1 float +0.17 %).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
@@ -377,7 +457,16 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
-       unreleased: rotation stabilisation for frames with collinear samples (default on:
+       unreleased (issue 18): the divergence term of the rotation stabilisation
+             (desc.rotation_divergence, default 4: removes the tetrahedral frames' spurious
+             low modes and the hexahedral frames' zero-energy rotations; changes results
+             slightly, see ACCURACY); St Venant-Kirchhoff refuses det F <= 0
+             (FRM_ERR_INVERTED); descriptions without their cookie refused before their log
+             callback is called, frm_shape_desc and frm_poisson_desc gained cookies (start
+             them from their default functions); shape functions refuse non-finite input and
+             Shepard exponents <= 1, samplings frame_spacing < sample_spacing; every entry
+             point renamed in float builds.
+       earlier unreleased: rotation stabilisation for frames with collinear samples (default on:
              changes tetrahedral one-sample models); static and implicit solvers fall back
              to K's positive-definite part on indefinite linearisations; static line search
              judged by the residual below the energy's round-off; the round-off floor stops
@@ -415,25 +504,68 @@ typedef FRM_REAL frm_real;
 #define FRM_HOSTDEV
 #endif
 
-/* Float builds rename the entry points that take or make frm_real data, so that a float
-   and a double translation unit cannot be linked together by mistake. FRM_REAL must be
-   the single token float or double. */
+/* Float builds rename every public entry point (every FRMDEF function, ..._f32), so that
+   a float and a double translation unit cannot be linked together by mistake, whichever
+   functions a program calls (tests/test_frames_elem.c reads this list back against the
+   declarations). FRM_REAL must be the single token float or double. */
 #define FRM__IS_float 1
 #define FRM__IS_double 0
 #define FRM__CAT2(a, b) a##b
 #define FRM__CAT(a, b) FRM__CAT2(a, b)
 #if FRM__CAT(FRM__IS_, FRM_REAL)
-#define frm_model_create frm_model_create_f32
-#define frm_model_default_desc frm_model_default_desc_f32
+#define frm_version frm_version_f32
+#define frm_error_string frm_error_string_f32
+#define frm_shape_tet frm_shape_tet_f32
+#define frm_shape_hex frm_shape_hex_f32
+#define frm_shape_shepard frm_shape_shepard_f32
+#define frm_shape_mls frm_shape_mls_f32
 #define frm_sampling_hexes frm_sampling_hexes_f32
 #define frm_sampling_tets frm_sampling_tets_f32
 #define frm_sampling_meshless frm_sampling_meshless_f32
 #define frm_sampling_box frm_sampling_box_f32
 #define frm_sampling_surface frm_sampling_surface_f32
-#define frm_shape_tet frm_shape_tet_f32
-#define frm_shape_hex frm_shape_hex_f32
-#define frm_shape_shepard frm_shape_shepard_f32
-#define frm_shape_mls frm_shape_mls_f32
+#define frm_sampling_apply frm_sampling_apply_f32
+#define frm_sampling_free frm_sampling_free_f32
+#define frm_shape_default_desc frm_shape_default_desc_f32
+#define frm_poisson_default_desc frm_poisson_default_desc_f32
+#define frm_model_default_desc frm_model_default_desc_f32
+#define frm_model_create frm_model_create_f32
+#define frm_model_destroy frm_model_destroy_f32
+#define frm_model_fix_frame frm_model_fix_frame_f32
+#define frm_model_drive_frame frm_model_drive_frame_f32
+#define frm_model_release_frame frm_model_release_frame_f32
+#define frm_model_frame_state frm_model_frame_state_f32
+#define frm_model_set_external frm_model_set_external_f32
+#define frm_model_clear_external frm_model_clear_external_f32
+#define frm_model_set_gravity frm_model_set_gravity_f32
+#define frm_model_set_solver frm_model_set_solver_f32
+#define frm_model_set_stiffness_mode frm_model_set_stiffness_mode_f32
+#define frm_model_step frm_model_step_f32
+#define frm_model_step_ex frm_model_step_ex_f32
+#define frm_model_solve_static frm_model_solve_static_f32
+#define frm_model_newton_step frm_model_newton_step_f32
+#define frm_model_frame_count frm_model_frame_count_f32
+#define frm_model_sample_count frm_model_sample_count_f32
+#define frm_model_pair_count frm_model_pair_count_f32
+#define frm_model_positions frm_model_positions_f32
+#define frm_model_orientations frm_model_orientations_f32
+#define frm_model_velocities frm_model_velocities_f32
+#define frm_model_set_poses frm_model_set_poses_f32
+#define frm_model_set_velocities frm_model_set_velocities_f32
+#define frm_model_sample_positions frm_model_sample_positions_f32
+#define frm_model_deformation_gradients frm_model_deformation_gradients_f32
+#define frm_model_forces frm_model_forces_f32
+#define frm_model_total_forces frm_model_total_forces_f32
+#define frm_model_energy frm_model_energy_f32
+#define frm_model_last_stats frm_model_last_stats_f32
+#define frm_model_mass_block frm_model_mass_block_f32
+#define frm_model_memory_bytes frm_model_memory_bytes_f32
+#define frm_model_stabilized_frames frm_model_stabilized_frames_f32
+#define frm_model_prepare_stiffness frm_model_prepare_stiffness_f32
+#define frm_model_apply_stiffness frm_model_apply_stiffness_f32
+#define frm_model_assemble_stiffness frm_model_assemble_stiffness_f32
+#define frm_model_stiffness_blocks frm_model_stiffness_blocks_f32
+#define frm_model_stiffness_block frm_model_stiffness_block_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
@@ -484,7 +616,7 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_STIFFNESS_MODE, -24, "unknown stiffness mode, or assembled blocks requested from a matrix-free model") \
     X(FRM_ERR_NOT_FINITE, -25, "result not finite; the last valid state was kept") \
     X(FRM_ERR_NO_CONVERGENCE, -26, "solver did not converge; the last valid state was kept") \
-    X(FRM_ERR_INVERTED, -27, "a Neo-Hookean sample would invert (det F <= 0); the last valid state was kept") \
+    X(FRM_ERR_INVERTED, -27, "a sample would invert or mirror (det F <= 0; Neo-Hookean and St Venant-Kirchhoff); the last valid state was kept") \
     X(FRM_ERR_FRAME_RANGE, -28, "frame index out of range") \
     X(FRM_ERR_NOT_NEIGHBORS, -29, "the two frames share no sample (no stiffness block between them)") \
     X(FRM_ERR_SHAPE_DEGENERATE, -30, "shape function undefined: flat or inverted element, coincident or coplanar frames") \
@@ -587,6 +719,13 @@ typedef struct frm_desc {
                                         boundary frames of tetrahedra with one sample each) to
                                         the samples' rotation; frames whose samples spread in
                                         3D are not affected (see MODEL and LIMITS) */
+    frm_real rotation_divergence; /* dimensionless, default 4 (0: the thesis's model): ties the
+                                     divergence of the frames' rotation field to the
+                                     material's, which is zero (a rotation field half the curl
+                                     of the displacement has none). Removes the frames'
+                                     rotations that move no material (tetrahedral frames'
+                                     spurious low modes, hexahedral frames' layers turning about
+                                     their normal); of order h^2 for smooth fields (see MODEL) */
     frm_real frame_coupling; /* dimensionless, default 0 (the thesis's model exactly): weight
                                 of the coupling term that ties each frame's own prediction
                                 of a sample to the blended position (see MODEL); 1e-2
@@ -661,17 +800,19 @@ typedef struct frm_shape_desc {
     int nearest;         /* k for FRM_SUPPORT_NEAREST, 1..16 (MLS needs >= 4), default 8 */
     frm_real radius;     /* m: the support radius for FRM_SUPPORT_RADIUS; ignored otherwise */
     frm_real power;      /* Shepard exponent p of eq. 4.9, > 1, default 2 */
+    unsigned int internal_cookie; /* set by frm_shape_default_desc; do not touch */
 } frm_shape_desc;
 
 /* Poisson-disk sampling of a domain (thesis sec. 4.1, "Domain sampling", after Bridson
    2007): frames from a coarser distance than samples. */
 typedef struct frm_poisson_desc {
-    frm_real frame_spacing;  /* m, least distance between frames, > sample_spacing */
+    frm_real frame_spacing;  /* m, least distance between frames, >= sample_spacing */
     frm_real sample_spacing; /* m, least distance between samples */
     unsigned int seed;       /* same seed, same points, on every platform; default 1 */
     frm_real volume;         /* m^3 split evenly over the samples; <= 0 (default): the
                                 domain's own volume (needed for a flat or linear box) */
     int max_points;          /* refuse (FRM_ERR_SAMPLING) to make more points, default 1e6 */
+    unsigned int internal_cookie; /* set by frm_poisson_default_desc; do not touch */
 } frm_poisson_desc;
 
 /* Frames, samples and their neighbour table, owning its arrays: what frm_sampling_*
@@ -700,13 +841,14 @@ FRMDEF const char *frm_error_string(int code);
 
 /* Tetrahedral barycentric (linear) functions of the 4 corners (12 coordinates, m, any
    orientation) at point: weights[4], gradients[4 * 3] (1/m, constant in the element).
-   FRM_ERR_SHAPE_DEGENERATE for a flat tetrahedron. */
+   FRM_ERR_SHAPE_DEGENERATE for a flat tetrahedron; FRM_ERR_ARG for a non-finite corner or point. */
 FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], frm_real weights[4],
                          frm_real gradients[12]);
 /* Hexahedral trilinear functions of the 8 corners (corner (a, b, c), a, b, c in {0, 1}, is
    index a + 2 b + 4 c, as hexmesh_grid in examples/tetmesh.h) at the parametric point
    xi in [0, 1]^3: the physical point (may be NULL), weights[8], gradients[8 * 3] (1/m)
-   and det(dx/dxi) (m^3, may be NULL). FRM_ERR_SHAPE_DEGENERATE if det <= 0 there. */
+   and det(dx/dxi) (m^3, may be NULL). FRM_ERR_SHAPE_DEGENERATE if det <= 0 there;
+   FRM_ERR_ARG for a non-finite corner or xi. */
 FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_real point[3],
                          frm_real weights[8], frm_real gradients[24], frm_real *jacobian_det);
 /* Shepard inverse-distance functions (eqs. 4.8-4.9) of `count` frames (3 * count
@@ -714,14 +856,16 @@ FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_r
    form); radius > 0: w_i ~ ((R - d_i)+ / (R d_i))^p (Franke-Little, zero at the support's
    edge; frames beyond R get weight 0, at least one must be inside). A point on a frame
    gets that frame's weight 1 and zero gradients (the limit for p > 1). Coplanar and
-   collinear frames are fine. FRM_ERR_SHAPE_DEGENERATE if two frames coincide. */
+   collinear frames are fine. FRM_ERR_SHAPE_DEGENERATE if two frames coincide; FRM_ERR_ARG
+   for a non-finite frame or point, power <= 1 or not finite, radius not finite. */
 FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real point[3], frm_real power,
                              frm_real radius, frm_real *weights, frm_real *gradients);
 /* Linear moving least squares functions (eqs. 4.5-4.7 with p = [1 x y z]) of `count`
    frames at point, Wendland C2 kernel of support radius > 0 (m). First-order
    consistent: sum w_i x_i = point and sum x_i grad w_i^T = I. Weights may be negative.
    FRM_ERR_SHAPE_DEGENERATE if the frames inside the radius are fewer than 4 or (nearly)
-   coplanar: the moment matrix is singular (table 4.1). */
+   coplanar: the moment matrix is singular (table 4.1); FRM_ERR_ARG for a non-finite frame,
+   point or radius. */
 FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point[3], frm_real radius,
                          frm_real *weights, frm_real *gradients);
 
@@ -1083,8 +1227,12 @@ FRM_HOSTDEV static inline void frm_first_piola(const frm_real F[9], const frm_re
        SVK (eq. 3.53):  S = lambda tr(E) I + 2 mu E
        Neo-Hookean:     S = mu (I - C^-1) + lambda ln J C^-1 = 2 mu C^-1 E + lambda ln J C^-1
    (J - 1 by frm_det_minus_one, ln J by log1p: small strains keep their digits). Returns 0,
-   or FRM_ERR_INVERTED for a Neo-Hookean sample with J <= 0 (the energy is infinite
-   there). Room for more laws: add a case here and in frm_material_dstress. */
+   or FRM_ERR_INVERTED for a sample with J <= 0: Neo-Hookean's energy is infinite there
+   (S, psi not computed); St Venant-Kirchhoff's is finite and has a minimum of zero at
+   every mirror image of the rest state (F = diag(1, 1, -1): E = 0), so a solver would
+   happily settle a layer there; S and psi are computed, and a caller that accepts
+   mirrored SVK samples may use them. Room for more laws: add a case here and in
+   frm_material_dstress. */
 FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real lambda, const frm_real H[9],
                                                   frm_real S[6], frm_real *psi, frm_real *cache)
 {
@@ -1138,7 +1286,7 @@ FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real
     *psi = (frm_real)0.5 * lambda * tr * tr +
            mu * (E[0] * E[0] + E[1] * E[1] + E[2] * E[2] + 2 * (E[3] * E[3] + E[4] * E[4] + E[5] * E[5]));
     (void)cache;
-    return 0;
+    return 1 + frm_det_minus_one(H) <= 0 ? FRM_ERR_INVERTED : 0; /* NaN: left to the non-finite checks */
 }
 
 /* dS for a strain variation dE (6) at the state frm_material_stress cached (eq. 3.68):
@@ -1414,30 +1562,57 @@ FRM_HOSTDEV static inline void frm_stab_stress(frm_real c, const frm_real Qm[9],
             T[3 * r + k] = h * (X[3 * r + k] + Qm[3 * r] * X[k] + Qm[3 * r + 1] * X[3 + k] + Qm[3 * r + 2] * X[6 + k]);
 }
 
-/* The rotation stabilisation of one (sample, frame) pair (see MODEL): with A = Q^T F the
-   sample's deformation seen in the frame's rest axes, omega = axial(skew A) its rotation
-   relative to the frame and m = N omega (N the frame's projector on the rotations its
-   samples do not see, rest axes, 6 Voigt),
-       E = c/2 omega . m,   T = c/2 Q [m]x,   dE = T : dF - dtheta . sum_j f_j x t_j
-   (f_j, t_j the columns of F, T; dtheta the frame's rotation). The caller adds T / v to
-   the sample's P (the T : dF part reaches every frame through B^T); the frame's own share
-   torque = sum_j f_j x t_j is returned with T, m and E. H = F - I and Qm = Q - I keep
-   small rotations' digits: skew(Q^T F) = skew(Qm^T + H + Qm^T H). */
-FRM_HOSTDEV static inline frm_real frm_pair_stab_force(const frm_real H[9], const frm_real F[9], const frm_real Qm[9],
-                                                       const frm_real N[6], frm_real c, frm_real T[9],
-                                                       frm_real torque[3], frm_real m[3])
+/* The rotation of a sample relative to one of its frames (see MODEL, rotation
+   stabilisation): with A = Q^T F the sample's deformation seen in the frame's rest axes,
+   omega = axial(skew A). H = F - I and Qm = Q - I keep small rotations' digits:
+   skew(Q^T F) = skew(Qm^T + H + Qm^T H). */
+FRM_HOSTDEV static inline void frm_pair_stab_omega(const frm_real H[9], const frm_real Qm[9], frm_real om[3])
 {
-    frm_real A[9], om[3], Nm[9];
+    frm_real A[9];
     int r, k;
     for (r = 0; r < 3; r++)
         for (k = 0; k < 3; k++)
             A[3 * r + k] = Qm[3 * k + r] + H[3 * r + k] + Qm[r] * H[k] + Qm[3 + r] * H[3 + k] + Qm[6 + r] * H[6 + k];
     frm_skew_axial(A, om);
-    frm_sym_to_matrix(N, Nm);
-    for (r = 0; r < 3; r++) m[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
-    frm_stab_stress(c, Qm, m, T);
-    frm_column_cross_sum(F, T, torque);
-    return (frm_real)0.5 * c * (om[0] * m[0] + om[1] * m[1] + om[2] * m[2]);
+}
+
+/* Its variation for the sample's dF and the frame's rotation dtheta (Q -> exp([dtheta]x) Q):
+   domega = axial(skew(Q^T (dF - [dtheta]x F))). dtheta may be NULL (zero). */
+FRM_HOSTDEV static inline void frm_pair_stab_domega(const frm_real F[9], const frm_real dF[9], const frm_real Qm[9],
+                                                    const frm_real *dtheta, frm_real om[3])
+{
+    frm_real D[9], A[9];
+    int r, k;
+    for (k = 0; k < 9; k++) D[k] = dF[k];
+    if (dtheta)
+        for (k = 0; k < 3; k++) { /* D = dF - [dtheta]x F, column by column */
+            D[k] -= dtheta[1] * F[6 + k] - dtheta[2] * F[3 + k];
+            D[3 + k] -= dtheta[2] * F[k] - dtheta[0] * F[6 + k];
+            D[6 + k] -= dtheta[0] * F[3 + k] - dtheta[1] * F[k];
+        }
+    for (r = 0; r < 3; r++) /* A = Q^T D */
+        for (k = 0; k < 3; k++)
+            A[3 * r + k] = D[3 * r + k] + Qm[r] * D[k] + Qm[3 + r] * D[3 + k] + Qm[6 + r] * D[6 + k];
+    frm_skew_axial(A, om);
+}
+
+/* Z = Q [g]x = [g]x + Qm [g]x for a pair's weight gradient g: the divergence term's
+   direction, g . axial(skew(Q^T A)) = Z : A / 2 for any A (row r of Qm [g]x is qm_r x g). */
+FRM_HOSTDEV static inline void frm_stab_direction(const frm_real Qm[9], const frm_real g[3], frm_real Z[9])
+{
+    int r;
+    for (r = 0; r < 3; r++) {
+        const frm_real *q = Qm + 3 * r;
+        Z[3 * r] = q[1] * g[2] - q[2] * g[1];
+        Z[3 * r + 1] = q[2] * g[0] - q[0] * g[2];
+        Z[3 * r + 2] = q[0] * g[1] - q[1] * g[0];
+    }
+    Z[1] -= g[2];
+    Z[2] += g[1];
+    Z[3] += g[2];
+    Z[5] -= g[0];
+    Z[6] -= g[1];
+    Z[7] += g[0];
 }
 
 /* The frame-own second-order part of the stabilisation, X = sym(F T^T) - tr(F^T T) I (6,
@@ -1458,31 +1633,20 @@ FRM_HOSTDEV static inline void frm_pair_stab_rotation(const frm_real F[9], const
 }
 
 /* The stabilisation's stiffness (symmetric part, less the frame-own X above) for one pair:
-   for the sample's dF and the frame's dtheta,
-       omega1 = axial(skew(Q^T (dF - [dtheta]x F))),   Ta = c/2 Q [N omega1]x,
-       dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
+   for the sample's dF, the frame's dtheta and u = N domega + g dD grad w the Gauss-Newton
+   conjugate of the pair's domega (frm_pair_stab_domega; see frm__stab_sample_apply),
+       Ta = c/2 Q [u]x,   dPx = Ta + [dtheta]x T,   torque = -sum_j (f_j x ta_j + df_j x t_j),
    dPx a stress-like term (absolute: the caller divides by the volume and adds it to dP,
-   which B^T takes to every frame), torque the frame's own row. definite = 1 keeps the
-   Gauss-Newton part only (Ta; -sum f_j x ta_j), which is positive semi-definite. m is
-   the linearisation's m = N omega. */
+   which B^T takes to every frame), torque the frame's own row, T = c/2 Q [m]x with m the
+   linearisation's conjugate. definite = 1 keeps the Gauss-Newton part only (Ta;
+   -sum f_j x ta_j), which is positive semi-definite. dtheta may be NULL (zero). */
 FRM_HOSTDEV static inline void frm_pair_stab_apply(const frm_real F[9], const frm_real dF[9], const frm_real Qm[9],
-                                                   const frm_real N[6], frm_real c, const frm_real m[3],
-                                                   const frm_real dtheta[3], int definite, frm_real dPx[9],
+                                                   frm_real c, const frm_real u[3], const frm_real m[3],
+                                                   const frm_real *dtheta, int definite, frm_real dPx[9],
                                                    frm_real torque[3])
 {
-    frm_real D[9], A[9], om[3], u[3], Nm[9], t[3];
+    frm_real t[3];
     int r, k;
-    for (k = 0; k < 3; k++) { /* D = dF - [dtheta]x F, column by column */
-        D[k] = dF[k] - (dtheta[1] * F[6 + k] - dtheta[2] * F[3 + k]);
-        D[3 + k] = dF[3 + k] - (dtheta[2] * F[k] - dtheta[0] * F[6 + k]);
-        D[6 + k] = dF[6 + k] - (dtheta[0] * F[3 + k] - dtheta[1] * F[k]);
-    }
-    for (r = 0; r < 3; r++) /* A = Q^T D */
-        for (k = 0; k < 3; k++)
-            A[3 * r + k] = D[3 * r + k] + Qm[r] * D[k] + Qm[3 + r] * D[3 + k] + Qm[6 + r] * D[6 + k];
-    frm_skew_axial(A, om);
-    frm_sym_to_matrix(N, Nm);
-    for (r = 0; r < 3; r++) u[r] = Nm[3 * r] * om[0] + Nm[3 * r + 1] * om[1] + Nm[3 * r + 2] * om[2];
     frm_stab_stress(c, Qm, u, dPx);
     frm_column_cross_sum(F, dPx, torque);
     for (r = 0; r < 3; r++) torque[r] = -torque[r];
@@ -1491,11 +1655,12 @@ FRM_HOSTDEV static inline void frm_pair_stab_apply(const frm_real F[9], const fr
         frm_stab_stress(c, Qm, m, T);
         frm_column_cross_sum(dF, T, t);
         for (r = 0; r < 3; r++) torque[r] -= t[r];
-        for (k = 0; k < 3; k++) { /* dPx += [dtheta]x T */
-            dPx[k] += dtheta[1] * T[6 + k] - dtheta[2] * T[3 + k];
-            dPx[3 + k] += dtheta[2] * T[k] - dtheta[0] * T[6 + k];
-            dPx[6 + k] += dtheta[0] * T[3 + k] - dtheta[1] * T[k];
-        }
+        if (dtheta)
+            for (k = 0; k < 3; k++) { /* dPx += [dtheta]x T */
+                dPx[k] += dtheta[1] * T[6 + k] - dtheta[2] * T[3 + k];
+                dPx[3 + k] += dtheta[2] * T[k] - dtheta[0] * T[6 + k];
+                dPx[6 + k] += dtheta[0] * T[3 + k] - dtheta[1] * T[k];
+            }
     }
 }
 
@@ -1562,7 +1727,9 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM_ASSERT(x) assert(x)
 #endif
 
-#define FRM__COOKIE 0x46524D53u /* "FRMS" */
+#define FRM__COOKIE 0x46524D53u         /* "FRMS" */
+#define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
+#define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
@@ -1608,6 +1775,8 @@ struct frm_model {
     int stiffness_mode, has_blocks;
     double regularization, solve_regularization; /* static solves: eps added to K's rotational diagonal */
     frm_real stab_beta;                          /* rotation_stabilization */
+    frm_real stab_gamma;                         /* rotation_divergence */
+    int stab_on;                                 /* the stabilisation has a term (beta with unseen rotations, or gamma) */
     int stab_frames;                             /* frames with a rotation their samples do not see */
     double newton_previous;                      /* |f| at the previous Newton iteration */
     double floor_residual;                       /* |f| of the last iteration below the round-off floor, or 0 */
@@ -1640,6 +1809,9 @@ struct frm_model {
 
     /* samples */
     frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_hstab; /* g = gamma h^2 of the stabilisation's divergence term (m^2) */
+    frm_real *s_stabY; /* 9: Y = sum of Z_k over the pairs of frames without unseen rotations, at the linearisation */
+    frm_real *s_stabD; /* 1: D at the linearisation */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
@@ -1650,8 +1822,9 @@ struct frm_model {
     frm_real *p_weight, *p_grad, *p_local, *p_rlev; /* 1, 3, 3, 3: rest lever abar = Rbar lbar = pbar - xbar */
     frm_real *p_G, *p_H, *p_A, *p_C;       /* 9, 6, 3 (lever), 3 (coupling g) at the linearisation */
     frm_real *p_out;                       /* 6: pass-1 partial contributions */
-    frm_real *p_stab;                      /* 3: m = N omega of the stabilisation at the linearisation
-                                              (pairs of stabilised frames; NULL when there are none) */
+    frm_real *p_stab;                      /* 3: the stabilisation at the linearisation: pairs of frames with
+                                              unseen rotations m_k = N omega_k + g D grad w_k, the others
+                                              t_k = sum_j f_j x z_j (F, Z_k); NULL without stabilisation */
 
     /* per sample chunk: energy partial sums and errors of the last pass */
     double *chunk_energy;
@@ -1939,6 +2112,11 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_mu, frm_real, S);
     FRM__CARVE(c, m->s_lambda, frm_real, S);
     FRM__CARVE(c, m->s_couple, frm_real, S);
+    FRM__CARVE(c, m->s_hstab, frm_real, S);
+    if (m->stab_on) {
+        FRM__CARVE(c, m->s_stabY, frm_real, 9 * S);
+        FRM__CARVE(c, m->s_stabD, frm_real, S);
+    }
     FRM__CARVE(c, m->s_law, unsigned char, S);
     FRM__CARVE(c, m->s_stab, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
@@ -1958,7 +2136,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_A, frm_real, 3 * P);
     FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
-    if (m->stab_frames) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
+    if (m->stab_on) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
     for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
@@ -2013,6 +2191,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
     if (!(frm__finite((double)d->rotation_stabilization) && d->rotation_stabilization >= 0))
         return frm__fail(d, FRM_ERR_ARG, "rotation_stabilization must be finite and >= 0");
+    if (!(frm__finite((double)d->rotation_divergence) && d->rotation_divergence >= 0))
+        return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -2164,6 +2344,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.static_regularization = (frm_real)1e-10;
     d.frame_coupling = 0;
     d.rotation_stabilization = (frm_real)0.5;
+    d.rotation_divergence = (frm_real)4;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
@@ -2390,7 +2571,9 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     if (!out) return FRM_ERR_ARG;
     *out = NULL;
     if (!d) return FRM_ERR_ARG;
-    if (d->internal_cookie != FRM__COOKIE) return frm__fail(d, FRM_ERR_DESC, "start from frm_model_default_desc()");
+    /* not made by frm_model_default_desc: every field, the log callback included, may be
+       garbage, so refuse without calling it */
+    if (d->internal_cookie != FRM__COOKIE) return FRM_ERR_DESC;
     if (d->frame_count < 1 || d->frame_count > 100000000 || !d->frame_positions)
         return frm__fail(d, FRM_ERR_FRAME_COUNT, "frame_count must be >= 1 with positions");
     if (d->sample_count < 1 || d->sample_count > 100000000 || !d->sample_positions || !d->sample_volumes)
@@ -2446,11 +2629,13 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         tmp.sq_total = (int)sq;
     }
     tmp.stab_beta = d->rotation_stabilization;
+    tmp.stab_gamma = d->rotation_divergence;
     if (tmp.stab_beta > 0)
         for (i = 0; i < n; i++) {
             double N[6];
             tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
         }
+    tmp.stab_on = tmp.stab_frames > 0 || tmp.stab_gamma > 0;
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
     frm__layout(&tmp, &carver);
@@ -2498,13 +2683,14 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
     memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
     memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
-    if (m->stab_frames)
+    if (m->stab_frames) /* beta N: the unseen rotations of frames with collinear samples */
         for (i = 0; i < n; i++) {
             double N[6];
             m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
-            for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)N[k];
+            for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)(N[k] * (double)m->stab_beta);
             for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
         }
+
 
     /* samples */
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
@@ -2544,6 +2730,18 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         }
         h2 = wsum > 0 ? h2 / wsum : 0;
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
+        m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
+        if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
+                                    sum_k xbar_k grad w_k^T = I, i.e. sum_k abar_k grad w_k^T = -I */
+            double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, err = 0;
+            int q, r;
+            for (p = m->s_start[s]; p < m->s_start[s + 1]; p++)
+                for (r = 0; r < 3; r++)
+                    for (q = 0; q < 3; q++) A[3 * r + q] += (double)m->p_rlev[3 * p + r] * (double)m->p_grad[3 * p + q];
+            for (r = 0; r < 9; r++) err += fabs(A[r]);
+            if (err <= 1e-3) m->s_stab[s] = 1;
+            else m->s_hstab[s] = 0; /* zero-order (Shepard): left to the thesis's model */
+        }
     }
     i = frm__compute_masses(m, d);
     if (i >= 0) {
@@ -2604,6 +2802,122 @@ static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
     for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
 }
 
+/* The rotation stabilisation of sample s (see MODEL): its energy (returned), its stress
+   added to P (divided by the volume), each pair's T_k into T (9 n, for the frame-own
+   second-order term) and the frame-own torques into stq (3 n). With D = sum_k grad w_k .
+   omega_k = Y : F / 2, Y = sum_k Z_k: pairs of frames without unseen rotations have
+   T_k = c g D / 2 Z_k (no omega_k needed); those with them the general
+   T_k = c/2 Q_k [N_k omega_k + g D grad w_k]x. With linearize, the data K v needs. */
+static double frm__stab_sample_force(frm_model *m, int s, const frm_real H[9], const frm_real F[9], frm_real P[9],
+                                     frm_real *T, frm_real *stq, int linearize)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
+    frm_real v = m->s_volume[s], c = m->s_mu[s] * v, g = m->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
+    frm_real sD;
+    double energy = 0;
+    for (r = 0; r < 9; r++) Dall[r] = 0;
+    for (k = 0; k < n; k++) { /* Z_k into T, Y over the plain pairs, Dall over the others */
+        const frm_real *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        frm_stab_direction(m->relm + 9 * i, gk, T + 9 * k);
+        for (r = 0; r < 9; r++) {
+            if (m->f_stab_on[i]) Dall[r] += T[9 * k + r];
+            else Y[r] += T[9 * k + r];
+        }
+    }
+    for (r = 0; r < 9; r++) Dall[r] += Y[r];
+    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
+                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
+    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
+    sD = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
+    for (k = 0; k < n; k++) {
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            const frm_real *N = m->f_stab + 6 * i, *gk = m->p_grad + 3 * (size_t)(b + k);
+            frm_real om[3], mk[3];
+            frm_pair_stab_omega(H, m->relm + 9 * i, om);
+            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
+            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+            frm_stab_stress(c, m->relm + 9 * i, mk, T + 9 * k);
+            frm_column_cross_sum(F, T + 9 * k, stq + 3 * k);
+            for (r = 0; r < 9; r++) P[r] += T[9 * k + r] / v;
+            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mk, sizeof mk);
+        } else {
+            frm_real t[3];
+            frm_column_cross_sum(F, T + 9 * k, t);
+            for (r = 0; r < 3; r++) stq[3 * k + r] = sD * t[r];
+            for (r = 0; r < 9; r++) T[9 * k + r] *= sD;
+            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), t, sizeof t);
+        }
+    }
+    if (linearize) {
+        memcpy(m->s_stabY + 9 * (size_t)s, Y, sizeof Y);
+        m->s_stabD[s] = D;
+    }
+    return energy;
+}
+
+/* The stabilisation's part of K v for sample s (see frm__stab_sample_force): for the
+   sample's dF and each pair's frame rotation dth[k] (NULL: zero), the stress-like sum
+   dPx (absolute: divide by the volume) and each pair's frame-own torque row stq (3 n).
+   dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (+ g_k . domega_k for the general pairs), the
+   Gauss-Newton part c g dD Z_k / 2 (stress) and -c g dD t_k / 2 (torque), and unless
+   definite the second-order part of T_k = c g D Z_k / 2: [dtheta_k]x T_k and
+   -sum_j df_j x t_kj. */
+static void frm__stab_sample_apply(const frm_model *m, int s, const frm_real dF[9], const frm_real *const *dth,
+                                   int definite, frm_real dPx[9], frm_real *stq)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
+    const frm_real *F = m->lin_F + 9 * (size_t)s, *Y = m->s_stabY + 9 * (size_t)s;
+    frm_real c = m->s_mu[s] * m->s_volume[s], g = m->s_hstab[s], D = m->s_stabD[s], dD, s1, s2, om[3 * FRM_MAX_NEIGHBORS];
+    dD = (frm_real)0.5 * (Y[0] * dF[0] + Y[1] * dF[1] + Y[2] * dF[2] + Y[3] * dF[3] + Y[4] * dF[4] + Y[5] * dF[5] +
+                          Y[6] * dF[6] + Y[7] * dF[7] + Y[8] * dF[8]);
+    for (k = 0; k < n; k++) {
+        const frm_real *t = m->p_stab + 3 * (size_t)(b + k), *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            frm_pair_stab_domega(F, dF, m->relm + 9 * i, dth[k], om + 3 * k);
+            dD += gk[0] * om[3 * k] + gk[1] * om[3 * k + 1] + gk[2] * om[3 * k + 2];
+        } else if (dth[k])
+            dD -= (frm_real)0.5 * (dth[k][0] * t[0] + dth[k][1] * t[1] + dth[k][2] * t[2]);
+    }
+    s1 = (frm_real)0.5 * c * g * dD;
+    s2 = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) dPx[r] = s1 * Y[r];
+    for (k = 0; k < n; k++) {
+        const frm_real *t = m->p_stab + 3 * (size_t)(b + k), *gk = m->p_grad + 3 * (size_t)(b + k);
+        i = m->p_frame[b + k];
+        if (m->f_stab_on[i]) {
+            const frm_real *N = m->f_stab + 6 * i, *o = om + 3 * k;
+            frm_real u[3], d[9];
+            u[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2] + g * dD * gk[0];
+            u[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2] + g * dD * gk[1];
+            u[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2] + g * dD * gk[2];
+            frm_pair_stab_apply(F, dF, m->relm + 9 * i, c, u, t, dth[k], definite, d, stq + 3 * k);
+            for (r = 0; r < 9; r++) dPx[r] += d[r];
+            continue;
+        }
+        for (r = 0; r < 3; r++) stq[3 * k + r] = -s1 * t[r];
+        if (!definite && s2 != 0) {
+            frm_real Z[9], w[3];
+            const frm_real *th = dth[k];
+            frm_stab_direction(m->relm + 9 * i, gk, Z);
+            frm_column_cross_sum(dF, Z, w);
+            for (r = 0; r < 3; r++) stq[3 * k + r] -= s2 * w[r];
+            if (th)
+                for (r = 0; r < 3; r++) { /* dPx += [dtheta]x T_k, column r */
+                    dPx[r] += s2 * (th[1] * Z[6 + r] - th[2] * Z[3 + r]);
+                    dPx[3 + r] += s2 * (th[2] * Z[r] - th[0] * Z[6 + r]);
+                    dPx[6 + r] += s2 * (th[0] * Z[3 + r] - th[1] * Z[r]);
+                }
+        }
+    }
+}
+
 typedef struct frm__force_ctx {
     frm_model *m;
     int linearize, outputs;
@@ -2642,24 +2956,14 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             }
             energy += (double)v * (double)psi;
             frm_first_piola(F, S, P);
-            if (stab) { /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                frm_real cst = m->stab_beta * m->s_mu[s] * v, mv[3];
-                for (k = 0; k < n; k++) {
-                    int i = m->p_frame[b + k];
-                    if (!m->f_stab_on[i]) continue;
-                    energy += (double)frm_pair_stab_force(H, F, m->relm + 9 * i, m->f_stab + 6 * i, cst, sT + 9 * k,
-                                                          stq + 3 * k, mv);
-                    if (ctx->linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mv, sizeof mv);
-                    for (r = 0; r < 9; r++) P[r] += sT[9 * k + r] / v;
-                }
-            }
+            if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
+                energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
             for (k = 0; k < n; k++)
                 frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
             if (stab)
                 for (k = 0; k < n; k++)
-                    if (m->f_stab_on[m->p_frame[b + k]])
-                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
+                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
                 energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
                                                             m->p_out + 6 * (size_t)b,
@@ -2682,7 +2986,7 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                     frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
                                        m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k), Hs);
-                    if (stab && m->f_stab_on[m->p_frame[b + k]]) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
+                    if (stab) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
                     if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)(b + k), lever + 3 * k, Hs);
                 }
             }
@@ -2861,21 +3165,17 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
                           m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
             if (m->s_stab[s]) {
-                frm_real cst = m->stab_beta * m->s_mu[s] * vol, dPx[9];
-                for (k = 0; k < n; k++) {
-                    int i = m->p_frame[b + k];
-                    if (!m->f_stab_on[i]) continue;
-                    frm_pair_stab_apply(m->lin_F + 9 * (size_t)s, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst,
-                                        m->p_stab + 3 * (size_t)(b + k), v + 6 * i + 3, m->lin_definite, dPx, stq + 3 * k);
-                    for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
-                }
+                frm_real dPx[9];
+                const frm_real *dth[FRM_MAX_NEIGHBORS];
+                for (k = 0; k < n; k++) dth[k] = v + 6 * m->p_frame[b + k] + 3;
+                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
+                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
             }
             for (k = b; k < b + n; k++)
                 frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
             if (m->s_stab[s])
                 for (k = 0; k < n; k++)
-                    if (m->f_stab_on[m->p_frame[b + k]])
-                        for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
+                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
             if (m->s_couple[s] != 0)
                 frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->s_couple[s], v,
                                           m->p_out + 6 * (size_t)b);
@@ -2985,24 +3285,17 @@ static void frm__add_rotational(const frm_real *H, frm_real *D)
 static void frm__stab_columns(const frm_model *m, int s, int a, frm_real cols[54], frm_real *rows)
 {
     int b = m->s_start[s], n = m->s_start[s + 1] - b, c, k, r, pa = b + a;
-    frm_real vol = m->s_volume[s], cst = m->stab_beta * m->s_mu[s] * vol, zero[3] = {0, 0, 0};
-    const frm_real *F = m->lin_F + 9 * (size_t)s;
+    frm_real vol = m->s_volume[s], tq[3 * FRM_MAX_NEIGHBORS];
+    const frm_real *dth[FRM_MAX_NEIGHBORS];
     for (c = 0; c < 6; c++) {
-        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dPx[9];
         dq[c] = 1;
         frm_pair_dF(dq, m->p_grad + 3 * (size_t)pa, m->p_G + 9 * (size_t)pa, dF);
-        for (k = 0; k < n; k++) {
-            int i = m->p_frame[b + k];
-            frm_real dPx[9], tq[3];
-            if (!m->f_stab_on[i]) {
-                for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = 0;
-                continue;
-            }
-            frm_pair_stab_apply(F, dF, m->relm + 9 * i, m->f_stab + 6 * i, cst, m->p_stab + 3 * (size_t)(b + k),
-                                k == a ? dq + 3 : zero, m->lin_definite, dPx, tq);
-            for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
-            for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[r];
-        }
+        for (k = 0; k < n; k++) dth[k] = k == a && c >= 3 ? dq + 3 : NULL;
+        frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, tq);
+        for (r = 0; r < 9; r++) cols[9 * c + r] += dPx[r] / vol;
+        for (k = 0; k < n; k++)
+            for (r = 0; r < 3; r++) rows[18 * k + 3 * c + r] = tq[3 * k + r];
     }
 }
 
@@ -3041,7 +3334,7 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                                          m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
-                if (m->s_stab[s] && m->f_stab_on[i])
+                if (m->s_stab[s])
                     for (k = 0; k < 6; k++)
                         for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * a + 3 * k + r];
                 frm__add_rotational(m->p_H + 6 * (size_t)p, K);
@@ -3097,7 +3390,7 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
                 for (q = 0; q < n; q++) {
                     frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
                     frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)(b + q), m->p_G + 9 * (size_t)(b + q), K);
-                    if (m->s_stab[s] && m->f_stab_on[m->p_frame[b + q]])
+                    if (m->s_stab[s])
                         for (k = 0; k < 6; k++)
                             for (r = 0; r < 3; r++) K[6 * k + 3 + r] += rows[18 * q + 3 * k + r];
                     if (m->s_couple[s] != 0)
@@ -3116,6 +3409,7 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
    its product every iteration, the block mode assembles once and then streams 288 bytes
    a block. With 8 neighbours blocks win beyond about 30 CG iterations a linearisation. */
 #define FRM__COST_PAIR_ITER 35.0      /* pair-mode K v, per pair per iteration */
+#define FRM__COST_PAIR_STAB 30.0      /* its rotation stabilisation's divergence term (hexahedra, 8 neighbours) */
 #define FRM__COST_BLOCK_ITER 8.0      /* block-mode K v, per block per iteration */
 #define FRM__COST_ASSEMBLE_PAIR 500.0 /* assembly: the tangent columns, per pair */
 #define FRM__COST_ASSEMBLE_SLOT 60.0  /* assembly: one slot-pair block, per (pair, slot) */
@@ -3128,7 +3422,7 @@ static int frm__choose_mode(const frm_model *m)
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
     it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
-    pairs = it * FRM__COST_PAIR_ITER * m->pair_count;
+    pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
@@ -3665,8 +3959,8 @@ FRMDEF int frm_model_solve_static(frm_model *m)
 
 static int frm__linearize(frm_model *m, double *energy, int definite);
 
-/* The light check after a step of a model with Neo-Hookean samples: F of every such
-   sample has det F > 0 (else the new state has infinite energy). */
+/* The light check after a step: every sample has det F > 0 (a Neo-Hookean sample's energy
+   is infinite otherwise, a St Venant-Kirchhoff one's may sit in a mirrored minimum). */
 static int frm__check_inversion(frm_model *m)
 {
     int s;
@@ -3674,7 +3968,6 @@ static int frm__check_inversion(frm_model *m)
     for (s = 0; s < m->sample_count; s++) {
         int b = m->s_start[s];
         frm_real F[9], J;
-        if (m->s_law[s] != FRM_LAW_NEO_HOOKEAN) continue;
         frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
                                m->p_rlev + 3 * b, NULL, m->disp, m->relm, F, NULL, NULL, NULL);
         J = 1 + frm_det_minus_one(F); /* F holds H */
@@ -3763,7 +4056,7 @@ static int frm__implicit_step(frm_model *m, double dt)
         frm__restore_state(m);
         return FRM_ERR_NOT_FINITE;
     }
-    if (m->has_neo_hookean && frm__check_inversion(m)) {
+    if (frm__check_inversion(m)) { /* both laws (issue 18: SVK has minima at mirror images) */
         frm__restore_state(m);
         return FRM_ERR_INVERTED;
     }
@@ -4141,6 +4434,7 @@ FRMDEF int frm_shape_tet(const frm_real corners[12], const frm_real point[3], fr
     double X[4][3], p[3], w[4], g[4][3];
     int k, r;
     if (!corners || !point || !weights || !gradients) return FRM_ERR_ARG;
+    if (!frm__all_finite(corners, 12) || !frm__all_finite(point, 3)) return FRM_ERR_ARG;
     for (k = 0; k < 4; k++)
         for (r = 0; r < 3; r++) X[k][r] = (double)corners[3 * k + r];
     for (r = 0; r < 3; r++) p[r] = (double)point[r];
@@ -4199,6 +4493,7 @@ FRMDEF int frm_shape_hex(const frm_real corners[24], const frm_real xi[3], frm_r
     double X[8][3], x[3], p[3], w[8], g[8][3], det;
     int a, r;
     if (!corners || !xi || !weights || !gradients) return FRM_ERR_ARG;
+    if (!frm__all_finite(corners, 24) || !frm__all_finite(xi, 3)) return FRM_ERR_ARG;
     for (a = 0; a < 8; a++)
         for (r = 0; r < 3; r++) X[a][r] = (double)corners[3 * a + r];
     for (r = 0; r < 3; r++) x[r] = (double)xi[r];
@@ -4276,6 +4571,8 @@ FRMDEF int frm_shape_shepard(const frm_real *frames, int count, const frm_real p
     double X[3 * 64], p[3], w[64], g[3 * 64];
     int i, err;
     if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    if (!frm__all_finite(frames, 3 * (size_t)count) || !frm__all_finite(point, 3)) return FRM_ERR_ARG;
+    if (!(frm__finite((double)power) && power > 1) || !frm__finite((double)radius)) return FRM_ERR_ARG;
     for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
     for (i = 0; i < 3; i++) p[i] = (double)point[i];
     err = frm__shepard_functions(X, count, p, (double)power, (double)radius, w, g);
@@ -4390,6 +4687,8 @@ FRMDEF int frm_shape_mls(const frm_real *frames, int count, const frm_real point
     double X[3 * 64], p[3], w[64], g[3 * 64];
     int i, err;
     if (!frames || !point || !weights || !gradients || count < 1 || count > 64) return FRM_ERR_ARG;
+    if (!frm__all_finite(frames, 3 * (size_t)count) || !frm__all_finite(point, 3) || !frm__finite((double)radius))
+        return FRM_ERR_ARG;
     for (i = 0; i < 3 * count; i++) X[i] = (double)frames[i];
     for (i = 0; i < 3; i++) p[i] = (double)point[i];
     err = frm__mls_functions(X, count, p, (double)radius, w, g);
@@ -4410,6 +4709,7 @@ FRMDEF frm_shape_desc frm_shape_default_desc(void)
     s.nearest = 8;
     s.radius = 0;
     s.power = 2;
+    s.internal_cookie = FRM__SHAPE_COOKIE;
     return s;
 }
 
@@ -4422,6 +4722,7 @@ FRMDEF frm_poisson_desc frm_poisson_default_desc(void)
     p.seed = 1;
     p.volume = 0;
     p.max_points = 1000000;
+    p.internal_cookie = FRM__POISSON_COOKIE;
     return p;
 }
 
@@ -4776,6 +5077,7 @@ static int frm__grid_query(const frm__grid *g, const double *X, const double *p,
 
 static int frm__check_shape(const frm_shape_desc *sh)
 {
+    if (sh->internal_cookie != FRM__SHAPE_COOKIE) return FRM_ERR_DESC;
     if ((int)sh->shape != FRM_SHAPE_SHEPARD && (int)sh->shape != FRM_SHAPE_MLS) return FRM_ERR_SAMPLING;
     if (sh->support == FRM_SUPPORT_NEAREST) {
         if (sh->nearest < 1 || sh->nearest > FRM_MAX_NEIGHBORS) return FRM_ERR_SAMPLING;
@@ -4784,7 +5086,7 @@ static int frm__check_shape(const frm_shape_desc *sh)
         if (!(frm__finite((double)sh->radius) && sh->radius > 0)) return FRM_ERR_SAMPLING;
     } else
         return FRM_ERR_SAMPLING;
-    if (sh->shape == FRM_SHAPE_SHEPARD && !(frm__finite((double)sh->power) && sh->power > 0)) return FRM_ERR_SAMPLING;
+    if (sh->shape == FRM_SHAPE_SHEPARD && !(frm__finite((double)sh->power) && sh->power > 1)) return FRM_ERR_SAMPLING;
     return FRM_OK;
 }
 
@@ -5210,13 +5512,15 @@ static int frm__poisson(const double lo[3], const double hi[3], const frm__surfa
     return err;
 }
 
-static int frm__check_poisson(const frm_poisson_desc *p)
+static int frm__check_poisson(const frm_poisson_desc *p, const frm_shape_desc *shape)
 {
     if (!p) return FRM_ERR_ARG;
+    if (p->internal_cookie != FRM__POISSON_COOKIE) return FRM_ERR_DESC;
     if (!(frm__finite((double)p->frame_spacing) && p->frame_spacing > 0) ||
         !(frm__finite((double)p->sample_spacing) && p->sample_spacing > 0) || !frm__finite((double)p->volume) ||
-        p->max_points < 1)
+        p->max_points < 1 || p->frame_spacing < p->sample_spacing) /* frames coarser than samples */
         return FRM_ERR_SAMPLING;
+    if (shape) return frm__check_shape(shape); /* before the points are made */
     return FRM_OK;
 }
 
@@ -5264,7 +5568,7 @@ FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_r
     if (!out) return FRM_ERR_ARG;
     memset(out, 0, sizeof *out);
     if (!lo || !hi || !frm__vec3_finite(lo) || !frm__vec3_finite(hi)) return FRM_ERR_ARG;
-    err = frm__check_poisson(p);
+    err = frm__check_poisson(p, shape);
     if (err) return err;
     memset(&alloc, 0, sizeof alloc);
     if (allocator) alloc = *allocator;
@@ -5289,7 +5593,7 @@ FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int
     int err;
     if (!out) return FRM_ERR_ARG;
     memset(out, 0, sizeof *out);
-    err = frm__check_poisson(p);
+    err = frm__check_poisson(p, shape);
     if (err) return err;
     memset(&alloc, 0, sizeof alloc);
     if (allocator) alloc = *allocator;

@@ -292,7 +292,8 @@ static void invisible_projector(const frm_sampling *s, int i, double N[9])
    with Rodrigues rotations, the law's energy density in double, the coupling term
    1/2 eps mu v / h^2 sum_k |w_k| |d_k - p|^2 (h^2 = sum |w| |lbar|^2 / sum |w|) and the
    rotation stabilisation 1/2 beta mu v omega . N omega per (sample, frame k), omega the
-   axial vector of skew(R_k^T F) (rest frames axis-aligned) and N k's invisible rotations. */
+   axial vector of skew(R_k^T F) (rest frames axis-aligned) and N k's invisible rotations,
+   plus 1/2 gamma mu v h^2 (sum_k grad w_k . omega_k)^2 per sample (rotation_divergence). */
 static double independent_energy(const scene *sc)
 {
     const frm_sampling *s = &sc->s;
@@ -305,7 +306,7 @@ static double independent_energy(const scene *sc)
     if (sc->d.rotation_stabilization > 0)
         for (k = 0; k < s->frame_count; k++) invisible_projector(s, k, Nf + 9 * k);
     for (smp = 0; smp < s->sample_count; smp++) {
-        double F[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, C[9], J, psi, D[3 * 16], pb[3] = {0, 0, 0}, h2 = 0, wabs = 0, Ec = 0;
+        double F[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, C[9], J, psi, D[3 * 16], pb[3] = {0, 0, 0}, h2 = 0, wabs = 0, Ec = 0, Dv;
         int nk = 0;
         for (e = s->neighbor_start[smp]; e < s->neighbor_start[smp + 1]; e++, nk++) {
             int i = s->neighbor_frames[e];
@@ -332,11 +333,12 @@ static double independent_energy(const scene *sc)
             Ec += 0.5 * fabs(w) * q2;
         }
         if (h2 > 0) W += (double)sc->d.frame_coupling * mu * (double)s->sample_volumes[smp] / (h2 / wabs) * Ec;
+        Dv = 0;
         for (e = s->neighbor_start[smp]; e < s->neighbor_start[smp + 1]; e++) {
             int i = s->neighbor_frames[e];
             const double *N = Nf + 9 * i;
             double qq[4], R[9], A[9], om[3], Nom[3];
-            if (N[0] + N[4] + N[8] == 0) continue;
+            if (sc->d.rotation_stabilization == 0 && sc->d.rotation_divergence == 0) continue;
             for (k = 0; k < 4; k++) qq[k] = q[4 * i + k];
             q_matrix(qq, R);
             for (r = 0; r < 3; r++)
@@ -344,9 +346,23 @@ static double independent_energy(const scene *sc)
             om[0] = 0.5 * (A[7] - A[5]);
             om[1] = 0.5 * (A[2] - A[6]);
             om[2] = 0.5 * (A[3] - A[1]);
+            for (r = 0; r < 3; r++) Dv += (double)s->neighbor_gradients[3 * e + r] * om[r];
             for (r = 0; r < 3; r++) Nom[r] = N[3 * r] * om[0] + N[3 * r + 1] * om[1] + N[3 * r + 2] * om[2];
             W += 0.5 * (double)sc->d.rotation_stabilization * mu * (double)s->sample_volumes[smp] *
                  (om[0] * Nom[0] + om[1] * Nom[1] + om[2] * Nom[2]);
+        }
+        /* and the divergence of the frames' rotation field: 1/2 gamma mu v h^2 D^2,
+           D = sum_k grad w_k . omega_k (issue 18) */
+        { /* only where the weights reproduce linear fields: sum_k lbar_k grad w_k^T = -I */
+            double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, lin = 0;
+            for (e = s->neighbor_start[smp]; e < s->neighbor_start[smp + 1]; e++)
+                for (r = 0; r < 3; r++)
+                    for (c = 0; c < 3; c++)
+                        A[3 * r + c] += ((double)s->sample_positions[3 * smp + r] - s->frame_positions[3 * s->neighbor_frames[e] + r]) *
+                                        (double)s->neighbor_gradients[3 * e + c];
+            for (r = 0; r < 9; r++) lin += fabs(A[r]);
+            if (h2 > 0 && lin <= 1e-3)
+                W += 0.5 * (double)sc->d.rotation_divergence * mu * (double)s->sample_volumes[smp] * (h2 / wabs) * Dv * Dv;
         }
         for (r = 0; r < 3; r++)
             for (c = 0; c < 3; c++) C[3 * r + c] = F[r] * F[c] + F[3 + r] * F[3 + c] + F[6 + r] * F[6 + c];
@@ -2039,7 +2055,8 @@ static void test_validation_errors(void)
     d = base;
     d.internal_cookie = 0;
     CHECK_INT(FRM_ERR_DESC, try_create(&d));
-    CHECK_INT(FRM_ERR_DESC, lc.last_code); /* and the logger heard of it */
+    /* the logger is not called: a description not made by the default function may hold a
+       garbage callback (issue 18 item 12, tests/test_frames_elem.c) */
     d = base;
     d.frame_count = 0;
     CHECK_INT(FRM_ERR_FRAME_COUNT, try_create(&d));

@@ -1,0 +1,856 @@
+/* Tests of frames.h's element parts for issue 18 ("no silent wrong answers"): creation
+   from a description not made by its default function, the float renames of every
+   entry point, shape functions and samplings refusing what their docs forbid, St
+   Venant-Kirchhoff refusing mirrored samples, and the rotation stabilisation that ties
+   every frame's rotation to the material's (no spurious low modes on tetrahedral frames,
+   no zero-energy rotations on hexahedral frames one cell across). */
+#define FRAMES_IMPLEMENTATION
+#include "../frames.h"
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "test.h"
+
+#define IS_FLOAT (sizeof(frm_real) == sizeof(float))
+
+static frm_real *alloc_reals(int count)
+{
+    return (frm_real *)calloc(count > 0 ? (size_t)count : 1, sizeof(frm_real));
+}
+
+/* ---- item 12: a description not made by its default function ---------------------- */
+
+/* A description filled with 0xA5 bytes (what a stack struct holds before anyone sets it)
+   is refused with FRM_ERR_DESC: its log callback is garbage and must not be called. */
+static void test_garbage_descriptions(void)
+{
+    frm_desc d;
+    frm_shape_desc sh;
+    frm_poisson_desc p;
+    frm_sampling s;
+    frm_model *m = (frm_model *)&m;
+    frm_real frames[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, samples[3] = {(frm_real)0.2, (frm_real)0.2, (frm_real)0.2};
+    frm_real lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    memset(&d, 0xA5, sizeof d);
+    CHECK_INT(FRM_ERR_DESC, frm_model_create(&d, &m));
+    CHECK(m == NULL);
+    memset(&sh, 0xA5, sizeof sh);
+    CHECK_INT(FRM_ERR_DESC, frm_sampling_meshless(&s, frames, 4, samples, 1, 1, &sh, NULL));
+    CHECK(s.frame_count == 0 && s.frame_positions == NULL);
+    memset(&p, 0xA5, sizeof p);
+    CHECK_INT(FRM_ERR_DESC, frm_sampling_box(&s, lo, hi, &p, NULL, NULL));
+    p = frm_poisson_default_desc();
+    CHECK_INT(FRM_ERR_DESC, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+    {
+        /* a closed surface (a tetrahedron) */
+        frm_real v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+        int tri[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+        memset(&p, 0xA5, sizeof p);
+        CHECK_INT(FRM_ERR_DESC, frm_sampling_surface(&s, v, 4, tri, 4, &p, NULL, NULL));
+        p = frm_poisson_default_desc();
+        CHECK_INT(FRM_ERR_DESC, frm_sampling_surface(&s, v, 4, tri, 4, &p, &sh, NULL));
+    }
+    /* a copy of a default description stays valid */
+    sh = frm_shape_default_desc();
+    CHECK_INT(FRM_OK, frm_sampling_meshless(&s, frames, 4, samples, 1, 1, &sh, NULL));
+    frm_sampling_free(&s);
+}
+
+/* ---- item 8: every entry point renamed in float builds ---------------------------- */
+
+#define STR2(x) #x
+#define STR(x) STR2(x)
+#define NAME(f) {#f, STR(f)}
+typedef struct entry_name {
+    const char *plain, *expanded;
+} entry_name;
+
+/* Every FRMDEF function of frames.h: the name after macro expansion carries _f32 in float
+   builds and is unchanged in double builds. The header's own list is read back from
+   frames.h below, so a function added later without a rename fails here. */
+static void test_float_renames(void)
+{
+    static const entry_name names[] = {
+        NAME(frm_version), NAME(frm_error_string), NAME(frm_shape_tet), NAME(frm_shape_hex), NAME(frm_shape_shepard),
+        NAME(frm_shape_mls), NAME(frm_sampling_hexes), NAME(frm_sampling_tets), NAME(frm_sampling_meshless),
+        NAME(frm_sampling_box), NAME(frm_sampling_surface), NAME(frm_sampling_apply), NAME(frm_sampling_free),
+        NAME(frm_shape_default_desc), NAME(frm_poisson_default_desc), NAME(frm_model_default_desc),
+        NAME(frm_model_create), NAME(frm_model_destroy), NAME(frm_model_fix_frame), NAME(frm_model_drive_frame),
+        NAME(frm_model_release_frame), NAME(frm_model_frame_state), NAME(frm_model_set_external),
+        NAME(frm_model_clear_external), NAME(frm_model_set_gravity), NAME(frm_model_set_solver),
+        NAME(frm_model_set_stiffness_mode), NAME(frm_model_step), NAME(frm_model_step_ex), NAME(frm_model_solve_static),
+        NAME(frm_model_newton_step), NAME(frm_model_frame_count), NAME(frm_model_sample_count),
+        NAME(frm_model_pair_count), NAME(frm_model_positions), NAME(frm_model_orientations),
+        NAME(frm_model_velocities), NAME(frm_model_set_poses), NAME(frm_model_set_velocities),
+        NAME(frm_model_sample_positions), NAME(frm_model_deformation_gradients), NAME(frm_model_forces),
+        NAME(frm_model_total_forces), NAME(frm_model_energy), NAME(frm_model_last_stats), NAME(frm_model_mass_block),
+        NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_prepare_stiffness),
+        NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
+        NAME(frm_model_stiffness_block)};
+    int count = (int)(sizeof names / sizeof names[0]), i, declared = 0, renamed = 0;
+    char line[1024];
+    FILE *f;
+    for (i = 0; i < count; i++) {
+        char want[128];
+        snprintf(want, sizeof want, "%s%s", names[i].plain, IS_FLOAT ? "_f32" : "");
+        if (strcmp(want, names[i].expanded) != 0) {
+            fprintf(stderr, "    %s expands to %s\n", names[i].plain, names[i].expanded);
+            CHECK(0);
+        }
+    }
+    /* every function declared FRMDEF in the header's public part has a rename line
+       "#define name name_f32" and is in the list above */
+    f = fopen("frames.h", "r");
+    if (!f) f = fopen("../frames.h", "r");
+    if (!f) {
+        printf("    frames.h not found from the working directory: the header scan is skipped\n");
+        return;
+    }
+    {
+        char (*decl)[64] = (char (*)[64])calloc(512, 64), (*ren)[64] = (char (*)[64])calloc(512, 64);
+        while (fgets(line, sizeof line, f)) {
+            if (strstr(line, "#endif /* FRAMES_H */")) break;
+            if (strncmp(line, "FRMDEF ", 7) == 0) {
+                char *paren = strchr(line, '('), *start;
+                if (!paren) continue;
+                start = paren;
+                while (start > line && (start[-1] == '_' || (start[-1] >= 'a' && start[-1] <= 'z') ||
+                                        (start[-1] >= '0' && start[-1] <= '9')))
+                    start--;
+                if (declared < 512 && paren - start < 63) {
+                    memcpy(decl[declared], start, (size_t)(paren - start));
+                    declared++;
+                }
+            } else {
+                char a[64], b[80];
+                if (sscanf(line, "#define %63s %79s", a, b) == 2 && strncmp(a, "frm_", 4) == 0) {
+                    size_t la = strlen(a);
+                    if (strncmp(a, b, la) == 0 && strcmp(b + la, "_f32") == 0 && renamed < 512) strcpy(ren[renamed++], a);
+                }
+            }
+        }
+        fclose(f);
+        CHECK(declared > 0);
+        for (i = 0; i < declared; i++) {
+            int k, found = 0, listed = 0;
+            for (k = 0; k < renamed; k++) found |= strcmp(decl[i], ren[k]) == 0;
+            for (k = 0; k < count; k++) listed |= strcmp(decl[i], names[k].plain) == 0;
+            if (!found || !listed) {
+                fprintf(stderr, "    %s: %s\n", decl[i], !found ? "no float rename in frames.h" : "missing from this test's list");
+                CHECK(0);
+            }
+        }
+        printf("    %d entry points declared, %d renamed in float builds\n", declared, renamed);
+        CHECK_INT(declared, renamed);
+        free(decl);
+        free(ren);
+    }
+}
+
+/* ---- item 15: shape functions and samplings refuse what the docs forbid ------------ */
+
+static void test_shape_refusals(void)
+{
+    frm_real nan_ = (frm_real)NAN, inf_ = (frm_real)INFINITY;
+    frm_real tet[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, hex[24], w[64], g[192], pt[3], x[3];
+    frm_real fr[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int a, k;
+    for (a = 0; a < 8; a++)
+        for (k = 0; k < 3; k++) hex[3 * a + k] = (frm_real)((a >> k) & 1);
+    for (k = 0; k < 3; k++) {
+        frm_real bad[2];
+        int b;
+        bad[0] = nan_;
+        bad[1] = inf_;
+        for (b = 0; b < 2; b++) {
+            pt[0] = pt[1] = pt[2] = (frm_real)0.2;
+            pt[k] = bad[b];
+            CHECK_INT(FRM_ERR_ARG, frm_shape_tet(tet, pt, w, g));
+            CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, 2, 0, w, g));
+            CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, 2, 3, w, g));
+            CHECK_INT(FRM_ERR_ARG, frm_shape_mls(fr, 4, pt, 3, w, g));
+            x[0] = x[1] = x[2] = (frm_real)0.5;
+            x[k] = bad[b];
+            CHECK_INT(FRM_ERR_ARG, frm_shape_hex(hex, x, pt, w, g, NULL));
+        }
+    }
+    /* non-finite corners or frames */
+    pt[0] = pt[1] = pt[2] = (frm_real)0.2;
+    tet[4] = nan_;
+    CHECK_INT(FRM_ERR_ARG, frm_shape_tet(tet, pt, w, g));
+    tet[4] = 0;
+    hex[7] = inf_;
+    x[0] = x[1] = x[2] = (frm_real)0.5;
+    CHECK_INT(FRM_ERR_ARG, frm_shape_hex(hex, x, pt, w, g, NULL));
+    hex[7] = 0;
+    fr[5] = nan_;
+    CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, 2, 0, w, g));
+    CHECK_INT(FRM_ERR_ARG, frm_shape_mls(fr, 4, pt, 3, w, g));
+    fr[5] = 0;
+    /* the exponent must exceed 1 (the limit on a frame needs it), radius finite */
+    CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, (frm_real)0.5, 0, w, g));
+    CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, 1, 0, w, g));
+    CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, nan_, 0, w, g));
+    CHECK_INT(FRM_ERR_ARG, frm_shape_shepard(fr, 4, pt, 2, nan_, w, g));
+    CHECK_INT(FRM_ERR_ARG, frm_shape_mls(fr, 4, pt, inf_, w, g));
+    CHECK_INT(FRM_OK, frm_shape_shepard(fr, 4, pt, (frm_real)1.5, 0, w, g));
+    CHECK_INT(FRM_OK, frm_shape_tet(tet, pt, w, g));
+    {
+        frm_shape_desc sh = frm_shape_default_desc();
+        frm_poisson_desc p = frm_poisson_default_desc();
+        frm_sampling s;
+        frm_real smp[3] = {(frm_real)0.2, (frm_real)0.2, (frm_real)0.2}, lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+        sh.power = (frm_real)0.5;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_meshless(&s, fr, 4, smp, 1, 1, &sh, NULL));
+        sh.power = 1;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_meshless(&s, fr, 4, smp, 1, 1, &sh, NULL));
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        sh = frm_shape_default_desc();
+        p.frame_spacing = (frm_real)0.1;
+        p.sample_spacing = (frm_real)0.2;
+        CHECK_INT(FRM_ERR_SAMPLING, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        CHECK(s.frame_count == 0);
+        p.frame_spacing = (frm_real)0.4;
+        CHECK_INT(FRM_OK, frm_sampling_box(&s, lo, hi, &p, &sh, NULL));
+        frm_sampling_free(&s);
+    }
+}
+
+/* ---- item 5: St Venant-Kirchhoff refuses mirrored samples -------------------------- */
+
+/* A unit cube of 2 x 2 x 4 hexahedral cells, St Venant-Kirchhoff (E = 10 kPa, nu = 0.3),
+   compressed to s = 0.5 in one static solve: the bottom face's frames at (t x, t y, 0),
+   the top face's at (t x, t y, s) with t the lateral stretch of the uniaxial state
+   (S_xx = 0: E_xx = -nu E_zz), so the homogeneous state F = diag(t, t, s) is the
+   equilibrium and P_zz = E/2 (s^3 - s) (REFERENCES R4). Putting the top frames at their
+   targets turns the top layer (z from 0.75 to 1) into a mirrored one, F_zz = -1, where
+   SVK's energy has a minimum of zero: the solver once returned success with that layer
+   mirrored and P_zz = 0. Now a sample with det F <= 0 is refused: the solve lands on the
+   closed form with every det F > 0, or returns an error and keeps its state. */
+static void test_svk_mirrored_compression(void)
+{
+    hexmesh h;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, E = 1e4, nu = 0.3, sz = 0.5, Ezz = 0.5 * (sz * sz - 1), t, Pzz;
+    frm_real *x, q[4] = {0, 0, 0, 1};
+    const frm_real *F;
+    int i, err, minus = 0;
+    t = sqrt(1 + 2 * (-nu * Ezz));
+    REQUIRE(hexmesh_grid(&h, lo, hi, 2, 2, 4) == TETMESH_OK);
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    REQUIRE(frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    d.material.law = FRM_LAW_SVK;
+    d.material.young_modulus = (frm_real)E;
+    d.material.poisson_ratio = (frm_real)nu;
+    d.gravity[2] = 0;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    for (i = 0; i < h.node_count; i++) {
+        frm_real target[3];
+        double z = h.nodes[3 * i + 2];
+        if (z != 0 && z != 1) continue;
+        target[0] = (frm_real)(t * (h.nodes[3 * i] - 0.5) + 0.5);
+        target[1] = (frm_real)(t * (h.nodes[3 * i + 1] - 0.5) + 0.5);
+        target[2] = (frm_real)(sz * z);
+        REQUIRE(frm_model_drive_frame(m, i, target, q) == FRM_OK);
+    }
+    err = frm_model_solve_static(m);
+    F = frm_model_deformation_gradients(m);
+    for (i = 0; i < s.sample_count; i++) {
+        const frm_real *f = F + 9 * i;
+        double det = f[0] * ((double)f[4] * f[8] - (double)f[5] * f[7]) - f[1] * ((double)f[3] * f[8] - (double)f[5] * f[6]) +
+                     f[2] * ((double)f[3] * f[7] - (double)f[4] * f[6]);
+        minus += !(det > 0);
+    }
+    if (err == FRM_OK) {
+        const frm_real *fi;
+        double fz = 0, expect = 0.5 * E * (sz * sz * sz - sz);
+        REQUIRE(frm_model_forces(m, &fi) == FRM_OK);
+        for (i = 0; i < h.node_count; i++)
+            if (h.nodes[3 * i + 2] == 1) fz += (double)fi[6 * i + 2];
+        Pzz = -fz / 1.0; /* reference area 1 m^2 */
+        printf("    SVK cube to s = 0.5 in one call: success, P_zz %.2f Pa (R4 %.2f), %d mirrored samples\n", Pzz, expect, minus);
+        CHECK_INT(0, minus);
+        CHECK_REL(expect, Pzz, IS_FLOAT ? 1e-3 : 1e-5);
+    } else {
+        printf("    SVK cube to s = 0.5 in one call: %s (state kept: %d mirrored samples)\n", frm_error_string(err), minus);
+        CHECK(err == FRM_ERR_INVERTED || err == FRM_ERR_NO_CONVERGENCE || err == FRM_ERR_STALLED);
+        CHECK_INT(0, minus); /* the rest state was kept */
+    }
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    free(x);
+    hexmesh_free(&h);
+}
+
+
+/* The implicit step too: one St Venant-Kirchhoff cell (2^3 samples) with its bottom frames
+   fixed and a top corner driven through the bottom face in one step (the bench's squash):
+   the step returns FRM_ERR_INVERTED and keeps its state, or ends with every det F > 0. */
+static void test_svk_mirrored_step(void)
+{
+    hexmesh h;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    frm_real *x, q[4] = {0, 0, 0, 1}, target[3] = {-0.5f, -0.5f, -0.5f}, before[3];
+    const frm_real *F;
+    int i, err, corner = -1, minus = 0;
+    REQUIRE(hexmesh_grid(&h, lo, hi, 1, 1, 1) == TETMESH_OK);
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    REQUIRE(frm_sampling_hexes(&s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    d.material.law = FRM_LAW_SVK;
+    d.gravity[2] = 0;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    for (i = 0; i < h.node_count; i++) {
+        if (h.nodes[3 * i + 2] == 0) frm_model_fix_frame(m, i);
+        if (h.nodes[3 * i] == 1 && h.nodes[3 * i + 1] == 1 && h.nodes[3 * i + 2] == 1) corner = i;
+    }
+    REQUIRE(corner >= 0);
+    REQUIRE(frm_model_drive_frame(m, corner, target, q) == FRM_OK);
+    for (i = 0; i < 3; i++) before[i] = frm_model_positions(m)[3 * corner + i];
+    err = frm_model_step(m);
+    F = frm_model_deformation_gradients(m);
+    for (i = 0; i < s.sample_count; i++) {
+        const frm_real *f = F + 9 * i;
+        double det = f[0] * ((double)f[4] * f[8] - (double)f[5] * f[7]) - f[1] * ((double)f[3] * f[8] - (double)f[5] * f[6]) +
+                     f[2] * ((double)f[3] * f[7] - (double)f[4] * f[6]);
+        minus += !(det > 0);
+    }
+    printf("    SVK cell, a corner driven through the bottom in one implicit step: %s, %d mirrored samples\n",
+           frm_error_string(err), minus);
+    CHECK_INT(0, minus);
+    if (err) {
+        CHECK_INT(FRM_ERR_INVERTED, err);
+        for (i = 0; i < 3; i++) CHECK(frm_model_positions(m)[3 * corner + i] == before[i]);
+    }
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    free(x);
+    hexmesh_free(&h);
+}
+
+/* ---- item 18: modes of the linearised model ----------------------------------------- */
+
+/* Eigen-decomposition of a symmetric n x n matrix (row-major V in, eigenvectors out in its
+   columns; d the eigenvalues, ascending): Householder tridiagonalisation and the implicit
+   QL algorithm (EISPACK tred2 / tql2, after the public-domain JAMA translation). */
+static void sym_eigen(double *V, int n, double *d)
+{
+    double *e = (double *)calloc((size_t)n, sizeof(double)), f, g, h, hh, scale, tst1, eps = pow(2.0, -52.0);
+    int i, j, k, l, m, iter;
+    for (j = 0; j < n; j++) d[j] = V[n * (n - 1) + j];
+    for (i = n - 1; i > 0; i--) {
+        scale = 0;
+        h = 0;
+        for (k = 0; k < i; k++) scale += fabs(d[k]);
+        if (scale == 0) {
+            e[i] = d[i - 1];
+            for (j = 0; j < i; j++) {
+                d[j] = V[n * (i - 1) + j];
+                V[n * i + j] = 0;
+                V[n * j + i] = 0;
+            }
+        } else {
+            for (k = 0; k < i; k++) {
+                d[k] /= scale;
+                h += d[k] * d[k];
+            }
+            f = d[i - 1];
+            g = sqrt(h);
+            if (f > 0) g = -g;
+            e[i] = scale * g;
+            h = h - f * g;
+            d[i - 1] = f - g;
+            for (j = 0; j < i; j++) e[j] = 0;
+            for (j = 0; j < i; j++) {
+                f = d[j];
+                V[n * j + i] = f;
+                g = e[j] + V[n * j + j] * f;
+                for (k = j + 1; k <= i - 1; k++) {
+                    g += V[n * k + j] * d[k];
+                    e[k] += V[n * k + j] * f;
+                }
+                e[j] = g;
+            }
+            f = 0;
+            for (j = 0; j < i; j++) {
+                e[j] /= h;
+                f += e[j] * d[j];
+            }
+            hh = f / (h + h);
+            for (j = 0; j < i; j++) e[j] -= hh * d[j];
+            for (j = 0; j < i; j++) {
+                f = d[j];
+                g = e[j];
+                for (k = j; k <= i - 1; k++) V[n * k + j] -= (f * e[k] + g * d[k]);
+                d[j] = V[n * (i - 1) + j];
+                V[n * i + j] = 0;
+            }
+        }
+        d[i] = h;
+    }
+    for (i = 0; i < n - 1; i++) {
+        V[n * (n - 1) + i] = V[n * i + i];
+        V[n * i + i] = 1;
+        h = d[i + 1];
+        if (h != 0) {
+            for (k = 0; k <= i; k++) d[k] = V[n * k + i + 1] / h;
+            for (j = 0; j <= i; j++) {
+                g = 0;
+                for (k = 0; k <= i; k++) g += V[n * k + i + 1] * V[n * k + j];
+                for (k = 0; k <= i; k++) V[n * k + j] -= g * d[k];
+            }
+        }
+        for (k = 0; k <= i; k++) V[n * k + i + 1] = 0;
+    }
+    for (j = 0; j < n; j++) {
+        d[j] = V[n * (n - 1) + j];
+        V[n * (n - 1) + j] = 0;
+    }
+    V[n * (n - 1) + n - 1] = 1;
+    e[0] = 0;
+    /* tql2 */
+    for (i = 1; i < n; i++) e[i - 1] = e[i];
+    e[n - 1] = 0;
+    f = 0;
+    tst1 = 0;
+    for (l = 0; l < n; l++) {
+        tst1 = fmax(tst1, fabs(d[l]) + fabs(e[l]));
+        m = l;
+        while (m < n) {
+            if (fabs(e[m]) <= eps * tst1) break;
+            m++;
+        }
+        if (m > l) {
+            iter = 0;
+            do {
+                double p, r, dl1, c, c2, c3, el1, s, s2;
+                iter++;
+                g = d[l];
+                p = (d[l + 1] - g) / (2 * e[l]);
+                r = hypot(p, 1.0);
+                if (p < 0) r = -r;
+                d[l] = e[l] / (p + r);
+                d[l + 1] = e[l] * (p + r);
+                dl1 = d[l + 1];
+                h = g - d[l];
+                for (i = l + 2; i < n; i++) d[i] -= h;
+                f += h;
+                p = d[m];
+                c = 1;
+                c2 = c;
+                c3 = c;
+                el1 = e[l + 1];
+                s = 0;
+                s2 = 0;
+                for (i = m - 1; i >= l; i--) {
+                    c3 = c2;
+                    c2 = c;
+                    s2 = s;
+                    g = c * e[i];
+                    h = c * p;
+                    r = hypot(p, e[i]);
+                    e[i + 1] = s * r;
+                    s = e[i] / r;
+                    c = p / r;
+                    p = c * d[i] - s * g;
+                    d[i + 1] = h + s * (c * g + s * d[i]);
+                    for (k = 0; k < n; k++) {
+                        h = V[n * k + i + 1];
+                        V[n * k + i + 1] = s * V[n * k + i] + c * h;
+                        V[n * k + i] = c * V[n * k + i] - s * h;
+                    }
+                }
+                p = -s * s2 * c3 * el1 * e[l] / dl1;
+                e[l] = s * p;
+                d[l] = c * p;
+            } while (fabs(e[l]) > eps * tst1 && iter < 60);
+        }
+        d[l] = d[l] + f;
+        e[l] = 0;
+    }
+    for (i = 0; i < n - 1; i++) { /* sort ascending, vectors along */
+        k = i;
+        f = d[i];
+        for (j = i + 1; j < n; j++)
+            if (d[j] < f) {
+                k = j;
+                f = d[j];
+            }
+        if (k != i) {
+            d[k] = d[i];
+            d[i] = f;
+            for (j = 0; j < n; j++) {
+                f = V[n * j + i];
+                V[n * j + i] = V[n * j + k];
+                V[n * j + k] = f;
+            }
+        }
+    }
+    free(e);
+}
+
+/* The modes of the linearised model at its current state: K (symmetric part, built
+   column by column from frm_model_apply_stiffness) and the generalized mass (6x6 blocks,
+   frm_model_mass_block) on the free frames, A = M^-1/2 K M^-1/2 (M block-diagonal) and
+   its eigenvalues lambda = omega^2. freq: 6 * free frames values (Hz, ascending; a negative
+   lambda gives a negative frequency -sqrt(-lambda) / 2 pi). rot: the share of each of the
+   lowest `nrot` modes' kinetic energy in the frames' rotations (x^T M_rr x / x^T M x per
+   frame, summed), or NULL. Returns the number of modes. */
+static int model_modes(frm_model *m, double *freq, double *rot, int nrot)
+{
+    int F = frm_model_frame_count(m), nf = 0, i, j, r, c, k, n, *free_ = (int *)malloc(sizeof(int) * (size_t)F);
+    double *K, *L, *A, *Mb, pi = 3.14159265358979323846;
+    frm_real *v = alloc_reals(6 * F), *out = alloc_reals(6 * F);
+    for (i = 0; i < F; i++)
+        if (frm_model_frame_state(m, i) == 0) free_[nf++] = i;
+    n = 6 * nf;
+    K = (double *)calloc((size_t)n * n, sizeof(double));
+    A = (double *)calloc((size_t)n * n, sizeof(double));
+    L = (double *)calloc((size_t)nf * 36, sizeof(double));
+    Mb = (double *)calloc((size_t)nf * 36, sizeof(double));
+    if (frm_model_prepare_stiffness(m) != FRM_OK) n = 0;
+    for (j = 0; j < n; j++) {
+        memset(v, 0, sizeof(frm_real) * 6 * (size_t)F);
+        v[6 * free_[j / 6] + j % 6] = 1;
+        frm_model_apply_stiffness(m, v, out, 1);
+        for (i = 0; i < n; i++) K[(size_t)n * i + j] = (double)out[6 * free_[i / 6] + i % 6];
+    }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < i; j++) K[(size_t)n * i + j] = K[(size_t)n * j + i] = 0.5 * (K[(size_t)n * i + j] + K[(size_t)n * j + i]);
+    for (i = 0; i < nf && n; i++) { /* L_i = M_i^-1/2 by its eigen-decomposition */
+        double Mi[36], V[36], ev[6];
+        frm_real mb[36];
+        frm_model_mass_block(m, free_[i], mb);
+        for (k = 0; k < 36; k++) Mi[k] = Mb[36 * i + k] = (double)mb[k];
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < r; c++) Mi[6 * r + c] = Mi[6 * c + r] = 0.5 * (Mi[6 * r + c] + Mi[6 * c + r]);
+        memcpy(V, Mi, sizeof V);
+        sym_eigen(V, 6, ev);
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < 6; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += V[6 * r + k] * V[6 * c + k] / sqrt(ev[k]);
+                L[36 * i + 6 * r + c] = t;
+            }
+    }
+    for (i = 0; i < n; i++) /* A = L K L */
+        for (j = 0; j < n; j++) {
+            double t = 0;
+            int bi = i / 6, bj = j / 6;
+            for (r = 0; r < 6; r++) {
+                double krow = 0;
+                for (c = 0; c < 6; c++) krow += K[(size_t)n * (6 * bi + r) + 6 * bj + c] * L[36 * bj + 6 * c + j % 6];
+                t += L[36 * bi + 6 * (i % 6) + r] * krow;
+            }
+            A[(size_t)n * i + j] = t;
+        }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < i; j++) A[(size_t)n * i + j] = A[(size_t)n * j + i] = 0.5 * (A[(size_t)n * i + j] + A[(size_t)n * j + i]);
+    if (n) sym_eigen(A, n, K); /* K now holds the eigenvalues */
+    for (i = 0; i < n; i++) freq[i] = (K[i] >= 0 ? sqrt(K[i]) : -sqrt(-K[i])) / (2 * pi);
+    for (k = 0; rot && k < nrot && k < n; k++) { /* x = L y: kinetic shares */
+        double tot = 0, rr = 0;
+        for (i = 0; i < nf; i++) {
+            double x[6], Mx[6];
+            for (r = 0; r < 6; r++) {
+                x[r] = 0;
+                for (c = 0; c < 6; c++) x[r] += L[36 * i + 6 * r + c] * A[(size_t)n * (6 * i + c) + k];
+            }
+            for (r = 0; r < 6; r++) {
+                Mx[r] = 0;
+                for (c = 0; c < 6; c++) Mx[r] += Mb[36 * i + 6 * r + c] * x[c];
+            }
+            for (r = 0; r < 6; r++) tot += x[r] * Mx[r];
+            for (r = 3; r < 6; r++) { /* the rotations alone: x_r^T J x_r */
+                double t = 0;
+                for (c = 3; c < 6; c++) t += Mb[36 * i + 6 * r + c] * x[c];
+                rr += x[r] * t;
+            }
+        }
+        rot[k] = tot > 0 ? rr / tot : 0;
+    }
+    free(free_);
+    free(v);
+    free(out);
+    free(K);
+    free(A);
+    free(L);
+    free(Mb);
+    return n;
+}
+
+/* The R3 beam (1 x 0.1 x 0.1 m, E = 1 MPa, nu = 0.3, rho = 1000) of 10 k x k x k cubes, 5
+   tetrahedra each, one sample per tetrahedron (the bench's tet4 body), clamped at x = 0,
+   no gravity. */
+static int tet_beam(frm_sampling *s, frm_model **m, int k, double gamma)
+{
+    tetmesh t;
+    frm_desc d = frm_model_default_desc();
+    frm_real *x;
+    int i, err;
+    if (tetmesh_beam(&t, 1, 0.1, 0.1, 10 * k, k, k, TETMESH_SPLIT5) != TETMESH_OK) return -1;
+    x = alloc_reals(3 * t.node_count);
+    for (i = 0; i < 3 * t.node_count; i++) x[i] = (frm_real)t.nodes[i];
+    for (i = 0; i < t.node_count; i++)
+        if (fabs(t.nodes[3 * i]) < 1e-12) x[3 * i] = 0;
+    err = frm_sampling_tets(s, x, t.node_count, t.tets, t.tet_count, 1, NULL, NULL);
+    free(x);
+    tetmesh_free(&t);
+    if (err) return err;
+    frm_sampling_apply(s, &d);
+    d.material.young_modulus = (frm_real)1e6;
+    d.material.poisson_ratio = (frm_real)0.3;
+    d.material.density = 1000;
+    d.gravity[2] = 0;
+    d.rotation_divergence = (frm_real)gamma;
+    d.parallel_min_pairs = 1 << 30;
+    err = frm_model_create(&d, m);
+    if (err) return err;
+    for (i = 0; i < s->frame_count; i++)
+        if (s->frame_positions[3 * i] == 0) frm_model_fix_frame(*m, i);
+    return 0;
+}
+
+/* Modes below `limit` Hz (not counting those at or below zero: none on a clamped beam)
+   and, of those, the ones whose kinetic energy is mostly the frames' rotations. */
+static void count_low(const double *freq, const double *rot, int n, double limit, int *low, int *rotational)
+{
+    int i;
+    *low = *rotational = 0;
+    for (i = 0; i < n && freq[i] < limit; i++) {
+        (*low)++;
+        if (i < 8 && rot[i] > 0.5) (*rotational)++;
+    }
+}
+
+/* The R3 beam with tetrahedral frames, one sample per tetrahedron (REFERENCES R3, 3D:
+   first bending 0.5091 Hz, twice on the square section; second bending 3.0531 Hz; first
+   torsion 4.5101 Hz). The thesis's model (rotation_divergence = 0) has a mode at 0.39 Hz
+   (one cell across) / 0.42 Hz (two) below the first bending mode and one at 2.3 / 2.5 Hz
+   below the second, in which the frames turn about the beam's axis while the material
+   hardly moves (more than 90 % of their kinetic energy is the frames' rotation). The
+   divergence term removes them: on two cells across no mode lies in (0, 0.95 x 0.5091 Hz),
+   the lowest two are the bending pair within 3 % of 0.5091 Hz (the discretisation is soft:
+   its static sag is +4.6 % of beam theory, which alone puts the frequency 2.2 % low), and no
+   mode below 0.95 x the second bending frequency is mostly rotation. One cell across
+   (quick builds) the bending pair itself sits 12 % low (sag +29 %), so there the check is
+   that the modes below 0.95 x 3.0531 Hz are the two bending pairs, none rotational. */
+static void test_tet_beam_modes(void)
+{
+    int k, k0 = TEST_IS_QUICK ? 1 : 2;
+    for (k = 1; k <= 2; k++) {
+        int pass;
+        if (k != k0 && !(k == 1 && !TEST_IS_QUICK)) continue;
+        for (pass = 0; pass < 2; pass++) { /* 0: the thesis's rotations (the defect), 1: default */
+            frm_sampling s;
+            frm_model *m;
+            frm_desc probe = frm_model_default_desc();
+            double *freq, rot[8];
+            int n, i, low1, rot1, low2, rot2;
+            if (pass == 0 && k == 2) continue; /* the defect is shown once, on the small beam */
+            REQUIRE(tet_beam(&s, &m, k, pass == 0 ? 0 : (double)probe.rotation_divergence) == FRM_OK);
+            freq = (double *)calloc((size_t)6 * s.frame_count, sizeof(double));
+            n = model_modes(m, freq, rot, 8);
+            REQUIRE(n > 8);
+            printf("    tet frames, R3 beam %d x %d x %d cells (%d DoF), rotation_divergence %g: lowest modes (Hz, rotation "
+                   "share of kinetic energy):\n     ",
+                   10 * k, k, k, n, pass == 0 ? 0.0 : (double)probe.rotation_divergence);
+            for (i = 0; i < 8; i++) printf(" %.4f (%.2f)", freq[i], rot[i]);
+            printf("\n");
+            CHECK(freq[0] > 0);
+            count_low(freq, rot, n, 0.95 * 0.5091, &low1, &rot1);
+            count_low(freq, rot, n, 0.95 * 3.0531, &low2, &rot2);
+            if (pass == 0) { /* the thesis's model shows the defect the test is for */
+                CHECK(rot1 >= 1);
+                CHECK(rot2 >= 2);
+            } else if (k == 2) {
+                CHECK_INT(0, low1);
+                CHECK_INT(0, rot2);
+                CHECK_INT(2, low2);
+                CHECK_REL(0.5091, freq[0], 0.03);
+                CHECK_REL(0.5091, freq[1], 0.03);
+            } else {
+                CHECK_INT(0, rot2);
+                CHECK_INT(4, low2);
+                CHECK(rot[0] < 0.1 && rot[1] < 0.1);
+            }
+            free(freq);
+            frm_model_destroy(m);
+            frm_sampling_free(&s);
+        }
+    }
+}
+
+/* A hexahedral beam [0, L] x [-W/2, W/2]^2 of nx x n x n cells, 2^3 sub-cell samples each
+   (frames at the nodes), clamped at x = 0; gamma < 0: the default rotation_divergence. */
+static int hex_beam(frm_sampling *s, frm_model **m, double L, double W, int nx, int n, double E, double rho, double gamma,
+                    int gravity)
+{
+    hexmesh h;
+    frm_desc d = frm_model_default_desc();
+    double lo[3], hi[3];
+    frm_real *x;
+    int i, err;
+    lo[0] = 0;
+    lo[1] = lo[2] = -W / 2;
+    hi[0] = L;
+    hi[1] = hi[2] = W / 2;
+    if (hexmesh_grid(&h, lo, hi, nx, n, n) != TETMESH_OK) return -1;
+    x = alloc_reals(3 * h.node_count);
+    for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+    for (i = 0; i < h.node_count; i++)
+        if (h.nodes[3 * i] == 0) x[3 * i] = 0;
+    err = frm_sampling_hexes(s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
+    free(x);
+    hexmesh_free(&h);
+    if (err) return err;
+    frm_sampling_apply(s, &d);
+    d.material.young_modulus = (frm_real)E;
+    d.material.poisson_ratio = (frm_real)0.3;
+    d.material.density = (frm_real)rho;
+    if (!gravity) d.gravity[2] = 0;
+    if (gamma >= 0) d.rotation_divergence = (frm_real)gamma;
+    d.parallel_min_pairs = 1 << 30;
+    err = frm_model_create(&d, m);
+    if (err) return err;
+    for (i = 0; i < s->frame_count; i++)
+        if (s->frame_positions[3 * i] == 0) frm_model_fix_frame(*m, i);
+    return 0;
+}
+
+/* Hexahedral frames one cell across: on a tensor-product grid a layer of frames normal to
+   an axis, turning about that axis, moves no material at all (the bilinear face
+   interpolation reproduces the in-plane coordinates): zero-energy modes of the
+   linearisation, and static solves stalled. Their rotation field has a divergence, which
+   the divergence term holds. The R3 beam of 10 x 1 x 1 cells: the thesis's model
+   (rotation_divergence = 0) has generalized eigenvalues of (K, M) at zero (below 1e-6 of
+   the first bending mode's; float's round-off of K puts them within 0.04 Hz); with the default none lies below 0.8 x 0.5091 Hz (the bending
+   pair itself is 8 % low one cell across: the frames' rotations make one cell soft, see
+   the R1 test below). */
+static void test_hex_beam_modes(void)
+{
+    int pass;
+    for (pass = 0; pass < 2; pass++) {
+        frm_sampling s;
+        frm_model *m;
+        double *freq, rot[6];
+        int n, i;
+        REQUIRE(hex_beam(&s, &m, 1, 0.1, 10, 1, 1e6, 1000, pass == 0 ? 0 : -1, 0) == FRM_OK);
+        freq = (double *)calloc((size_t)6 * s.frame_count, sizeof(double));
+        n = model_modes(m, freq, rot, 6);
+        REQUIRE(n > 6);
+        printf("    hex frames, R3 beam 10 x 1 x 1 cells (%d DoF), %s: lowest modes (Hz, rotation share):\n     ", n,
+               pass == 0 ? "rotation_divergence 0" : "default");
+        for (i = 0; i < 6; i++) printf(" %.4f (%.2f)", freq[i], rot[i]);
+        printf("; highest %.1f\n", freq[n - 1]);
+        if (pass == 0) CHECK(fabs(freq[0]) < (IS_FLOAT ? 0.2 : 1e-3) * 0.5091); /* float: K's round-off, 0.04 Hz */
+        else CHECK(freq[0] > 0.8 * 0.5091);
+        free(freq);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+}
+
+/* The tip of the R1 beam (16 x 0.5 x 0.5 m steel, own weight) with hexahedral frames. */
+static double hex_r1_tip(int nx, int n, int *err, int *newton)
+{
+    frm_sampling s;
+    frm_model *m;
+    double L = 16, W = 0.5, tip = 0;
+    int i, c = 0;
+    *newton = 0;
+    *err = hex_beam(&s, &m, L, W, nx, n, 200e9, 31200 / (L * W * W), -1, 1);
+    if (*err) return 0;
+    *err = frm_model_set_solver(m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-10), 20000, (frm_real)(IS_FLOAT ? 1e-3 : 1e-6), 30);
+    if (!*err) *err = frm_model_solve_static(m);
+    *newton = frm_model_last_stats(m)->newton_iterations;
+    for (i = 0; i < s.frame_count; i++)
+        if (fabs((double)s.frame_positions[3 * i] - L) < 1e-9 * L) {
+            tip -= (double)frm_model_positions(m)[3 * i + 2] - (double)s.frame_positions[3 * i + 2];
+            c++;
+        }
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    return tip / c;
+}
+
+/* R1 with hexahedral frames one cell across (32 x 1 x 1 cells of 0.5 m): the static solve
+   used to stall (FRM_ERR_STALLED); it converges in a few Newton iterations and lands 20 %
+   above the 3D reference 0.150169 m (measured +20.4 %), the discretisation's own error:
+   one cell across the frames' rotations make a cell soft in bending, as tetrahedral frames
+   one cell across (+29 % on R3), and two cells across (64 x 2 x 2, full builds) it is +4.1 %
+   (the thesis's 24 x 4 x 4: +0.2 %, tests/test_frames.c). Checked: converged, within
+   [0, +25 %] one cell across, [0, +6 %] at two. */
+static void test_hex_one_cell_r1(void)
+{
+    double ref = 0.150169, tip;
+    int err, newton;
+    tip = hex_r1_tip(32, 1, &err, &newton);
+    printf("    R1 hex frames 33 x 2 x 2: %s, tip %.6f m (3D %.6f: %+.2f %%), %d Newton\n", frm_error_string(err), tip, ref,
+           100 * (tip / ref - 1), newton);
+    CHECK_INT(FRM_OK, err);
+    CHECK(newton <= 10);
+    CHECK(tip > ref && tip < 1.25 * ref);
+    if (!TEST_IS_QUICK) {
+        tip = hex_r1_tip(64, 2, &err, &newton);
+        printf("    R1 hex frames 65 x 3 x 3: %s, tip %.6f m (%+.2f %%), %d Newton\n", frm_error_string(err), tip,
+               100 * (tip / ref - 1), newton);
+        CHECK_INT(FRM_OK, err);
+        CHECK(tip > ref && tip < 1.06 * ref);
+    }
+}
+
+/* R2, the soft cantilever 16 x 1 x 1 m (E = 40 kPa, 5 kg), with hexahedral frames one and
+   two cells across: the static solve stalled at every resolution; now it converges, below
+   linear theory's 7.53 m (large deformation), the tip falling under refinement towards the
+   tetrahedral frames' limit of about 6.54 m (tests/test_frames.c). Measured 7.203, 6.656 m. */
+static void test_hex_soft_cantilever_r2(void)
+{
+    int r, count = TEST_IS_QUICK ? 1 : 2;
+    double tip[2];
+    for (r = 0; r < count; r++) {
+        frm_sampling s;
+        frm_model *m;
+        double L = 16, t = 0;
+        int i, c = 0, err;
+        REQUIRE(hex_beam(&s, &m, L, 1, 16 * (r + 1), r + 1, 40e3, 5.0 / 16, -1, 1) == FRM_OK);
+        REQUIRE(frm_model_set_solver(m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-8), 5000, (frm_real)(IS_FLOAT ? 1e-4 : 1e-6), 100) ==
+                FRM_OK);
+        err = frm_model_solve_static(m);
+        for (i = 0; i < s.frame_count; i++)
+            if (fabs((double)s.frame_positions[3 * i] - L) < 1e-9 * L) {
+                t -= (double)frm_model_positions(m)[3 * i + 2] - (double)s.frame_positions[3 * i + 2];
+                c++;
+            }
+        tip[r] = t / c;
+        printf("    R2 hex frames %d x %d x %d: %s, tip %.4f m, %d Newton, %d CG\n", 16 * (r + 1) + 1, r + 2, r + 2,
+               frm_error_string(err), tip[r], frm_model_last_stats(m)->newton_iterations,
+               frm_model_last_stats(m)->cg_iterations);
+        CHECK_INT(FRM_OK, err);
+        CHECK(tip[r] > 6 && tip[r] < 7.53);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+    if (count == 2) CHECK(tip[1] < tip[0]);
+}
+
+static const test_case cases[] = {
+    TEST(test_garbage_descriptions),
+    TEST(test_float_renames),
+    TEST(test_shape_refusals),
+    TEST(test_svk_mirrored_compression),
+    TEST(test_svk_mirrored_step),
+    TEST(test_tet_beam_modes),
+    TEST(test_hex_beam_modes),
+    TEST(test_hex_one_cell_r1),
+    TEST(test_hex_soft_cantilever_r2),
+};
+
+int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
