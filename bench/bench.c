@@ -1253,8 +1253,17 @@ int main(int argc, char **argv)
         for (j = 0; j < n && count < 256; j++)
             if (selected(&o, table + j)) models[count++] = table + j;
     }
-    printf("bench: %d model entries, %s, %s, %s, git %s%s\n", count, env_cpu, env_compiler, BENCH_FLAGS, BENCH_GIT,
-           o.quick ? ", quick" : "");
+    {
+        const char *wait = getenv("OMP_WAIT_POLICY");
+        printf("bench: %d model entries, %s, %s, %s, git %s%s, OMP_WAIT_POLICY=%s\n", count, env_cpu, env_compiler,
+               BENCH_FLAGS, BENCH_GIT, o.quick ? ", quick" : "", wait ? wait : "(unset)");
+#ifdef _OPENMP
+        /* spinning threads on a busy machine time the neighbours, not the kernel (Makefile) */
+        if ((o.parts & 4) && o.threads > 1 && !wait)
+            fprintf(stderr, "bench: OMP_WAIT_POLICY is unset: on a busy machine the 2-thread rows may measure "
+                            "spinning; `make bench` sets it to passive\n");
+#endif
+    }
     set_threads(1);
     if (o.parts & 1) run_trade(&o, models, count);
     set_threads(1);
