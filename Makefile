@@ -20,6 +20,8 @@
 # the programs whose headers have parallel loops; the sanitizer build skips the two
 # compile-only programs (their code is the same headers the other programs exercise).
 # Each PASS line in build/<configuration>/<program>.log gives the case's CPU time.
+# tests/test_examples.sh runs the example programs with bad arguments, a missing output
+# directory and a full standard output (about 3 s); its cases count in the same total.
 
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 WARN := -Wall -Wextra -pedantic -Werror
@@ -51,8 +53,11 @@ COMPILE_ONLY := test_compile_all test_compile_static
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
 TESTS_omp-double := test_frames test_heml test_heml_sim test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
-RESULTS := $(foreach c,$(CONFIGS),$(foreach t,$(TESTS_$(c)),build/$(c)/$(t).result))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
+# the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a
+# test program of a configuration named "examples"
+RESULTS := $(foreach c,$(CONFIGS),$(foreach t,$(TESTS_$(c)),build/$(c)/$(t).result)) \
+           build/examples/test_examples.result
 
 .PHONY: all test test-run examples bench bench-quick clean
 # keep the test binaries between runs (they are intermediate files of the .result rules)
@@ -86,6 +91,12 @@ examples: $(foreach e,$(EXAMPLES),build/examples/$(e))
 build/examples/%: examples/%.c $(HEADERS)
 	@mkdir -p build/examples
 	gcc -std=c99 -O2 $(WARN) -o $@ $< -lm
+
+build/examples/test_examples.result: tests/test_examples.sh $(foreach e,$(EXAMPLES),build/examples/$(e))
+	@rm -rf build/tmp/examples
+	@sh tests/test_examples.sh build/examples build/tmp/examples > build/examples/test_examples.log 2>&1; \
+	  echo "$$?" > build/examples/test_examples.status; \
+	  grep '^RESULT ' build/examples/test_examples.log > $@ || echo "RESULT 0 1 crashed" > $@
 
 # The bench: bench.c plus every adapter bench/model_*.c compiled twice (double, float).
 # Built for this machine; the flags and git revision go into every CSV row.
