@@ -17,7 +17,10 @@
       cheapest configuration reaching 10 %, 1 % and 0.1 % error.
    2. stability: largest stable time step by bisection, Poisson ratio towards 0.5, a
       tetrahedron pushed through zero volume, a 180 degree twist, the scene 1e6 m from the
-      origin; each outcome classified. stability.csv.
+      origin; each outcome classified. stability.csv. Then the stress sweep (>>sweep, also
+      alone with --parts sweep): every model entry over E, nu, static and implicit Euler
+      at dt 1e-6 to 1 s, each run right, an error code, or a success with a wrong answer
+      (the count issue 18 wants at zero). sweep.csv.
    3. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
       the memory-bandwidth bound of the bytes each header says its kernel moves, with the
       bandwidth measured in the same run by a STREAM triad. kernels.csv.
