@@ -4,6 +4,11 @@
 # typed by hand:
 #
 #   sh bench/readme_tables.sh [RESULTS_DIR]     (default bench/results)
+#   sh bench/readme_tables.sh --update README.md [RESULTS_DIR]
+#
+# --update replaces, in the file given, each table whose header row starts like one of
+# these tables' (its first 15 characters) with the regenerated one, and leaves every
+# other line alone.
 #
 # 1. the speed/accuracy trade (trade.csv): per scene and header, the best error and the
 #    cheapest configuration (seconds to the answer) under 10 % and 1 %; R2 (no closed form)
@@ -15,6 +20,34 @@
 # Errors are as the bench wrote them: R1 and R3 against the converged 3D solid, R3's
 # frequency corrected for the integrator's phase error (bench.c, integrator_frequency).
 # The prose around the tables quotes figures from them: check it after regenerating.
+if [ "$1" = "--update" ]; then
+    readme=$2
+    [ -w "$readme" ] || { echo "readme_tables.sh: cannot update '$readme'" >&2; exit 1; }
+    tables=$(mktemp) || exit 1
+    out=$(mktemp) || exit 1
+    sh "$0" ${3:+"$3"} > "$tables" || { rm -f "$tables" "$out"; exit 1; }
+    # header signature -> table, then one pass over the README
+    awk -v tables="$tables" '
+    BEGIN {
+        while ((getline line < tables) > 0) {
+            if (line ~ /^\|/) {
+                if (!intable) { sig = substr(line, 1, 15); intable = 1; text[sig] = "" }
+                text[sig] = text[sig] line "\n"
+            } else intable = 0
+        }
+    }
+    skipping && /^\|/ { next }
+    { skipping = 0 }
+    /^\|/ && (substr($0, 1, 15) in text) && !done[substr($0, 1, 15)] {
+        sig = substr($0, 1, 15); printf "%s", text[sig]; done[sig] = 1; skipping = 1; replaced++; next
+    }
+    { print }
+    END { printf "readme_tables.sh: %d tables replaced\n", replaced > "/dev/stderr" }
+    ' "$readme" > "$out" && cat "$out" > "$readme"
+    rc=$?
+    rm -f "$tables" "$out"
+    exit $rc
+fi
 dir=${1:-bench/results}
 for f in trade.csv stability.csv; do
     [ -r "$dir/$f" ] || { echo "readme_tables.sh: cannot read $dir/$f" >&2; exit 1; }
