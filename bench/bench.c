@@ -748,6 +748,10 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) {
         double t0 = now();
         printf("%s\n", scenes[s].title);
+        if (!strcmp(scenes[s].name, "R3"))
+            printf("  (frequency from the tip's zero crossings, corrected for the integrator's phase error: Euler "
+                   "schemes w = tan(w_h dt) / dt, semi-implicit Euler w = 2 sin(w_h dt / 2) / dt; \"measured\" is "
+                   "the uncorrected one)\n");
         for (i = 0; i < count; i++) scenes[s].run(models[i], o);
         printf("  (%s: %.1f s)\n", scenes[s].name, now() - t0);
     }
