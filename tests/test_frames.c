@@ -1433,8 +1433,9 @@ static void test_solver_extremes(void)
         err = frm_model_solve_static(sc.m);
         printf("    hex one cell across: %s after %d Newton iterations\n", frm_error_string(err),
                frm_model_last_stats(sc.m)->newton_iterations);
-        CHECK(err == FRM_OK || err == FRM_ERR_STALLED);
-        CHECK(frm_model_last_stats(sc.m)->newton_iterations <= 2 + 10 + 2);
+        /* the load continuation cuts the increment down to min_increment before it gives up */
+        CHECK(err == FRM_OK || err == FRM_ERR_STALLED || err == FRM_ERR_NO_CONVERGENCE);
+        CHECK(frm_model_last_stats(sc.m)->increments + frm_model_last_stats(sc.m)->increment_cuts <= 64);
         scene_free(&sc);
     }
 }
@@ -2340,6 +2341,278 @@ static void test_error_strings(void)
     CHECK(strcmp(frm_version(), v) == 0);
 }
 
+/* ---- issue 18: no silent wrong answers (solvers) --------------------------------------- */
+
+/* Sum over the frames of |v_k|^2 for the translation (k < 3) and rotation parts, split by
+   whether the frame is free (state 0) or held. */
+static double norm_frames(const frm_model *m, const frm_real *v, int free_frames)
+{
+    int i, k, n = frm_model_frame_count(m);
+    double s = 0;
+    for (i = 0; i < n; i++)
+        if ((frm_model_frame_state(m, i) == 0) == free_frames)
+            for (k = 0; k < 6; k++) s += (double)v[6 * i + k] * v[6 * i + k];
+    return sqrt(s);
+}
+
+/* |f| over the free frames, the load (gravity + external) over the free frames and the
+   reactions (the total force on the held frames) at the model's state. */
+static void residual_parts(frm_model *m, double *res, double *load, double *reaction)
+{
+    int n = frm_model_frame_count(m), k;
+    const frm_real *f, *fi;
+    frm_real *t = alloc_reals(6 * n), *l = alloc_reals(6 * n);
+    REQUIRE(frm_model_total_forces(m, &f) == FRM_OK);
+    memcpy(t, f, sizeof(frm_real) * 6 * (size_t)n);
+    REQUIRE(frm_model_forces(m, &fi) == FRM_OK);
+    for (k = 0; k < 6 * n; k++) l[k] = t[k] - fi[k];
+    *res = norm_frames(m, t, 1);
+    *load = norm_frames(m, l, 1);
+    *reaction = norm_frames(m, t, 0);
+    free(t);
+    free(l);
+}
+
+/* Item 13: a load whose |b|^2 overflows (1e156 N on the README cube) must not pass the CG's
+   tolerance (inf): the static solve and the implicit step fail with FRM_ERR_NOT_FINITE and
+   keep the state (before: success without moving). Float: 1e30 N, any error. */
+static void test_i18_huge_load(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    scene sc;
+    int n, i, err, top = -1;
+    frm_real *x0, *q0, f[3] = {0, 0, 0};
+    REQUIRE(scene_hex(&sc, lo, hi, 2, 2, 2, 2, FRM_LAW_NEO_HOOKEAN, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    for (i = 0; i < n; i++) {
+        if (sc.s.frame_positions[3 * i + 2] == 0) frm_model_fix_frame(sc.m, i);
+        if (sc.s.frame_positions[3 * i + 2] == 1) top = i;
+    }
+    f[2] = (frm_real)(IS_FLOAT ? 1e30 : 1e156);
+    REQUIRE(frm_model_set_external(sc.m, top, f, NULL) == FRM_OK);
+    get_poses(sc.m, &x0, &q0);
+    err = frm_model_solve_static(sc.m);
+    printf("    1e%d N static: %s\n", IS_FLOAT ? 30 : 156, frm_error_string(err));
+    if (IS_FLOAT) CHECK(err != FRM_OK);
+    else CHECK_INT(FRM_ERR_NOT_FINITE, err);
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    err = frm_model_step(sc.m);
+    printf("    1e%d N implicit step: %s\n", IS_FLOAT ? 30 : 156, frm_error_string(err));
+    if (IS_FLOAT) CHECK(err != FRM_OK);
+    else CHECK_INT(FRM_ERR_NOT_FINITE, err);
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    free(x0);
+    free(q0);
+    scene_free(&sc);
+}
+
+/* Item 14: the static solve's residual is judged against newton_tolerance times the
+   documented scale, max(|load|, |reactions|) at the returned state (gravity and external
+   forces on the free frames; the total force on the held frames), never against the
+   starting residual: a beam started 27 % stretched (before: success with a residual 265
+   times the documented tolerance). */
+static void test_i18_residual_scale(void)
+{
+    scene sc;
+    int n, i;
+    frm_real *x, *q;
+    double res = 0, load = 0, reaction = 0, tol;
+    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    n = frm_model_frame_count(sc.m);
+    get_poses(sc.m, &x, &q);
+    for (i = 0; i < n; i++) x[3 * i] = (frm_real)(1.27 * x[3 * i]);
+    REQUIRE(frm_model_set_poses(sc.m, x, q) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+    residual_parts(sc.m, &res, &load, &reaction);
+    tol = (double)frm_model_default_desc().newton_tolerance;
+    printf("    started 27 %% stretched: |f| %.3g N, load %.3g N, reactions %.3g N: %.3g x the tolerance\n", res, load,
+           reaction, res / (tol * (load > reaction ? load : reaction)));
+    CHECK(res <= tol * (load > reaction ? load : reaction) * 1.0001);
+    free(x);
+    free(q);
+    scene_free(&sc);
+}
+
+/* Gravity on a meshless body equals its weight: the translational parts of the gravity
+   forces (total force at rest minus the internal force, which is zero there) sum to rho V g
+   with V the box's volume, computed here. */
+static void test_i18_gravity_weight(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {0.4, 0.3, 0.2}, sum[3] = {0, 0, 0}, rho = 1000, V = 0.4 * 0.3 * 0.2;
+    scene sc;
+    const frm_real *f;
+    int i, k, n;
+    REQUIRE(scene_box(&sc, lo, hi, 0.15, 0.06, FRM_SHAPE_SHEPARD, 8, FRM_LAW_SVK, 1e5, 0.3) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    REQUIRE(frm_model_total_forces(sc.m, &f) == FRM_OK);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) sum[k] += (double)f[6 * i + k];
+    printf("    %d frames: weight %.6f N, rho V g %.6f N\n", n, sum[2], -rho * V * 9.81);
+    CHECK_REL(-rho * V * 9.81, sum[2], IS_FLOAT ? 1e-5 : 1e-10);
+    CHECK_NEAR(0, sum[0], 1e-9 * rho * V * 9.81 + (IS_FLOAT ? 1e-4 : 0));
+    CHECK_NEAR(0, sum[1], 1e-9 * rho * V * 9.81 + (IS_FLOAT ? 1e-4 : 0));
+    scene_free(&sc);
+}
+
+/* Dense Gaussian elimination with partial pivoting: A x = b (A n x n, destroyed). */
+static void dense_solve(double *A, double *b, int n)
+{
+    int i, j, k;
+    for (k = 0; k < n; k++) {
+        int p = k;
+        for (i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (p != k) {
+            double t;
+            for (j = 0; j < n; j++) t = A[k * n + j], A[k * n + j] = A[p * n + j], A[p * n + j] = t;
+            t = b[k], b[k] = b[p], b[p] = t;
+        }
+        for (i = k + 1; i < n; i++) {
+            double l = A[i * n + k] / A[k * n + k];
+            for (j = k; j < n; j++) A[i * n + j] -= l * A[k * n + j];
+            b[i] -= l * b[k];
+        }
+    }
+    for (i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (j = i + 1; j < n; j++) s -= A[i * n + j] * b[j];
+        b[i] = s / A[i * n + i];
+    }
+}
+
+/* The generalized displacement of every frame from rest: translation, and the rotation
+   vector 2 q_xyz (small angles; rest orientations are the identity here). */
+static void frame_displacements(const frm_model *m, const frm_sampling *s, double *u)
+{
+    int i, k, n = frm_model_frame_count(m);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) {
+            u[6 * i + k] = (double)frm_model_positions(m)[3 * i + k] - s->frame_positions[3 * i + k];
+            u[6 * i + 3 + k] = 2 * (double)frm_model_orientations(m)[4 * i + k];
+        }
+}
+
+/* A small hexahedral beam with Rayleigh damping, clamped at x = 0, started at rest with a
+   non-zero velocity (small amplitude: the linear regime, no gravity). */
+static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
+{
+    double lo[3] = {0, -0.25, -0.25}, hi[3] = {1, 0.25, 0.25};
+    frm_real g[3] = {0, 0, 0}, *v;
+    int i, k, n;
+    REQUIRE(scene_hex(sc, lo, hi, 2, 1, 1, 2, FRM_LAW_SVK, 1e4, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    frm_model_destroy(sc->m);
+    sc->d.mass_damping = (frm_real)alpha;
+    sc->d.stiffness_damping = (frm_real)beta;
+    REQUIRE(frm_model_create(&sc->d, &sc->m) == FRM_OK);
+    n = frm_model_frame_count(sc->m);
+    clamp_beam(sc->m, &sc->s);
+    REQUIRE(frm_model_set_gravity(sc->m, g) == FRM_OK);
+    REQUIRE(frm_model_set_solver(sc->m, (frm_real)(IS_FLOAT ? 1e-6 : 1e-12), 1000, (frm_real)(IS_FLOAT ? 1e-5 : 1e-10), 30) ==
+            FRM_OK);
+    v = alloc_reals(6 * n);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 6; k++)
+            v[6 * i + k] = frm_model_frame_state(sc->m, i) ? 0
+                                                           : (frm_real)(amplitude * (k == 2 ? sc->s.frame_positions[3 * i]
+                                                                                     : k == 4 ? -1.0 : 0.1 * (k == 1)));
+    REQUIRE(frm_model_set_velocities(sc->m, v) == FRM_OK);
+    free(v);
+}
+
+/* Implicit Euler with Rayleigh damping (alpha M + beta K) and a non-zero start velocity
+   against the closed form of its discrete recurrence, computed here from the assembled K
+   and the mass blocks:
+       (M (1 + alpha dt) + (dt^2 + beta dt) K) v1 = M v0 - dt K u0,   u1 = u0 + dt v1
+   (a wrong damping sign, a dropped M v0 or a K v term shows at once); then the order of
+   accuracy: the changes between dt, dt/2 and dt/4 halve (first order). */
+static void test_i18_implicit_recurrence(void)
+{
+    scene sc;
+    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err = 0, top = 0;
+    int n, nf = 0, i, j, a, b, step, steps = 20, *map;
+    double *K, *M, *A, *u, *v, *rhs, *uf;
+    damped_beam(&sc, alpha, beta, amp);
+    n = frm_model_frame_count(sc.m);
+    map = (int *)malloc(sizeof(int) * (size_t)n);
+    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(sc.m, i) ? -1 : nf++;
+    K = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    M = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    A = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    u = (double *)calloc((size_t)6 * n, sizeof(double));
+    v = (double *)calloc((size_t)6 * nf, sizeof(double));
+    rhs = (double *)calloc((size_t)6 * nf, sizeof(double));
+    uf = (double *)calloc((size_t)6 * n, sizeof(double));
+    REQUIRE(frm_model_assemble_stiffness(sc.m) == FRM_OK);
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++) {
+            frm_real B[36];
+            if (map[i] < 0 || map[j] < 0) continue;
+            if (frm_model_stiffness_block(sc.m, i, j, B) != FRM_OK) continue;
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) K[(6 * map[i] + a) * 6 * nf + 6 * map[j] + b] = (double)B[6 * a + b];
+        }
+    for (i = 0; i < n; i++) {
+        frm_real B[36];
+        if (map[i] < 0) continue;
+        REQUIRE(frm_model_mass_block(sc.m, i, B) == FRM_OK);
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) M[(6 * map[i] + a) * 6 * nf + 6 * map[i] + b] = (double)B[6 * a + b];
+    }
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) v[6 * map[i] + a] = (double)frm_model_velocities(sc.m)[6 * i + a];
+    for (step = 0; step < steps; step++) {
+        int N = 6 * nf;
+        REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
+        for (a = 0; a < N; a++) {
+            double s = 0;
+            for (b = 0; b < N; b++) {
+                s += M[a * N + b] * v[b] - dt * K[a * N + b] * u[b];
+                A[a * N + b] = M[a * N + b] * (1 + alpha * dt) + (dt * dt + beta * dt) * K[a * N + b];
+            }
+            rhs[a] = s;
+        }
+        dense_solve(A, rhs, N);
+        for (a = 0; a < N; a++) {
+            v[a] = rhs[a];
+            u[a] += dt * v[a];
+        }
+    }
+    frame_displacements(sc.m, &sc.s, uf);
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) {
+                double d = uf[6 * i + a] - u[6 * map[i] + a];
+                err += d * d;
+                top += u[6 * map[i] + a] * u[6 * map[i] + a];
+            }
+    err = sqrt(err / top);
+    printf("    %d steps of %.2f s, alpha %.2f, beta %.2f: frames against the recurrence %.2e (relative)\n", steps, dt, alpha,
+           beta, err);
+    CHECK(err < (IS_FLOAT ? 2e-2 : 1e-4));
+    scene_free(&sc);
+    { /* order: u(T) at dt, dt/2, dt/4 */
+        double uT[3][6 * 64], d1 = 0, d2 = 0, T = 4.0;
+        int r;
+        for (r = 0; r < 3; r++) {
+            double h = 0.01 / (1 << r);
+            damped_beam(&sc, alpha, beta, amp);
+            for (step = 0; step < (int)(T / h + 0.5); step++) REQUIRE(frm_model_step_ex(sc.m, (frm_real)h) == FRM_OK);
+            REQUIRE(6 * frm_model_frame_count(sc.m) <= 6 * 64);
+            frame_displacements(sc.m, &sc.s, uT[r]);
+            scene_free(&sc);
+        }
+        for (a = 0; a < 6 * n; a++) {
+            d1 += (uT[0][a] - uT[1][a]) * (uT[0][a] - uT[1][a]);
+            d2 += (uT[1][a] - uT[2][a]) * (uT[1][a] - uT[2][a]);
+        }
+        printf("    order: changes %.3e, %.3e, ratio %.3f (first order: 2)\n", sqrt(d1), sqrt(d2), sqrt(d1 / d2));
+        CHECK(sqrt(d1 / d2) > 1.7 && sqrt(d1 / d2) < 2.4);
+    }
+    free(map), free(K), free(M), free(A), free(u), free(v), free(rhs), free(uf);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -2364,6 +2637,10 @@ static const test_case cases[] = {
     TEST(test_no_allocation_after_create),
     TEST(test_validation_errors),
     TEST(test_error_strings),
+    TEST(test_i18_huge_load),
+    TEST(test_i18_residual_scale),
+    TEST(test_i18_gravity_weight),
+    TEST(test_i18_implicit_recurrence),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
