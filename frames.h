@@ -3624,13 +3624,11 @@ static int frm__accept(frm_model *m)
 }
 
 #define FRM__MAX_HALVINGS 12
-/* A static solve whose residual has not halved for this many Newton iterations stops the
-   increment (mechanisms make it wander) instead of running to the cap; the continuation
-   then cuts the increment. */
-#define FRM__STALL_ITERATIONS 10
-/* ... or whose residual rose in this many consecutive iterations (energy descent walking
-   into a mechanism). */
-#define FRM__STALL_RISES 3
+/* A static increment whose residual has not halved for this many Newton iterations stops
+   (mechanisms make it wander) instead of running to the cap; the continuation then cuts
+   the increment. Not fewer: near incompressibility the residual (dominated by the stiff
+   volumetric modes) swings by orders of magnitude while the energy falls steadily. */
+#define FRM__STALL_ITERATIONS 15
 /* Least regularisation (fraction of |K_ii| on the rotational diagonal) of a static solve's
    positive-definite attempt, whose K may be singular along rotations nothing holds. */
 #define FRM__DEFINITE_REGULARIZATION 1e-6
@@ -3823,22 +3821,20 @@ FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
 }
 
 /* Newton iterations of one static increment until |f| <= tol * scale; a residual that has
-   not halved in FRM__STALL_ITERATIONS or rose FRM__STALL_RISES times in a row stalls the
-   increment (FRM_ERR_STALLED). */
+   not halved in FRM__STALL_ITERATIONS stalls the increment (FRM_ERR_STALLED). */
 static int frm__static_increment(frm_model *m, double tol, int *iterations, double *res, double *scale)
 {
-    double mark = 0, previous = 0;
-    int it, mark_it = 0, rises = 0, converged = 0, err = FRM_OK;
+    double mark = 0;
+    int it, mark_it = 0, converged = 0, err = FRM_OK;
     m->floor_residual = 0;
     for (it = 0;; it++) {
         err = frm__newton_iteration(m, it == 0, tol, &converged, res, scale);
+        if (getenv("FRMDBG")) fprintf(stderr, "  it %d err %d conv %d res %.3e scale %.3e cg %d def %d neg %d lsc %d\n", it, err, converged, *res, *scale, m->stats.cg_iterations_last, m->stats.definite_solves, m->stats.negative_curvature, m->stats.line_search_cuts);
         if (err || converged || it == m->newton_max_iterations) break;
-        rises = it > 0 && *res > previous ? rises + 1 : 0;
-        previous = *res;
         if (it == 0 || *res < mark) { /* progress: the residual halved since the last mark */
             mark = 0.5 * *res;
             mark_it = it;
-        } else if (it - mark_it >= FRM__STALL_ITERATIONS || rises >= FRM__STALL_RISES) {
+        } else if (it - mark_it >= FRM__STALL_ITERATIONS) {
             err = FRM_ERR_STALLED;
             break;
         }
@@ -3902,6 +3898,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
                                                                                : (double)m->newton_tolerance;
         frm__copy_state(m, m->inc_state);
         frm__set_load(m, trial, g_full);
+        if (getenv("FRMDBG")) fprintf(stderr, "increment %.5f (inc %.5f)\n", trial, inc);
         err = frm__static_increment(m, tol, &iterations, &res, &scale);
         if (!err) err = frm__accept(m);
         attempts++;
