@@ -3829,7 +3829,6 @@ static int frm__static_increment(frm_model *m, double tol, int *iterations, doub
     m->floor_residual = 0;
     for (it = 0;; it++) {
         err = frm__newton_iteration(m, it == 0, tol, &converged, res, scale);
-        if (getenv("FRMDBG")) fprintf(stderr, "  it %d err %d conv %d res %.3e scale %.3e cg %d def %d neg %d lsc %d\n", it, err, converged, *res, *scale, m->stats.cg_iterations_last, m->stats.definite_solves, m->stats.negative_curvature, m->stats.line_search_cuts);
         if (err || converged || it == m->newton_max_iterations) break;
         if (it == 0 || *res < mark) { /* progress: the residual halved since the last mark */
             mark = 0.5 * *res;
@@ -3898,7 +3897,6 @@ FRMDEF int frm_model_solve_static(frm_model *m)
                                                                                : (double)m->newton_tolerance;
         frm__copy_state(m, m->inc_state);
         frm__set_load(m, trial, g_full);
-        if (getenv("FRMDBG")) fprintf(stderr, "increment %.5f (inc %.5f)\n", trial, inc);
         err = frm__static_increment(m, tol, &iterations, &res, &scale);
         if (!err) err = frm__accept(m);
         attempts++;

@@ -5,8 +5,6 @@
    (R3), a 180 degree torsion and a coplanar Shepard sheet, determinism, allocation
    discipline and every validation error. */
 #define FRAMES_IMPLEMENTATION
-#include <stdio.h>
-#include <stdlib.h>
 #include "../frames.h"
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
@@ -2706,7 +2704,6 @@ static int cube_uniaxial(frm_law law, double E, double nu, double s0, int max_in
                 CHECK_INT(FRM_OK, frm_model_set_external(sc.m, i, fz, NULL));
             }
         err = frm_model_solve_static(sc.m);
-        if (getenv("CUBEDBG")) { double r1, l1, re1; residual_parts(sc.m, &r1, &l1, &re1); printf("        load control: res %.3e load %.3e reac %.3e inc %d\n", r1, l1, re1, frm_model_last_stats(sc.m)->increments); }
         for (i = 0; i < n; i++)
             if (sc.s.frame_positions[3 * i + 2] == 1) z += frm_model_positions(sc.m)[3 * i + 2], c++;
         *s = z / c;
@@ -2742,7 +2739,6 @@ static void test_i18_cube_uniaxial_load(void)
                 CHECK_INT(FRM_OK, err);
                 rel = fabs(s - target) / fabs(target - 1);
                 closed = fabs(uniaxial_stress((frm_law)law, E, nus[j], s) - P) / fabs(P);
-                if (getenv("CUBEDBG")) printf("      law %d nu %g target %g: %s, s %.6f, rel %.2e, closed form %.2e\n", law, nus[j], target, frm_error_string(err), s, rel, closed);
                 if (rel > worst) worst = rel;
                 if (closed > worst_closed) worst_closed = closed;
                 CHECK(rel < (IS_FLOAT ? 1e-3 : 1e-5));
