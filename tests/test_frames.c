@@ -2690,7 +2690,7 @@ static int cube_uniaxial(frm_law law, double E, double nu, double s0, int max_in
                 err = frm_model_solve_static(sc.m);
             }
             if (err) break;
-            REQUIRE(frm_model_total_forces(sc.m, &f) == FRM_OK ? 1 : 1);
+            if (frm_model_total_forces(sc.m, &f) != FRM_OK) return -100;
             for (i = 0; i < n; i++) {
                 load[i] = sc.s.frame_positions[3 * i + 2] == 1 ? -f[6 * i + 2] : 0;
                 *P += (double)load[i];
@@ -2946,6 +2946,111 @@ static void test_i18_far_from_origin(void)
     CHECK_REL(sag[0], sag[1], 1e-6);
 }
 
+/* Implicit Euler at a large step: one step of 1e3 s from rest is the static equilibrium
+   (the inertia M v / dt vanishes), here a soft tetrahedral beam sagging about 10 % of its
+   length. The Newton step meets the static solve; the linearised step (implicit_linearized
+   = 1, one iteration) is printed for comparison. */
+static void test_i18_implicit_large_step(void)
+{
+    scene sc;
+    double tip_static, tip_newton, tip_linear;
+    frm_real g[3] = {0, 0, (frm_real)-0.1};
+    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+    tip_static = -end_face_z(sc.m, &sc.s, 1);
+    frm_model_destroy(sc.m);
+    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_step_ex(sc.m, (frm_real)1e3));
+    tip_newton = -end_face_z(sc.m, &sc.s, 1);
+    printf("    one step of 1e3 s: %d Newton, residual %.2g of its scale\n", frm_model_last_stats(sc.m)->newton_iterations,
+           (double)frm_model_last_stats(sc.m)->residual);
+    frm_model_destroy(sc.m);
+    sc.d.implicit_linearized = 1;
+    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_step_ex(sc.m, (frm_real)1e3));
+    tip_linear = -end_face_z(sc.m, &sc.s, 1);
+    printf("    tip: static %.6f m, Newton implicit step %.6f m, linearised step %.6f m\n", tip_static, tip_newton, tip_linear);
+    CHECK(tip_static > 0.05);
+    CHECK_REL(tip_static, tip_newton, IS_FLOAT ? 1e-3 : 1e-4);
+    scene_free(&sc);
+}
+
+/* A reduced stress sweep: E from 1 Pa to 200 GPa, nu from 0 to 0.4999, a small tetrahedral
+   beam under its own weight (static solve; implicit steps of 1e-6, 1e-2 and 1 s from rest)
+   and a cube squashed to half its height (static, driven top face, Neo-Hookean). Every run
+   either returns an error code or agrees with the same run at a 100 times finer
+   tolerance: never success with a wrong answer. */
+static void test_i18_stress_sweep(void)
+{
+    static const double youngs[4] = {1, 1e4, 1e8, 2e11}, nus[3] = {0, 0.3, 0.4999}, steps[3] = {1e-6, 1e-2, 1};
+    int e, j, mode, fine, runs = 0, ok_runs = 0, errors = 0;
+    double worst = 0;
+    for (e = 0; e < 4; e++)
+        for (j = 0; j < 3; j++)
+            for (mode = 0; mode < 5; mode += TEST_IS_QUICK ? 2 : 1) {
+                double result[2] = {0, 0}, scale = 0;
+                int err[2] = {0, 0};
+                for (fine = 0; fine < 2; fine++) {
+                    scene sc;
+                    int i;
+                    double ntol = (double)frm_model_default_desc().newton_tolerance * (fine ? 0.01 : 1);
+                    double ctol = (double)frm_model_default_desc().cg_tolerance * (fine ? 0.01 : 1);
+                    if (mode < 4)
+                        REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 4, 1, 1, FRM_LAW_NEO_HOOKEAN, youngs[e], nus[j], 1000, FRM_STIFFNESS_AUTO) ==
+                                FRM_OK);
+                    else {
+                        double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+                        REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, youngs[e], nus[j], 1000, FRM_STIFFNESS_AUTO) ==
+                                FRM_OK);
+                    }
+                    REQUIRE(frm_model_set_solver(sc.m, (frm_real)ctol, 20000, (frm_real)ntol, 30) == FRM_OK);
+                    if (mode < 4) clamp_beam(sc.m, &sc.s);
+                    else
+                        for (i = 0; i < sc.s.frame_count; i++) {
+                            const frm_real *x = sc.s.frame_positions + 3 * i;
+                            if (x[2] == 0) frm_model_fix_frame(sc.m, i);
+                            if (x[2] == 1) {
+                                frm_real p[3], q[4] = {0, 0, 0, 1};
+                                p[0] = x[0], p[1] = x[1], p[2] = (frm_real)0.5;
+                                frm_model_drive_frame(sc.m, i, p, q);
+                            }
+                        }
+                    if (mode == 0 || mode == 4) err[fine] = frm_model_solve_static(sc.m);
+                    else err[fine] = frm_model_step_ex(sc.m, (frm_real)steps[mode - 1]);
+                    if (mode < 4) {
+                        result[fine] = end_face_z(sc.m, &sc.s, 1);
+                        scale = mode == 0 ? 1.0 : 9.81 * steps[mode - 1] * steps[mode - 1];
+                    } else { /* the squashed cube: the bulge of its last frame (a corner of the top face) */
+                        result[fine] = frm_model_positions(sc.m)[3 * (sc.s.frame_count - 1)];
+                        scale = 1;
+                    }
+                    scene_free(&sc);
+                    if (err[0]) break; /* an error code: nothing to compare */
+                }
+                runs++;
+                if (err[0]) {
+                    errors++;
+                    continue;
+                }
+                ok_runs++;
+                if (err[1] == FRM_OK) {
+                    double d = fabs(result[0] - result[1]) / scale;
+                    if (d > worst) worst = d;
+                    if (!(d < (IS_FLOAT ? 1e-2 : 1e-3)))
+                        printf("    E %g nu %g mode %d: %.9g against %.9g (fine)\n", youngs[e], nus[j], mode, result[0], result[1]);
+                    CHECK(d < (IS_FLOAT ? 1e-2 : 1e-3));
+                }
+            }
+    printf("    %d runs: %d converged (worst difference to the 100 x finer run %.2g of its scale), %d error codes\n", runs,
+           ok_runs, worst, errors);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -2979,6 +3084,8 @@ static const test_case cases[] = {
     TEST(test_i18_cook_membrane),
     TEST(test_i18_static_extremes),
     TEST(test_i18_far_from_origin),
+    TEST(test_i18_implicit_large_step),
+    TEST(test_i18_stress_sweep),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
