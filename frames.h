@@ -86,8 +86,9 @@
           material (or a per-sample table), gravity, time step, solver settings.
        3. frm_model_create(&d, &m) validates everything and allocates all memory once.
        4. Boundary conditions and loads: frm_model_fix_frame, frm_model_drive_frame (a
-          prescribed pose), frm_model_release_frame, frm_model_set_external (force and
-          torque), frm_model_set_gravity.
+          prescribed pose), frm_model_release_frame, frm_model_set_frame_axes (some
+          translation and rotation axes held: symmetry planes, rollers, plane strain),
+          frm_model_set_external (force and torque), frm_model_set_gravity.
        5. frm_model_step (implicit Euler) or frm_model_solve_static (Newton), or
           frm_model_newton_step to watch a solve; frm_model_last_stats for iterations.
        6. Read frm_model_positions / _orientations / _velocities, and
@@ -118,11 +119,17 @@
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
-   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted
-   Neo-Hookean sample (FRM_ERR_INVERTED), without convergence (FRM_ERR_NO_CONVERGENCE) or,
-   for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
-   iterations or rose in 3 in a row, see LIMITS) leaves positions, orientations and velocities exactly as they
-   were.
+   A step or solve never reports success with an unconverged or unchecked result: one that
+   meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
+   FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
+   its start (FRM_ERR_INVERTED; St Venant-Kirchhoff may with allow_inversion = 1, counted
+   in frm_stats.inverted), does not converge (FRM_ERR_NO_CONVERGENCE: a Newton run at its
+   cap, a CG solve at cg_max_iterations above its tolerance, a line search that finds no
+   decrease, a continuation cut below min_increment or past max_increments; FRM_ERR_STALLED
+   when its last increment stopped because the residual had not halved in 15 Newton
+   iterations, see LIMITS), or starts or ends with a state too far from rest for frm_real
+   (FRM_ERR_PRECISION: eps(frm_real) max|u| > precision_limit h_min, see LIMITS) leaves
+   positions, orientations and velocities exactly as they were.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
    time, different models by different threads. The per-sample and per-frame passes run
@@ -229,26 +236,71 @@
        whose samples hang above them): when CG meets non-positive curvature, or its step
        is not a descent direction, the iteration is solved again with K's positive-definite
        part (below; frm_stats.definite_solves counts them), which always gives a descent
-       direction. Converged when |f| <= newton_tolerance |load|, or when |f| is below the
-       round-off floor (64 eps times the size of the partial forces it sums, plus K times
-       one ulp of the displacements) and a further Newton iteration no longer halves it
-       (below the floor the 2-norm does not tell how far the soft modes are: a slender
-       steel beam in float has a floor above its load). A solve whose residual has not
-       halved in 10 iterations, or rose in 3 in a row, stops with FRM_ERR_STALLED
-       (mechanisms, see LIMITS).
+       direction. A line search that finds no decrease fails the iteration (it never takes a
+       step that raises the potential). Converged when |f| <= newton_tolerance * max(|load|,
+       |reactions|) at the returned state (|f| over the free components; the load: gravity
+       and external forces on them; the reactions: the total force on the held components,
+       i.e. fixed and driven frames and held axes; under pure displacement control the
+       reactions are the scale), or when |f| is below the round-off floor (64 eps times the
+       size of the partial forces it sums, plus K times one ulp of the displacements) and a
+       further Newton iteration no longer halves it (below the floor the 2-norm does not
+       tell how far the soft modes are: a slender steel beam in float has a floor above its
+       load). frm_stats.residual is |f| over that scale (residual_force: |f| itself).
+       Continuation: the solve first tries the whole load (gravity and external loads
+       scaled by lambda, driven frames moved lambda of the way from their starting poses,
+       along the rotation for orientations) in one increment; an increment whose Newton run
+       fails (cap, no decrease, an increment whose residual has not halved in 15
+       iterations: FRM_ERR_STALLED, a non-finite or inverted trial, a sample newly
+       inverted) restarts from its starting state at a quarter of its size
+       (frm_stats.increment_cuts), an increment that converged in 6 Newton iterations or
+       fewer doubles the next; intermediate increments converge to 1e-3 (or
+       newton_tolerance if tighter), the last one to newton_tolerance. The solve gives up
+       (the last attempt's code, state kept) below min_increment (default 1e-4 of the
+       load) or after max_increments attempts (default 64). A CG solve at its cap fails at
+       once (smaller increments do not help it). Acceptance before success: the residual
+       test above, every value finite, no sample newly inverted (allow_inversion), the
+       precision check; frm_stats.negative_curvature counts the CG solves that met
+       non-positive curvature (each then redone with K+, below). Held axes' values (and
+       the rest of the state) are the starting point: they are not continued.
        static_regularization (default 1e-10; 1e-6 at least in the positive-definite
        attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
        only: the forces and the equilibrium are unchanged. Keep it small: a slender beam's
        softest bending mode sits near 1e-7 of the diagonal, and 1e-6 made Newton linear.
-       Implicit Euler (eq. 3.64) with Rayleigh damping, one linearisation per step:
+       Implicit Euler (eq. 3.64) with Rayleigh damping D = alpha M + beta K, by default as
+       the minimisation of the step's incremental potential over the step's displacement
+       dq (translation, rotation vector from the start orientation), v = dq / dt:
+           Psi(dq) = 1/2 |dq - dt v_t|_M^2 + dt/2 dq^T D dq + dt^2 (W + V_g - f_ext . dq),
+       whose stationarity is M (v - v_t) = dt (f - D v). Newton iterations
+           (M (1 + dt alpha) + (dt^2 + dt beta) K) delta_v = r,   r = dt f - M (v - v_t) - dt D v,
+       each followed by a backtracking Armijo line search on Psi (the damping's K frozen at
+       the iteration's linearisation), until |r| <= newton_tolerance * max(|r_0|, dt
+       |load|, dt |reactions|), r_0 the residual at the step's start (frm_stats.residual
+       is the ratio), at most newton_max_iterations (else FRM_ERR_NO_CONVERGENCE, state
+       kept). So a step lowers its own objective at any dt, E and nu (measured: one step of
+       1e3 s from rest lands on the static solution to 1e-4 with a soft beam sagging 19 %
+       of its length; the single linearisation lands 2.9 % off). The first iteration is
+       exactly the linearised step below. M is taken at the step's start. Driven frames
+       are put at their targets before the first iteration; velocities are dq / dt (q =
+       exp(dt omega) q_t renormalised: |q| = 1 to round-off for ever). If CG meets
+       non-positive curvature (M + dt^2 K indefinite: a large dt on a stressed body), the
+       iteration is solved again with K's positive-definite part, with which the system is
+       positive definite at any dt. Cost: usually 2 to 3 linear solves a step where the
+       linearised step makes one (tests/test_frames.c's R3: 2.9 times the time).
+       implicit_linearized = 1: the thesis's single linearisation per step,
            (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
-       then v += dv, x += dt v, q = exp(dt omega) q renormalised (|q| = 1 to round-off for
-       ever). Fixed frames do not move, driven frames reach their targets in the step and
-       enter the right-hand side through K. The CG starts from the previous step's dv. If
-       CG meets non-positive curvature (M + dt^2 K indefinite: large dt on a stressed
-       body), the step is linearised again with K's positive-definite part, with which the
-       system is positive definite at any dt (the scheme stays implicit Euler with an
-       approximate Jacobian: same equilibria, stable).
+       then v += dv, x += dt v; driven frames reach their targets in the step and enter the
+       right-hand side through K; the CG starts from the previous step's dv. Stable at any
+       dt (with the positive-definite fallback) but accurate only while a step changes K
+       little: under large deformation per step (soft bodies, large dt, nu near 0.5) its
+       result is not the implicit Euler step (2.9 % off the static answer above at dt =
+       1e3 s) and nothing reports it.
+       Held axes (frm_model_set_frame_axes): the held components are projected out of every
+       linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
+       line search and the step update; their velocity is zero; their forces count as
+       reactions in the residual's scale.
+       One CG policy: a linear solve stopped at cg_max_iterations above its tolerance fails
+       the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
+       far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
        K's positive-definite part K+: the material term (positive for SVK; Neo-Hookean with
        2 (mu - lambda ln J) kept >= 0), the geometric term dF S with the positive part of
        S, each frame's own rotational term (its pairs' derivative of B through the frame's
@@ -339,8 +391,9 @@
          the stabilisation does not see it (stabilising every hexahedral frame's rotation
          makes bending 30 % too stiff). Small deformations on two or more cells across
          solve well (R1, R3); one cell across, or large deformation (R2), the mode buckles
-         and the static solve stops with FRM_ERR_STALLED (0.2-0.5 s on the bench's beams)
-         rather than running to the cap. Use tetrahedral or meshless frames there, or
+         and the static solve ends in an error code (FRM_ERR_STALLED or
+         FRM_ERR_NO_CONVERGENCE once the load continuation has cut its increments to
+         min_increment: several seconds on the bench's beams), never in a wrong success. Use tetrahedral or meshless frames there, or
          frame_coupling = 1e-2 (which makes coarse, elongated cells stiffer in bending: R1
          at 25 x 5 x 5 becomes 31 % too stiff). Implicit steps stay stable at any time step
          (the positive-definite fallback), the mode then moves dynamically.
@@ -366,8 +419,17 @@
          and taken at the start of each step; gyroscopic terms are neglected.
        - Constant external torques have no potential: with them the static Newton's
          symmetric Jacobian converges linearly, not quadratically.
-       - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m; at
-         1e6 m a mesh of centimetres degenerates, FRM_ERR_SHAPE_DEGENERATE); steel-like
+       - Precision far from rest. The state is kept as displacements u from the rest
+         pose, so a body at rest far from the origin is exact, but once it has moved far
+         (u of 1e6 m in float: ghost forces 16-29 times a 1 % stretch's) the rounding of u
+         fakes strains. A step or solve that starts or would end with eps(frm_real) max|u|
+         > precision_limit h_min (default 1e-4; h_min the smallest sample's support, its
+         largest rest lever) fails with FRM_ERR_PRECISION and keeps the state: in float
+         with h_min = 0.1 m that is |u| above about 84 m, in double 4e10 m. Move the rest
+         pose with the body (re-create it) for long travels in float; 0 disables the
+         check. There is no per-body origin. Rest positions far from the origin carry
+         float's rounding at creation (1e6 m: a mesh of centimetres degenerates,
+         FRM_ERR_SHAPE_DEGENERATE); steel-like
          stiffness needs the round-off floor to stop Newton, which it does only once
          Newton no longer halves the residual (R1 float +0.16 %).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
@@ -377,7 +439,17 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
-       unreleased: rotation stabilisation for frames with collinear samples (default on:
+       unreleased (issue 18): static solve with load continuation (max_increments,
+             min_increment), a line search that never climbs and an acceptance test
+             (residual against max(|load|, |reactions|), allow_inversion,
+             precision_limit / FRM_ERR_PRECISION); implicit Euler by Newton on the
+             incremental potential (implicit_linearized = 1 keeps the single
+             linearisation); frm_model_set_frame_axes / frm_model_frame_axes; CG fails
+             at its cap and on a non-finite |b|^2 (cg_fail_at_cap removed); frm_stats in
+             the common layout (line_search_halvings -> line_search_cuts, residual
+             relative, residual_force, increments, increment_cuts, negative_curvature,
+             inverted).
+       earlier, unreleased: rotation stabilisation for frames with collinear samples (default on:
              changes tetrahedral one-sample models); static and implicit solvers fall back
              to K's positive-definite part on indefinite linearisations; static line search
              judged by the residual below the energy's round-off; the round-off floor stops
@@ -851,17 +923,20 @@ FRMDEF int frm_model_set_stiffness_mode(frm_model *m, frm_stiffness_mode mode);
 
 /* ---- simulation ---- */
 
-/* One implicit Euler step (eq. 3.64, one linearisation) of the description's time step. */
+/* One implicit Euler step (eq. 3.64) of the description's time step (see frm_model_step_ex). */
 FRMDEF int frm_model_step(frm_model *m);
-/* One implicit Euler step of dt seconds:
+/* One implicit Euler step of dt seconds: Newton iterations with a line search on the
+   step's incremental potential to newton_tolerance (or, with implicit_linearized, the
+   single linearisation
        (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
-   v += dv, x += dt v, q = exp(dt omega) q (renormalised). On failure (not finite, CG not
-   converged with cg_fail_at_cap, inverted sample) the state is unchanged. */
+   v += dv, x += dt v), q = exp(dt omega) q (renormalised); see SOLVERS. On failure (not
+   finite, not converged, a CG solve at its cap, a sample newly inverted, precision) the
+   state is unchanged. */
 FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
 /* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
-   the total potential energy, each solved by block-Jacobi CG; velocities are set to zero.
-   Driven frames are first put at their prescribed poses. On failure (newton cap reached,
-   not finite) the state is unchanged. */
+   the total potential energy, each solved by block-Jacobi CG, inside an adaptive load
+   continuation (see SOLVERS); velocities are set to zero. Driven frames end at their
+   prescribed poses. On failure (see ERRORS) the state is unchanged. */
 FRMDEF int frm_model_solve_static(frm_model *m);
 /* One Newton iteration of the static solve (for watching it converge). *residual (may be
    NULL) receives |f| over the free frames after the iteration. Velocities set to zero. */
