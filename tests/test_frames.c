@@ -3051,6 +3051,47 @@ static void test_i18_stress_sweep(void)
            ok_runs, worst, errors);
 }
 
+/* The new solver settings are validated at creation (FRM_ERR_SOLVER), and held axes take
+   only masks of three bits on free frames; fixing, driving or releasing clears them. */
+static void test_i18_settings_validation(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    scene sc;
+    frm_desc d;
+    frm_real p[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1};
+    REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 1, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    d = sc.d;
+    d.max_increments = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.min_increment = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d.min_increment = (frm_real)1.5;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.precision_limit = -1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.implicit_linearized = 2;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.allow_inversion = -1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 8, 0));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 0, 9));
+    CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_set_frame_axes(sc.m, 99, 1, 0));
+    CHECK_INT(FRM_OK, frm_model_set_frame_axes(sc.m, 0, 5, 2));
+    CHECK_INT(5 | 2 << 3, frm_model_frame_axes(sc.m, 0));
+    CHECK_INT(FRM_OK, frm_model_fix_frame(sc.m, 0));
+    CHECK_INT(0, frm_model_frame_axes(sc.m, 0));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 1, 0)); /* fixed */
+    CHECK_INT(FRM_OK, frm_model_release_frame(sc.m, 0));
+    CHECK_INT(FRM_OK, frm_model_set_frame_axes(sc.m, 0, 1, 0));
+    CHECK_INT(FRM_OK, frm_model_drive_frame(sc.m, 0, p, q));
+    CHECK_INT(0, frm_model_frame_axes(sc.m, 0));
+    scene_free(&sc);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -3086,6 +3127,7 @@ static const test_case cases[] = {
     TEST(test_i18_far_from_origin),
     TEST(test_i18_implicit_large_step),
     TEST(test_i18_stress_sweep),
+    TEST(test_i18_settings_validation),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
