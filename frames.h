@@ -4147,13 +4147,16 @@ static int frm__implicit_newton(frm_model *m, double dt)
     frm__apply_driven(m);
     for (it = 0;; it++) {
         double W0, slope, noise, eMd, qMd, dMd, qKd, dKd, eta;
-        int h, accepted = 0;
+        int h, accepted = 0, cheap = it > 0 && beta_d == 0;
         for (attempt = 0;; attempt++) {
-            err = frm__linearize(m, &W0, attempt);
+            /* without stiffness damping the residual needs no K: a plain force pass tells
+               whether the step has converged before paying for a linearisation */
+            err = cheap ? frm__force_pass(m, 0, 0, &W0) : frm__linearize(m, &W0, attempt);
             if (err) return err;
             frm__total_force(m, f);
             frm__step_displacement(m, dq);
-            frm__stiffness_product(m, dq, kq, 0);
+            if (beta_d != 0) frm__stiffness_product(m, dq, kq, 0);
+            else memset(kq, 0, sizeof(frm_real) * (size_t)n6);
             /* r = dt f - M (v - v_t) - dt D v, with dq = dt v */
             for (i = 0; i < m->frame_count; i++) {
                 double mq[6], mv[6];
@@ -4178,6 +4181,11 @@ static int frm__implicit_newton(frm_model *m, double dt)
                 break;
             }
             if (attempt == 0 && it == m->newton_max_iterations) break;
+            if (cheap) {
+                cheap = 0;
+                err = frm__linearize(m, &W0, 0);
+                if (err) return err;
+            }
             frm__build_precond(m, a_mass, a_stiff);
             eta = it == 0 ? (double)m->cg_tolerance : 1e-3 * (norm / previous) * (norm / previous);
             if (eta < 0.1 * (double)m->newton_tolerance * ref / norm) eta = 0.1 * (double)m->newton_tolerance * ref / norm;
@@ -4200,8 +4208,13 @@ static int frm__implicit_newton(frm_model *m, double dt)
         previous = norm;
         /* the Newton step delta = dt dv; Psi along it (the damping's K frozen at this iteration) */
         for (k = 0; k < n6; k++) dv[k] = (frm_real)(dt * (double)dv[k]);
-        frm__stiffness_product(m, dq, kq, 0);
-        frm__stiffness_product(m, dv, kd, 0);
+        if (beta_d != 0) {
+            frm__stiffness_product(m, dq, kq, 0);
+            frm__stiffness_product(m, dv, kd, 0);
+        } else {
+            memset(kq, 0, sizeof(frm_real) * (size_t)n6);
+            memset(kd, 0, sizeof(frm_real) * (size_t)n6);
+        }
         eMd = qMd = dMd = 0;
         for (i = 0; i < m->frame_count; i++) {
             double md[6];
