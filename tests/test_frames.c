@@ -2721,7 +2721,8 @@ static int cube_uniaxial(frm_law law, double E, double nu, double s0, int max_in
    or 0.75 to 1.5: every solve converges to the stretch its load came from (displacement
    control of the same model), and that stress against the closed form R4 / R5 at the
    computed stretch is printed (the 2-cell discretisation's error). Printed too: how many
-   the single increment (the solver before the continuation) fails. */
+   of the s = 0.9 cases a single increment fails (measured: none; the stalls came from the
+   former line search and stall rule). */
 static void test_i18_cube_uniaxial_load(void)
 {
     static const double stretches[7] = {0.7, 0.75, 0.8, 0.9, 1.1, 1.25, 1.5};
@@ -2745,7 +2746,8 @@ static void test_i18_cube_uniaxial_load(void)
                 if (rel > worst) worst = rel;
                 if (closed > worst_closed) worst_closed = closed;
                 CHECK(rel < (IS_FLOAT ? 1e-3 : 1e-5));
-                single_failed += cube_uniaxial((frm_law)law, E, nus[j], target, 1, &s, &P) != FRM_OK;
+                if (k == 3) /* one case per law and nu: the single increment (the solver before the continuation) */
+                    single_failed += cube_uniaxial((frm_law)law, E, nus[j], target, 1, &s, &P) != FRM_OK;
                 cases++;
             }
     printf("    %d load cases converged, worst |s - s0| / |s0 - 1| %.2e (closed form R4/R5 at s: %.1f %%, the 2-cell "
@@ -2993,10 +2995,10 @@ static void test_i18_implicit_large_step(void)
    tolerance: never success with a wrong answer. */
 static void test_i18_stress_sweep(void)
 {
-    static const double youngs[4] = {1, 1e4, 1e8, 2e11}, nus[3] = {0, 0.3, 0.4999}, steps[3] = {1e-6, 1e-2, 1};
+    static const double youngs[3] = {1, 1e6, 2e11}, nus[3] = {0, 0.3, 0.4999}, steps[3] = {1e-6, 1e-2, 1};
     int e, j, mode, fine, runs = 0, ok_runs = 0, errors = 0;
     double worst = 0;
-    for (e = 0; e < 4; e++)
+    for (e = 0; e < 3; e++)
         for (j = 0; j < 3; j++)
             for (mode = 0; mode < 5; mode += TEST_IS_QUICK ? 2 : 1) {
                 double result[2] = {0, 0}, scale = 0;
