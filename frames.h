@@ -506,6 +506,8 @@ typedef FRM_REAL frm_real;
 #define frm_shape_hex frm_shape_hex_f32
 #define frm_shape_shepard frm_shape_shepard_f32
 #define frm_shape_mls frm_shape_mls_f32
+#define frm_model_set_frame_axes frm_model_set_frame_axes_f32
+#define frm_model_frame_axes frm_model_frame_axes_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
