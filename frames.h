@@ -86,8 +86,9 @@
           material (or a per-sample table), gravity, time step, solver settings.
        3. frm_model_create(&d, &m) validates everything and allocates all memory once.
        4. Boundary conditions and loads: frm_model_fix_frame, frm_model_drive_frame (a
-          prescribed pose), frm_model_release_frame, frm_model_set_external (force and
-          torque), frm_model_set_gravity.
+          prescribed pose), frm_model_release_frame, frm_model_set_frame_axes (some
+          translation and rotation axes held: symmetry planes, rollers, plane strain),
+          frm_model_set_external (force and torque), frm_model_set_gravity.
        5. frm_model_step (implicit Euler) or frm_model_solve_static (Newton), or
           frm_model_newton_step to watch a solve; frm_model_last_stats for iterations.
        6. Read frm_model_positions / _orientations / _velocities, and
@@ -124,12 +125,17 @@
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
-   A step or solve that would end non-finite (FRM_ERR_NOT_FINITE), with an inverted or
-   mirrored sample (FRM_ERR_INVERTED: det F <= 0, Neo-Hookean and St Venant-Kirchhoff alike;
-   frm_model_forces and _energy refuse such a state too), without convergence (FRM_ERR_NO_CONVERGENCE) or,
-   for a static solve, stalled (FRM_ERR_STALLED: the residual has not halved in 10 Newton
-   iterations or rose in 3 in a row, see LIMITS) leaves positions, orientations and velocities exactly as they
-   were.
+   A step or solve never reports success with an unconverged or unchecked result: one that
+   meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
+   FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
+   its start (FRM_ERR_INVERTED: det F <= 0, Neo-Hookean and St Venant-Kirchhoff alike;
+   frm_model_forces and _energy refuse such a state too), does not converge (FRM_ERR_NO_CONVERGENCE: a Newton run at its
+   cap, a CG solve at cg_max_iterations above its tolerance, a line search that finds no
+   decrease, a continuation cut below min_increment or past max_increments; FRM_ERR_STALLED
+   when its last increment stopped because the residual had not halved in 15 Newton
+   iterations, see LIMITS), or starts or ends with a state too far from rest for frm_real
+   (FRM_ERR_PRECISION: eps(frm_real) max|u| > precision_limit h_min, see LIMITS) leaves
+   positions, orientations and velocities exactly as they were.
 
    THREADING AND DETERMINISM: no global state; one model may be used by one thread at a
    time, different models by different threads. The per-sample and per-frame passes run
@@ -283,26 +289,71 @@
        whose samples hang above them): when CG meets non-positive curvature, or its step
        is not a descent direction, the iteration is solved again with K's positive-definite
        part (below; frm_stats.definite_solves counts them), which always gives a descent
-       direction. Converged when |f| <= newton_tolerance |load|, or when |f| is below the
-       round-off floor (64 eps times the size of the partial forces it sums, plus K times
-       one ulp of the displacements) and a further Newton iteration no longer halves it
-       (below the floor the 2-norm does not tell how far the soft modes are: a slender
-       steel beam in float has a floor above its load). A solve whose residual has not
-       halved in 10 iterations, or rose in 3 in a row, stops with FRM_ERR_STALLED
-       (mechanisms, see LIMITS).
+       direction. A line search that finds no decrease fails the iteration (it never takes a
+       step that raises the potential). Converged when |f| <= newton_tolerance * max(|load|,
+       |reactions|) at the returned state (|f| over the free components; the load: gravity
+       and external forces on them; the reactions: the total force on the held components,
+       i.e. fixed and driven frames and held axes; under pure displacement control the
+       reactions are the scale), or when |f| is below the round-off floor (64 eps times the
+       size of the partial forces it sums, plus K times one ulp of the displacements) and a
+       further Newton iteration no longer halves it (below the floor the 2-norm does not
+       tell how far the soft modes are: a slender steel beam in float has a floor above its
+       load). frm_stats.residual is |f| over that scale (residual_force: |f| itself).
+       Continuation: the solve first tries the whole load (gravity and external loads
+       scaled by lambda, driven frames moved lambda of the way from their starting poses,
+       along the rotation for orientations) in one increment; an increment whose Newton run
+       fails (cap, no decrease, an increment whose residual has not halved in 15
+       iterations: FRM_ERR_STALLED, a non-finite or inverted trial, a sample newly
+       inverted) restarts from its starting state at a quarter of its size
+       (frm_stats.increment_cuts), an increment that converged in 6 Newton iterations or
+       fewer doubles the next; intermediate increments converge to 1e-3 (or
+       newton_tolerance if tighter), the last one to newton_tolerance. The solve gives up
+       (the last attempt's code, state kept) below min_increment (default 1e-4 of the
+       load) or after max_increments attempts (default 64). A CG solve at its cap fails at
+       once (smaller increments do not help it). Acceptance before success: the residual
+       test above, every value finite, no sample inverted (det F <= 0: both laws refuse it), the
+       precision check; frm_stats.negative_curvature counts the CG solves that met
+       non-positive curvature (each then redone with K+, below). Held axes' values (and
+       the rest of the state) are the starting point: they are not continued.
        static_regularization (default 1e-10; 1e-6 at least in the positive-definite
        attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
        only: the forces and the equilibrium are unchanged. Keep it small: a slender beam's
        softest bending mode sits near 1e-7 of the diagonal, and 1e-6 made Newton linear.
-       Implicit Euler (eq. 3.64) with Rayleigh damping, one linearisation per step:
+       Implicit Euler (eq. 3.64) with Rayleigh damping D = alpha M + beta K, by default as
+       the minimisation of the step's incremental potential over the step's displacement
+       dq (translation, rotation vector from the start orientation), v = dq / dt:
+           Psi(dq) = 1/2 |dq - dt v_t|_M^2 + dt/2 dq^T D dq + dt^2 (W + V_g - f_ext . dq),
+       whose stationarity is M (v - v_t) = dt (f - D v). Newton iterations
+           (M (1 + dt alpha) + (dt^2 + dt beta) K) delta_v = r,   r = dt f - M (v - v_t) - dt D v,
+       each followed by a backtracking Armijo line search on Psi (the damping's K frozen at
+       the iteration's linearisation), until |r| <= newton_tolerance * max(|r_0|, dt
+       |load|, dt |reactions|), r_0 the residual at the step's start (frm_stats.residual
+       is the ratio), at most newton_max_iterations (else FRM_ERR_NO_CONVERGENCE, state
+       kept). So a step lowers its own objective at any dt, E and nu (measured: one step of
+       1e3 s from rest lands on the static solution to 1e-4 with a soft beam sagging 19 %
+       of its length; the single linearisation lands 2.9 % off). The first iteration is
+       exactly the linearised step below. M is taken at the step's start. Driven frames
+       are put at their targets before the first iteration; velocities are dq / dt (q =
+       exp(dt omega) q_t renormalised: |q| = 1 to round-off for ever). If CG meets
+       non-positive curvature (M + dt^2 K indefinite: a large dt on a stressed body), the
+       iteration is solved again with K's positive-definite part, with which the system is
+       positive definite at any dt. Cost: usually 2 to 3 linear solves a step where the
+       linearised step makes one (tests/test_frames.c's R3: 2.9 times the time).
+       implicit_linearized = 1: the thesis's single linearisation per step,
            (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
-       then v += dv, x += dt v, q = exp(dt omega) q renormalised (|q| = 1 to round-off for
-       ever). Fixed frames do not move, driven frames reach their targets in the step and
-       enter the right-hand side through K. The CG starts from the previous step's dv. If
-       CG meets non-positive curvature (M + dt^2 K indefinite: large dt on a stressed
-       body), the step is linearised again with K's positive-definite part, with which the
-       system is positive definite at any dt (the scheme stays implicit Euler with an
-       approximate Jacobian: same equilibria, stable).
+       then v += dv, x += dt v; driven frames reach their targets in the step and enter the
+       right-hand side through K; the CG starts from the previous step's dv. Stable at any
+       dt (with the positive-definite fallback) but accurate only while a step changes K
+       little: under large deformation per step (soft bodies, large dt, nu near 0.5) its
+       result is not the implicit Euler step (2.9 % off the static answer above at dt =
+       1e3 s) and nothing reports it.
+       Held axes (frm_model_set_frame_axes): the held components are projected out of every
+       linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
+       line search and the step update; their velocity is zero; their forces count as
+       reactions in the residual's scale.
+       One CG policy: a linear solve stopped at cg_max_iterations above its tolerance fails
+       the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
+       far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
        K's positive-definite part K+: the material term (positive for SVK; Neo-Hookean with
        2 (mu - lambda ln J) kept >= 0), the geometric term dF S with the positive part of
        S, each frame's own rotational term (its pairs' derivative of B through the frame's
@@ -413,8 +464,9 @@
          cells across); at coarse resolution the divergence term stiffens the tetrahedral
          frames' torsion (R3 at two cells across: 4.85 Hz against 4.44 Hz without it, 3D
          4.51 Hz; of order h^2). With rotation_divergence = 0 (the thesis's model) static
-         solves of hexahedral frames one cell across or in large deformation stop with
-         FRM_ERR_STALLED (0.2-0.5 s on the bench's beams). Shepard samples (zero order)
+         solves of hexahedral frames one cell across or in large deformation end in an
+         error code (FRM_ERR_STALLED, or FRM_ERR_NO_CONVERGENCE once the load continuation
+         has cut its increments to min_increment), never in a wrong success. Shepard samples (zero order)
          carry no divergence term (see MODEL).
          The stabilisation costs: on every sample with linear weights its force pass
          carries the term (measured +70 % on the hexahedral R1 beam, +26 % on tetrahedra)
@@ -446,8 +498,17 @@
          and taken at the start of each step; gyroscopic terms are neglected.
        - Constant external torques have no potential: with them the static Newton's
          symmetric Jacobian converges linearly, not quadratically.
-       - Float: positions far from the origin carry float's rounding (2e3 m: 1e-4 m; at
-         1e6 m a mesh of centimetres degenerates, FRM_ERR_SHAPE_DEGENERATE); steel-like
+       - Precision far from rest. The state is kept as displacements u from the rest
+         pose, so a body at rest far from the origin is exact, but once it has moved far
+         (u of 1e6 m in float: ghost forces 16-29 times a 1 % stretch's) the rounding of u
+         fakes strains. A step or solve that starts or would end with eps(frm_real) max|u|
+         > precision_limit h_min (default 1e-4; h_min the smallest sample's support, its
+         largest rest lever) fails with FRM_ERR_PRECISION and keeps the state: in float
+         with h_min = 0.1 m that is |u| above about 84 m, in double 4e10 m. Move the rest
+         pose with the body (re-create it) for long travels in float; 0 disables the
+         check. There is no per-body origin. Rest positions far from the origin carry
+         float's rounding at creation (1e6 m: a mesh of centimetres degenerates,
+         FRM_ERR_SHAPE_DEGENERATE); steel-like
          stiffness needs the round-off floor to stop Newton, which it does only once
          Newton no longer halves the residual (R1 float +0.17 %).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
@@ -466,7 +527,17 @@
              them from their default functions); shape functions refuse non-finite input and
              Shepard exponents <= 1, samplings frame_spacing < sample_spacing; every entry
              point renamed in float builds.
-       earlier unreleased: rotation stabilisation for frames with collinear samples (default on:
+       unreleased (issue 18): static solve with load continuation (max_increments,
+             min_increment), a line search that never climbs and an acceptance test
+             (residual against max(|load|, |reactions|), no inverted sample,
+             precision_limit / FRM_ERR_PRECISION); implicit Euler by Newton on the
+             incremental potential (implicit_linearized = 1 keeps the single
+             linearisation); frm_model_set_frame_axes / frm_model_frame_axes; CG fails
+             at its cap and on a non-finite |b|^2 (cg_fail_at_cap removed); frm_stats in
+             the common layout (line_search_halvings -> line_search_cuts, residual
+             relative, residual_force, increments, increment_cuts, negative_curvature,
+             inverted).
+       earlier, unreleased: rotation stabilisation for frames with collinear samples (default on:
              changes tetrahedral one-sample models); static and implicit solvers fall back
              to K's positive-definite part on indefinite linearisations; static line search
              judged by the residual below the energy's round-off; the round-off floor stops
@@ -566,6 +637,8 @@ typedef FRM_REAL frm_real;
 #define frm_model_assemble_stiffness frm_model_assemble_stiffness_f32
 #define frm_model_stiffness_blocks frm_model_stiffness_blocks_f32
 #define frm_model_stiffness_block frm_model_stiffness_block_f32
+#define frm_model_set_frame_axes frm_model_set_frame_axes_f32
+#define frm_model_frame_axes frm_model_frame_axes_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
@@ -616,20 +689,21 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_STIFFNESS_MODE, -24, "unknown stiffness mode, or assembled blocks requested from a matrix-free model") \
     X(FRM_ERR_NOT_FINITE, -25, "result not finite; the last valid state was kept") \
     X(FRM_ERR_NO_CONVERGENCE, -26, "solver did not converge; the last valid state was kept") \
-    X(FRM_ERR_INVERTED, -27, "a sample would invert or mirror (det F <= 0; Neo-Hookean and St Venant-Kirchhoff); the last valid state was kept") \
+    X(FRM_ERR_INVERTED, -27, "a step or solve would leave a sample inverted or mirrored (det F <= 0; both laws are undefined there); the last valid state was kept") \
     X(FRM_ERR_FRAME_RANGE, -28, "frame index out of range") \
     X(FRM_ERR_NOT_NEIGHBORS, -29, "the two frames share no sample (no stiffness block between them)") \
     X(FRM_ERR_SHAPE_DEGENERATE, -30, "shape function undefined: flat or inverted element, coincident or coplanar frames") \
     X(FRM_ERR_INDEX_RANGE, -31, "element or triangle node index out of range") \
     X(FRM_ERR_SAMPLING, -32, "sampling settings invalid (spacing, Gauss order, support) or too many points") \
     X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume") \
-    X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept")
+    X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept") \
+    X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -35
+    FRM_ERR_LAST_ = -36
 };
 
 /* Constitutive laws (per sample). Both are written in terms of the Green-Lagrange strain
@@ -740,14 +814,26 @@ typedef struct frm_desc {
 
     /* solvers */
     frm_real cg_tolerance;     /* relative residual of each CG solve, default 1e-6 (1e-4 float) */
-    int cg_max_iterations;     /* default 1000 */
-    int cg_fail_at_cap;        /* 1 (default): a CG solve stopped by cg_max_iterations above
-                                  the tolerance fails the implicit step (state kept); 0: the
-                                  step goes on with the iterate reached (fixed real-time cost,
-                                  as the thesis's 50 iterations per step) */
-    frm_real newton_tolerance; /* static solve: |residual| <= tol * |load|, default 1e-6
-                                  (1e-4 float) */
-    int newton_max_iterations; /* default 30 */
+    int cg_max_iterations;     /* default 1000; a CG solve stopped by it above its tolerance
+                                  fails the step or solve (FRM_ERR_NO_CONVERGENCE, state kept):
+                                  an unconverged solve never reports success */
+    frm_real newton_tolerance; /* static solve: |residual| <= tol * max(|load|, |reactions|);
+                                  implicit step: |residual| <= tol * its scale (see SOLVERS);
+                                  default 1e-6 (1e-4 float) */
+    int newton_max_iterations; /* Newton iterations per static increment or implicit step,
+                                  default 30 */
+    int implicit_linearized;   /* 0 (default): implicit Euler minimises the step's incremental
+                                  potential by Newton iterations with a line search; 1: one
+                                  linearised iteration per step (the thesis's eq. 3.64; cheaper,
+                                  accurate only while the step moves little, see SOLVERS) */
+    int max_increments;        /* static solve: load increments at most (continuation), default 64 */
+    frm_real min_increment;    /* static solve: smallest load fraction of an increment before the
+                                  solve gives up, default 1e-4 */
+    frm_real precision_limit;  /* dimensionless, default 1e-4: a step or solve fails with
+                                  FRM_ERR_PRECISION when eps(frm_real) max|u| > precision_limit
+                                  h_min (u the frames' displacement from rest, h_min the
+                                  smallest rest lever between a sample and its frames): the
+                                  rounding of the state would fake strains above it; 0 disables */
     frm_real static_regularization; /* static solves add this times |K_ii| to each frame's
                                        rotational diagonal inside CG (not to the forces: the
                                        equilibrium is unchanged), default 1e-10 (at least 1e-6
@@ -769,20 +855,33 @@ typedef struct frm_desc {
     unsigned int internal_cookie; /* set by frm_model_default_desc; do not touch */
 } frm_desc;
 
-/* Statistics of the last step or static solve (frm_model_last_stats). */
+/* Statistics of the last step or static solve (frm_model_last_stats). The first eleven
+   fields are common to the three headers (same names, meanings and order). */
 typedef struct frm_stats {
-    int newton_iterations;     /* static solve: Newton iterations; implicit step: 1 */
-    int cg_iterations;         /* CG iterations, summed over the Newton iterations */
-    int cg_iterations_last;    /* CG iterations of the last linear solve */
+    int newton_iterations;     /* Newton iterations, summed over increments (1 for a linearised
+                                  implicit step) */
+    int cg_iterations;         /* CG iterations, summed */
     frm_real cg_residual;      /* relative residual |r| / |b| of the last linear solve */
-    frm_real residual;         /* static solve: final |f| over the free frames (N and N m) */
+    frm_real residual;         /* final nonlinear residual over its reference scale (static
+                                  solve: |f| / max(|load|, |reactions|); Newton implicit step:
+                                  see SOLVERS); 0 where there is none */
+    int increments;            /* static solve: continuation increments accepted (1: the whole
+                                  load at once) */
+    int increment_cuts;        /* static solve: increments cut back after a failed attempt */
+    int line_search_cuts;      /* line-search step reductions, summed */
+    int negative_curvature;    /* linear solves that met a direction of non-positive curvature */
+    int inverted;              /* samples with det F <= 0 at the end (0 on success: both laws
+                                  refuse det F <= 0, no allow_inversion option in frames) */
+    int force_evaluations;     /* force passes */
+    int stiffness_products;    /* K * v products */
+    /* frames' own */
+    int cg_iterations_last;    /* CG iterations of the last linear solve */
+    frm_real residual_force;   /* the final residual itself, |f| over the free components (N and
+                                  N m; implicit: N s) */
     frm_real initial_residual; /* static solve: |f| before the first iteration */
-    int line_search_halvings;  /* static solve: step halvings, summed */
     int definite_solves;       /* linear solves redone with the positive-definite part of K because the
                                   linearisation was indefinite (see SOLVERS) */
     int stiffness_mode;        /* FRM_STIFFNESS_PAIRS or FRM_STIFFNESS_BLOCKS (last linearisation) */
-    int force_evaluations;     /* force passes in the step */
-    int stiffness_products;    /* K * v products in the step */
 } frm_stats;
 
 /* Energies of the current state (frm_model_energy), J. */
@@ -935,8 +1034,19 @@ FRMDEF int frm_model_fix_frame(frm_model *m, int i);
    with it there. The pose stays prescribed until frm_model_release_frame. */
 FRMDEF int frm_model_drive_frame(frm_model *m, int i, const frm_real position[3],
                                  const frm_real orientation[4]);
-/* Frees a fixed or driven frame. */
+/* Frees a fixed or driven frame (and its held axes). */
 FRMDEF int frm_model_release_frame(frm_model *m, int i);
+/* Holds some components of a free frame at their current values: bit k (k = 0, 1, 2 for
+   x, y, z, world axes) of translation_axes holds the position's component k, bit k of
+   rotation_axes the rotation about world axis k (symmetry planes: the normal translation
+   and the two in-plane rotations; rollers; plane strain). The static solve, the implicit
+   step and CG project those components out (their velocity is zero). 0, 0 frees them;
+   fixing, driving or releasing the frame clears them. FRM_ERR_ARG for masks above 7 or a
+   fixed or driven frame. */
+FRMDEF int frm_model_set_frame_axes(frm_model *m, int i, unsigned translation_axes, unsigned rotation_axes);
+/* The held axes of frame i: translation mask | rotation mask << 3 (0 for none), < 0 on
+   error. */
+FRMDEF int frm_model_frame_axes(const frm_model *m, int i);
 /* 0 free, 1 fixed, 2 driven, < 0 error. */
 FRMDEF int frm_model_frame_state(const frm_model *m, int i);
 /* Constant external force (N) and torque (N m, about the frame's origin), world axes, on
@@ -955,17 +1065,20 @@ FRMDEF int frm_model_set_stiffness_mode(frm_model *m, frm_stiffness_mode mode);
 
 /* ---- simulation ---- */
 
-/* One implicit Euler step (eq. 3.64, one linearisation) of the description's time step. */
+/* One implicit Euler step (eq. 3.64) of the description's time step (see frm_model_step_ex). */
 FRMDEF int frm_model_step(frm_model *m);
-/* One implicit Euler step of dt seconds:
+/* One implicit Euler step of dt seconds: Newton iterations with a line search on the
+   step's incremental potential to newton_tolerance (or, with implicit_linearized, the
+   single linearisation
        (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
-   v += dv, x += dt v, q = exp(dt omega) q (renormalised). On failure (not finite, CG not
-   converged with cg_fail_at_cap, inverted sample) the state is unchanged. */
+   v += dv, x += dt v), q = exp(dt omega) q (renormalised); see SOLVERS. On failure (not
+   finite, not converged, a CG solve at its cap, a sample newly inverted, precision) the
+   state is unchanged. */
 FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
 /* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
-   the total potential energy, each solved by block-Jacobi CG; velocities are set to zero.
-   Driven frames are first put at their prescribed poses. On failure (newton cap reached,
-   not finite) the state is unchanged. */
+   the total potential energy, each solved by block-Jacobi CG, inside an adaptive load
+   continuation (see SOLVERS); velocities are set to zero. Driven frames end at their
+   prescribed poses. On failure (see ERRORS) the state is unchanged. */
 FRMDEF int frm_model_solve_static(frm_model *m);
 /* One Newton iteration of the static solve (for watching it converge). *residual (may be
    NULL) receives |f| over the free frames after the iteration. Velocities set to zero. */
@@ -1761,7 +1874,7 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 
 struct frm_model {
     int frame_count, sample_count, pair_count, block_count, sq_total;
-    int sample_chunks, frame_chunks, parallel, has_neo_hookean;
+    int sample_chunks, frame_chunks, parallel;
     frm_allocator allocator;
     frm_parallel_for_fn parallel_for;
     void *parallel_user;
@@ -1771,7 +1884,9 @@ struct frm_model {
     /* settings */
     frm_real gravity[3], time_step, mass_damping, stiffness_damping;
     frm_real cg_tolerance, newton_tolerance;
-    int cg_max_iterations, newton_max_iterations, cg_fail_at_cap;
+    int cg_max_iterations, newton_max_iterations, implicit_linearized, max_increments;
+    double min_increment, precision_limit, h_min; /* h_min: smallest rest lever (see precision_limit) */
+    double load_scale;                            /* continuation: fraction of gravity and external loads */
     int stiffness_mode, has_blocks;
     double regularization, solve_regularization; /* static solves: eps added to K's rotational diagonal */
     frm_real stab_beta;                          /* rotation_stabilization */
@@ -1790,6 +1905,10 @@ struct frm_model {
     frm_real *mass_world;                      /* 10: m, c (3), J (6), world axes (mass_update) */
     frm_real *ext;                             /* 6: external force, torque */
     unsigned char *state;
+    unsigned char *axes;   /* 1: held components of a free frame (bits 0-2 translation, 3-5 rotation) */
+    frm_real *ext_full;    /* 6: the external loads while a static solve scales them */
+    frm_real *inc_state;   /* 13: the state at the start of a static increment */
+    frm_real *drive_start; /* 7: driven frames' poses at the start of a static solve */
     frm_real *target;      /* 7: prescribed position, orientation */
     frm_real *force;       /* 6: internal generalized force (last pass) */
     double *force_scale;   /* 1: sum over the frame's pairs of |partial force|^2 (round-off scale) */
@@ -1813,6 +1932,7 @@ struct frm_model {
     frm_real *s_stabY; /* 9: Y = sum of Z_k over the pairs of frames without unseen rotations, at the linearisation */
     frm_real *s_stabD; /* 1: D at the linearisation */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
+    unsigned char *s_inverted;     /* 1: det F <= 0 at the start of the step or solve */
     int *s_start;
     frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
     frm_real *s_pos, *s_F;               /* outputs: 3, 9 */
@@ -2087,6 +2207,10 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->mass_world, frm_real, 10 * n);
     FRM__CARVE(c, m->ext, frm_real, 6 * n);
     FRM__CARVE(c, m->state, unsigned char, n);
+    FRM__CARVE(c, m->axes, unsigned char, n);
+    FRM__CARVE(c, m->ext_full, frm_real, 6 * n);
+    FRM__CARVE(c, m->inc_state, frm_real, 13 * n);
+    FRM__CARVE(c, m->drive_start, frm_real, 7 * n);
     FRM__CARVE(c, m->target, frm_real, 7 * n);
     FRM__CARVE(c, m->force, frm_real, 6 * n);
     FRM__CARVE(c, m->force_scale, double, n);
@@ -2119,6 +2243,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     }
     FRM__CARVE(c, m->s_law, unsigned char, S);
     FRM__CARVE(c, m->s_stab, unsigned char, S);
+    FRM__CARVE(c, m->s_inverted, unsigned char, S);
     FRM__CARVE(c, m->s_start, int, S + 1);
     FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
     FRM__CARVE(c, m->lin_S, frm_real, 6 * S);
@@ -2185,7 +2310,10 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_DAMPING, "damping");
     if (!(frm__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
         !(frm__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_max_iterations < 1 ||
-        !(frm__finite((double)d->static_regularization) && d->static_regularization >= 0))
+        !(frm__finite((double)d->static_regularization) && d->static_regularization >= 0) || d->max_increments < 1 ||
+        !(frm__finite((double)d->min_increment) && d->min_increment > 0 && d->min_increment <= 1) ||
+        !(frm__finite((double)d->precision_limit) && d->precision_limit >= 0) || d->implicit_linearized < 0 ||
+        d->implicit_linearized > 1)
         return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
     if (!(frm__finite((double)d->frame_coupling) && d->frame_coupling >= 0))
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
@@ -2338,9 +2466,12 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.time_step = (frm_real)1e-2;
     d.cg_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.cg_max_iterations = 1000;
-    d.cg_fail_at_cap = 1;
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
+    d.implicit_linearized = 0;
+    d.max_increments = 64;
+    d.min_increment = (frm_real)1e-4;
+    d.precision_limit = (frm_real)1e-4;
     d.static_regularization = (frm_real)1e-10;
     d.frame_coupling = 0;
     d.rotation_stabilization = (frm_real)0.5;
@@ -2662,9 +2793,13 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->stiffness_damping = d->stiffness_damping;
     m->cg_tolerance = d->cg_tolerance;
     m->cg_max_iterations = d->cg_max_iterations;
-    m->cg_fail_at_cap = d->cg_fail_at_cap;
     m->newton_tolerance = d->newton_tolerance;
     m->newton_max_iterations = d->newton_max_iterations;
+    m->implicit_linearized = d->implicit_linearized;
+    m->max_increments = d->max_increments;
+    m->min_increment = (double)d->min_increment;
+    m->precision_limit = (double)d->precision_limit;
+    m->load_scale = 1;
     m->stiffness_mode = d->stiffness_mode;
     m->regularization = (double)d->static_regularization;
 
@@ -2703,7 +2838,6 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         m->s_mu[s] = (frm_real)(E / (2.0 * (1.0 + nu)));
         m->s_lambda[s] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
         m->s_law[s] = (unsigned char)mat->law;
-        if (mat->law == FRM_LAW_NEO_HOOKEAN) m->has_neo_hookean = 1;
     }
 
     /* pairs: lbar = Rbar^T (pbar_s - xbar_i) (eq. 3.33), in double */
@@ -2720,14 +2854,18 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             m->p_rlev[3 * p + r] = (frm_real)dx[r];
         }
     }
+    m->h_min = HUGE_VAL;
     for (s = 0; s < S; s++) { /* c = eps mu v / h^2, h^2 the mean squared lever */
-        double h2 = 0, wsum = 0;
+        double h2 = 0, wsum = 0, lmax = 0;
         for (p = m->s_start[s]; p < m->s_start[s + 1]; p++) {
             double w = fabs((double)m->p_weight[p]);
             const frm_real *l = m->p_local + 3 * p;
-            h2 += w * ((double)l[0] * l[0] + (double)l[1] * l[1] + (double)l[2] * l[2]);
+            double l2 = (double)l[0] * l[0] + (double)l[1] * l[1] + (double)l[2] * l[2];
+            h2 += w * l2;
             wsum += w;
+            if (l2 > lmax) lmax = l2;
         }
+        if (lmax > 0 && sqrt(lmax) < m->h_min) m->h_min = sqrt(lmax); /* the sample's support size */
         h2 = wsum > 0 ? h2 / wsum : 0;
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
         m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
@@ -3134,7 +3272,20 @@ static double frm__norm_free(const frm_model *m, const frm_real *v)
     int i, k;
     for (i = 0; i < m->frame_count; i++)
         if (m->state[i] == FRM__FREE)
-            for (k = 0; k < 6; k++) s[k & 3] += (double)v[6 * i + k] * v[6 * i + k];
+            for (k = 0; k < 6; k++)
+                if (!((m->axes[i] >> k) & 1)) s[k & 3] += (double)v[6 * i + k] * v[6 * i + k];
+    return sqrt((s[0] + s[1]) + (s[2] + s[3]));
+}
+
+/* Euclidean norm over the held components (fixed and driven frames, held axes): the
+   reactions when v is the total force. */
+static double frm__norm_held(const frm_model *m, const frm_real *v)
+{
+    double s[4] = {0, 0, 0, 0};
+    int i, k;
+    for (i = 0; i < m->frame_count; i++)
+        for (k = 0; k < 6; k++)
+            if (m->state[i] != FRM__FREE || ((m->axes[i] >> k) & 1)) s[k & 3] += (double)v[6 * i + k] * v[6 * i + k];
     return sqrt((s[0] + s[1]) + (s[2] + s[3]));
 }
 
@@ -3568,6 +3719,13 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
         frm__mass_matrix(m, i, M);
         for (k = 0; k < 36; k++) A[k] = a_mass * M[k] + a_stiff * (double)m->kdiag[36 * (size_t)i + k];
         for (k = 3; k < 6; k++) A[7 * k] += a_stiff * m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]);
+        if (m->axes[i]) /* held components: identity rows and columns, zeroed in the inverse below */
+            for (k = 0; k < 6; k++)
+                if ((m->axes[i] >> k) & 1) {
+                    int l;
+                    for (l = 0; l < 6; l++) A[6 * k + l] = A[6 * l + k] = 0;
+                    A[7 * k] = 1;
+                }
         if (!frm__invert6(A, inv)) {
             double V[36], ev[6], top = 0;
             int r, c;
@@ -3587,6 +3745,9 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
                 }
             fixed++;
         }
+        if (m->axes[i])
+            for (k = 0; k < 36; k++)
+                if (((m->axes[i] >> (k / 6)) & 1) || ((m->axes[i] >> (k % 6)) & 1)) inv[k] = 0;
         for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
     }
     return fixed;
@@ -3594,23 +3755,36 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
 
 /* >>solver ----------------------------------------------------------------------------- */
 
-/* out = (a_mass M + a_stiff K) v on the free frames, 0 on the others. */
+/* Zeroes the components that are not solved for: fixed and driven frames, held axes. */
+static void frm__mask(const frm_model *m, frm_real *v)
+{
+    int i, k;
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] != FRM__FREE)
+            for (k = 0; k < 6; k++) v[6 * i + k] = 0;
+        else if (m->axes[i])
+            for (k = 0; k < 6; k++)
+                if ((m->axes[i] >> k) & 1) v[6 * i + k] = 0;
+}
+
+/* out = (a_mass M + a_stiff K) v on the free components, 0 on the others. */
 static void frm__system_product(frm_model *m, double a_mass, double a_stiff, const frm_real *v, frm_real *out)
 {
     int i, k;
     frm__stiffness_product(m, v, out, 0);
     for (i = 0; i < m->frame_count; i++) {
         double mv[6] = {0, 0, 0, 0, 0, 0};
+        double reg[6] = {0, 0, 0, 0, 0, 0};
         if (m->state[i] != FRM__FREE) {
             for (k = 0; k < 6; k++) out[6 * i + k] = 0;
             continue;
         }
-        double reg[6] = {0, 0, 0, 0, 0, 0};
         if (a_mass != 0) frm__mass_apply(m, i, v + 6 * i, mv);
         if (m->solve_regularization != 0)
             for (k = 3; k < 6; k++) reg[k] = m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]) * v[6 * i + k];
         for (k = 0; k < 6; k++) out[6 * i + k] = (frm_real)(a_stiff * ((double)out[6 * i + k] + reg[k]) + a_mass * mv[k]);
     }
+    frm__mask(m, out);
 }
 
 /* z = P r per frame. */
@@ -3638,24 +3812,27 @@ static double frm__dot(const frm_model *m, const frm_real *a, const frm_real *b)
 #define FRM__CG_OK 0
 #define FRM__CG_CAP 1
 #define FRM__CG_NEGATIVE 2
+#define FRM__CG_NOT_FINITE 3
 
-/* Block-Jacobi preconditioned CG on (a_mass M + a_stiff K) x = b over the free frames
-   (b and the initial x are masked here). Stops at |r| <= cg_tolerance |b|, at the cap, or
-   on a direction of non-positive curvature (x then holds the last iterate, or the
-   preconditioned residual if that happened at once). The vector work is serial, in a
+/* Block-Jacobi preconditioned CG on (a_mass M + a_stiff K) x = b over the free components
+   (b and the initial x are masked here). Stops at |r| <= tolerance |b|, at the cap
+   (FRM__CG_CAP), on a direction of non-positive curvature (FRM__CG_NEGATIVE: x then holds
+   the last iterate, or the preconditioned residual if that happened at once; counted in
+   stats.negative_curvature), or on a non-finite |b|^2 or iterate (FRM__CG_NOT_FINITE: an
+   overflowing load must never pass an infinite tolerance). The vector work is serial, in a
    fixed order. */
 static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
     frm_real *r = m->vec[FRM__V_R], *z = m->vec[FRM__V_Z], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
-    int i, k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
+    int k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
     double bb, rr, rz, tol2;
-    for (i = 0; i < m->frame_count; i++)
-        if (m->state[i] != FRM__FREE)
-            for (k = 0; k < 6; k++) b[6 * i + k] = x[6 * i + k] = 0;
+    frm__mask(m, b);
+    frm__mask(m, x);
     for (k = 0; k < n6; k++) nonzero |= x[k] != 0;
     bb = frm__dot(m, b, b);
     m->stats.cg_iterations_last = 0;
     m->stats.cg_residual = 0;
+    if (!frm__finite(bb)) return FRM__CG_NOT_FINITE;
     if (bb == 0) {
         memset(x, 0, sizeof(frm_real) * (size_t)n6);
         return FRM__CG_OK;
@@ -3675,7 +3852,7 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
         frm__system_product(m, a_mass, a_stiff, p, q);
         pq = frm__dot(m, p, q);
         if (!(pq > 0) || !(rz > 0)) {
-            status = FRM__CG_NEGATIVE;
+            status = frm__finite(pq) && frm__finite(rz) ? FRM__CG_NEGATIVE : FRM__CG_NOT_FINITE;
             if (it == 0) memcpy(x, z, sizeof(frm_real) * (size_t)n6);
             break;
         }
@@ -3691,7 +3868,9 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
         rz = rz_new;
         for (k = 0; k < n6; k++) p[k] = z[k] + (frm_real)beta * p[k];
     }
+    if (status == FRM__CG_OK && !frm__finite(rr)) status = FRM__CG_NOT_FINITE;
     if (status == FRM__CG_OK && !(rr <= tol2)) status = FRM__CG_CAP;
+    if (status == FRM__CG_NEGATIVE) m->stats.negative_curvature++;
     m->stats.cg_iterations_last = it;
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
@@ -3699,22 +3878,22 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     return status;
 }
 
-static void frm__save_state(frm_model *m)
+static void frm__copy_state(const frm_model *m, frm_real *dst)
 {
     int i;
     for (i = 0; i < m->frame_count; i++) {
-        frm_real *b = m->backup + 13 * (size_t)i;
+        frm_real *b = dst + 13 * (size_t)i;
         memcpy(b, m->disp + 3 * i, 3 * sizeof(frm_real));
         memcpy(b + 3, m->quat + 4 * i, 4 * sizeof(frm_real));
         memcpy(b + 7, m->vel + 6 * i, 6 * sizeof(frm_real));
     }
 }
 
-static void frm__restore_state(frm_model *m)
+static void frm__paste_state(frm_model *m, const frm_real *src)
 {
     int i;
     for (i = 0; i < m->frame_count; i++) {
-        const frm_real *b = m->backup + 13 * (size_t)i;
+        const frm_real *b = src + 13 * (size_t)i;
         memcpy(m->disp + 3 * i, b, 3 * sizeof(frm_real));
         memcpy(m->quat + 4 * i, b + 3, 4 * sizeof(frm_real));
         memcpy(m->vel + 6 * i, b + 7, 6 * sizeof(frm_real));
@@ -3722,6 +3901,9 @@ static void frm__restore_state(frm_model *m)
     frm__update_frames(m);
     m->lin_valid = 0;
 }
+
+static void frm__save_state(frm_model *m) { frm__copy_state(m, m->backup); }
+static void frm__restore_state(frm_model *m) { frm__paste_state(m, m->backup); }
 
 /* Puts the driven frames at their prescribed poses. */
 static void frm__apply_driven(frm_model *m)
@@ -3754,44 +3936,130 @@ static void frm__set_trial(frm_model *m, const frm_real *step, double alpha)
     }
 }
 
+/* The step-time precision check (desc.precision_limit): eps(frm_real) max |u| against
+   precision_limit h_min. */
+static int frm__check_precision(const frm_model *m)
+{
+    double top = 0, eps = FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    int k;
+    if (!(m->precision_limit > 0)) return FRM_OK;
+    for (k = 0; k < 3 * m->frame_count; k++) {
+        double u = fabs((double)m->disp[k]);
+        if (u > top) top = u;
+    }
+    return eps * top > m->precision_limit * m->h_min ? FRM_ERR_PRECISION : FRM_OK;
+}
+
+/* det F of every sample at the current state. mark: records which are inverted (the start
+   of a step or solve) and returns 0; otherwise sets stats.inverted to the inverted count
+   and returns how many were not inverted at the mark. */
+static int frm__inversions(frm_model *m, int mark)
+{
+    int s, total = 0, fresh = 0;
+    frm__update_frames(m);
+    for (s = 0; s < m->sample_count; s++) {
+        int b = m->s_start[s], inv;
+        frm_real H[9], J;
+        frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
+                               m->p_rlev + 3 * b, NULL, m->disp, m->relm, H, NULL, NULL, NULL);
+        J = 1 + frm_det_minus_one(H);
+        inv = !(J > 0);
+        if (mark) m->s_inverted[s] = (unsigned char)inv;
+        else {
+            total += inv;
+            fresh += inv && !m->s_inverted[s];
+        }
+    }
+    if (!mark) m->stats.inverted = total;
+    return fresh;
+}
+
+/* The checks of a result before it is accepted: finite, no sample newly inverted (unless
+   both laws are undefined at det F <= 0), within the precision limit. */
+static int frm__accept(frm_model *m)
+{
+    int fresh;
+    if (!frm__all_finite(m->disp, 3 * (size_t)m->frame_count) || !frm__all_finite(m->quat, 4 * (size_t)m->frame_count) ||
+        !frm__all_finite(m->vel, 6 * (size_t)m->frame_count))
+        return FRM_ERR_NOT_FINITE;
+    fresh = frm__inversions(m, 0);
+    if (fresh) return FRM_ERR_INVERTED;
+    return frm__check_precision(m);
+}
+
 #define FRM__MAX_HALVINGS 12
-/* A static solve whose residual has not halved for this many Newton iterations stops with
-   FRM_ERR_STALLED (mechanisms make it wander, see LIMITS) instead of running to the cap. */
-#define FRM__STALL_ITERATIONS 10
-/* ... or whose residual rose in this many consecutive iterations (energy descent walking
-   into a mechanism). */
-#define FRM__STALL_RISES 3
+/* A static increment whose residual has not halved for this many Newton iterations stops
+   (mechanisms make it wander) instead of running to the cap; the continuation then cuts
+   the increment. Not fewer: near incompressibility the residual (dominated by the stiff
+   volumetric modes) swings by orders of magnitude while the energy falls steadily. */
+#define FRM__STALL_ITERATIONS 15
 /* Least regularisation (fraction of |K_ii| on the rotational diagonal) of a static solve's
    positive-definite attempt, whose K may be singular along rotations nothing holds. */
 #define FRM__DEFINITE_REGULARIZATION 1e-6
+/* Intermediate increments of the continuation converge to this relative residual (or the
+   Newton tolerance if tighter): their equilibria are only starting points. */
+#define FRM__INCREMENT_TOLERANCE 1e-3
+/* An increment that converged in at most this many Newton iterations doubles the next. */
+#define FRM__GROW_ITERATIONS 6
+
+/* The change of the total potential along the line search from the backup state:
+       W - W0 + V_g - V_g(0) - alpha f_ext . dq
+   (the constant external torques have no potential; their work along the path is exact). */
+static double frm__potential_change(const frm_model *m, double W, double W0, const frm_real *dq, double alpha)
+{
+    double dphi = W - W0;
+    int i, r;
+    for (i = 0; i < m->frame_count; i++) {
+        frm_real cg_new[3];
+        const frm_real *b = m->backup + 13 * (size_t)i;
+        double mg = m->grav_local[4 * (size_t)i];
+        if (m->state[i] != FRM__FREE) continue;
+        frm__gravity_moment(m, i, cg_new);
+        for (r = 0; r < 3; r++) {
+            dphi -= (double)m->gravity[r] *
+                    (mg * ((double)m->disp[3 * i + r] - b[r]) + ((double)cg_new[r] - m->lin_gravity[3 * i + r]));
+            dphi -= alpha * ((double)m->ext[6 * i + r] * dq[6 * i + r] + (double)m->ext[6 * i + 3 + r] * dq[6 * i + 3 + r]);
+        }
+    }
+    return dphi;
+}
+
+/* The static residual's scale: max(|load|, |reactions|), the load being gravity and the
+   external forces on the free components, the reactions the total force on the held ones
+   (f: the total force, m->force the internal one). */
+static double frm__static_scale(const frm_model *m, const frm_real *f, double *load_norm)
+{
+    frm_real *load = m->vec[FRM__V_T];
+    double l, reaction;
+    int k;
+    for (k = 0; k < 6 * m->frame_count; k++) load[k] = f[k] - m->force[k];
+    l = frm__norm_free(m, load);
+    reaction = frm__norm_held(m, f);
+    if (load_norm) *load_norm = l;
+    return l > reaction ? l : reaction;
+}
 
 /* One Newton iteration (sec. 3.6): K dq = f by CG, then a backtracking (Armijo) line
-   search on the total potential along q(alpha) = q (+) alpha dq:
-       phi(alpha) - phi(0) = W(alpha) - W(0) + V_g(alpha) - V_g(0) - alpha f_ext . dq
-   (the constant external torques have no potential; their work along the path is exact).
-   *ref < 0 is set to the load's norm (or the first residual if larger); *converged tells
-   whether |f| <= newton_tolerance * ref held before the iteration, in which case nothing
-   moves. *res gets |f| after. */
-static int frm__newton_iteration(frm_model *m, double *ref, int *converged, double *res)
+   search on the total potential along q(alpha) = q (+) alpha dq. first: the first
+   iteration of an increment. tol: the relative residual that counts as converged;
+   *converged tells whether it held before the iteration (nothing moves then). *res gets
+   |f| after, *scale the residual's scale. */
+static int frm__newton_iteration(frm_model *m, int first, double tol, int *converged, double *res, double *scale)
 {
     frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X], *trial_f = m->vec[FRM__V_T];
-    double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta;
-    int err, h, i, r, attempt, accepted = 0, first = *ref < 0;
+    double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta, ref;
+    int err, h, attempt, accepted = 0;
     *converged = 0;
     err = frm__force_pass(m, 1, 0, &W0);
     if (err) return err;
     frm__total_force(m, f);
     norm = frm__norm_free(m, f);
+    ref = frm__static_scale(m, f, NULL);
     *res = norm;
-    if (*ref < 0) {
-        frm_real *load = m->vec[FRM__V_T];
-        for (i = 0; i < m->frame_count; i++)
-            for (r = 0; r < 6; r++) load[6 * i + r] = f[6 * i + r] - m->force[6 * i + r];
-        *ref = frm__norm_free(m, load);
-        if (norm > *ref) *ref = norm;
-        m->stats.initial_residual = (frm_real)norm;
-    }
-    if (norm <= (double)m->newton_tolerance * *ref) {
+    *scale = ref;
+    if (!frm__finite(norm) || !frm__finite(ref)) return FRM_ERR_NOT_FINITE;
+    if (first && m->stats.newton_iterations == 0) m->stats.initial_residual = (frm_real)norm;
+    if (norm <= tol * ref) {
         *converged = 1;
         return FRM_OK;
     }
@@ -3809,7 +4077,7 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
     /* inexact Newton (Eisenstat-Walker): solve as accurately as the step can use */
     eta = first ? 1e-3 : (norm / m->newton_previous) * (norm / m->newton_previous);
     if (eta > 1e-3) eta = 1e-3;
-    if (eta < 0.1 * (double)m->newton_tolerance * *ref / norm) eta = 0.1 * (double)m->newton_tolerance * *ref / norm;
+    if (eta < 0.1 * tol * ref / norm) eta = 0.1 * tol * ref / norm;
     if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
     m->newton_previous = norm;
     for (attempt = 0;; attempt++) {
@@ -3820,8 +4088,10 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
                                                                                               : m->regularization;
         frm__build_precond(m, 0.0, 1.0);
         memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
-        cg = frm__cg(m, 0.0, 1.0, eta, f, dq); /* a capped solve still gives a descent direction */
+        cg = frm__cg(m, 0.0, 1.0, eta, f, dq);
         m->solve_regularization = 0;
+        if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
+        if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE; /* one CG policy: capped is not converged */
         slope = frm__dot(m, f, dq);
         if (m->lin_definite || (cg != FRM__CG_NEGATIVE && slope > 0 && frm__all_finite(dq, 6 * (size_t)m->frame_count)))
             break;
@@ -3834,30 +4104,19 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
     }
     if (!(slope > 0) || !frm__all_finite(dq, 6 * (size_t)m->frame_count)) { /* not a descent direction */
         frm__precond_apply(m, f, dq);
+        frm__mask(m, dq);
         slope = frm__dot(m, f, dq);
         if (!(slope > 0)) return FRM_ERR_NO_CONVERGENCE;
     }
     frm__save_state(m);
     noise = 64.0 * (FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON) * (fabs(W0) + slope);
     for (h = 0; h <= FRM__MAX_HALVINGS && !accepted; h++) {
-        double alpha = ldexp(1.0, -h), W, dphi = 0;
+        double alpha = ldexp(1.0, -h), W, dphi;
         frm__set_trial(m, dq, alpha);
         err = frm__force_pass(m, 0, 0, &W);
-        m->stats.line_search_halvings += h > 0;
+        m->stats.line_search_cuts += h > 0;
         if (err) continue;
-        dphi = W - W0;
-        for (i = 0; i < m->frame_count; i++) {
-            frm_real cg_new[3];
-            const frm_real *b = m->backup + 13 * (size_t)i;
-            double mg = m->grav_local[4 * (size_t)i];
-            if (m->state[i] != FRM__FREE) continue;
-            frm__gravity_moment(m, i, cg_new);
-            for (r = 0; r < 3; r++) {
-                dphi -= (double)m->gravity[r] *
-                        (mg * ((double)m->disp[3 * i + r] - b[r]) + ((double)cg_new[r] - m->lin_gravity[3 * i + r]));
-                dphi -= alpha * ((double)m->ext[6 * i + r] * dq[6 * i + r] + (double)m->ext[6 * i + 3 + r] * dq[6 * i + 3 + r]);
-            }
-        }
+        dphi = frm__potential_change(m, W, W0, dq, alpha);
         if (dphi <= -1e-4 * alpha * slope && dphi < -noise) accepted = 1; /* a real decrease (Armijo) */
         else if (dphi <= noise) { /* the energy cannot tell (round-off): the residual must fall */
             double rn;
@@ -3873,8 +4132,8 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
             best_alpha = alpha;
         }
     }
-    if (!accepted) { /* no decrease found: take the best trial, if any was valid */
-        if (best_alpha == 0) {
+    if (!accepted) { /* no Armijo decrease: take the best trial only if the energy did not rise */
+        if (best_alpha == 0 || best > noise) {
             frm__restore_state(m);
             return err ? err : FRM_ERR_NO_CONVERGENCE;
         }
@@ -3889,6 +4148,7 @@ static int frm__newton_iteration(frm_model *m, double *ref, int *converged, doub
     m->lin_valid = 0;
     frm__total_force(m, f);
     *res = frm__norm_free(m, f);
+    *scale = frm__static_scale(m, f, NULL);
     m->stats.newton_iterations++;
     return FRM_OK;
 }
@@ -3902,49 +4162,132 @@ static void frm__reset_stats(frm_model *m)
 
 FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
 {
-    double ref = -1, res = 0;
+    double res = 0, scale = 0;
     int converged, err;
     if (!m) return FRM_ERR_ARG;
     frm__reset_stats(m);
+    err = frm__check_precision(m);
+    if (err) return err;
     frm__save_state(m);
     memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
     frm__apply_driven(m);
-    err = frm__newton_iteration(m, &ref, &converged, &res);
+    err = frm__newton_iteration(m, 1, (double)m->newton_tolerance, &converged, &res, &scale);
     if (err) {
         memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
         frm__restore_state(m);
         return err;
     }
     memset(m->vel, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
-    m->stats.residual = (frm_real)res;
+    m->stats.residual_force = (frm_real)res;
+    m->stats.residual = (frm_real)(scale > 0 ? res / scale : (res > 0 ? HUGE_VAL : 0));
     if (residual) *residual = (frm_real)res;
     return FRM_OK;
 }
 
-FRMDEF int frm_model_solve_static(frm_model *m)
+/* Newton iterations of one static increment until |f| <= tol * scale; a residual that has
+   not halved in FRM__STALL_ITERATIONS stalls the increment (FRM_ERR_STALLED). */
+static int frm__static_increment(frm_model *m, double tol, int *iterations, double *res, double *scale)
 {
-    double ref = -1, res = 0, mark = 0, previous = 0;
-    int it, mark_it = 0, rises = 0, converged = 0, err = FRM_OK;
-    if (!m) return FRM_ERR_ARG;
-    frm__reset_stats(m);
-    frm__save_state(m);
-    memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
-    frm__apply_driven(m);
+    double mark = 0;
+    int it, mark_it = 0, converged = 0, err = FRM_OK;
+    m->floor_residual = 0;
     for (it = 0;; it++) {
-        err = frm__newton_iteration(m, &ref, &converged, &res);
+        err = frm__newton_iteration(m, it == 0, tol, &converged, res, scale);
         if (err || converged || it == m->newton_max_iterations) break;
-        rises = it > 0 && res > previous ? rises + 1 : 0;
-        previous = res;
-        if (it == 0 || res < mark) { /* progress: the residual halved since the last mark */
-            mark = 0.5 * res;
+        if (it == 0 || *res < mark) { /* progress: the residual halved since the last mark */
+            mark = 0.5 * *res;
             mark_it = it;
-        } else if (it - mark_it >= FRM__STALL_ITERATIONS || rises >= FRM__STALL_RISES) {
+        } else if (it - mark_it >= FRM__STALL_ITERATIONS) {
             err = FRM_ERR_STALLED;
             break;
         }
     }
+    *iterations = it;
     if (!err && !converged) err = FRM_ERR_NO_CONVERGENCE;
-    m->stats.residual = (frm_real)res;
+    return err;
+}
+
+/* The loads at fraction lambda of the continuation: gravity and external loads scaled,
+   driven frames on the way from their starting poses (position linearly, orientation
+   along the rotation from start to target). */
+static void frm__set_load(frm_model *m, double lambda, const frm_real g_full[3])
+{
+    int i, r;
+    for (r = 0; r < 3; r++) m->gravity[r] = (frm_real)(lambda * (double)g_full[r]);
+    for (i = 0; i < 6 * m->frame_count; i++) m->ext[i] = (frm_real)(lambda * (double)m->ext_full[i]);
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] == FRM__DRIVEN) {
+            const frm_real *s = m->drive_start + 7 * i, *t = m->target + 7 * i;
+            frm_real w[3];
+            for (r = 0; r < 3; r++)
+                m->disp[3 * i + r] = (frm_real)((double)s[r] + lambda * ((double)t[r] - (double)s[r]) - m->rest_pos[3 * i + r]);
+            if (lambda >= 1) memcpy(m->quat + 4 * i, t + 3, 4 * sizeof(frm_real));
+            else {
+                frm__quat_delta(s + 3, t + 3, w);
+                for (r = 0; r < 3; r++) w[r] = (frm_real)(lambda * (double)w[r]);
+                memcpy(m->quat + 4 * i, s + 3, 4 * sizeof(frm_real));
+                frm_quat_integrate(m->quat + 4 * i, w);
+            }
+        }
+    frm__update_frames(m);
+    m->lin_valid = 0;
+}
+
+FRMDEF int frm_model_solve_static(frm_model *m)
+{
+    frm_real g_full[3];
+    double lambda = 0, inc = 1, res = 0, scale = 0, tol;
+    int i, r, attempts = 0, err = FRM_OK, iterations;
+    if (!m) return FRM_ERR_ARG;
+    frm__reset_stats(m);
+    err = frm__check_precision(m);
+    if (err) return err;
+    frm__save_state(m);
+    memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+    frm__inversions(m, 1);
+    for (r = 0; r < 3; r++) g_full[r] = m->gravity[r];
+    memcpy(m->ext_full, m->ext, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    for (i = 0; i < m->frame_count; i++) {
+        for (r = 0; r < 3; r++) m->drive_start[7 * i + r] = m->rest_pos[3 * i + r] + m->disp[3 * i + r];
+        memcpy(m->drive_start + 7 * i + 3, m->quat + 4 * i, 4 * sizeof(frm_real));
+    }
+    /* load continuation: the whole load first; an increment that fails (no convergence, a
+       stall, an inversion, a non-finite trial) is cut to a quarter from its start, one that
+       converged quickly doubles the next */
+    while (lambda < 1) {
+        double trial = lambda + inc;
+        if (trial > 1 - 1e-12) trial = 1;
+        tol = trial < 1 && (double)m->newton_tolerance < FRM__INCREMENT_TOLERANCE ? FRM__INCREMENT_TOLERANCE
+                                                                               : (double)m->newton_tolerance;
+        frm__copy_state(m, m->inc_state);
+        frm__set_load(m, trial, g_full);
+        err = frm__static_increment(m, tol, &iterations, &res, &scale);
+        if (!err) err = frm__accept(m);
+        attempts++;
+        if (!err) {
+            lambda = trial;
+            m->stats.increments++;
+            if (iterations <= FRM__GROW_ITERATIONS) inc *= 2;
+            if (lambda < 1 && attempts >= m->max_increments) {
+                err = FRM_ERR_NO_CONVERGENCE;
+                break;
+            }
+            continue;
+        }
+        frm__paste_state(m, m->inc_state);
+        /* a non-finite load or a linear solve at its cap does not get better in smaller
+           increments; neither does the precision limit */
+        if (err == FRM_ERR_PRECISION || (err == FRM_ERR_NOT_FINITE && !frm__finite(scale)) ||
+            (err == FRM_ERR_NO_CONVERGENCE && m->stats.cg_residual > 0 && m->lin_iterations >= m->cg_max_iterations))
+            break;
+        m->stats.increment_cuts++;
+        inc *= 0.25;
+        if (inc < m->min_increment || attempts >= m->max_increments) break;
+    }
+    for (r = 0; r < 3; r++) m->gravity[r] = g_full[r];
+    memcpy(m->ext, m->ext_full, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    m->stats.residual_force = (frm_real)res;
+    m->stats.residual = (frm_real)(scale > 0 ? res / scale : (res > 0 ? HUGE_VAL : 0));
     memset(m->vec[FRM__V_DV], 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     if (err) {
         memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
@@ -3959,36 +4302,10 @@ FRMDEF int frm_model_solve_static(frm_model *m)
 
 static int frm__linearize(frm_model *m, double *energy, int definite);
 
-/* The light check after a step: every sample has det F > 0 (a Neo-Hookean sample's energy
-   is infinite otherwise, a St Venant-Kirchhoff one's may sit in a mirrored minimum). */
-static int frm__check_inversion(frm_model *m)
+/* Driven frames: the velocity change that reaches the target in dt (into drive). */
+static int frm__drive_velocities(frm_model *m, double dt, frm_real *drive)
 {
-    int s;
-    frm__update_frames(m);
-    for (s = 0; s < m->sample_count; s++) {
-        int b = m->s_start[s];
-        frm_real F[9], J;
-        frm_sample_deformation(m->s_start[s + 1] - b, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b,
-                               m->p_rlev + 3 * b, NULL, m->disp, m->relm, F, NULL, NULL, NULL);
-        J = 1 + frm_det_minus_one(F); /* F holds H */
-        if (!(J > 0)) return FRM_ERR_INVERTED;
-    }
-    return FRM_OK;
-}
-
-/* Implicit Euler, eq. 3.64 with our sign of K (K = -df/dq) and Rayleigh damping
-   D = alpha M + beta K:
-       (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
-   one linearisation at the start of the step (M and K at q_t). Driven frames move to
-   their targets, which enter the right-hand side through K. */
-static int frm__implicit_step(frm_model *m, double dt)
-{
-    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
-    frm_real *drive = m->vec[FRM__V_DRIVE];
-    double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
-    int err, i, k, cg, attempt, any_driven = 0;
-    frm__save_state(m);
-    /* driven frames: the velocity that reaches the target in dt */
+    int i, k, any = 0;
     for (i = 0; i < m->frame_count; i++) {
         for (k = 0; k < 6; k++) drive[6 * i + k] = 0;
         if (m->state[i] == FRM__DRIVEN) {
@@ -3999,9 +4316,26 @@ static int frm__implicit_step(frm_model *m, double dt)
                                    m->vel[6 * i + k];
                 drive[6 * i + 3 + k] = (frm_real)(w[k] / dt) - m->vel[6 * i + 3 + k];
             }
-            any_driven = 1;
+            any = 1;
         }
     }
+    return any;
+}
+
+/* The linearised implicit Euler (desc.implicit_linearized = 1), eq. 3.64 with our sign of
+   K (K = -df/dq) and Rayleigh damping D = alpha M + beta K:
+       (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - (dt + beta) K v - alpha M v),
+   one linearisation at the start of the step (M and K at q_t): the first Newton iteration
+   of the incremental potential below, with a full step. Driven frames move to their
+   targets, which enter the right-hand side through K. */
+static int frm__implicit_linearized(frm_model *m, double dt)
+{
+    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
+    frm_real *drive = m->vec[FRM__V_DRIVE];
+    double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
+    int err, i, k, cg, attempt, any_driven;
+    frm__save_state(m);
+    any_driven = frm__drive_velocities(m, dt, drive);
     for (attempt = 0;; attempt++) {
         err = frm__linearize(m, NULL, attempt);
         if (err) return err;
@@ -4029,9 +4363,9 @@ static int frm__implicit_step(frm_model *m, double dt)
            keeps the system positive definite at any dt */
         m->stats.definite_solves++;
     }
-    if ((cg == FRM__CG_CAP && m->cg_fail_at_cap) || cg == FRM__CG_NEGATIVE) {
+    if (cg != FRM__CG_OK) {
         frm__restore_state(m);
-        return FRM_ERR_NO_CONVERGENCE;
+        return cg == FRM__CG_NOT_FINITE ? FRM_ERR_NOT_FINITE : FRM_ERR_NO_CONVERGENCE;
     }
     for (i = 0; i < m->frame_count; i++) {
         frm_real *v = m->vel + 6 * i, th[3];
@@ -4045,25 +4379,207 @@ static int frm__implicit_step(frm_model *m, double dt)
             memcpy(m->quat + 4 * i, m->target + 7 * i + 3, 4 * sizeof(frm_real));
             continue;
         }
+        for (k = 0; k < 6; k++)
+            if ((m->axes[i] >> k) & 1) v[k] = 0;
         for (k = 0; k < 3; k++) {
             m->disp[3 * i + k] += (frm_real)dt * v[k];
             th[k] = (frm_real)dt * v[3 + k];
         }
         frm_quat_integrate(m->quat + 4 * i, th);
     }
-    if (!frm__all_finite(m->disp, 3 * (size_t)m->frame_count) || !frm__all_finite(m->quat, 4 * (size_t)m->frame_count) ||
-        !frm__all_finite(m->vel, 6 * (size_t)m->frame_count)) {
+    err = frm__accept(m);
+    if (err) {
         frm__restore_state(m);
-        return FRM_ERR_NOT_FINITE;
-    }
-    if (frm__check_inversion(m)) { /* both laws (issue 18: SVK has minima at mirror images) */
-        frm__restore_state(m);
-        return FRM_ERR_INVERTED;
+        return err;
     }
     memcpy(m->vec[FRM__V_DV], dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     frm__update_frames(m);
     m->lin_valid = 0;
     m->stats.newton_iterations = 1;
+    return FRM_OK;
+}
+
+/* The step's displacement dq = q - q_t of every free frame from the step's start (kept in
+   inc_state): translation, and the rotation vector from the start orientation. */
+static void frm__step_displacement(const frm_model *m, frm_real *dq)
+{
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *b = m->inc_state + 13 * (size_t)i;
+        for (k = 0; k < 3; k++) dq[6 * i + k] = m->disp[3 * i + k] - b[k];
+        frm__quat_delta(b + 3, m->quat + 4 * i, dq + 6 * i + 3);
+    }
+    frm__mask(m, dq);
+}
+
+/* Implicit Euler as the minimisation of the step's incremental potential (our form of eq.
+   3.64 taken to convergence). With dq the step's displacement, v = dq / dt, v_t the start
+   velocity, M the mass at the start of the step and D = alpha M + beta K:
+       Psi(dq) = 1/2 |dq - dt v_t|_M^2 + dt/2 dq^T D dq + dt^2 (W + V_g - f_ext . dq)
+   whose stationarity is M (v - v_t) = dt (f - D v), implicit Euler. Newton iterations
+       (M (1 + dt alpha) + (dt^2 + dt beta) K) delta_v = r,
+       r = dt f - M (v - v_t) - dt D v            (momentum, N s)
+   with a backtracking Armijo line search on Psi (the damping's K frozen per iteration),
+   until |r| <= newton_tolerance * max(|r_0|, dt |load|, dt |reactions|), r_0 the residual
+   at the step's start (the first iteration is the linearised step). Driven frames are at
+   their targets from the first iteration. */
+static int frm__implicit_newton(frm_model *m, double dt)
+{
+    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X];
+    frm_real *dq = m->vec[FRM__V_DRIVE], *kd = m->vec[FRM__V_P];
+    double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
+    double a_mass = 1.0 + dt * alpha_d, a_stiff = dt * dt + dt * beta_d, ref = 0, norm = 0, previous = 0;
+    int err, i, k, it, cg, attempt, converged = 0, n6 = 6 * m->frame_count;
+    frm_real *kq = m->vec[FRM__V_R]; /* K dq; CG overwrites it, so it is recomputed after */
+    frm__copy_state(m, m->inc_state);
+    frm__mass_update(m);
+    frm__apply_driven(m);
+    for (it = 0;; it++) {
+        double W0, slope, noise, eMd, qMd, dMd, qKd, dKd, eta;
+        int h, accepted = 0, cheap = it > 0 && beta_d == 0;
+        for (attempt = 0;; attempt++) {
+            /* without stiffness damping the residual needs no K: a plain force pass tells
+               whether the step has converged before paying for a linearisation */
+            err = cheap ? frm__force_pass(m, 0, 0, &W0) : frm__linearize(m, &W0, attempt);
+            if (err) return err;
+            frm__total_force(m, f);
+            frm__step_displacement(m, dq);
+            if (beta_d != 0) frm__stiffness_product(m, dq, kq, 0);
+            else memset(kq, 0, sizeof(frm_real) * (size_t)n6);
+            /* r = dt f - M (v - v_t) - dt D v, with dq = dt v */
+            for (i = 0; i < m->frame_count; i++) {
+                double mq[6], mv[6];
+                frm__mass_apply(m, i, dq + 6 * i, mq);
+                frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
+                for (k = 0; k < 6; k++)
+                    b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
+                                              beta_d * (double)kq[6 * i + k]);
+            }
+            frm__mask(m, b);
+            norm = sqrt(frm__dot(m, b, b));
+            if (!frm__finite(norm)) return FRM_ERR_NOT_FINITE;
+            if (it == 0 && attempt == 0) {
+                double load;
+                ref = dt * frm__static_scale(m, f, &load);
+                if (norm > ref) ref = norm;
+                if (!frm__finite(ref)) return FRM_ERR_NOT_FINITE;
+            }
+            if (attempt == 0 && (norm <= (double)m->newton_tolerance * ref || (it > 0 && norm <= dt * frm__round_off_floor(m) &&
+                                                                             norm > 0.5 * previous))) {
+                converged = 1;
+                break;
+            }
+            if (attempt == 0 && it == m->newton_max_iterations) break;
+            if (cheap) {
+                cheap = 0;
+                err = frm__linearize(m, &W0, 0);
+                if (err) return err;
+            }
+            frm__build_precond(m, a_mass, a_stiff);
+            eta = it == 0 ? (double)m->cg_tolerance : 1e-3 * (norm / previous) * (norm / previous);
+            if (eta < 0.1 * (double)m->newton_tolerance * ref / norm) eta = 0.1 * (double)m->newton_tolerance * ref / norm;
+            if (eta > 1e-3) eta = 1e-3;
+            if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
+            if (it == 0) /* warm start: the new velocity, about the start one plus the last step's change */
+                for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->vec[FRM__V_DV][k];
+            else
+                memset(dv, 0, sizeof(frm_real) * (size_t)n6);
+            cg = frm__cg(m, a_mass, a_stiff, eta, b, dv);
+            if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
+            if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE;
+            if (cg == FRM__CG_OK || attempt) break;
+            /* M + dt^2 K indefinite (compressed samples, the rotations' second-order terms, gravity,
+               a large dt): this iteration uses K's positive-definite part */
+            m->stats.definite_solves++;
+        }
+        if (converged || (attempt == 0 && it == m->newton_max_iterations)) break;
+        if (cg != FRM__CG_OK) return FRM_ERR_NO_CONVERGENCE;
+        previous = norm;
+        /* the Newton step delta = dt dv; Psi along it (the damping's K frozen at this iteration) */
+        for (k = 0; k < n6; k++) dv[k] = (frm_real)(dt * (double)dv[k]);
+        if (beta_d != 0) {
+            frm__stiffness_product(m, dq, kq, 0);
+            frm__stiffness_product(m, dv, kd, 0);
+        } else {
+            memset(kq, 0, sizeof(frm_real) * (size_t)n6);
+            memset(kd, 0, sizeof(frm_real) * (size_t)n6);
+        }
+        eMd = qMd = dMd = 0;
+        for (i = 0; i < m->frame_count; i++) {
+            double md[6];
+            const frm_real *vt = m->inc_state + 13 * (size_t)i + 7;
+            frm__mass_apply(m, i, dv + 6 * i, md);
+            for (k = 0; k < 6; k++) {
+                double ek = (double)dq[6 * i + k] - dt * (double)vt[k];
+                if (m->state[i] != FRM__FREE || ((m->axes[i] >> k) & 1)) continue;
+                eMd += ek * md[k];
+                qMd += (double)dq[6 * i + k] * md[k];
+                dMd += (double)dv[6 * i + k] * md[k];
+            }
+        }
+        qKd = frm__dot(m, kq, dv);
+        dKd = frm__dot(m, kd, dv);
+        slope = dt * frm__dot(m, b, dv); /* -dPsi/dalpha at 0: the gradient of Psi is -dt r */
+        if (!(slope > 0)) return FRM_ERR_NO_CONVERGENCE;
+        frm__save_state(m);
+        noise = 64.0 * (FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON) * (dt * dt * fabs(W0) + slope);
+        for (h = 0; h <= FRM__MAX_HALVINGS && !accepted; h++) {
+            double a = ldexp(1.0, -h), W, dpsi;
+            frm__set_trial(m, dv, a);
+            err = frm__force_pass(m, 0, 0, &W);
+            m->stats.line_search_cuts += h > 0;
+            if (err) continue;
+            dpsi = dt * dt * frm__potential_change(m, W, W0, dv, a) + a * eMd + 0.5 * a * a * dMd +
+                   0.5 * dt * alpha_d * (2 * a * qMd + a * a * dMd) + 0.5 * dt * beta_d * (2 * a * qKd + a * a * dKd);
+            if (dpsi <= -1e-4 * a * slope && dpsi < -noise) accepted = 1;
+            else if (dpsi <= noise) { /* round-off: accept the step only if the residual falls, judged next iteration */
+                accepted = 1;
+            }
+        }
+        if (!accepted) {
+            frm__restore_state(m);
+            return err ? err : FRM_ERR_NO_CONVERGENCE;
+        }
+        m->stats.newton_iterations++;
+    }
+    m->stats.residual_force = (frm_real)norm;
+    m->stats.residual = (frm_real)(ref > 0 ? norm / ref : 0);
+    if (!converged) return FRM_ERR_NO_CONVERGENCE;
+    /* velocities: the step's displacement over dt (driven frames: the same, fixed: zero) */
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *s = m->inc_state + 13 * (size_t)i;
+        frm_real *v = m->vel + 6 * i, w[3];
+        if (m->state[i] == FRM__FIXED) {
+            for (k = 0; k < 6; k++) v[k] = 0;
+            continue;
+        }
+        frm__quat_delta(s + 3, m->quat + 4 * i, w);
+        for (k = 0; k < 3; k++) {
+            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
+            v[3 + k] = (frm_real)((double)w[k] / dt);
+        }
+        for (k = 0; k < 6; k++) {
+            if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
+            m->vec[FRM__V_DV][6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
+        }
+    }
+    return FRM_OK;
+}
+
+static int frm__implicit_step(frm_model *m, double dt)
+{
+    int err = frm__check_precision(m);
+    if (err) return err;
+    frm__inversions(m, 1);
+    if (m->implicit_linearized) return frm__implicit_linearized(m, dt);
+    err = frm__implicit_newton(m, dt);
+    if (!err) err = frm__accept(m);
+    if (err) {
+        frm__paste_state(m, m->inc_state);
+        return err;
+    }
+    frm__update_frames(m);
+    m->lin_valid = 0;
     return FRM_OK;
 }
 
@@ -4110,6 +4626,7 @@ FRMDEF int frm_model_fix_frame(frm_model *m, int i)
     int err = frm__check_frame(m, i);
     if (err) return err;
     m->state[i] = FRM__FIXED;
+    m->axes[i] = 0;
     memset(m->vel + 6 * i, 0, 6 * sizeof(frm_real));
     return FRM_OK;
 }
@@ -4121,6 +4638,7 @@ FRMDEF int frm_model_drive_frame(frm_model *m, int i, const frm_real position[3]
     if (!position || !orientation || !frm__vec3_finite(position)) return FRM_ERR_ARG;
     if (!frm__quat_valid(orientation)) return FRM_ERR_QUATERNION;
     m->state[i] = FRM__DRIVEN;
+    m->axes[i] = 0;
     memcpy(m->target + 7 * i, position, 3 * sizeof(frm_real));
     frm__quat_normalized(orientation, m->target + 7 * i + 3);
     return FRM_OK;
@@ -4131,7 +4649,25 @@ FRMDEF int frm_model_release_frame(frm_model *m, int i)
     int err = frm__check_frame(m, i);
     if (err) return err;
     m->state[i] = FRM__FREE;
+    m->axes[i] = 0;
     return FRM_OK;
+}
+
+FRMDEF int frm_model_set_frame_axes(frm_model *m, int i, unsigned translation_axes, unsigned rotation_axes)
+{
+    int err = frm__check_frame(m, i), k;
+    if (err) return err;
+    if (translation_axes > 7 || rotation_axes > 7 || m->state[i] != FRM__FREE) return FRM_ERR_ARG;
+    m->axes[i] = (unsigned char)(translation_axes | rotation_axes << 3);
+    for (k = 0; k < 6; k++)
+        if ((m->axes[i] >> k) & 1) m->vel[6 * i + k] = 0;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_frame_axes(const frm_model *m, int i)
+{
+    int err = frm__check_frame(m, i);
+    return err ? err : (int)m->axes[i];
 }
 
 FRMDEF int frm_model_frame_state(const frm_model *m, int i)

@@ -1449,8 +1449,9 @@ static void test_solver_extremes(void)
         err = frm_model_solve_static(sc.m);
         printf("    hex one cell across: %s after %d Newton iterations\n", frm_error_string(err),
                frm_model_last_stats(sc.m)->newton_iterations);
-        CHECK(err == FRM_OK || err == FRM_ERR_STALLED);
-        CHECK(frm_model_last_stats(sc.m)->newton_iterations <= 2 + 10 + 2);
+        /* the load continuation cuts the increment down to min_increment before it gives up */
+        CHECK(err == FRM_OK || err == FRM_ERR_STALLED || err == FRM_ERR_NO_CONVERGENCE);
+        CHECK(frm_model_last_stats(sc.m)->increments + frm_model_last_stats(sc.m)->increment_cuts <= 64);
         scene_free(&sc);
     }
 }
@@ -2357,6 +2358,761 @@ static void test_error_strings(void)
     CHECK(strcmp(frm_version(), v) == 0);
 }
 
+/* ---- issue 18: no silent wrong answers (solvers) --------------------------------------- */
+
+/* The norm of v over the free components (free_components = 1: free frames, axes not
+   held) or over the held ones (0: fixed and driven frames, held axes). */
+static double norm_frames(const frm_model *m, const frm_real *v, int free_components)
+{
+    int i, k, n = frm_model_frame_count(m);
+    double s = 0;
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 6; k++) {
+            int held = frm_model_frame_state(m, i) != 0 || ((frm_model_frame_axes(m, i) >> k) & 1);
+            if (held != free_components) s += (double)v[6 * i + k] * v[6 * i + k];
+        }
+    return sqrt(s);
+}
+
+/* |f| over the free frames, the load (gravity + external) over the free frames and the
+   reactions (the total force on the held frames) at the model's state. */
+static void residual_parts(frm_model *m, double *res, double *load, double *reaction)
+{
+    int n = frm_model_frame_count(m), k;
+    const frm_real *f, *fi;
+    frm_real *t = alloc_reals(6 * n), *l = alloc_reals(6 * n);
+    REQUIRE(frm_model_total_forces(m, &f) == FRM_OK);
+    memcpy(t, f, sizeof(frm_real) * 6 * (size_t)n);
+    REQUIRE(frm_model_forces(m, &fi) == FRM_OK);
+    for (k = 0; k < 6 * n; k++) l[k] = t[k] - fi[k];
+    *res = norm_frames(m, t, 1);
+    *load = norm_frames(m, l, 1);
+    *reaction = norm_frames(m, t, 0);
+    free(t);
+    free(l);
+}
+
+/* Item 13: a load whose |b|^2 overflows (1e156 N on the README cube) must not pass the CG's
+   tolerance (inf): the static solve and the implicit step fail with FRM_ERR_NOT_FINITE and
+   keep the state (before: success without moving). Float: 1e30 N, any error. */
+static void test_i18_huge_load(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    scene sc;
+    int n, i, err, top = -1;
+    frm_real *x0, *q0, f[3] = {0, 0, 0};
+    REQUIRE(scene_hex(&sc, lo, hi, 2, 2, 2, 2, FRM_LAW_NEO_HOOKEAN, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    for (i = 0; i < n; i++) {
+        if (sc.s.frame_positions[3 * i + 2] == 0) frm_model_fix_frame(sc.m, i);
+        if (sc.s.frame_positions[3 * i + 2] == 1) top = i;
+    }
+    f[2] = (frm_real)(IS_FLOAT ? 1e30 : 1e156);
+    REQUIRE(frm_model_set_external(sc.m, top, f, NULL) == FRM_OK);
+    get_poses(sc.m, &x0, &q0);
+    err = frm_model_solve_static(sc.m);
+    printf("    1e%d N static: %s\n", IS_FLOAT ? 30 : 156, frm_error_string(err));
+    if (IS_FLOAT) CHECK(err != FRM_OK);
+    else CHECK_INT(FRM_ERR_NOT_FINITE, err);
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    err = frm_model_step(sc.m);
+    printf("    1e%d N implicit step: %s\n", IS_FLOAT ? 30 : 156, frm_error_string(err));
+    if (IS_FLOAT) CHECK(err != FRM_OK);
+    else CHECK_INT(FRM_ERR_NOT_FINITE, err);
+    CHECK(memcmp(x0, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    free(x0);
+    free(q0);
+    scene_free(&sc);
+}
+
+/* Item 14: the static solve's residual is judged against newton_tolerance times the
+   documented scale, max(|load|, |reactions|) at the returned state (gravity and external
+   forces on the free frames; the total force on the held frames), never against the
+   starting residual: a beam started 27 % stretched (before: success with a residual 265
+   times the documented tolerance). */
+static void test_i18_residual_scale(void)
+{
+    scene sc;
+    int n, i;
+    frm_real *x, *q;
+    double res = 0, load = 0, reaction = 0, tol;
+    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    n = frm_model_frame_count(sc.m);
+    get_poses(sc.m, &x, &q);
+    for (i = 0; i < n; i++) x[3 * i] = (frm_real)(1.27 * x[3 * i]);
+    REQUIRE(frm_model_set_poses(sc.m, x, q) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+    residual_parts(sc.m, &res, &load, &reaction);
+    tol = (double)frm_model_default_desc().newton_tolerance;
+    printf("    started 27 %% stretched: |f| %.3g N, load %.3g N, reactions %.3g N: %.3g x the tolerance\n", res, load,
+           reaction, res / (tol * (load > reaction ? load : reaction)));
+    CHECK(res <= tol * (load > reaction ? load : reaction) * 1.0001);
+    free(x);
+    free(q);
+    scene_free(&sc);
+}
+
+/* Gravity on a meshless body equals its weight: the translational parts of the gravity
+   forces (total force at rest minus the internal force, which is zero there) sum to rho V g
+   with V the box's volume, computed here. */
+static void test_i18_gravity_weight(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {0.4, 0.3, 0.2}, sum[3] = {0, 0, 0}, rho = 1000, V = 0.4 * 0.3 * 0.2;
+    scene sc;
+    const frm_real *f;
+    int i, k, n;
+    REQUIRE(scene_box(&sc, lo, hi, 0.15, 0.06, FRM_SHAPE_SHEPARD, 8, FRM_LAW_SVK, 1e5, 0.3) == FRM_OK);
+    n = frm_model_frame_count(sc.m);
+    REQUIRE(frm_model_total_forces(sc.m, &f) == FRM_OK);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) sum[k] += (double)f[6 * i + k];
+    printf("    %d frames: weight %.6f N, rho V g %.6f N\n", n, sum[2], -rho * V * 9.81);
+    CHECK_REL(-rho * V * 9.81, sum[2], IS_FLOAT ? 1e-5 : 1e-10);
+    CHECK_NEAR(0, sum[0], 1e-9 * rho * V * 9.81 + (IS_FLOAT ? 1e-4 : 0));
+    CHECK_NEAR(0, sum[1], 1e-9 * rho * V * 9.81 + (IS_FLOAT ? 1e-4 : 0));
+    scene_free(&sc);
+}
+
+/* Dense Gaussian elimination with partial pivoting: A x = b (A n x n, destroyed). */
+static void dense_solve(double *A, double *b, int n)
+{
+    int i, j, k;
+    for (k = 0; k < n; k++) {
+        int p = k;
+        for (i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+        if (p != k) {
+            double t;
+            for (j = 0; j < n; j++) t = A[k * n + j], A[k * n + j] = A[p * n + j], A[p * n + j] = t;
+            t = b[k], b[k] = b[p], b[p] = t;
+        }
+        for (i = k + 1; i < n; i++) {
+            double l = A[i * n + k] / A[k * n + k];
+            for (j = k; j < n; j++) A[i * n + j] -= l * A[k * n + j];
+            b[i] -= l * b[k];
+        }
+    }
+    for (i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (j = i + 1; j < n; j++) s -= A[i * n + j] * b[j];
+        b[i] = s / A[i * n + i];
+    }
+}
+
+/* The generalized displacement of every frame from rest: translation, and the rotation
+   vector 2 q_xyz (small angles; rest orientations are the identity here). */
+static void frame_displacements(const frm_model *m, const frm_sampling *s, double *u)
+{
+    int i, k, n = frm_model_frame_count(m);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) {
+            u[6 * i + k] = (double)frm_model_positions(m)[3 * i + k] - s->frame_positions[3 * i + k];
+            u[6 * i + 3 + k] = 2 * (double)frm_model_orientations(m)[4 * i + k];
+        }
+}
+
+/* A small hexahedral beam with Rayleigh damping, clamped at x = 0, started at rest with a
+   non-zero velocity (small amplitude: the linear regime, no gravity). */
+static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
+{
+    double lo[3] = {0, -0.25, -0.25}, hi[3] = {1, 0.25, 0.25};
+    frm_real g[3] = {0, 0, 0}, *v;
+    int i, k, n;
+    REQUIRE(scene_hex(sc, lo, hi, 2, 1, 1, 2, FRM_LAW_SVK, 1e4, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    frm_model_destroy(sc->m);
+    sc->d.mass_damping = (frm_real)alpha;
+    sc->d.stiffness_damping = (frm_real)beta;
+    REQUIRE(frm_model_create(&sc->d, &sc->m) == FRM_OK);
+    n = frm_model_frame_count(sc->m);
+    clamp_beam(sc->m, &sc->s);
+    REQUIRE(frm_model_set_gravity(sc->m, g) == FRM_OK);
+    REQUIRE(frm_model_set_solver(sc->m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-12), 1000, (frm_real)(IS_FLOAT ? 1e-4 : 1e-10), 30) ==
+            FRM_OK);
+    v = alloc_reals(6 * n);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 6; k++)
+            v[6 * i + k] = frm_model_frame_state(sc->m, i) ? 0
+                                                           : (frm_real)(amplitude * (k == 2 ? sc->s.frame_positions[3 * i]
+                                                                                     : k == 4 ? -1.0 : 0.1 * (k == 1)));
+    REQUIRE(frm_model_set_velocities(sc->m, v) == FRM_OK);
+    free(v);
+}
+
+/* Implicit Euler with Rayleigh damping (alpha M + beta K) and a non-zero start velocity
+   against the closed form of its discrete recurrence, computed here from the assembled K
+   and the mass blocks:
+       (M (1 + alpha dt) + (dt^2 + beta dt) K) v1 = M v0 - dt K u0,   u1 = u0 + dt v1
+   (a wrong damping sign, a dropped M v0 or a K v term shows at once); then the order of
+   accuracy: the changes between dt, dt/2 and dt/4 halve (first order). */
+static void test_i18_implicit_recurrence(void)
+{
+    scene sc;
+    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err = 0, top = 0;
+    int n, nf = 0, i, j, a, b, step, steps = 20, *map;
+    double *K, *M, *A, *u, *v, *rhs, *uf;
+    damped_beam(&sc, alpha, beta, amp);
+    n = frm_model_frame_count(sc.m);
+    map = (int *)malloc(sizeof(int) * (size_t)n);
+    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(sc.m, i) ? -1 : nf++;
+    K = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    M = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    A = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
+    u = (double *)calloc((size_t)6 * n, sizeof(double));
+    v = (double *)calloc((size_t)6 * nf, sizeof(double));
+    rhs = (double *)calloc((size_t)6 * nf, sizeof(double));
+    uf = (double *)calloc((size_t)6 * n, sizeof(double));
+    REQUIRE(frm_model_assemble_stiffness(sc.m) == FRM_OK);
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++) {
+            frm_real B[36];
+            if (map[i] < 0 || map[j] < 0) continue;
+            if (frm_model_stiffness_block(sc.m, i, j, B) != FRM_OK) continue;
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) K[(6 * map[i] + a) * 6 * nf + 6 * map[j] + b] = (double)B[6 * a + b];
+        }
+    for (i = 0; i < n; i++) {
+        frm_real B[36];
+        if (map[i] < 0) continue;
+        REQUIRE(frm_model_mass_block(sc.m, i, B) == FRM_OK);
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) M[(6 * map[i] + a) * 6 * nf + 6 * map[i] + b] = (double)B[6 * a + b];
+    }
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) v[6 * map[i] + a] = (double)frm_model_velocities(sc.m)[6 * i + a];
+    for (step = 0; step < steps; step++) {
+        int N = 6 * nf;
+        REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
+        for (a = 0; a < N; a++) {
+            double s = 0;
+            for (b = 0; b < N; b++) {
+                s += M[a * N + b] * v[b] - dt * K[a * N + b] * u[b];
+                A[a * N + b] = M[a * N + b] * (1 + alpha * dt) + (dt * dt + beta * dt) * K[a * N + b];
+            }
+            rhs[a] = s;
+        }
+        dense_solve(A, rhs, N);
+        for (a = 0; a < N; a++) {
+            v[a] = rhs[a];
+            u[a] += dt * v[a];
+        }
+    }
+    frame_displacements(sc.m, &sc.s, uf);
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) {
+                double d = uf[6 * i + a] - u[6 * map[i] + a];
+                err += d * d;
+                top += u[6 * map[i] + a] * u[6 * map[i] + a];
+            }
+    err = sqrt(err / top);
+    printf("    %d steps of %.2f s, alpha %.2f, beta %.2f: frames against the recurrence %.2e (relative)\n", steps, dt, alpha,
+           beta, err);
+    CHECK(err < (IS_FLOAT ? 2e-2 : 1e-4));
+    scene_free(&sc);
+    { /* order: u(T) at dt, dt/2, dt/4 */
+        double uT[3][6 * 64], d1 = 0, d2 = 0, T = 4.0;
+        int r;
+        for (r = 0; r < 3; r++) {
+            double h = 0.01 / (1 << r);
+            damped_beam(&sc, alpha, beta, amp);
+            for (step = 0; step < (int)(T / h + 0.5); step++) REQUIRE(frm_model_step_ex(sc.m, (frm_real)h) == FRM_OK);
+            REQUIRE(6 * frm_model_frame_count(sc.m) <= 6 * 64);
+            frame_displacements(sc.m, &sc.s, uT[r]);
+            scene_free(&sc);
+        }
+        for (a = 0; a < 6 * n; a++) {
+            d1 += (uT[0][a] - uT[1][a]) * (uT[0][a] - uT[1][a]);
+            d2 += (uT[1][a] - uT[2][a]) * (uT[1][a] - uT[2][a]);
+        }
+        printf("    order: changes %.3e, %.3e, ratio %.3f (first order: 2)\n", sqrt(d1), sqrt(d2), sqrt(d1 / d2));
+        if (IS_FLOAT) /* float's rounding (amplitude 1e-3) blurs the small changes */
+            CHECK(sqrt(d1 / d2) > 1.4 && sqrt(d1 / d2) < 2.8);
+        else
+            CHECK(sqrt(d1 / d2) > 1.7 && sqrt(d1 / d2) < 2.3);
+    }
+    free(map), free(K), free(M), free(A), free(u), free(v), free(rhs), free(uf);
+}
+
+/* Holds the symmetry planes x = 0, y = 0, z = 0 (those a frame lies on): the normal
+   translation and the two in-plane rotations of each. */
+static void symmetry_planes(frm_model *m, const frm_sampling *s, int planes)
+{
+    int i, a;
+    for (i = 0; i < s->frame_count; i++) {
+        unsigned t = 0, r = 0;
+        for (a = 0; a < 3; a++)
+            if (((planes >> a) & 1) && fabs((double)s->frame_positions[3 * i + a]) < 1e-12) {
+                t |= 1u << a;
+                r |= 7u & ~(1u << a);
+            }
+        if (t && frm_model_frame_state(m, i) == 0) CHECK_INT(FRM_OK, frm_model_set_frame_axes(m, i, t, r));
+    }
+}
+
+/* R4 / R5: the first Piola-Kirchhoff stress of uniaxial stretch s with free lateral faces. */
+static double uniaxial_stress(frm_law law, double E, double nu, double s)
+{
+    double mu = E / (2 * (1 + nu)), lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), t = 1;
+    int k;
+    if (law == FRM_LAW_SVK) return mu * (3 * lambda + 2 * mu) / (2 * (lambda + mu)) * (s * s * s - s);
+    for (k = 0; k < 100; k++) { /* P_xx(t) = mu (t - 1/t) + lambda ln(s t^2) / t = 0 */
+        double g = mu * (t - 1 / t) + lambda * log(s * t * t) / t;
+        double dg = mu * (1 + 1 / (t * t)) + lambda * (2 - log(s * t * t)) / (t * t);
+        t -= g / dg;
+    }
+    return mu * (s - 1 / s) + lambda * log(s * t * t) / s;
+}
+
+/* A unit cube of 2 x 2 x 2 trilinear cells (8 sub-cell samples each) with the symmetry
+   planes x, y, z = 0 held. Displacement control first: the face z = 1 held at the stretch
+   s0 (the start state scaled in z), which gives the reactions R_i of its frames and the
+   nominal stress P = sum R_i (the model's own, discretisation included). Then load
+   control on a fresh model: the loads R_i on that face, the whole load in one call
+   (max_increments 1: the solver as it was, a single Newton run). Returns the load-control
+   solve's code, its stretch *s and the displacement-control stress *P. */
+static int cube_uniaxial(frm_law law, double E, double nu, double s0, int max_increments, double *s, double *P)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, z = 0;
+    scene sc;
+    frm_real g[3] = {0, 0, 0}, *x, *q, *load;
+    const frm_real *f;
+    int i, n, c = 0, err, pass;
+    *s = 0;
+    *P = 0;
+    if (scene_hex(&sc, lo, hi, 2, 2, 2, 2, law, E, nu, 1000, FRM_STIFFNESS_AUTO) != FRM_OK) return -100;
+    n = frm_model_frame_count(sc.m);
+    load = alloc_reals(n);
+    for (pass = 0; pass < 2; pass++) {
+        if (pass) {
+            frm_model_destroy(sc.m);
+            sc.d.max_increments = max_increments;
+            if (frm_model_create(&sc.d, &sc.m) != FRM_OK) return -100;
+        }
+        frm_model_set_gravity(sc.m, g);
+        symmetry_planes(sc.m, &sc.s, 7);
+        if (!pass) {
+            int step, steps = (int)ceil(fabs(s0 - 1) / 0.1 - 1e-9);
+            for (i = 0; i < n; i++)
+                if (sc.s.frame_positions[3 * i + 2] == 1) { /* add z to the symmetry planes' axes */
+                    int axes = frm_model_frame_axes(sc.m, i);
+                    CHECK_INT(FRM_OK, frm_model_set_frame_axes(sc.m, i, (unsigned)(axes & 7) | 4u, (unsigned)axes >> 3));
+                }
+            err = FRM_OK;
+            for (step = 1; step <= steps && !err; step++) { /* the held face moved in steps of 0.1 at most */
+                get_poses(sc.m, &x, &q);
+                for (i = 0; i < n; i++)
+                    if (sc.s.frame_positions[3 * i + 2] == 1) x[3 * i + 2] = (frm_real)(1 + (s0 - 1) * step / steps);
+                frm_model_set_poses(sc.m, x, q);
+                free(x);
+                free(q);
+                err = frm_model_solve_static(sc.m);
+            }
+            if (err) break;
+            if (frm_model_total_forces(sc.m, &f) != FRM_OK) return -100;
+            for (i = 0; i < n; i++) {
+                load[i] = sc.s.frame_positions[3 * i + 2] == 1 ? -f[6 * i + 2] : 0;
+                *P += (double)load[i];
+            }
+            continue;
+        }
+        for (i = 0; i < n; i++)
+            if (load[i] != 0) {
+                frm_real fz[3] = {0, 0, 0};
+                fz[2] = load[i];
+                CHECK_INT(FRM_OK, frm_model_set_external(sc.m, i, fz, NULL));
+            }
+        err = frm_model_solve_static(sc.m);
+        for (i = 0; i < n; i++)
+            if (sc.s.frame_positions[3 * i + 2] == 1) z += frm_model_positions(sc.m)[3 * i + 2], c++;
+        *s = z / c;
+    }
+    free(load);
+    scene_free(&sc);
+    return err;
+}
+
+/* Item 4: uniaxial load control of a cube (symmetry planes, a load on the top face, one
+   call), St Venant-Kirchhoff and Neo-Hookean, nu 0.3 and 0.45, stretches 0.7 (Neo-Hookean)
+   or 0.75 to 1.5: every solve converges to the stretch its load came from (displacement
+   control of the same model), and that stress against the closed form R4 / R5 at the
+   computed stretch is printed (the 2-cell discretisation's error). Printed too: how many
+   of the s = 0.9 cases a single increment fails (measured: none; the stalls came from the
+   former line search and stall rule). */
+static void test_i18_cube_uniaxial_load(void)
+{
+    static const double stretches[7] = {0.7, 0.75, 0.8, 0.9, 1.1, 1.25, 1.5};
+    static const double nus[2] = {0.3, 0.45};
+    int law, k, j, cases = 0, single_failed = 0, errors = 0;
+    double worst = 0, worst_closed = 0, E = 1e6;
+    for (law = 0; law < 2; law++)
+        for (j = 0; j < 2; j++)
+            for (k = (law == FRM_LAW_SVK); k < 7; k += TEST_IS_QUICK ? 3 : 1) {
+                double target = stretches[k], P, s, rel, closed;
+                int err = cube_uniaxial((frm_law)law, E, nus[j], target, 64, &s, &P);
+                /* at 0.7 and 1.5 the hexahedral frames' invisible rotations (LIMITS) may end the solve
+                   in an error code: allowed, never a wrong success */
+                if (err && (k == 0 || k == 6)) {
+                    errors++;
+                    continue;
+                }
+                CHECK_INT(FRM_OK, err);
+                rel = fabs(s - target) / fabs(target - 1);
+                closed = fabs(uniaxial_stress((frm_law)law, E, nus[j], s) - P) / fabs(P);
+                if (rel > worst) worst = rel;
+                if (closed > worst_closed) worst_closed = closed;
+                CHECK(rel < (IS_FLOAT ? 1e-3 : 1e-5));
+                if (k == 3) /* one case per law and nu: the single increment (the solver before the continuation) */
+                    single_failed += cube_uniaxial((frm_law)law, E, nus[j], target, 1, &s, &P) != FRM_OK;
+                cases++;
+            }
+    printf("    %d load cases converged, worst |s - s0| / |s0 - 1| %.2e (closed form R4/R5 at s: %.1f %%, the 2-cell "
+           "discretisation); one increment only: %d failed; %d extreme cases ended in an error code\n", cases, worst,
+           100 * worst_closed, single_failed, errors);
+}
+
+/* Per-axis constraints: a hexahedral beam under gravity solved whole and as its half
+   y >= 0 with the symmetry plane y = 0 held (normal translation, in-plane rotations): the
+   same sag. */
+static void test_i18_symmetry_half(void)
+{
+    double lo[3] = {0, -0.1, -0.05}, hi[3] = {1, 0.1, 0.05}, tip[2];
+    frm_real g[3] = {0, 0, (frm_real)-0.02};
+    int half;
+    for (half = 0; half < 2; half++) {
+        scene sc;
+        if (half) lo[1] = 0;
+        REQUIRE(scene_hex(&sc, lo, hi, 8, half ? 1 : 2, 2, 2, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+        clamp_beam(sc.m, &sc.s);
+        if (half) symmetry_planes(sc.m, &sc.s, 2);
+        REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+        REQUIRE(frm_model_set_solver(sc.m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-10), 1000, (frm_real)(IS_FLOAT ? 1e-5 : 1e-10), 30) ==
+                FRM_OK);
+        CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+        { /* the frame at the centre of the end face (the face averages differ: half has no y < 0 row) */
+            int i;
+            for (i = 0; i < sc.s.frame_count; i++)
+                if (sc.s.frame_positions[3 * i] == 1 && sc.s.frame_positions[3 * i + 1] == 0 && sc.s.frame_positions[3 * i + 2] == 0)
+                    tip[half] = -(double)frm_model_positions(sc.m)[3 * i + 2];
+        }
+        scene_free(&sc);
+    }
+    printf("    tip sag: whole %.6f m, half with the symmetry plane %.6f m\n", tip[0], tip[1]);
+    CHECK(tip[0] > 1e-3);
+    CHECK_REL(tip[0], tip[1], IS_FLOAT ? 1e-3 : 1e-6);
+}
+
+/* Cook's membrane (R10) in plane strain (every frame's z translation and x, y rotations
+   held), Neo-Hookean mu = 80.194 MPa, K = 400,942 MPa (nu = 0.4999), F = 100 N on the
+   right edge of a 1 mm slab, tetrahedral frames: the solve converges in one call (the
+   continuation finds its increments) with its residual within the tolerance. Locked
+   linear tetrahedra stay far below the ~6.9 mm of mixed elements; printed, not checked. */
+static void test_i18_cook_membrane(void)
+{
+    int n = TEST_IS_QUICK ? 4 : 8, i, err, single;
+    tetmesh t;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, mu = 80.194e6, K = 400942e6, nu, E, res = 0, load = 0, reaction = 0;
+    double corner = 0;
+    frm_real *x;
+    frm_real g[3] = {0, 0, 0};
+    for (single = 0; single < 2; single++) {
+        scene sc;
+        const frm_stats *st;
+        memset(&sc, 0, sizeof sc);
+        REQUIRE(tetmesh_box(&t, lo, hi, n, n, 1, TETMESH_SPLIT6) == TETMESH_OK);
+        x = alloc_reals(3 * t.node_count);
+        for (i = 0; i < t.node_count; i++) { /* (xi, eta, zeta) to the tapered panel, m */
+            double xi = t.nodes[3 * i], eta = t.nodes[3 * i + 1];
+            x[3 * i] = (frm_real)(0.048 * xi);
+            x[3 * i + 1] = (frm_real)(0.044 * xi + eta * (0.044 + 0.016 * xi - 0.044 * xi));
+            x[3 * i + 2] = (frm_real)(0.001 * t.nodes[3 * i + 2]);
+        }
+        REQUIRE(frm_sampling_tets(&sc.s, x, t.node_count, t.tets, t.tet_count, 1, NULL, NULL) == FRM_OK);
+        free(x);
+        tetmesh_free(&t);
+        nu = (3 * K - 2 * mu) / (2 * (3 * K + mu));
+        E = 2 * mu * (1 + nu);
+        REQUIRE(scene_create(&sc, FRM_LAW_NEO_HOOKEAN, E, nu, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+        if (single) {
+            frm_model_destroy(sc.m);
+            sc.d.max_increments = 1;
+            REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+        }
+        REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+        REQUIRE(frm_model_set_solver(sc.m, sc.d.cg_tolerance, 20000, sc.d.newton_tolerance, sc.d.newton_max_iterations) ==
+                FRM_OK);
+        for (i = 0; i < sc.s.frame_count; i++) {
+            if (sc.s.frame_positions[3 * i] == 0) REQUIRE(frm_model_fix_frame(sc.m, i) == FRM_OK);
+            else REQUIRE(frm_model_set_frame_axes(sc.m, i, 4, 3) == FRM_OK);
+        }
+        for (i = 0; i < sc.s.frame_count; i++) /* F = 100 N over the right edge: end nodes carry half a share */
+            if (fabs(sc.s.frame_positions[3 * i] - 0.048) < 1e-6) {
+                double y = sc.s.frame_positions[3 * i + 1], share = (fabs(y - 0.044) < 1e-6 || fabs(y - 0.060) < 1e-6) ? 0.5 : 1;
+                frm_real f[3] = {0, 0, 0};
+                f[1] = (frm_real)(100.0 * share / (2.0 * n));
+                REQUIRE(frm_model_set_external(sc.m, i, f, NULL) == FRM_OK);
+            }
+        err = frm_model_solve_static(sc.m);
+        st = frm_model_last_stats(sc.m);
+        if (single) {
+            printf("    one increment only (as before): %s\n", frm_error_string(err));
+            scene_free(&sc);
+            break;
+        }
+        CHECK_INT(FRM_OK, err);
+        residual_parts(sc.m, &res, &load, &reaction);
+        for (i = 0; i < sc.s.frame_count; i++)
+            if (fabs(sc.s.frame_positions[3 * i] - 0.048) < 1e-6 && fabs(sc.s.frame_positions[3 * i + 1] - 0.060) < 1e-6)
+                corner = frm_model_positions(sc.m)[3 * i + 1] - sc.s.frame_positions[3 * i + 1];
+        printf("    Cook %d x %d: corner u_y %.3f mm, %d increments (%d cut), %d Newton, |f| / scale %.2g\n", n, n,
+               1e3 * corner, st->increments, st->increment_cuts, st->newton_iterations,
+               res / (load > reaction ? load : reaction));
+        /* float may stop at the round-off floor just above the tolerance (see SOLVERS) */
+        CHECK(res <= (double)sc.d.newton_tolerance * (load > reaction ? load : reaction) * (IS_FLOAT ? 10 : 1.0001));
+        CHECK(corner > 1e-3 && corner < 8e-3);
+        scene_free(&sc);
+    }
+}
+
+/* Item 4: nearly incompressible Neo-Hookean beams (nu = 0.49 and 0.4999, tip sag about
+   10 % of the length) with tetrahedral frames, and the soft cantilever R2 with tetrahedral
+   frames at the default solver settings: each static solve converges in one call.
+   (Hexahedral frames need the stabilisation of their invisible rotations for this, see
+   LIMITS: they end in an error code, never in a wrong success.) */
+static void test_i18_static_extremes(void)
+{
+    static const double nus[2] = {0.49, 0.4999};
+    int j, hex;
+    for (hex = 0; hex < 1; hex++)
+        for (j = 0; j < (TEST_IS_QUICK ? 1 : 2); j++) {
+            scene sc;
+            frm_real g[3] = {0, 0, (frm_real)-0.1};
+            int err;
+            const frm_stats *st;
+            if (hex) REQUIRE(scene_beam(&sc, 1, 0.1, 0.1, 10, 2, 2, 2, FRM_QUADRATURE_SUBCELL, FRM_LAW_NEO_HOOKEAN, 1e5, nus[j], 1000) == FRM_OK);
+            else REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_NEO_HOOKEAN, 1e5, nus[j], 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+            clamp_face(sc.m, &sc.s);
+            REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+            err = frm_model_solve_static(sc.m);
+            st = frm_model_last_stats(sc.m);
+            printf("    %s beam nu = %g: %s, tip %.4f m, %d increments (%d cut), %d Newton\n", hex ? "hex" : "tet", nus[j],
+                   frm_error_string(err), -end_face_z(sc.m, &sc.s, 1), st->increments, st->increment_cuts,
+                   st->newton_iterations);
+            if (IS_FLOAT && nus[j] > 0.495) /* float CG cannot resolve nu = 0.4999's conditioning: a code, not a wrong answer */
+                CHECK(err == FRM_OK || err == FRM_ERR_NO_CONVERGENCE);
+            else
+                CHECK_INT(FRM_OK, err);
+            scene_free(&sc);
+        }
+    {
+        scene sc;
+        int i, err;
+        const frm_stats *st;
+        REQUIRE(scene_tet(&sc, 16, 1, 1, 16, 1, 1, 4, FRM_LAW_SVK, 40e3, 0.3) == FRM_OK);
+        frm_model_destroy(sc.m);
+        for (i = 0; i < sc.s.frame_count; i++) sc.s.frame_positions[3 * i + 1] -= (frm_real)0.5, sc.s.frame_positions[3 * i + 2] -= (frm_real)0.5;
+        for (i = 0; i < sc.s.sample_count; i++) sc.s.sample_positions[3 * i + 1] -= (frm_real)0.5, sc.s.sample_positions[3 * i + 2] -= (frm_real)0.5;
+        REQUIRE(scene_create(&sc, FRM_LAW_SVK, 40e3, 0.3, 5.0 / 16, FRM_STIFFNESS_AUTO) == FRM_OK);
+        clamp_beam(sc.m, &sc.s);
+        err = frm_model_solve_static(sc.m);
+        st = frm_model_last_stats(sc.m);
+        printf("    R2 16 x 1 x 1 tetrahedral frames, default settings: %s, tip %.4f m, %d increments, %d Newton\n",
+               frm_error_string(err), -end_face_z(sc.m, &sc.s, 16), st->increments, st->newton_iterations);
+        CHECK_INT(FRM_OK, err);
+        CHECK(-end_face_z(sc.m, &sc.s, 16) > 4 && -end_face_z(sc.m, &sc.s, 16) < 6);
+        scene_free(&sc);
+    }
+}
+
+/* Item 10: a body moved 1e6 m from rest. In float the rounding of the state fakes strains
+   far above precision_limit: the step and the static solve return FRM_ERR_PRECISION and
+   keep the state (before: success, ghost forces moving the body). In double the solve
+   converges to the sag of the body at rest. */
+static void test_i18_far_from_origin(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5}, sag[2];
+    int off;
+    for (off = 0; off < 2; off++) {
+        scene sc;
+        frm_real *x, *q;
+        int n, i, err;
+        REQUIRE(scene_hex(&sc, lo, hi, 2, 1, 1, 2, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+        n = frm_model_frame_count(sc.m);
+        get_poses(sc.m, &x, &q);
+        for (i = 0; i < n; i++) x[3 * i] = (frm_real)((double)x[3 * i] + 1e6 * off);
+        REQUIRE(frm_model_set_poses(sc.m, x, q) == FRM_OK);
+        clamp_beam(sc.m, &sc.s);
+        if (off && IS_FLOAT) {
+            err = frm_model_step(sc.m);
+            CHECK_INT(FRM_ERR_PRECISION, err);
+            CHECK(memcmp(x, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+            CHECK_INT(FRM_ERR_PRECISION, frm_model_solve_static(sc.m));
+            CHECK(memcmp(x, frm_model_positions(sc.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+            frm_model_destroy(sc.m);
+            sc.d.precision_limit = 0; /* the check off: what the solver did before */
+            REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+            REQUIRE(frm_model_set_poses(sc.m, x, q) == FRM_OK);
+            clamp_beam(sc.m, &sc.s);
+            err = frm_model_solve_static(sc.m);
+            printf("    float, 1e6 m out, check off: %s, sag %.4f m (at rest: %.6f m)\n", frm_error_string(err),
+                   0.25 - end_face_z(sc.m, &sc.s, 1), sag[0]);
+            sag[1] = sag[0];
+        } else {
+            CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+            sag[off] = 0.25 - end_face_z(sc.m, &sc.s, 1);
+        }
+        free(x);
+        free(q);
+        scene_free(&sc);
+    }
+    printf("    sag at rest %.8f m, 1e6 m out %.8f m\n", sag[0], sag[1]);
+    CHECK_REL(sag[0], sag[1], 1e-6);
+}
+
+/* Implicit Euler at a large step: one step of 1e3 s from rest is the static equilibrium
+   (the inertia M v / dt vanishes), here a soft tetrahedral beam sagging about 10 % of its
+   length. The Newton step meets the static solve; the linearised step (implicit_linearized
+   = 1, one iteration) is printed for comparison. */
+static void test_i18_implicit_large_step(void)
+{
+    scene sc;
+    double tip_static, tip_newton, tip_linear;
+    frm_real g[3] = {0, 0, (frm_real)-0.1};
+    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_NEO_HOOKEAN, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+    tip_static = -end_face_z(sc.m, &sc.s, 1);
+    frm_model_destroy(sc.m);
+    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_step_ex(sc.m, (frm_real)1e3));
+    tip_newton = -end_face_z(sc.m, &sc.s, 1);
+    printf("    one step of 1e3 s: %d Newton, residual %.2g of its scale\n", frm_model_last_stats(sc.m)->newton_iterations,
+           (double)frm_model_last_stats(sc.m)->residual);
+    frm_model_destroy(sc.m);
+    sc.d.implicit_linearized = 1;
+    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+    clamp_face(sc.m, &sc.s);
+    REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+    CHECK_INT(FRM_OK, frm_model_step_ex(sc.m, (frm_real)1e3));
+    tip_linear = -end_face_z(sc.m, &sc.s, 1);
+    printf("    tip: static %.6f m, Newton implicit step %.6f m, linearised step %.6f m\n", tip_static, tip_newton, tip_linear);
+    CHECK(tip_static > 0.05);
+    CHECK_REL(tip_static, tip_newton, IS_FLOAT ? 1e-3 : 1e-4);
+    scene_free(&sc);
+}
+
+/* A reduced stress sweep: E from 1 Pa to 200 GPa, nu from 0 to 0.4999, a small tetrahedral
+   beam under its own weight (static solve; implicit steps of 1e-6, 1e-2 and 1 s from rest)
+   and a cube squashed to half its height (static, driven top face, Neo-Hookean). Every run
+   either returns an error code or agrees with the same run at a 100 times finer
+   tolerance: never success with a wrong answer. */
+static void test_i18_stress_sweep(void)
+{
+    static const double youngs[3] = {1, 1e6, 2e11}, nus[3] = {0, 0.3, 0.4999}, steps[3] = {1e-6, 1e-2, 1};
+    int e, j, mode, fine, runs = 0, ok_runs = 0, errors = 0;
+    double worst = 0;
+    for (e = 0; e < 3; e++)
+        for (j = 0; j < 3; j++)
+            for (mode = 0; mode < 5; mode += TEST_IS_QUICK ? 2 : 1) {
+                double result[2] = {0, 0}, scale = 0;
+                int err[2] = {0, 0};
+                for (fine = 0; fine < 2; fine++) {
+                    scene sc;
+                    int i;
+                    double ntol = (double)frm_model_default_desc().newton_tolerance * (fine ? 0.01 : 1);
+                    double ctol = (double)frm_model_default_desc().cg_tolerance * (fine ? 0.01 : 1);
+                    if (mode < 4)
+                        REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 4, 1, 1, FRM_LAW_NEO_HOOKEAN, youngs[e], nus[j], 1000, FRM_STIFFNESS_AUTO) ==
+                                FRM_OK);
+                    else {
+                        double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+                        REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, youngs[e], nus[j], 1000, FRM_STIFFNESS_AUTO) ==
+                                FRM_OK);
+                    }
+                    REQUIRE(frm_model_set_solver(sc.m, (frm_real)ctol, 20000, (frm_real)ntol, 30) == FRM_OK);
+                    if (mode < 4) clamp_beam(sc.m, &sc.s);
+                    else
+                        for (i = 0; i < sc.s.frame_count; i++) {
+                            const frm_real *x = sc.s.frame_positions + 3 * i;
+                            if (x[2] == 0) frm_model_fix_frame(sc.m, i);
+                            if (x[2] == 1) {
+                                frm_real p[3], q[4] = {0, 0, 0, 1};
+                                p[0] = x[0], p[1] = x[1], p[2] = (frm_real)0.5;
+                                frm_model_drive_frame(sc.m, i, p, q);
+                            }
+                        }
+                    if (mode == 0 || mode == 4) err[fine] = frm_model_solve_static(sc.m);
+                    else err[fine] = frm_model_step_ex(sc.m, (frm_real)steps[mode - 1]);
+                    if (mode < 4) {
+                        result[fine] = end_face_z(sc.m, &sc.s, 1);
+                        scale = mode == 0 ? 1.0 : 9.81 * steps[mode - 1] * steps[mode - 1];
+                    } else { /* the squashed cube: the bulge of its last frame (a corner of the top face) */
+                        result[fine] = frm_model_positions(sc.m)[3 * (sc.s.frame_count - 1)];
+                        scale = 1;
+                    }
+                    scene_free(&sc);
+                    if (err[0]) break; /* an error code: nothing to compare */
+                }
+                runs++;
+                if (err[0]) {
+                    errors++;
+                    continue;
+                }
+                ok_runs++;
+                if (err[1] == FRM_OK) {
+                    double d = fabs(result[0] - result[1]) / scale;
+                    if (d > worst) worst = d;
+                    if (!(d < (IS_FLOAT ? 1e-2 : 1e-3)))
+                        printf("    E %g nu %g mode %d: %.9g against %.9g (fine)\n", youngs[e], nus[j], mode, result[0], result[1]);
+                    CHECK(d < (IS_FLOAT ? 1e-2 : 1e-3));
+                }
+            }
+    printf("    %d runs: %d converged (worst difference to the 100 x finer run %.2g of its scale), %d error codes\n", runs,
+           ok_runs, worst, errors);
+}
+
+/* The new solver settings are validated at creation (FRM_ERR_SOLVER), and held axes take
+   only masks of three bits on free frames; fixing, driving or releasing clears them. */
+static void test_i18_settings_validation(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    scene sc;
+    frm_desc d;
+    frm_real p[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1};
+    REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 1, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    d = sc.d;
+    d.max_increments = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.min_increment = 0;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d.min_increment = (frm_real)1.5;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.precision_limit = -1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    d = sc.d;
+    d.implicit_linearized = 2;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&d));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 8, 0));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 0, 9));
+    CHECK_INT(FRM_ERR_FRAME_RANGE, frm_model_set_frame_axes(sc.m, 99, 1, 0));
+    CHECK_INT(FRM_OK, frm_model_set_frame_axes(sc.m, 0, 5, 2));
+    CHECK_INT(5 | 2 << 3, frm_model_frame_axes(sc.m, 0));
+    CHECK_INT(FRM_OK, frm_model_fix_frame(sc.m, 0));
+    CHECK_INT(0, frm_model_frame_axes(sc.m, 0));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_frame_axes(sc.m, 0, 1, 0)); /* fixed */
+    CHECK_INT(FRM_OK, frm_model_release_frame(sc.m, 0));
+    CHECK_INT(FRM_OK, frm_model_set_frame_axes(sc.m, 0, 1, 0));
+    CHECK_INT(FRM_OK, frm_model_drive_frame(sc.m, 0, p, q));
+    CHECK_INT(0, frm_model_frame_axes(sc.m, 0));
+    scene_free(&sc);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -2381,6 +3137,18 @@ static const test_case cases[] = {
     TEST(test_no_allocation_after_create),
     TEST(test_validation_errors),
     TEST(test_error_strings),
+    TEST(test_i18_huge_load),
+    TEST(test_i18_residual_scale),
+    TEST(test_i18_gravity_weight),
+    TEST(test_i18_implicit_recurrence),
+    TEST(test_i18_cube_uniaxial_load),
+    TEST(test_i18_symmetry_half),
+    TEST(test_i18_cook_membrane),
+    TEST(test_i18_static_extremes),
+    TEST(test_i18_far_from_origin),
+    TEST(test_i18_implicit_large_step),
+    TEST(test_i18_stress_sweep),
+    TEST(test_i18_settings_validation),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
