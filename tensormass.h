@@ -478,7 +478,7 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_TET_INVERTED, -10, "negatively oriented rest tetrahedron") \
     X(TMASS_ERR_NONMANIFOLD, -11, "a triangle is shared by more than two tetrahedra") \
     X(TMASS_ERR_YOUNG_MODULUS, -12, "Young's modulus not finite and > 0") \
-    X(TMASS_ERR_POISSON_RATIO, -13, "Poisson ratio outside (-1, 0.5)") \
+    X(TMASS_ERR_POISSON_RATIO, -13, "Poisson ratio outside (-1, 0.5), or too close to 0.5 for float (above 0.4994)") \
     X(TMASS_ERR_DENSITY, -14, "density not finite and > 0") \
     X(TMASS_ERR_TIME_STEP, -15, "time step not finite and > 0") \
     X(TMASS_ERR_DAMPING, -16, "damping coefficient not finite and >= 0") \
@@ -608,6 +608,9 @@ typedef struct tmass_stats {
                                solves and implicit steps; explicit steps do not count: 0) */
     int force_evaluations;  /* force passes (elastic force or spring force + tangent) */
     int stiffness_products; /* K times vector products (CG iterations and setup) */
+    tmass_real cg_condition; /* (tensormass extra) estimated condition number of the
+                                Jacobi-scaled matrix, largest over the call's linear
+                                solves (see SOLVERS: LIMITS OF FLOAT) */
 } tmass_stats;
 
 /* Energies of the current state (tmass_energy). */
@@ -906,6 +909,9 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #define TMASS__COOKIE 0x544D4153u /* "TMAS" */
 #define TMASS__ALIGN 64
 #define TMASS__VEC_BLOCK 4096 /* reals per block of vector loops and dot partial sums */
+#define TMASS__EPS (sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON)
+/* largest eps(tmass_real) lambda / mu the tensor model accepts (LIMITS; float: nu <= 0.4994) */
+#define TMASS__LAMBDA_MU_LIMIT 1e-4
 #define TMASS__SCRATCH 10      /* 3n scratch vectors */
 
 /* node states */
@@ -1196,6 +1202,13 @@ static int tmass__validate_material(const tmass_desc *d, double E, double nu, in
     }
     if (d->kind == TMASS_TENSOR_MASS && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
         snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
+       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
+    if (d->kind == TMASS_TENSOR_MASS && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
+        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
+                 nu, t);
         return TMASS_ERR_POISSON_RATIO;
     }
     return TMASS_OK;
@@ -2082,7 +2095,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     tmass__cg_ctx k;
     int n3 = 3 * m->node_count, i, it, blocks = m->partial_count;
     tmass_real *pinv = s[4];
-    double bb = 0.0, rr, rz, tol2;
+    double bb = 0.0, rr, rz, tol2, pdp, rho_min = HUGE_VAL, rho_max = 0.0;
     k.m = m;
     k.r = s[0];
     k.z = s[1];
@@ -2131,8 +2144,9 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         rr += (double)k.r[i] * k.r[i];
         rz += (double)k.r[i] * k.z[i];
     }
+    pdp = rz; /* p . D p for p = z: r . z */
     for (it = 0; it < m->cg_max_iterations && rr > tol2; it++) {
-        double pq, rz_new;
+        double pq, rz_new, rho;
         tmass__matvec(m, k.p, k.q);
         tmass__run(m, blocks, tmass__cg_apply, &k);
         pq = tmass__sum_partials(m, 0);
@@ -2145,6 +2159,11 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             m->cg_indefinite = 1;
             break;
         }
+        /* the Rayleigh quotient of D^-1 A along p (D the Jacobi diagonal) lies between
+           its extreme eigenvalues: their ratio bounds cond from below */
+        rho = pq / pdp;
+        if (rho > rho_max) rho_max = rho;
+        if (rho < rho_min) rho_min = rho;
         k.alpha = rz / pq;
         tmass__run(m, blocks, tmass__cg_update, &k);
         rr = tmass__sum_partials(m, 0);
@@ -2155,6 +2174,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             break;
         }
         k.beta = rz_new / rz;
+        pdp = rz_new + k.beta * k.beta * pdp; /* z_new . D p_old = r_new . p_old = 0 */
         rz = rz_new;
         tmass__run(m, blocks, tmass__cg_direction, &k);
     }
@@ -2163,6 +2183,8 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     m->stats.cg_residual = (tmass_real)sqrt(rr / bb);
     m->stats.stiffness_products += it + 1;
     m->stats.negative_curvature += m->cg_indefinite;
+    if (rho_max > 0.0 && rho_min > 0.0 && rho_max / rho_min > (double)m->stats.cg_condition)
+        m->stats.cg_condition = (tmass_real)(rho_max / rho_min);
     if (rr <= tol2) return TMASS_OK;
     return tmass__finite(rr) ? TMASS_ERR_NO_CONVERGENCE : TMASS_ERR_NOT_FINITE;
 }
