@@ -131,7 +131,11 @@
    newton_iterations, cg_iterations, cg_residual, residual, increments, increment_cuts,
    line_search_cuts, negative_curvature, inverted, force_evaluations, stiffness_products.
        Linear solves: Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
-       1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS).
+       1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS). Its
+       dot products accumulate in double. A relative residual does not bound the error
+       (error <= cond |r| / |b|): in float, nearly incompressible materials are refused at
+       creation for that reason (LIMITS); stats.cg_condition is a lower bound of the
+       Jacobi-scaled condition number, the largest over the call's solves.
        Tensor-mass static solve: the model is linear, so one converged CG solve is the
        exact answer of the model (newton_iterations = increments = 1, residual = 0). It is
        accepted whatever the deformation: tetrahedra that end inverted are counted in
@@ -318,6 +322,21 @@
          |u| of about 200 m; in double never in practice). Re-create the model at the new
          place, or use double. Float also cannot represent a step that moves the body by
          less than eps |u|: at dt = 1e-6 s a float body may not move at all.
+       - Near incompressibility in float: the tensors are stored in tmass_real, and
+         rounding them perturbs the shear (bending) stiffness by about eps lambda / mu,
+         which a nearly incompressible body amplifies. Float builds refuse eps lambda / mu
+         > 1e-4, nu > 0.4994, at creation (TMASS_ERR_POISSON_RATIO; double: nu >
+         0.5 - 1e-12, never in practice). Measured on a 1 x 0.1 x 0.1 m beam of 20 x 2 x 2
+         five-tet cells against a double P1 solve of the same mesh: at nu = 0.4999 the
+         float-stored K, solved exactly, is 1.8 % off at the tip, and float's static
+         solve and damped implicit steps returned success 1.1 % off (their CG also cannot
+         resolve it: the true residual was 55 |b| when CG's recursive one read 8.6e-6).
+         At nu = 0.499 float is within 0.05 % (0.2 % at 40 x 4 x 4 cells), at 0.45 within
+         0.007 %. No check on a single solve can catch this: an implicit step's matrix
+         M + dt^2 K is well conditioned, and the steps converge to the float K's
+         equilibrium. stats.cg_condition reports a lower bound of the Jacobi-scaled
+         condition number (Rayleigh quotients of CG's directions) for information; it
+         underestimates by 30 to 200 times and is not used to refuse anything.
        - Tetrahedra inverted by a large load are counted (stats.inverted) but not refused
          by the linear model (see SOLVERS).
        - Inactive (cut-off) vertices keep their last position and do not move.
@@ -337,7 +356,9 @@
              desc fields newton_iterations, newton_tolerance, divergence_strain,
              precision_limit; TMASS_IMPLICIT_EULER_LINEARIZED; springs' static
              continuation and Newton implicit Euler; the common stats struct; every
-             entry point renamed in float builds.
+             entry point renamed in float builds. Float builds refuse nu > 0.4994 (the
+             float-stored tensors were 1-2 % off at nu = 0.4999, with success codes);
+             stats.cg_condition.
        0.2.0 (2026-12-01) precomputed quasi-static model (save/load, progress) and the
              hybrid model; compliance columns precomputed 8 per CG sweep. Springs: the
              stretch without cancellation (float static solves of stiff meshes used to
@@ -552,7 +573,7 @@ typedef struct tmass_desc {
 
     /* material */
     tmass_real young_modulus;             /* Pa, default 1e4 (soft tissue) */
-    tmass_real poisson_ratio;             /* in (-1, 0.5), default 0.3 */
+    tmass_real poisson_ratio;             /* in (-1, 0.5) (float: <= 0.4994, LIMITS), default 0.3 */
     const tmass_real *tet_young_modulus;  /* optional per-tet Pa (tet_count values) or NULL */
     const tmass_real *tet_poisson_ratio;  /* optional per-tet ratio or NULL */
     tmass_real density;                   /* kg/m^3, default 1000 */
@@ -610,7 +631,7 @@ typedef struct tmass_stats {
     int stiffness_products; /* K times vector products (CG iterations and setup) */
     tmass_real cg_condition; /* (tensormass extra) estimated condition number of the
                                 Jacobi-scaled matrix, largest over the call's linear
-                                solves (see SOLVERS: LIMITS OF FLOAT) */
+                                solves; a lower bound, see SOLVERS and LIMITS) */
 } tmass_stats;
 
 /* Energies of the current state (tmass_energy). */
