@@ -131,7 +131,11 @@
    newton_iterations, cg_iterations, cg_residual, residual, increments, increment_cuts,
    line_search_cuts, negative_curvature, inverted, force_evaluations, stiffness_products.
        Linear solves: Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
-       1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS).
+       1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS). Its
+       dot products accumulate in double. A relative residual does not bound the error
+       (error <= cond |r| / |b|): in float, nearly incompressible materials are refused at
+       creation for that reason (LIMITS); stats.cg_condition is a lower bound of the
+       Jacobi-scaled condition number, the largest over the call's solves.
        Tensor-mass static solve: the model is linear, so one converged CG solve is the
        exact answer of the model (newton_iterations = increments = 1, residual = 0). It is
        accepted whatever the deformation: tetrahedra that end inverted are counted in
@@ -318,6 +322,21 @@
          |u| of about 200 m; in double never in practice). Re-create the model at the new
          place, or use double. Float also cannot represent a step that moves the body by
          less than eps |u|: at dt = 1e-6 s a float body may not move at all.
+       - Near incompressibility in float: the tensors are stored in tmass_real, and
+         rounding them perturbs the shear (bending) stiffness by about eps lambda / mu,
+         which a nearly incompressible body amplifies. Float builds refuse eps lambda / mu
+         > 1e-4, nu > 0.4994, at creation (TMASS_ERR_POISSON_RATIO; double: nu >
+         0.5 - 1e-12, never in practice). Measured on a 1 x 0.1 x 0.1 m beam of 20 x 2 x 2
+         five-tet cells against a double P1 solve of the same mesh: at nu = 0.4999 the
+         float-stored K, solved exactly, is 1.8 % off at the tip, and float's static
+         solve and damped implicit steps returned success 1.1 % off (their CG also cannot
+         resolve it: the true residual was 55 |b| when CG's recursive one read 8.6e-6).
+         At nu = 0.499 float is within 0.05 % (0.2 % at 40 x 4 x 4 cells), at 0.45 within
+         0.007 %. No check on a single solve can catch this: an implicit step's matrix
+         M + dt^2 K is well conditioned, and the steps converge to the float K's
+         equilibrium. stats.cg_condition reports a lower bound of the Jacobi-scaled
+         condition number (Rayleigh quotients of CG's directions) for information; it
+         underestimates by 30 to 200 times and is not used to refuse anything.
        - Tetrahedra inverted by a large load are counted (stats.inverted) but not refused
          by the linear model (see SOLVERS).
        - Inactive (cut-off) vertices keep their last position and do not move.
@@ -337,7 +356,9 @@
              desc fields newton_iterations, newton_tolerance, divergence_strain,
              precision_limit; TMASS_IMPLICIT_EULER_LINEARIZED; springs' static
              continuation and Newton implicit Euler; the common stats struct; every
-             entry point renamed in float builds.
+             entry point renamed in float builds. Float builds refuse nu > 0.4994 (the
+             float-stored tensors were 1-2 % off at nu = 0.4999, with success codes);
+             stats.cg_condition.
        0.2.0 (2026-12-01) precomputed quasi-static model (save/load, progress) and the
              hybrid model; compliance columns precomputed 8 per CG sweep. Springs: the
              stretch without cancellation (float static solves of stiff meshes used to
@@ -478,7 +499,7 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_TET_INVERTED, -10, "negatively oriented rest tetrahedron") \
     X(TMASS_ERR_NONMANIFOLD, -11, "a triangle is shared by more than two tetrahedra") \
     X(TMASS_ERR_YOUNG_MODULUS, -12, "Young's modulus not finite and > 0") \
-    X(TMASS_ERR_POISSON_RATIO, -13, "Poisson ratio outside (-1, 0.5)") \
+    X(TMASS_ERR_POISSON_RATIO, -13, "Poisson ratio outside (-1, 0.5), or too close to 0.5 for float (above 0.4994)") \
     X(TMASS_ERR_DENSITY, -14, "density not finite and > 0") \
     X(TMASS_ERR_TIME_STEP, -15, "time step not finite and > 0") \
     X(TMASS_ERR_DAMPING, -16, "damping coefficient not finite and >= 0") \
@@ -552,7 +573,7 @@ typedef struct tmass_desc {
 
     /* material */
     tmass_real young_modulus;             /* Pa, default 1e4 (soft tissue) */
-    tmass_real poisson_ratio;             /* in (-1, 0.5), default 0.3 */
+    tmass_real poisson_ratio;             /* in (-1, 0.5) (float: <= 0.4994, LIMITS), default 0.3 */
     const tmass_real *tet_young_modulus;  /* optional per-tet Pa (tet_count values) or NULL */
     const tmass_real *tet_poisson_ratio;  /* optional per-tet ratio or NULL */
     tmass_real density;                   /* kg/m^3, default 1000 */
@@ -608,6 +629,9 @@ typedef struct tmass_stats {
                                solves and implicit steps; explicit steps do not count: 0) */
     int force_evaluations;  /* force passes (elastic force or spring force + tangent) */
     int stiffness_products; /* K times vector products (CG iterations and setup) */
+    tmass_real cg_condition; /* (tensormass extra) estimated condition number of the
+                                Jacobi-scaled matrix, largest over the call's linear
+                                solves; a lower bound, see SOLVERS and LIMITS) */
 } tmass_stats;
 
 /* Energies of the current state (tmass_energy). */
@@ -906,6 +930,9 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #define TMASS__COOKIE 0x544D4153u /* "TMAS" */
 #define TMASS__ALIGN 64
 #define TMASS__VEC_BLOCK 4096 /* reals per block of vector loops and dot partial sums */
+#define TMASS__EPS (sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON)
+/* largest eps(tmass_real) lambda / mu the tensor model accepts (LIMITS; float: nu <= 0.4994) */
+#define TMASS__LAMBDA_MU_LIMIT 1e-4
 #define TMASS__SCRATCH 10      /* 3n scratch vectors */
 
 /* node states */
@@ -1196,6 +1223,13 @@ static int tmass__validate_material(const tmass_desc *d, double E, double nu, in
     }
     if (d->kind == TMASS_TENSOR_MASS && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
         snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
+       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
+    if (d->kind == TMASS_TENSOR_MASS && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
+        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
+                 nu, t);
         return TMASS_ERR_POISSON_RATIO;
     }
     return TMASS_OK;
@@ -2082,7 +2116,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     tmass__cg_ctx k;
     int n3 = 3 * m->node_count, i, it, blocks = m->partial_count;
     tmass_real *pinv = s[4];
-    double bb = 0.0, rr, rz, tol2;
+    double bb = 0.0, rr, rz, tol2, pdp, rho_min = HUGE_VAL, rho_max = 0.0;
     k.m = m;
     k.r = s[0];
     k.z = s[1];
@@ -2131,8 +2165,9 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         rr += (double)k.r[i] * k.r[i];
         rz += (double)k.r[i] * k.z[i];
     }
+    pdp = rz; /* p . D p for p = z: r . z */
     for (it = 0; it < m->cg_max_iterations && rr > tol2; it++) {
-        double pq, rz_new;
+        double pq, rz_new, rho;
         tmass__matvec(m, k.p, k.q);
         tmass__run(m, blocks, tmass__cg_apply, &k);
         pq = tmass__sum_partials(m, 0);
@@ -2145,6 +2180,11 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             m->cg_indefinite = 1;
             break;
         }
+        /* the Rayleigh quotient of D^-1 A along p (D the Jacobi diagonal) lies between
+           its extreme eigenvalues: their ratio bounds cond from below */
+        rho = pq / pdp;
+        if (rho > rho_max) rho_max = rho;
+        if (rho < rho_min) rho_min = rho;
         k.alpha = rz / pq;
         tmass__run(m, blocks, tmass__cg_update, &k);
         rr = tmass__sum_partials(m, 0);
@@ -2155,6 +2195,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             break;
         }
         k.beta = rz_new / rz;
+        pdp = rz_new + k.beta * k.beta * pdp; /* z_new . D p_old = r_new . p_old = 0 */
         rz = rz_new;
         tmass__run(m, blocks, tmass__cg_direction, &k);
     }
@@ -2163,6 +2204,8 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     m->stats.cg_residual = (tmass_real)sqrt(rr / bb);
     m->stats.stiffness_products += it + 1;
     m->stats.negative_curvature += m->cg_indefinite;
+    if (rho_max > 0.0 && rho_min > 0.0 && rho_max / rho_min > (double)m->stats.cg_condition)
+        m->stats.cg_condition = (tmass_real)(rho_max / rho_min);
     if (rr <= tol2) return TMASS_OK;
     return tmass__finite(rr) ? TMASS_ERR_NO_CONVERGENCE : TMASS_ERR_NOT_FINITE;
 }

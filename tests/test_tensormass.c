@@ -2246,8 +2246,9 @@ static int sweep_case(const tetmesh *mesh, int cube, double E, double nu, double
     /* matched: the error is within what the CG tolerance allows for this conditioning;
        judged against the step's own displacement (an error of the size of the move
        itself is a wrong answer) */
-    tol = IS_FLOAT ? 5e-2 : 1e-3; /* float CG stops at 1e-5 of |b|; at nu = 0.4999 the
-                                     condition number (about 1e4) lets 2 % through */
+    tol = IS_FLOAT ? 1e-2 : 1e-3; /* float CG stops at 1e-5 of |b|; float refuses nu =
+                                     0.4999 at creation (it let 1.8 % through), the worst
+                                     left is about 2e-4 */
     worst -= 8 * EPS * size; /* below the rounding of u itself nothing can be judged (in
                                 float a step of 1e-6 s moves less than u's last digit) */
     if (worst < 0) worst = 0;
@@ -2358,7 +2359,7 @@ static void test_stress_sweep(void)
     printf("    tensor sweep: %d matched (worst %.2e of the move), %d refused with a code, %d wrong\n", ok,
            worst_ok, refused, wrong);
     CHECK_INT(0, wrong);
-    CHECK(ok > 100);
+    CHECK(ok > (IS_FLOAT ? 90 : 100)); /* float refuses the 32 cases at nu = 0.4999 */
     { /* springs: E x (static, three dt), nu plays no part */
         int unjudged = 0;
         ok = refused = wrong = 0;
@@ -2391,8 +2392,112 @@ static void test_stress_sweep(void)
     tetmesh_free(&cube);
 }
 
+
+/* Float at nu = 0.4999 (issue 18, after its first fixes): the bench sweep's beam, 1 x 0.1 x
+   0.1 m in 20 x 2 x 2 five-tet cells, E = 1 kPa, clamped, under a load that bends it by
+   about 5 % of its length. The answer is checked against the test's own double-precision
+   P1 assembly (independent of the model's tensors) solved by dense Cholesky: a static
+   solve, the same load in 8 increments (each a static solve from the last answer) and 220
+   critically damped implicit steps of 1 s must each fail with a code (creation included),
+   or succeed with every node within 1 % of the largest displacement of the double answer.
+   Before the fix float returned success 1.1 % off (static and implicit): its tensors,
+   rounded to float, are another material (the exact solve of the float-stored K is 1.8 %
+   off at the tip) and its CG cannot resolve the answer (K's Jacobi-scaled condition
+   number is about 2e8). nu = 0.499 and 0.45 must still solve, in float too. */
+static double beam_field_error(const tmass_model *m, const double *ref, int n3)
+{
+    double worst = 0.0, size = 0.0;
+    int i;
+    for (i = 0; i < n3; i++) {
+        double e = fabs((double)tmass_positions(m)[i] - (double)tmass_rest_positions(m)[i] - ref[i]);
+        if (!(e <= worst)) worst = e;
+        if (fabs(ref[i]) > size) size = fabs(ref[i]);
+    }
+    return worst / size;
+}
+
+static void test_float_ill_conditioned_beam(void)
+{
+    static const double nus[3] = {0.4999, 0.499, 0.45};
+    tetmesh mesh;
+    int inu;
+    tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 20, 2, 2, TETMESH_SPLIT5);
+    for (inu = 0; inu < 3; inu++) {
+        double E = 1000.0, nu = nus[inu], rho = 1000.0, a = 0.1, gz = -0.1 * 8 * E * (a * a * a * a / 12) / (rho * a * a);
+        int n = mesh.node_count, n3 = 3 * n, i, j, k, t, inc, code, *is_free = (int *)calloc((size_t)n3, sizeof(int));
+        double *K = (double *)calloc((size_t)n3 * n3, sizeof(double)), *b = (double *)calloc((size_t)n3, sizeof(double));
+        double *ref = (double *)calloc((size_t)n3, sizeof(double)), err;
+        tmass_real g[3] = {0, 0, 0};
+        tmass_model *m;
+        for (t = 0; t < mesh.tet_count; t++) { /* the reference, all in double */
+            const double *p[4];
+            double Ke[12][12], V;
+            double gr[4][3];
+            for (j = 0; j < 4; j++) p[j] = mesh.nodes + 3 * mesh.tets[4 * t + j];
+            fem_element_stiffness(p, E, nu, Ke);
+            V = fem_gradients(p, gr);
+            for (j = 0; j < 4; j++) {
+                b[3 * mesh.tets[4 * t + j] + 2] += rho * V / 4 * gz;
+                for (k = 0; k < 4; k++) {
+                    int r, c;
+                    for (r = 0; r < 3; r++)
+                        for (c = 0; c < 3; c++)
+                            K[(size_t)(3 * mesh.tets[4 * t + j] + r) * n3 + 3 * mesh.tets[4 * t + k] + c] +=
+                                Ke[3 * j + r][3 * k + c];
+                }
+            }
+        }
+        for (i = 0; i < n3; i++) is_free[i] = mesh.nodes[3 * (i / 3)] != 0.0;
+        REQUIRE(dense_solve(K, b, ref, is_free, n3) == 0);
+        for (inc = 0; inc < 3; inc++) { /* 0: static in one call, 1: 8 increments, 2: implicit */
+            tmass_desc d = tmass_default_desc();
+            tmass_real *x = to_real(mesh.nodes, n3);
+            const char *what = inc == 0 ? "static" : inc == 1 ? "8 increments" : "implicit dt 1 s x220";
+            d.rest_positions = x;
+            d.node_count = n;
+            d.tets = mesh.tets;
+            d.tet_count = mesh.tet_count;
+            d.young_modulus = (tmass_real)E;
+            d.poisson_ratio = (tmass_real)nu;
+            d.density = (tmass_real)rho;
+            d.mass_damping = (tmass_real)(2 * 1.8751 * 1.8751 * sqrt(E * a * a / (12 * rho)));
+            d.cg_max_iterations = 100000;
+            code = tmass_create(&d, &m);
+            free(x);
+            if (code) { /* float refuses nu too close to 0.5 at creation (LIMITS) */
+                printf("    nu %g %-20s creation refused: %s\n", nu, what, tmass_error_string(code));
+                CHECK_INT(TMASS_ERR_POISSON_RATIO, code);
+                CHECK(IS_FLOAT && nu > 0.4994);
+                continue;
+            }
+            for (i = 0; i < n; i++)
+                if (mesh.nodes[3 * i] == 0.0) tmass_fix_node(m, i);
+            code = TMASS_OK;
+            for (j = 1; j <= (inc == 1 ? 8 : inc == 2 ? 220 : 1) && code == TMASS_OK; j++) {
+                g[2] = (tmass_real)(inc == 1 ? gz * j / 8.0 : gz);
+                tmass_set_gravity(m, g);
+                code = inc == 2 ? tmass_step_ex(m, (tmass_real)1.0, TMASS_IMPLICIT_EULER) : tmass_solve_static(m);
+            }
+            err = beam_field_error(m, ref, n3);
+            printf("    nu %g %-20s code %3d  error %.3g %% of |u|max  (cg %d iterations, condition %.3g)\n",
+                   nu, what, code, 100 * err, tmass_last_stats(m)->cg_iterations,
+                   (double)tmass_last_stats(m)->cg_condition);
+            if (code == TMASS_OK) CHECK(err <= 0.01);
+            else CHECK_INT(TMASS_ERR_NO_CONVERGENCE, code);
+            if (!IS_FLOAT || nu < 0.4994) CHECK_INT(TMASS_OK, code); /* must not refuse these */
+            tmass_destroy(m);
+        }
+        free(is_free);
+        free(K);
+        free(b);
+        free(ref);
+    }
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
+    TEST(test_float_ill_conditioned_beam),
     TEST(test_force_is_minus_energy_gradient),
     TEST(test_spring_force_is_minus_energy_gradient),
     TEST(test_stiffness_is_minus_force_gradient),
