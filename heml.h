@@ -372,7 +372,10 @@
        3e-5 above its minimum (W/E 0.1090467 / 0.1090434, the tangent's lowest eigenvalue
        -0.0027 E), a different one for each path and E (fields 14 to 129 % apart); in the
        hyperelastic cases Newton's own solves met no negative curvature at all. The probe
-       costs one Krylov solve per accepted increment.
+       costs one Krylov solve per accepted increment: on a nearly linear solve it doubles
+       the CG work (a steel beam 1 x 0.1 x 0.1 m, 40 x 4 x 4 cells, under gravity: 64 to
+       129 iterations, 0.029 to 0.058 s), on a large deformation less (E = 100 kPa, the
+       tip 1.06 m down: 2278 to 2854, 0.59 to 0.72 s); answers unchanged.
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
