@@ -115,6 +115,10 @@
                                 inverted tetrahedra (J <= 0) than its start, and
                                 allow_inversion is 0 (also: a Cauchy stress asked of an
                                 inverted tetrahedron).
+       HEML_ERR_UNSTABLE        a static solve converged to a saddle, an unstable
+                                equilibrium (see STATIC SOLVE: a buckled or squashed body
+                                held at its symmetric state); set leave_saddles = 1 for a
+                                minimum.
        HEML_ERR_DIVERGED        a semi-explicit step failed its divergence check (see
                                 INTEGRATORS): the time step is beyond the stability limit
                                 of the current state.
@@ -348,6 +352,30 @@
        takes 3 or 4 iterations in double; in float, 7 or 8, the energy criterion ending them
        (see LIMITS for what float resolves). stats.below_threshold counts the tetrahedra of
        the answer below J0, whose stress is the continuation's (LIMITS).
+       A converged answer must also be a minimum: a zero residual holds at saddles too,
+       and Newton converges to them (its line search only lowers the energy, so it cannot
+       climb out of one it started near, and a symmetric start stays symmetric). A probe
+       solve K x = b (a fixed pseudo-random b, CG to 1e-10, float 1e-5) looks for a
+       direction of negative curvature; one found is sharpened by a Rayleigh-quotient
+       minimisation (v . K v / v . K0 v, K0 the small-strain stiffness diagonal, up to 40
+       products) and counts when that quotient is below -1e3 eps (flatter is round-off).
+       At a saddle the solve fails with HEML_ERR_UNSTABLE (leave_saddles = 0, the default)
+       or (leave_saddles = 1) steps along -+v, |v|max = h_min / 4 halved up to 12 times, to
+       the first point whose potential is lower by more than its round-off, and Newton goes
+       on (up to 8 escapes per increment; a saddle no step lowers measurably:
+       HEML_ERR_ROUND_OFF). 0.3.0 without the probe returned saddles with success: the
+       bench's squashed cube (1 m, 2 x 2 x 2 cells of five tetrahedra, top face pushed down
+       0.5 m, E-independent) came back at its symmetric state for Neo-Hookean at
+       nu = 0.4999 with 16 % more energy than the minimum (W/E 155.9 against 134.3),
+       Mooney-Rivlin 27 % (89.07 / 70.37), St Venant-Kirchhoff pushed 0.25 m at nu = 0.45
+       3.8 % (0.04999 / 0.04815), and the mass-spring cube in float at a buckled saddle
+       3e-5 above its minimum (W/E 0.1090467 / 0.1090434, the tangent's lowest eigenvalue
+       -0.0027 E), a different one for each path and E (fields 14 to 129 % apart); in the
+       hyperelastic cases Newton's own solves met no negative curvature at all. The probe
+       costs one Krylov solve per accepted increment: on a nearly linear solve it doubles
+       the CG work (a steel beam 1 x 0.1 x 0.1 m, 40 x 4 x 4 cells, under gravity: 64 to
+       129 iterations, 0.029 to 0.058 s), on a large deformation less (E = 100 kPa, the
+       tip 1.06 m down: 2278 to 2854, 0.59 to 0.72 s); answers unchanged.
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
@@ -498,6 +526,15 @@
          there), and P_zz has its extremum at s = 1/sqrt(3).
        - Eq. 26 with lambda < 0 (nu below about -0.5): the tangent continuation below J0 is
          no longer restoring (its slope lambda (1 - ln J0) + mu turns negative).
+       - Symmetric bodies past a bifurcation (squashed, buckled) have several minima of equal
+         energy, mirror images of each other. By default heml_solve_static refuses the
+         symmetric saddle (HEML_ERR_UNSTABLE) rather than pick one; with leave_saddles = 1 it
+         returns one of them, and which one depends on the path (one call or increments)
+         and the round-off: compare such answers by energy, not by node positions (the
+         mass-spring cube above, float: one call and 8 increments end 0.65 m apart at the
+         same W/E 0.1090434, as double does, within 4e-8). Dynamics are not checked:
+         implicit and explicit steps from a symmetric state stay symmetric (in exact
+         arithmetic too), so damped dynamics can settle on the saddle.
        - Mass-spring networks: central forces only (Poisson ratio pinned near 1/4, shear
          stiffness set by the mesh), not inversion-safe.
        - Float builds: forces are exactly zero at rest and carry a relative round-off of
@@ -531,7 +568,9 @@
              its cap, default 20, newton_tolerance new) and HEML_IMPLICIT_EULER_LINEARIZED
              the old single iteration; the semi-explicit step has a divergence check
              (HEML_ERR_DIVERGED); HEML_ERR_PRECISION (precision_limit); every public
-             function is renamed in float builds; a garbage description no longer crashes
+             function is renamed in float builds; a static answer must be a minimum (a
+             saddle fails with HEML_ERR_UNSTABLE, or leave_saddles = 1 descends from it);
+             a garbage description no longer crashes
              heml_create; a load whose squared norm overflows fails; the stats have the
              names shared with tensormass.h and frames.h (residual, increments,
              increment_cuts, line_search_cuts, first eleven fields in a common order).
@@ -670,13 +709,14 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_INVERTED, -27, "tetrahedron inverted or flat (J <= 0): a static solve or implicit step would newly invert one (allow_inversion = 0), or a Cauchy stress is undefined; the last valid state was kept") \
     X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept") \
     X(HEML_ERR_DIVERGED, -29, "explicit step failed its divergence check (energy grew beyond the work done on the body); the last valid state was kept") \
-    X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept")
+    X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept") \
+    X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
     HEML_ERROR_LIST(HEML__ENUM)
 #undef HEML__ENUM
-    HEML_ERR_LAST_ = -31
+    HEML_ERR_LAST_ = -32
 };
 
 typedef enum heml_law {
@@ -804,6 +844,12 @@ typedef struct heml_desc {
     int allow_inversion;             /* 0 (default): a static solve or implicit step that would
                                         leave more tetrahedra inverted (J <= 0) than at its start
                                         fails with HEML_ERR_INVERTED; 1: allowed (stats.inverted) */
+    int leave_saddles;               /* heml_solve_static where its answer is a saddle (an unstable
+                                        equilibrium: a buckled or squashed body at its symmetric
+                                        state): 0 (default) fails with HEML_ERR_UNSTABLE; 1 moves
+                                        off it along its negative curvature to a minimum (one of
+                                        several equal ones where the body is symmetric: which one
+                                        depends on the path and the round-off) */
     heml_real precision_limit;       /* steps and solves fail with HEML_ERR_PRECISION when
                                         eps(heml_real) max|u| > precision_limit h_min (h_min the
                                         shortest rest edge): the rounding of the state may not fake
@@ -917,12 +963,15 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
    pin moves in adaptive increments, each from a tangent predictor) and Newton with
    preconditioned CG and an energy line search (the fully relaxed Prony response); sets
    velocities to zero and the viscous state to its relaxed value. Returns HEML_OK only
-   when the residual is below static_tolerance and (allow_inversion = 0) no more
-   tetrahedra are inverted than at the start (see STATIC SOLVE). On failure the state is
+   when the residual is below static_tolerance, the answer is a minimum (not a saddle:
+   HEML_ERR_UNSTABLE, or with leave_saddles = 1 the solve descends from it) and
+   (allow_inversion = 0) no more tetrahedra are inverted than at the start (see STATIC
+   SOLVE). On failure the state is
    unchanged: HEML_ERR_NO_CONVERGENCE (caps reached: static_max_iterations per increment,
    max_increments, min_increment), HEML_ERR_ROUND_OFF (the residual stopped falling at the
    round-off level of the forces, above the tolerance: loosen it or use double),
-   HEML_ERR_INVERTED, HEML_ERR_PRECISION, HEML_ERR_NOT_FINITE. */
+   HEML_ERR_UNSTABLE (a saddle), HEML_ERR_INVERTED, HEML_ERR_PRECISION,
+   HEML_ERR_NOT_FINITE. */
 HEMLDEF int heml_solve_static(heml_model *m);
 
 /* ---- kernels (for benchmarks and custom solvers) ---- */
@@ -1107,7 +1156,7 @@ struct heml_model {
     heml_integrator integrator;
     heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
     heml_real newton_tolerance, min_increment, precision_limit;
-    int cg_max_iterations, newton_iterations, static_max_iterations, max_increments, allow_inversion;
+    int cg_max_iterations, newton_iterations, static_max_iterations, max_increments, allow_inversion, leave_saddles;
     double h_min; /* shortest rest edge, m (the precision check) */
     /* divergence check of the semi-explicit step (heml__diverged): valid, the energy H0 and
        the energy scale at its reference state, the free degrees of freedom's potential
@@ -1180,6 +1229,7 @@ static int heml__all_finite(const heml_real *a, size_t count)
 }
 
 static heml_real heml__max(heml_real a, heml_real b) { return a > b ? a : b; }
+static double heml__max_d(double a, double b) { return a > b ? a : b; }
 
 /* Natural logarithm of a positive finite x, branch-free so that the kernels' loops
    vectorise (libm's log is a call): fdlibm's e_log.c / e_logf.c reduction to
@@ -2691,10 +2741,10 @@ static int heml__validate(const heml_desc *d)
         !(heml__finite((double)d->newton_tolerance) && d->newton_tolerance > 0) || d->max_increments < 1 ||
         !(heml__finite((double)d->min_increment) && d->min_increment > 0 && d->min_increment <= 1) ||
         !(heml__finite((double)d->precision_limit) && d->precision_limit >= 0) ||
-        (d->allow_inversion != 0 && d->allow_inversion != 1))
+        (d->allow_inversion != 0 && d->allow_inversion != 1) || (d->leave_saddles != 0 && d->leave_saddles != 1))
         return heml__fail(d, HEML_ERR_SOLVER, "cg_tolerance, cg_max_iterations, newton_iterations, newton_tolerance, "
                                               "static_max_iterations, static_tolerance, max_increments, "
-                                              "min_increment, precision_limit or allow_inversion");
+                                              "min_increment, precision_limit, allow_inversion or leave_saddles");
     for (i = 0; i < 3; i++)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -3206,6 +3256,7 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.max_increments = 64;
     d.min_increment = (heml_real)1e-4;
     d.allow_inversion = 0;
+    d.leave_saddles = 0;
     d.precision_limit = (heml_real)1e-4;
     d.cg_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-6);
     d.cg_max_iterations = 1000;
@@ -3304,6 +3355,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->max_increments = d->max_increments;
     m->min_increment = d->min_increment;
     m->allow_inversion = d->allow_inversion;
+    m->leave_saddles = d->leave_saddles;
     m->precision_limit = d->precision_limit;
     m->J0 = d->inversion_threshold;
     m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
@@ -3739,6 +3791,8 @@ typedef struct heml__objective {
     const heml_real *warm;    /* implicit: the first Krylov solve's initial guess, or NULL */
     double dt, alpha, tol;
     int max_iterations, coarse, energy_search, inverted_start;
+    int check_minimum; /* static: an answer must be a minimum (heml__saddle_escape) */
+    int leave_saddles; /* ... and a saddle is left for a minimum (else HEML_ERR_UNSTABLE) */
 } heml__objective;
 
 /* One evaluation of the objective at u: f, R, |R|, the reference scale max(|load|, |f|
@@ -3817,6 +3871,108 @@ static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_re
 }
 
 #define HEML__HALVINGS 12   /* line search: steps down to 2^-12 */
+#define HEML__ESCAPES 8     /* saddle escapes per Newton solve */
+
+/* Is the converged point u (pt, residual R) a minimum? A probe solve K x = b (b a fixed
+   pseudo-random vector on the free axes) by the Newton solves' preconditioned CG to a
+   tight tolerance: CG meets a direction of negative curvature p (p . K p <= 0) where the
+   tangent is indefinite, i.e. u is a saddle, an unstable equilibrium that damped dynamics
+   would leave (0.3.0 accepted such saddles: a mass-spring cube squashed by half in float,
+   success 3e-5 of the energy above the minimum, its tangent with an eigenvalue of
+   -0.0027 E). p is then sharpened into a direction of most negative curvature by up to
+   HEML__RAYLEIGH steps of a two-vector Rayleigh-Ritz minimisation of v . K v / v . K0 v
+   (K0 the small-strain stiffness diagonal, Jacobi-preconditioned gradient); a quotient
+   above -1e3 eps counts as flat within round-off (a minimum). At a saddle the state moves
+   along -+v (first the sign that does not ascend), |v|max = h_min / 4 halved up to
+   HEML__HALVINGS times, to the first point whose objective is lower by more than its
+   round-off, and Newton goes on from there. Returns HEML_OK (a minimum, as far as the
+   probe sees), 1 (escaped: u, R, pt updated), HEML_ERR_ROUND_OFF (a saddle that no step
+   lowers measurably: heml_real cannot tell it from a minimum) or HEML_ERR_NO_CONVERGENCE
+   (HEML__ESCAPES escapes already). Scratch 6, 7, 8, 9, 10-17, 21. */
+#define HEML__RAYLEIGH 40
+static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_real *u, heml_real *R, heml__point *pt,
+                               int *escapes)
+{
+    heml_real *b = m->scratch[6], *ut = m->scratch[7], *ft = m->scratch[8], *Rt = m->scratch[9];
+    heml_real *x = m->scratch[21], *krylov[8], *v, *kv, *w, *kw, *pinv;
+    int i, n3 = 3 * m->node_count, kerr, ls, sgn, it;
+    double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, rho = 0.0, vmax = 0.0, step, first, norm;
+    heml__point tp;
+    if (!ob->check_minimum) return HEML_OK;
+    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
+    for (i = 0; i < n3; i++) {
+        unsigned h = (unsigned)i * 2654435761u;
+        h ^= h >> 15;
+        h *= 2246822519u;
+        h ^= h >> 13;
+        b[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
+        x[i] = 0;
+    }
+    kerr = heml__cg(m, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse, krylov);
+    if (kerr == HEML_ERR_NOT_FINITE) return kerr;
+    if (kerr != HEML__NEGATIVE_CURVATURE) return HEML_OK;
+    v = krylov[2], kv = krylov[3], pinv = krylov[4], w = krylov[5], kw = krylov[6];
+    for (it = 0; it <= HEML__RAYLEIGH; it++) { /* v . K v / v . K0 v down, in span{v, P (K v - rho K0 v)} */
+        double a11 = 0, a12 = 0, a22 = 0, b11 = 0, b12 = 0, b22 = 0, det, mid, mu, cx, cy;
+        for (i = 0; i < n3; i++) {
+            double dg = (double)m->diag[i] * (double)m->free_mask[i];
+            a11 += (double)v[i] * (double)kv[i];
+            b11 += (double)v[i] * dg * (double)v[i];
+        }
+        if (!(b11 > 0) || !heml__finite(a11)) return HEML_OK;
+        rho = a11 / b11;
+        if (it == HEML__RAYLEIGH) break;
+        for (i = 0; i < n3; i++)
+            w[i] = (heml_real)((double)pinv[i] * ((double)kv[i] - rho * (double)m->diag[i] * (double)v[i]) *
+                               (double)m->free_mask[i]);
+        heml__cg_apply(m, ob->dmass, 1.0, w, kw);
+        for (i = 0; i < n3; i++) {
+            double dg = (double)m->diag[i] * (double)m->free_mask[i];
+            a12 += (double)v[i] * (double)kw[i];
+            a22 += (double)w[i] * (double)kw[i];
+            b12 += (double)v[i] * dg * (double)w[i];
+            b22 += (double)w[i] * dg * (double)w[i];
+        }
+        det = b11 * b22 - b12 * b12;
+        if (!(det > 1e-10 * b11 * b22) || !heml__finite(a22)) break; /* w adds no direction */
+        /* smallest root of det(A - mu B) = 0 */
+        mid = a11 * b22 + a22 * b11 - 2.0 * a12 * b12;
+        mu = (mid - sqrt(heml__max_d(mid * mid - 4.0 * det * (a11 * a22 - a12 * a12), 0.0))) / (2.0 * det);
+        cx = a12 - mu * b12, cy = -(a11 - mu * b11);
+        if (fabs(cx) + fabs(cy) == 0.0) cx = a22 - mu * b22, cy = -(a12 - mu * b12);
+        if (fabs(cx) + fabs(cy) == 0.0) break;
+        norm = sqrt(cx * cx * b11 + 2.0 * cx * cy * b12 + cy * cy * b22);
+        if (!(norm > 0)) break;
+        cx /= norm, cy /= norm;
+        for (i = 0; i < n3; i++) {
+            v[i] = (heml_real)(cx * (double)v[i] + cy * (double)w[i]);
+            kv[i] = (heml_real)(cx * (double)kv[i] + cy * (double)kw[i]);
+        }
+        if (!(mu < rho - 1e-3 * fabs(rho))) break; /* converged enough */
+    }
+    for (i = 0; i < n3; i++)
+        if (m->free_mask[i] > 0 && fabs((double)v[i]) > vmax) vmax = fabs((double)v[i]);
+    if (!(vmax > 0) || rho >= -1e3 * eps) return HEML_OK; /* flat within round-off */
+    if (!ob->leave_saddles) return HEML_ERR_UNSTABLE;
+    if (*escapes >= HEML__ESCAPES) return HEML_ERR_NO_CONVERGENCE;
+    first = heml__dot(R, v, n3) >= 0.0 ? 1.0 : -1.0; /* R = -grad: this sign does not ascend */
+    for (ls = 0, step = 0.25 * m->h_min / vmax; ls <= HEML__HALVINGS; ls++, step *= 0.5)
+        for (sgn = 0; sgn < 2; sgn++) {
+            heml_real t = (heml_real)((sgn ? -first : first) * step);
+            for (i = 0; i < n3; i++) ut[i] = u[i] + t * v[i] * m->free_mask[i];
+            heml__eval(m, ob, ut, ft, Rt, &tp);
+            if (!(heml__finite(tp.res) && tp.potential < pt->potential - pt->noise)) {
+                m->stats.line_search_cuts++;
+                continue;
+            }
+            ++*escapes;
+            *pt = tp;
+            memcpy(u, ut, sizeof(heml_real) * (size_t)n3);
+            memcpy(R, Rt, sizeof(heml_real) * (size_t)n3);
+            return 1;
+        }
+    return HEML_ERR_ROUND_OFF;
+}
 #define HEML__STALL 4       /* Newton iterations without progress that end a solve */
 #define HEML__SHIFT_MIN 1e-6 /* Levenberg-Marquardt shift after negative curvature, times the */
 #define HEML__SHIFT_MAX 1e3  /* small-strain stiffness diagonal: first and largest */
@@ -3833,14 +3989,15 @@ static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_re
    capped solve still gives a usable direction. The backtracking line search accepts a step that lowers Phi (Armijo, up to
    its round-off); where Phi is not a potential of the forces (a Prony history in a
    dynamic step, or a user law without an energy callback) a step that lowers |R|.
-   Converged when |R| <= tol max(|load|, |f|, |inertia|). When neither |R| nor Phi made
+   Converged when |R| <= tol max(|load|, |f|, |inertia|) and, for the static solve
+   (check_minimum), heml__saddle_escape finds no negative curvature. When neither |R| nor Phi made
    progress in HEML__STALL iterations, or the line search found no acceptable step, or
    after max_iterations: heml__stalled decides. Scratch 4..17. */
 static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
 {
     heml_real *f = m->scratch[4], *R = m->scratch[5], *delta = m->scratch[6], *ut = m->scratch[7];
     heml_real *ft = m->scratch[8], *Rt = m->scratch[9], *reg = m->scratch[21], *krylov[8];
-    int i, it, n3 = 3 * m->node_count, quiet = 0;
+    int i, it, n3 = 3 * m->node_count, quiet = 0, escapes = 0, done;
     double best, prev = 0.0, eta = 1e-3, tol = ob->tol, shift = 0.0;
     heml__point pt, tp;
     for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
@@ -3852,7 +4009,12 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
         int ls, accepted = 0, krylov_ok, kerr, by_energy = ob->energy_search && heml__finite(pt.potential);
         m->stats.residual = (heml_real)(pt.scale > 0 ? pt.res / pt.scale : 0.0);
         if (!heml__finite(pt.res) || !heml__finite(pt.scale)) return HEML_ERR_NOT_FINITE;
-        if (pt.res <= tol * pt.scale) return HEML_OK;
+        if (pt.res <= tol * pt.scale) {
+            done = heml__saddle_escape(m, ob, u, R, &pt, &escapes);
+            if (done != 1) return done;
+            quiet = 0, best = pt.res, prev = pt.res, shift = 0.0; /* escaped a saddle: go on */
+            continue;
+        }
         if (it > 0) {
             eta = 0.9 * (pt.res / prev) * (pt.res / prev);
             if (eta > 1e-3) eta = 1e-3;
@@ -3879,7 +4041,13 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
             slope = heml__dot(R, delta, n3);
             krylov_ok = 0;
         }
-        if (it == ob->max_iterations || quiet >= HEML__STALL) return heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+        if (it >= ob->max_iterations || quiet >= HEML__STALL) {
+            done = heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+            if (done == HEML_OK) done = heml__saddle_escape(m, ob, u, R, &pt, &escapes);
+            if (done != 1 || it >= ob->max_iterations) return done == 1 ? HEML_ERR_NO_CONVERGENCE : done;
+            quiet = 0, best = pt.res, prev = pt.res, shift = 0.0;
+            continue;
+        }
         m->stats.newton_iterations++;
         for (ls = 0; ls <= HEML__HALVINGS && !accepted; ls++, step *= 0.5) {
             heml_real t = (heml_real)step;
@@ -3893,7 +4061,13 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
                                  : tp.res <= (1.0 - 1e-4 * step) * pt.res;
             m->stats.line_search_cuts += !accepted;
         }
-        if (!accepted) return heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+        if (!accepted) {
+            done = heml__stalled(m, ob, u, &pt, slope, krylov_ok, ft);
+            if (done == HEML_OK) done = heml__saddle_escape(m, ob, u, R, &pt, &escapes);
+            if (done != 1) return done;
+            quiet = 0, best = pt.res, prev = pt.res, shift = 0.0;
+            continue;
+        }
         shift = shift > HEML__SHIFT_MIN ? 0.1 * shift : 0.0;
         quiet = tp.res < 0.9 * best || tp.potential < pt.potential - pt.noise ? 0 : quiet + 1;
         if (tp.res < best) best = tp.res;
@@ -4041,6 +4215,8 @@ HEMLDEF int heml_solve_static(heml_model *m)
     ob.max_iterations = m->static_max_iterations;
     ob.coarse = 1;
     ob.energy_search = 1; /* the relaxed Prony response is s f, of potential s W */
+    ob.check_minimum = 1;
+    ob.leave_saddles = m->leave_saddles;
     while (lambda < 1.0) {
         double trial = lambda + increment > 1.0 ? 1.0 : lambda + increment, slope;
         heml_real t = (heml_real)trial;
@@ -4079,7 +4255,8 @@ HEMLDEF int heml_solve_static(heml_model *m)
         if (!m->allow_inversion && m->stats.inverted > inverted_start) /* no prediction then */
             for (i = 0; i < n3; i++) u[i] = saved[i] + dpin[i];
         err = heml__newton(m, &ob, u);
-        if (!err && !m->allow_inversion && m->stats.inverted > inverted_start) err = HEML_ERR_INVERTED;
+        if ((!err || err == HEML_ERR_UNSTABLE) && !m->allow_inversion && m->stats.inverted > inverted_start)
+            err = HEML_ERR_INVERTED; /* (a saddle that is also inverted: the inversion says more) */
         if (err == HEML_OK) {
             lambda = trial;
             increment *= 2.0;
@@ -4088,7 +4265,9 @@ HEMLDEF int heml_solve_static(heml_model *m)
             memcpy(u, saved, sizeof(heml_real) * (size_t)n3);
             increment *= 0.5;
             m->stats.increment_cuts++;
-            if (err == HEML_ERR_ROUND_OFF || err == HEML_ERR_NOT_FINITE || increment < (double)m->min_increment) break;
+            if (err == HEML_ERR_ROUND_OFF || err == HEML_ERR_NOT_FINITE || err == HEML_ERR_UNSTABLE ||
+                increment < (double)m->min_increment)
+                break;
         }
     }
     if (lambda < 1.0) return err;

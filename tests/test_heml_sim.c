@@ -1265,6 +1265,24 @@ static void test_validation_errors(void)
         CHECK_INT(HEML_ERR_PRECISION, note(heml_step(m)));
     }
     heml_destroy(m);
+    /* a static answer at a saddle: the mass-spring cube (2 x 2 x 2 cells of five
+       tetrahedra) squashed by half between its pinned faces buckles */
+    {
+        tetmesh sq;
+        int i;
+        REQUIRE(tetmesh_beam(&sq, 1, 1, 1, 2, 2, 2, TETMESH_SPLIT5) == 0);
+        m = make_model(&sq, HEML_MASS_SPRING, 1e3, 0.25, 1000);
+        REQUIRE(m != NULL);
+        for (i = 0; i < sq.node_count; i++) {
+            heml_real u[3] = {0, 0, 0};
+            if (fabs(sq.nodes[3 * i + 2]) < 0.4) continue;
+            if (sq.nodes[3 * i + 2] > 0) u[2] = (heml_real)-0.5;
+            heml_set_displacement(m, i, u);
+        }
+        CHECK_INT(HEML_ERR_UNSTABLE, note(heml_solve_static(m)));
+        heml_destroy(m);
+        tetmesh_free(&sq);
+    }
     /* every error code was provoked above */
     for (code = -1; code > HEML_ERR_LAST_; code--) {
         if (!seen[-code]) printf("    never provoked: %d (%s)\n", code, heml_error_string(code));

@@ -6,7 +6,8 @@
    every entry point; a garbage description; loads whose norm overflows; states far from
    the origin in float; St Venant-Kirchhoff without a uniaxial state; the order of the
    integrators on a linear oscillator and implicit Euler against the closed form of its
-   recurrence; a reduced stress sweep (every run right or an error code). */
+   recurrence; a reduced stress sweep (every run right or an error code); static answers
+   are minima, not saddles (the squashed mass-spring cube). */
 #define HEML_IMPLEMENTATION
 #include "../heml.h"
 #define TETMESH_IMPLEMENTATION
@@ -144,6 +145,147 @@ static void test_static_large_imposed_displacement(void)
         free(J);
         heml_destroy(m);
     }
+    tetmesh_free(&mesh);
+}
+
+/* The mass-spring cube of the bench's stress sweep (1 m, 2 x 2 x 2 cells of five
+   tetrahedra, bottom face pinned, top face driven down by 0.5 m, no gravity) buckles:
+   its middle layer slides sideways. The squash has saddle points (unstable equilibria)
+   next to its minima, about 3e-5 of the energy above them; 0.3.0 accepted one in float
+   (success, residual 3e-5, the test's own tangent with an eigenvalue of -0.0027 E).
+   Every success here, in one call and in 8 increments, must be a minimum: the residual
+   and the tangent computed here in double from the springs' closed form (k = E vol / L^2
+   per link and tetrahedron), positive definite (Cholesky) on the free axes. */
+static int spring_cube_check(const tetmesh *mesh, heml_model *m, double E, double *W_out, double *res_out)
+{
+    static const int link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
+    int n = mesh->node_count, t, l, i, j, k, nf = 0, pd = 1;
+    int *fid = (int *)malloc(sizeof(int) * 3 * (size_t)n);
+    double *f = (double *)calloc(3 * (size_t)n, sizeof(double)), *H, W = 0, R2 = 0, F2 = 0;
+    const heml_real *x = heml_positions(m), *x0 = heml_rest_positions(m);
+    for (i = 0; i < 3 * n; i++) fid[i] = heml_node_pinned(m, i / 3) ? -1 : nf++;
+    H = (double *)calloc((size_t)nf * (size_t)nf + 1, sizeof(double));
+    for (t = 0; t < mesh->tet_count; t++) {
+        const int *q = mesh->tets + 4 * t;
+        double e[3][3], vol;
+        for (k = 0; k < 3; k++)
+            for (j = 0; j < 3; j++) e[k][j] = mesh->nodes[3 * q[k + 1] + j] - mesh->nodes[3 * q[0] + j];
+        vol = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) + e[0][1] * (e[1][2] * e[2][0] - e[1][0] * e[2][2]) +
+               e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+        for (l = 0; l < 6; l++) {
+            int a = q[link[l][0]], b = q[link[l][1]], nd[2], s1, s2, r, c;
+            double d[3], L2 = 0, l2 = 0, kk, len, L;
+            nd[0] = a, nd[1] = b;
+            for (j = 0; j < 3; j++) {
+                double D = mesh->nodes[3 * b + j] - mesh->nodes[3 * a + j];
+                d[j] = D + ((double)x[3 * b + j] - (double)x0[3 * b + j]) - ((double)x[3 * a + j] - (double)x0[3 * a + j]);
+                L2 += D * D;
+                l2 += d[j] * d[j];
+            }
+            kk = E * vol / L2, len = sqrt(l2), L = sqrt(L2);
+            W += 0.5 * kk * (len - L) * (len - L);
+            for (j = 0; j < 3; j++) {
+                f[3 * a + j] += kk * (len - L) / len * d[j];
+                f[3 * b + j] -= kk * (len - L) / len * d[j];
+            }
+            for (s1 = 0; s1 < 2; s1++)
+                for (s2 = 0; s2 < 2; s2++)
+                    for (r = 0; r < 3; r++)
+                        for (c = 0; c < 3; c++) {
+                            int I = fid[3 * nd[s1] + r], J = fid[3 * nd[s2] + c];
+                            double kab = kk * ((r == c) * (1 - L / len) + L / len * d[r] * d[c] / l2);
+                            if (I >= 0 && J >= 0) H[I * nf + J] += (s1 == s2 ? 1 : -1) * kab;
+                        }
+        }
+    }
+    for (i = 0; i < 3 * n; i++) {
+        F2 += f[i] * f[i];
+        if (fid[i] >= 0) R2 += f[i] * f[i];
+    }
+    for (j = 0; j < nf && pd; j++) { /* Cholesky in place: positive definite? */
+        double dj = H[j * nf + j];
+        for (k = 0; k < j; k++) dj -= H[j * nf + k] * H[j * nf + k];
+        if (!(dj > 1e-9 * E)) pd = 0;
+        else {
+            dj = sqrt(dj);
+            H[j * nf + j] = dj;
+            for (i = j + 1; i < nf; i++) {
+                double v = H[i * nf + j];
+                for (k = 0; k < j; k++) v -= H[i * nf + k] * H[j * nf + k];
+                H[i * nf + j] = v / dj;
+            }
+        }
+    }
+    *W_out = W;
+    *res_out = F2 > 0 ? sqrt(R2 / F2) : 0;
+    free(fid), free(f), free(H);
+    return pd;
+}
+
+static int spring_cube_squash(heml_model *m, const tetmesh *mesh, double fraction)
+{
+    int i, err = HEML_OK;
+    for (i = 0; i < mesh->node_count && !err; i++) {
+        double z = mesh->nodes[3 * i + 2];
+        heml_real u[3] = {0, 0, 0};
+        if (fabs(z + 0.5) < 1e-9) err = heml_set_displacement(m, i, u);
+        else if (fabs(z - 0.5) < 1e-9) {
+            u[2] = (heml_real)(-0.5 * fraction);
+            err = heml_set_displacement(m, i, u);
+        }
+    }
+    return err;
+}
+
+static void test_static_springs_squash_minimum(void)
+{
+    static const double youngs[3] = {1, 1e3, 1e6};
+    tetmesh mesh;
+    int e, leave, successes = 0;
+    REQUIRE(tetmesh_beam(&mesh, 1, 1, 1, 2, 2, 2, TETMESH_SPLIT5) == 0);
+    for (leave = 0; leave < 2; leave++)
+        for (e = 0; e < 3; e++) {
+            heml_material mt = heml_material_from_young(HEML_MASS_SPRING, youngs[e], 0.0);
+            heml_desc d = heml_default_desc();
+            heml_model *one, *inc;
+            double W1 = 0, W8 = 0, r1 = 0, r8 = 0, tol = IS_FLOAT ? 1e-4 : 1e-9;
+            int k, err1, err8 = HEML_OK, min1 = 0, min8 = 0;
+            d.leave_saddles = leave;
+            one = make_model_ex(&mesh, mt, 0.0, &d);
+            inc = make_model_ex(&mesh, mt, 0.0, &d);
+            REQUIRE(one != NULL && inc != NULL);
+            CHECK_INT(HEML_OK, spring_cube_squash(one, &mesh, 1.0));
+            err1 = heml_solve_static(one);
+            if (!err1) min1 = spring_cube_check(&mesh, one, youngs[e], &W1, &r1);
+            for (k = 1; k <= 8 && !err8; k++) {
+                CHECK_INT(HEML_OK, spring_cube_squash(inc, &mesh, k / 8.0));
+                err8 = heml_solve_static(inc);
+            }
+            if (!err8) min8 = spring_cube_check(&mesh, inc, youngs[e], &W8, &r8);
+            printf("    leave_saddles %d, E = %g: one call code %d (W/E %.8f, residual %.2g, %s), 8 increments code %d "
+                   "(W/E %.8f, residual %.2g, %s)\n",
+                   leave, youngs[e], err1, W1 / youngs[e], r1, min1 ? "minimum" : "not a minimum", err8,
+                   W8 / youngs[e], r8, min8 ? "minimum" : "not a minimum");
+            if (!err1) {
+                CHECK(min1);
+                CHECK(r1 <= 10 * tol);
+            } else
+                CHECK_INT(HEML_ERR_UNSTABLE, err1); /* the saddle said so */
+            if (!err8) {
+                CHECK(min8);
+                CHECK(r8 <= 10 * tol);
+            } else
+                CHECK_INT(HEML_ERR_UNSTABLE, err8);
+            if (leave) { /* the minimum is found, by both paths, at the same energy */
+                CHECK_INT(HEML_OK, err1);
+                CHECK_INT(HEML_OK, err8);
+                successes += !err1;
+            }
+            if (!err1 && !err8) CHECK_REL(W8, W1, IS_FLOAT ? 1e-5 : 1e-9);
+            heml_destroy(one);
+            heml_destroy(inc);
+        }
+    CHECK(successes == 3);
     tetmesh_free(&mesh);
 }
 
@@ -1009,6 +1151,7 @@ static void test_stress_sweep(void)
 static const test_case cases[] = {
     TEST(test_static_large_imposed_displacement),
     TEST(test_static_inversion_refused),
+    TEST(test_static_springs_squash_minimum),
     TEST(test_implicit_inversion_refused),
     TEST(test_incremental_potential_gradient),
     TEST(test_implicit_large_step_soft),
