@@ -475,6 +475,31 @@
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
+       - Spurious frame-rotation branch of coarse hexahedral frames in strong compression
+         (issue 18, measured; not fixed, not detected). The bench sweep's cube (1 m, 2 x 2 x
+         2 trilinear cells, 8 sub-cell samples each, bottom fixed, top driven down, nu =
+         0.45): squashed by half, Neo-Hookean, its symmetric equilibrium (the mirror
+         symmetries the continuum's unique answer has; frames' rotations held at zero) has W
+         = 348.09 J at E = 1 kPa, but an unstable one of the frames' model (the solves leave
+         it): two mirror images with the middle layer's frames turned up to 0.87 rad (0.67
+         rad from the mean material rotation of their samples) have W = 290.90 J, 16 % less,
+         and are the model's minima. The solves end there with success, in double too (8
+         increments), and which mirror they pick is round-off (float: one call and 8
+         increments 10-25 % of the largest displacement apart at every E from 1 Pa to 200
+         GPa; double: one call FRM_ERR_STALLED at the saddle). St Venant-Kirchhoff squashed
+         by a quarter: symmetric 0.038211 J (E = 1 Pa), a shallow branch 0.038210 J (0.06
+         rad, positions symmetric to 1e-5) and a deep one 0.033747 J (0.54 rad).
+         rotation_divergence moves it (16: 293.4 J, 0.80 rad; 64: every solve stalls) but
+         does not remove it at the default. No acceptance check separates it: the angle
+         between a free frame and the mean material rotation of its samples is 0.43-0.67 rad
+         on the branch and up to 0.62 rad in correct solves (tests/test_frames.c's uniaxial
+         cube). At 4 x 4 x 4 cells the same squash returns FRM_ERR_STALLED in one call and
+         in 8 increments (float; the symmetric state 280.50 J). Holding the free frames'
+         rotations (frm_model_set_frame_axes, rotation mask 7; zero is what the symmetries
+         impose here) gives the symmetric answer in 11 Newton iterations, one call and 8
+         increments 2e-5 apart in float; the sweep finds no wrong success with tetrahedral
+         frames. tests/test_frames.c test_i18_squashed_cube measures it; its strict checks
+         run with FRM_TEST_KNOWN_LIMITS set (and fail).
        - Hexahedral frames with Gauss points lock in bending near incompressibility, like
          trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
