@@ -18,7 +18,11 @@
 # run with gcc (double, float, OpenMP), while g++, clang and the sanitizer build run every
 # assertion on the reduced sizes of TEST_QUICK (tests/test.h); the OpenMP build runs only
 # the programs whose headers have parallel loops; the sanitizer build skips the two
-# compile-only programs (their code is the same headers the other programs exercise).
+# compile-only programs (their code is the same headers the other programs exercise) and
+# keeps line tables only (-g1: its reports still name file and line; full -g tripled the
+# sanitizer build's compile time, 45 s for test_frames alone); test_compile_all (the three
+# headers in one translation unit) runs in gcc double, g++ double and clang float, and
+# test_compile_static (the same with *_STATIC) in gcc float, g++ float and clang double.
 # Each PASS line in build/<configuration>/<program>.log gives the case's CPU time.
 # tests/test_examples.sh runs the example programs with bad arguments, a missing output
 # directory and a full standard output (about 3 s); its cases count in the same total.
@@ -37,7 +41,7 @@ CC_gxx-float    := g++ -std=c++11 -O1 -x c++ $(FLOAT) -DTEST_QUICK
 CC_clang-double := clang -std=c99 -O1 -DTEST_QUICK
 CC_clang-float  := clang -std=c99 -O1 $(FLOAT) -DTEST_QUICK
 CC_omp-double   := gcc -std=c99 -O2 -fopenmp
-CC_asan-double  := gcc -std=c99 -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined \
+CC_asan-double  := gcc -std=c99 -O1 -g1 -fno-omit-frame-pointer -fsanitize=address,undefined \
                    -fno-sanitize-recover=all -DTEST_QUICK
 
 # Passive waiting: libgomp's idle threads otherwise spin (about 300,000 polls, 0.1 to 1 ms)
@@ -53,6 +57,15 @@ COMPILE_ONLY := test_compile_all test_compile_static
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
 TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
+# each compile-only program in three configurations that together cover C and C++, gcc and
+# clang, double and float (every header also compiles alone in every configuration, as
+# part of its own test programs)
+TESTS_gcc-float := $(filter-out test_compile_all,$(TESTS))
+TESTS_gxx-float := $(filter-out test_compile_all,$(TESTS))
+TESTS_clang-double := $(filter-out test_compile_all,$(TESTS))
+TESTS_gcc-double := $(filter-out test_compile_static,$(TESTS))
+TESTS_gxx-double := $(filter-out test_compile_static,$(TESTS))
+TESTS_clang-float := $(filter-out test_compile_static,$(TESTS))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a
 # test program of a configuration named "examples"

@@ -4454,7 +4454,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
     frm_real *dq = m->vec[FRM__V_DRIVE], *kd = m->vec[FRM__V_P];
     double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
     double a_mass = 1.0 + dt * alpha_d, a_stiff = dt * dt + dt * beta_d, ref = 0, norm = 0, previous = 0;
-    int err, i, k, it, cg, attempt, converged = 0, n6 = 6 * m->frame_count;
+    int err, i, k, it, cg = FRM__CG_CAP, attempt, converged = 0, n6 = 6 * m->frame_count;
     frm_real *kq = m->vec[FRM__V_R]; /* K dq; CG overwrites it, so it is recomputed after */
     frm__copy_state(m, m->inc_state);
     frm__mass_update(m);
