@@ -472,6 +472,14 @@
          carries the term (measured +70 % on the hexahedral R1 beam, +26 % on tetrahedra)
          and the matrix-free K v about twice the time on hexahedra (+20 % on tetrahedra);
          assembled blocks are unchanged.
+       - Homogeneous states are not exact: the frames' rotations enter F through
+         sum_k w_k R_k, so free frames enrich the strain field beyond a compatible one and
+         a coarse model is softer than the continuum even where every displacement field
+         it needs is linear. Measured (issue 18): a unit cube of 2 x 2 x 2 hexahedral cells
+         in uniaxial stress (symmetry planes, the top face held at stretch s) carries 11 to
+         21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
+         Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
+         test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
