@@ -4193,16 +4193,26 @@ static void frm__reset_stats(frm_model *m)
     m->stats.stiffness_mode = mode;
 }
 
-FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
+/* The start of a static solve or Newton step: fresh stats, the precision check, the state
+   saved (the backup a failure restores, and start_state, the continuation's origin). */
+static int frm__begin_solve(frm_model *m)
 {
-    double res = 0, scale = 0;
-    int converged, err;
-    if (!m) return FRM_ERR_ARG;
+    int err;
     frm__reset_stats(m);
     err = frm__check_precision(m);
     if (err) return err;
     frm__save_state(m);
     memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
+{
+    double res = 0, scale = 0;
+    int converged, err;
+    if (!m) return FRM_ERR_ARG;
+    err = frm__begin_solve(m);
+    if (err) return err;
     frm__apply_driven(m);
     err = frm__newton_iteration(m, 1, (double)m->newton_tolerance, &converged, &res, &scale);
     if (err) {
@@ -4272,11 +4282,8 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     double lambda = 0, inc = 1, res = 0, scale = 0, tol;
     int i, r, attempts = 0, err = FRM_OK, iterations;
     if (!m) return FRM_ERR_ARG;
-    frm__reset_stats(m);
-    err = frm__check_precision(m);
+    err = frm__begin_solve(m);
     if (err) return err;
-    frm__save_state(m);
-    memcpy(m->start_state, m->backup, sizeof(frm_real) * 13 * (size_t)m->frame_count);
     frm__inversions(m, 1);
     for (r = 0; r < 3; r++) g_full[r] = m->gravity[r];
     memcpy(m->ext_full, m->ext, sizeof(frm_real) * 6 * (size_t)m->frame_count);
