@@ -536,16 +536,25 @@ enum {
 
 typedef enum tmass_model_kind {
     TMASS_TENSOR_MASS = 0, /* linear elasticity, Cotin et al. eqs. 5-6 (default) */
-    TMASS_MASS_SPRING = 1  /* springs on the mesh edges, eq. 7 (baseline) */
+    TMASS_MASS_SPRING = 1, /* springs on the mesh edges, eq. 7 (baseline) */
+    TMASS_MODEL_KIND_COUNT /* number of kinds (validation), not a kind */
 } tmass_model_kind;
 
 typedef enum tmass_integrator {
     TMASS_EXPLICIT_EULER = 0,
     TMASS_SEMI_IMPLICIT_EULER = 1,
     TMASS_RK4 = 2,
-    TMASS_IMPLICIT_EULER = 3,           /* springs: Newton on the incremental potential */
-    TMASS_IMPLICIT_EULER_LINEARIZED = 4 /* one linearised Newton iteration (see INTEGRATORS) */
+    TMASS_IMPLICIT_EULER = 3,            /* springs: Newton on the incremental potential */
+    TMASS_IMPLICIT_EULER_LINEARIZED = 4, /* one linearised Newton iteration (see INTEGRATORS) */
+    TMASS_INTEGRATOR_COUNT               /* number of integrators (validation), not one */
 } tmass_integrator;
+
+/* The solver of every linear system (static solve, implicit steps, Newton iterations,
+   quasi-static precomputation). */
+typedef enum tmass_linear_solver {
+    TMASS_LINEAR_SOLVER_CG = 0, /* Jacobi-preconditioned conjugate gradient (SOLVERS) */
+    TMASS_LINEAR_SOLVER_COUNT   /* number of solvers (validation), not one */
+} tmass_linear_solver;
 
 /* Custom allocator: alloc(size, align, user) returns memory aligned to `align` (a power
    of two <= 64) or NULL; free(ptr, size, user) releases it. */
@@ -584,6 +593,7 @@ typedef struct tmass_desc {
     tmass_real gravity[3];       /* m/s^2, default (0, 0, -9.81) */
     tmass_real time_step;        /* s, default 1e-3, used by tmass_step */
     tmass_integrator integrator; /* default TMASS_IMPLICIT_EULER */
+    tmass_linear_solver linear_solver; /* default TMASS_LINEAR_SOLVER_CG */
     tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-6 (1e-5 float) */
     int cg_max_iterations;       /* default 2000 */
 
@@ -933,7 +943,6 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #define TMASS__EPS (sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON)
 /* largest eps(tmass_real) lambda / mu the tensor model accepts (LIMITS; float: nu <= 0.4994) */
 #define TMASS__LAMBDA_MU_LIMIT 1e-4
-#define TMASS__SCRATCH 10      /* 3n scratch vectors */
 
 /* node states */
 #define TMASS__FREE 0
@@ -944,6 +953,7 @@ struct tmass_model {
     int node_count, tet_count, edge_total, edge_count, live_tets;
     tmass_model_kind kind;
     tmass_integrator integrator;
+    tmass_linear_solver linear_solver;
     tmass_real time_step, mass_damping, stiffness_damping, gravity[3], cg_tolerance;
     int cg_max_iterations;
     double divergence_strain, precision_limit, newton_tolerance;
@@ -991,8 +1001,28 @@ struct tmass_model {
     int *tri, *tri_owner, *face_pos;
     int tri_count;
 
-    /* scratch */
-    tmass_real *scratch[TMASS__SCRATCH];
+    /* working vectors (3n reals each), named by role; tmass__layout carves them and says
+       which roles share memory (roles of different entry points or integrators that never
+       run at the same time) */
+    tmass_real *step_u0, *step_v0;   /* a step's start: displacements and velocities, pinned
+                                        nodes at their targets (tmass__begin_step) */
+    tmass_real *step_u1, *step_v1;   /* a step's result, committed when it is accepted */
+    tmass_real *step_accel;          /* accelerations (explicit integrators, RK4 stages) */
+    tmass_real *force_work;          /* u + beta v for the stiffness-damped elastic force */
+    tmass_real *rk4_u, *rk4_v;       /* RK4 stage state */
+    tmass_real *implicit_rhs;        /* linearised implicit Euler: right-hand side */
+    tmass_real *implicit_diag;       /* M (1 + dt alpha) per degree of freedom (also Newton's) */
+    tmass_real *implicit_dv;         /* velocity increment solved for */
+    tmass_real *implicit_vfree;      /* springs: v0 on the free nodes */
+    tmass_real *implicit_kv;         /* springs: K v0_free */
+    tmass_real *newton_residual;     /* springs' Newton (implicit step, static solve) */
+    tmass_real *newton_dx, *newton_trial; /* Newton step and line-search trial point */
+    tmass_real *static_u;            /* static solve: the displacement solved for */
+    tmass_real *static_accepted;     /* springs' continuation: last accepted state */
+    tmass_real *qs_rhs, *qs_x;       /* quasi-static preload solve */
+    tmass_real *qs_mark;             /* quasi-static creation: precomputed-node marks (n) */
+    tmass_real *cg_r, *cg_z, *cg_p, *cg_q, *cg_pinv; /* CG: residual, preconditioned
+                                        residual, direction, A p, Jacobi inverse diagonal */
     tmass_real *dv_prev; /* implicit warm start */
     double *partials; /* 2 * partial_count block sums */
     int cg_indefinite; /* the last CG stopped on p . A p <= 0 */
@@ -1163,7 +1193,6 @@ static void *tmass__carve(tmass__carver *c, size_t bytes)
 static void tmass__layout(tmass_model *m, tmass__carver *c)
 {
     size_t n = (size_t)m->node_count, t = (size_t)m->tet_count, e = (size_t)m->edge_total;
-    int s;
     TMASS__CARVE(c, m->rest, tmass_real, 3 * n);
     TMASS__CARVE(c, m->disp, tmass_real, 3 * n);
     TMASS__CARVE(c, m->pos, tmass_real, 3 * n);
@@ -1200,118 +1229,42 @@ static void tmass__layout(tmass_model *m, tmass__carver *c)
     TMASS__CARVE(c, m->tri, int, 12 * t);
     TMASS__CARVE(c, m->tri_owner, int, 4 * t);
     TMASS__CARVE(c, m->face_pos, int, 4 * t);
-    for (s = 0; s < TMASS__SCRATCH; s++) TMASS__CARVE(c, m->scratch[s], tmass_real, 3 * n);
+    /* working vectors: 16 distinct 3n arrays (the 11 of 0.2.0 plus CG's own five, so no
+       output or state buffer is lent to CG any more). Roles that never run at the same
+       time share memory, set up here and only here:
+         - RK4's stage state, the linearised implicit Euler's vectors and the springs'
+           Newton vectors belong to different integrators of one step;
+         - the static solve and the quasi-static preload solve are entry points of their
+           own, never inside a step: they reuse the step's state vectors. */
+    TMASS__CARVE(c, m->step_u0, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_v0, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_u1, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_v1, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_accel, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->force_work, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_rhs, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_diag, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_dv, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->newton_trial, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_r, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_z, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_p, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_q, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_pinv, tmass_real, 3 * n);
     TMASS__CARVE(c, m->dv_prev, tmass_real, 3 * n);
+    m->rk4_u = m->implicit_rhs;
+    m->rk4_v = m->implicit_diag;
+    m->implicit_vfree = m->step_u1; /* read before the step's result is written */
+    m->implicit_kv = m->force_work; /* the springs' force needs no work vector */
+    m->newton_residual = m->implicit_rhs;
+    m->newton_dx = m->implicit_dv;
+    m->static_u = m->step_u1;
+    m->static_accepted = m->step_u0;
+    m->qs_rhs = m->step_u0;
+    m->qs_x = m->step_u1;
+    m->qs_mark = m->step_v0;
     TMASS__CARVE(c, m->partials, double, 2 * (size_t)m->partial_count);
     TMASS__CARVE(c, m->tear_list, int, t);
-}
-
-/* >>validation ------------------------------------------------------------------------ */
-
-static int tmass__fail(const tmass_desc *d, int code, const char *detail)
-{
-    if (d && d->log) d->log(code, detail, d->log_user);
-    return code;
-}
-
-static int tmass__validate_material(const tmass_desc *d, double E, double nu, int t, char *msg,
-                                    size_t msg_size)
-{
-    if (!(tmass__finite(E) && E > 0.0)) {
-        snprintf(msg, msg_size, "Young's modulus %g of tetrahedron %d", E, t);
-        return TMASS_ERR_YOUNG_MODULUS;
-    }
-    if (d->kind == TMASS_TENSOR_MASS && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
-        snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
-        return TMASS_ERR_POISSON_RATIO;
-    }
-    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
-       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
-    if (d->kind == TMASS_TENSOR_MASS && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
-        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
-                 nu, t);
-        return TMASS_ERR_POISSON_RATIO;
-    }
-    return TMASS_OK;
-}
-
-static int tmass__validate(const tmass_desc *d)
-{
-    char msg[160];
-    int i, t, err;
-    /* a desc without the cookie was not made by tmass_default_desc: nothing in it can be
-       trusted, its log callback least of all (issue 18) */
-    if (d->internal_cookie != TMASS__COOKIE) return TMASS_ERR_DESC;
-    if (d->kind != TMASS_TENSOR_MASS && d->kind != TMASS_MASS_SPRING)
-        return tmass__fail(d, TMASS_ERR_MODEL_KIND, "kind");
-    if (d->node_count < 4 || d->node_count > 200000000 || !d->rest_positions)
-        return tmass__fail(d, TMASS_ERR_NODE_COUNT, "node_count must be >= 4 with positions");
-    if (d->tet_count < 1 || d->tet_count > 200000000 || !d->tets)
-        return tmass__fail(d, TMASS_ERR_TET_COUNT, "tet_count must be >= 1 with indices");
-    if (!(tmass__finite(d->density) && d->density > 0))
-        return tmass__fail(d, TMASS_ERR_DENSITY, "density");
-    if (!(tmass__finite(d->time_step) && d->time_step > 0))
-        return tmass__fail(d, TMASS_ERR_TIME_STEP, "time_step");
-    if (!(tmass__finite(d->mass_damping) && d->mass_damping >= 0) ||
-        !(tmass__finite(d->stiffness_damping) && d->stiffness_damping >= 0))
-        return tmass__fail(d, TMASS_ERR_DAMPING, "damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 4)
-        return tmass__fail(d, TMASS_ERR_INTEGRATOR, "integrator");
-    if (!(tmass__finite(d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
-        return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
-    if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
-        return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
-    if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
-        !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
-        return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
-    for (i = 0; i < 3; i++)
-        if (!tmass__finite(d->gravity[i])) return tmass__fail(d, TMASS_ERR_ARG, "gravity");
-    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        return tmass__fail(d, TMASS_ERR_ARG, "allocator needs both alloc and free");
-    for (i = 0; i < 3 * d->node_count; i++)
-        if (!tmass__finite(d->rest_positions[i])) {
-            snprintf(msg, sizeof msg, "rest position of node %d is not finite", i / 3);
-            return tmass__fail(d, TMASS_ERR_NODE_NOT_FINITE, msg);
-        }
-    for (t = 0; t < d->tet_count; t++) {
-        const int *q = d->tets + 4 * t;
-        double E = d->tet_young_modulus ? (double)d->tet_young_modulus[t] : (double)d->young_modulus;
-        double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
-        double g[4][3], six_v, longest = 0.0;
-        int a, b;
-        for (a = 0; a < 4; a++) {
-            if (q[a] < 0 || q[a] >= d->node_count) {
-                snprintf(msg, sizeof msg, "tetrahedron %d: node index %d out of range", t, q[a]);
-                return tmass__fail(d, TMASS_ERR_INDEX_RANGE, msg);
-            }
-            for (b = 0; b < a; b++)
-                if (q[a] == q[b]) {
-                    snprintf(msg, sizeof msg, "tetrahedron %d uses node %d twice", t, q[a]);
-                    return tmass__fail(d, TMASS_ERR_INDEX_REPEATED, msg);
-                }
-        }
-        err = tmass__validate_material(d, E, nu, t, msg, sizeof msg);
-        if (err) return tmass__fail(d, err, msg);
-        for (a = 0; a < 4; a++)
-            for (b = a + 1; b < 4; b++) {
-                const tmass_real *pa = d->rest_positions + 3 * q[a], *pb = d->rest_positions + 3 * q[b];
-                double dx = (double)pa[0] - pb[0], dy = (double)pa[1] - pb[1], dz = (double)pa[2] - pb[2];
-                double l2 = dx * dx + dy * dy + dz * dz;
-                if (l2 > longest) longest = l2;
-            }
-        six_v = tmass__shape_gradients(d->rest_positions + 3 * q[0], d->rest_positions + 3 * q[1],
-                                       d->rest_positions + 3 * q[2], d->rest_positions + 3 * q[3], g);
-        /* a regular tetrahedron has 6V = l^3 / sqrt(2); flag slivers 1e8 times flatter */
-        if (!(fabs(six_v) > 1e-8 * longest * sqrt(longest))) {
-            snprintf(msg, sizeof msg, "tetrahedron %d is flat (6V = %g)", t, six_v);
-            return tmass__fail(d, TMASS_ERR_TET_DEGENERATE, msg);
-        }
-        if (six_v < 0.0) {
-            snprintf(msg, sizeof msg, "tetrahedron %d is negatively oriented", t);
-            return tmass__fail(d, TMASS_ERR_TET_INVERTED, msg);
-        }
-    }
-    return TMASS_OK;
 }
 
 /* >>precomputation -------------------------------------------------------------------- */
@@ -1498,33 +1451,213 @@ static void tmass__add_tensor(tmass_real *dst, const double *src, double sign)
     for (k = 0; k < 9; k++) dst[k] = (tmass_real)((double)dst[k] + sign * src[k]);
 }
 
-/* Adds (sign +1) or subtracts (-1) the contribution of tetrahedron t: tensors, spring
-   stiffnesses and lumped masses. The ten tensor updates of sec. 5.5. */
-static void tmass__apply_tet(tmass_model *m, int t, double sign)
+/* Adds (sign +1) or subtracts (-1) the contribution of tetrahedron t: tensors and
+   lumped masses. The ten tensor updates of sec. 5.5. */
+static void tmass__tensor_assemble_tet(tmass_model *m, int t, double sign)
 {
     double K[4][4][9], v;
     const int *q = m->tet_nodes + 4 * t;
     int j, l;
-    v = m->kind == TMASS_TENSOR_MASS ? tmass__tet_tensors(m, t, K) : tmass__rest_volume(m, t);
+    v = tmass__tet_tensors(m, t, K);
     for (j = 0; j < 4; j++) {
         m->mass[q[j]] = (tmass_real)((double)m->mass[q[j]] + sign * m->density * v / 4.0);
-        if (m->kind == TMASS_TENSOR_MASS) tmass__add_tensor(m->vertex_tensor + 9 * q[j], K[j][j], sign);
+        tmass__add_tensor(m->vertex_tensor + 9 * q[j], K[j][j], sign);
     }
     for (l = 0; l < 6; l++) {
         int j0 = tmass__edge_local[l][0], j1 = tmass__edge_local[l][1];
         int slot = m->edge_slot[m->tet_edges[6 * t + l]];
-        if (m->kind == TMASS_TENSOR_MASS) {
-            /* the slot stores K_ab with a < b */
-            if (q[j0] < q[j1])
-                tmass__add_tensor(m->edge_tensor + 9 * slot, K[j0][j1], sign);
-            else
-                tmass__add_tensor(m->edge_tensor + 9 * slot, K[j1][j0], sign);
-        } else {
-            double l0 = m->edge_rest_length[slot];
-            m->edge_stiffness[slot] =
-                (tmass_real)((double)m->edge_stiffness[slot] + sign * m->tet_young[t] * v / (l0 * l0));
+        /* the slot stores K_ab with a < b */
+        if (q[j0] < q[j1])
+            tmass__add_tensor(m->edge_tensor + 9 * slot, K[j0][j1], sign);
+        else
+            tmass__add_tensor(m->edge_tensor + 9 * slot, K[j1][j0], sign);
+    }
+}
+
+/* The same for springs: lumped masses and the six spring stiffnesses k = E V / l0^2. */
+static void tmass__spring_assemble_tet(tmass_model *m, int t, double sign)
+{
+    double v;
+    const int *q = m->tet_nodes + 4 * t;
+    int j, l;
+    v = tmass__rest_volume(m, t);
+    for (j = 0; j < 4; j++) m->mass[q[j]] = (tmass_real)((double)m->mass[q[j]] + sign * m->density * v / 4.0);
+    for (l = 0; l < 6; l++) {
+        int slot = m->edge_slot[m->tet_edges[6 * t + l]];
+        double l0 = m->edge_rest_length[slot];
+        m->edge_stiffness[slot] =
+            (tmass_real)((double)m->edge_stiffness[slot] + sign * m->tet_young[t] * v / (l0 * l0));
+    }
+}
+
+/* >>laws ------------------------------------------------------------------------------ */
+
+/* The model kinds (the "laws" of this header), one row per tmass_model_kind: every place
+   where the kind selects physics goes through this table (HOW TO EXTEND). */
+typedef struct tmass__kind_ops {
+    const char *name;
+    /* per-tetrahedron precomputation: add (sign +1) or remove (-1) tetrahedron t's
+       stiffness and lumped mass (creation, cutting) */
+    void (*assemble_tet)(tmass_model *m, int t, double sign);
+    /* internal force (elastic plus stiffness damping) at displacement u and velocity v
+       (v may be NULL) into out; w: a 3n work vector */
+    void (*force)(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out, tmass_real *w);
+    /* the force's differential for the linearised implicit Euler step from (x0, v0):
+       writes f(x0, v0) - dt K v0_free into f, leaves the system's stiffness part in the
+       edge tensors (what tmass__matvec applies) and returns its factor c, so that the
+       step solves (M (1 + dt alpha) + c K) dv = dt (f + loads) */
+    double (*differential)(tmass_model *m, tmass_real dt, const tmass_real *x0, const tmass_real *v0,
+                           tmass_real *f);
+    /* elastic energy at displacement u, J (may use m->force as work) */
+    double (*energy)(tmass_model *m, const tmass_real *u);
+    /* TMASS_IMPLICIT_EULER: a Newton solve of the nonlinear step, or NULL when the kind is
+       linear (the linearised step is then exact) */
+    int (*implicit_newton)(tmass_model *m, tmass_real dt);
+    /* static equilibrium from u (pinned entries at their targets), in place */
+    int (*static_solve)(tmass_model *m, tmass_real *u);
+    int flags; /* TMASS__KIND_* */
+} tmass__kind_ops;
+
+/* linear with constant tensors in the model: K is what the edge tensors hold, so the
+   quasi-static precomputation, the hybrid model and tmass_vertex_tensor apply */
+#define TMASS__KIND_LINEAR 1
+/* uses poisson_ratio (validated; lambda and mu stored per tetrahedron) */
+#define TMASS__KIND_POISSON 2
+
+static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w);
+static void tmass__spring_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w);
+static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f);
+static double tmass__spring_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f);
+static double tmass__tensor_energy(tmass_model *m, const tmass_real *u);
+static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u);
+static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt);
+static int tmass__tensor_static(tmass_model *m, tmass_real *u);
+static int tmass__spring_static(tmass_model *m, tmass_real *u);
+
+static const tmass__kind_ops tmass__kinds[] = {
+    /* TMASS_TENSOR_MASS */
+    {"tensor-mass", tmass__tensor_assemble_tet, tmass__tensor_force, tmass__tensor_differential,
+     tmass__tensor_energy, NULL, tmass__tensor_static, TMASS__KIND_LINEAR | TMASS__KIND_POISSON},
+    /* TMASS_MASS_SPRING */
+    {"mass-spring", tmass__spring_assemble_tet, tmass__spring_force, tmass__spring_differential,
+     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static, 0}};
+/* one row per kind (a negative array size stops the build otherwise) */
+typedef char tmass__kinds_size_check[sizeof tmass__kinds / sizeof tmass__kinds[0] == TMASS_MODEL_KIND_COUNT ? 1 : -1];
+
+static void tmass__apply_tet(tmass_model *m, int t, double sign) { tmass__kinds[m->kind].assemble_tet(m, t, sign); }
+
+/* >>validation ------------------------------------------------------------------------ */
+
+static int tmass__fail(const tmass_desc *d, int code, const char *detail)
+{
+    if (d && d->log) d->log(code, detail, d->log_user);
+    return code;
+}
+
+static int tmass__validate_material(const tmass_desc *d, double E, double nu, int t, char *msg,
+                                    size_t msg_size)
+{
+    if (!(tmass__finite(E) && E > 0.0)) {
+        snprintf(msg, msg_size, "Young's modulus %g of tetrahedron %d", E, t);
+        return TMASS_ERR_YOUNG_MODULUS;
+    }
+    int poisson = (tmass__kinds[d->kind].flags & TMASS__KIND_POISSON) != 0;
+    if (poisson && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
+        snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
+       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
+    if (poisson && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
+        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
+                 nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    return TMASS_OK;
+}
+
+static int tmass__validate(const tmass_desc *d)
+{
+    char msg[160];
+    int i, t, err;
+    /* a desc without the cookie was not made by tmass_default_desc: nothing in it can be
+       trusted, its log callback least of all (issue 18) */
+    if (d->internal_cookie != TMASS__COOKIE) return TMASS_ERR_DESC;
+    if ((unsigned)d->kind >= TMASS_MODEL_KIND_COUNT) return tmass__fail(d, TMASS_ERR_MODEL_KIND, "kind");
+    if (d->node_count < 4 || d->node_count > 200000000 || !d->rest_positions)
+        return tmass__fail(d, TMASS_ERR_NODE_COUNT, "node_count must be >= 4 with positions");
+    if (d->tet_count < 1 || d->tet_count > 200000000 || !d->tets)
+        return tmass__fail(d, TMASS_ERR_TET_COUNT, "tet_count must be >= 1 with indices");
+    if (!(tmass__finite(d->density) && d->density > 0))
+        return tmass__fail(d, TMASS_ERR_DENSITY, "density");
+    if (!(tmass__finite(d->time_step) && d->time_step > 0))
+        return tmass__fail(d, TMASS_ERR_TIME_STEP, "time_step");
+    if (!(tmass__finite(d->mass_damping) && d->mass_damping >= 0) ||
+        !(tmass__finite(d->stiffness_damping) && d->stiffness_damping >= 0))
+        return tmass__fail(d, TMASS_ERR_DAMPING, "damping");
+    if ((unsigned)d->integrator >= TMASS_INTEGRATOR_COUNT)
+        return tmass__fail(d, TMASS_ERR_INTEGRATOR, "integrator");
+    if ((unsigned)d->linear_solver >= TMASS_LINEAR_SOLVER_COUNT)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "linear_solver");
+    if (!(tmass__finite(d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
+    if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
+    if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
+        !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
+        return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
+    for (i = 0; i < 3; i++)
+        if (!tmass__finite(d->gravity[i])) return tmass__fail(d, TMASS_ERR_ARG, "gravity");
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return tmass__fail(d, TMASS_ERR_ARG, "allocator needs both alloc and free");
+    for (i = 0; i < 3 * d->node_count; i++)
+        if (!tmass__finite(d->rest_positions[i])) {
+            snprintf(msg, sizeof msg, "rest position of node %d is not finite", i / 3);
+            return tmass__fail(d, TMASS_ERR_NODE_NOT_FINITE, msg);
+        }
+    for (t = 0; t < d->tet_count; t++) {
+        const int *q = d->tets + 4 * t;
+        double E = d->tet_young_modulus ? (double)d->tet_young_modulus[t] : (double)d->young_modulus;
+        double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
+        double g[4][3], six_v, longest = 0.0;
+        int a, b;
+        for (a = 0; a < 4; a++) {
+            if (q[a] < 0 || q[a] >= d->node_count) {
+                snprintf(msg, sizeof msg, "tetrahedron %d: node index %d out of range", t, q[a]);
+                return tmass__fail(d, TMASS_ERR_INDEX_RANGE, msg);
+            }
+            for (b = 0; b < a; b++)
+                if (q[a] == q[b]) {
+                    snprintf(msg, sizeof msg, "tetrahedron %d uses node %d twice", t, q[a]);
+                    return tmass__fail(d, TMASS_ERR_INDEX_REPEATED, msg);
+                }
+        }
+        err = tmass__validate_material(d, E, nu, t, msg, sizeof msg);
+        if (err) return tmass__fail(d, err, msg);
+        for (a = 0; a < 4; a++)
+            for (b = a + 1; b < 4; b++) {
+                const tmass_real *pa = d->rest_positions + 3 * q[a], *pb = d->rest_positions + 3 * q[b];
+                double dx = (double)pa[0] - pb[0], dy = (double)pa[1] - pb[1], dz = (double)pa[2] - pb[2];
+                double l2 = dx * dx + dy * dy + dz * dz;
+                if (l2 > longest) longest = l2;
+            }
+        six_v = tmass__shape_gradients(d->rest_positions + 3 * q[0], d->rest_positions + 3 * q[1],
+                                       d->rest_positions + 3 * q[2], d->rest_positions + 3 * q[3], g);
+        /* a regular tetrahedron has 6V = l^3 / sqrt(2); flag slivers 1e8 times flatter */
+        if (!(fabs(six_v) > 1e-8 * longest * sqrt(longest))) {
+            snprintf(msg, sizeof msg, "tetrahedron %d is flat (6V = %g)", t, six_v);
+            return tmass__fail(d, TMASS_ERR_TET_DEGENERATE, msg);
+        }
+        if (six_v < 0.0) {
+            snprintf(msg, sizeof msg, "tetrahedron %d is negatively oriented", t);
+            return tmass__fail(d, TMASS_ERR_TET_INVERTED, msg);
         }
     }
+    return TMASS_OK;
 }
 
 /* >>creation -------------------------------------------------------------------------- */
@@ -1553,6 +1686,7 @@ TMASSDEF tmass_desc tmass_default_desc(void)
     d.gravity[2] = (tmass_real)-9.81;
     d.time_step = (tmass_real)1e-3;
     d.integrator = TMASS_IMPLICIT_EULER;
+    d.linear_solver = TMASS_LINEAR_SOLVER_CG;
     d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-6);
     d.cg_max_iterations = 2000;
     d.newton_iterations = 20;
@@ -1639,6 +1773,7 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
 
     m->kind = d->kind;
     m->integrator = d->integrator;
+    m->linear_solver = d->linear_solver;
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
     m->stiffness_damping = d->stiffness_damping;
@@ -1670,7 +1805,7 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
         int l;
         m->tet_young[t] = E_t;
-        if (d->kind == TMASS_TENSOR_MASS) {
+        if (tmass__kinds[d->kind].flags & TMASS__KIND_POISSON) {
             m->tet_lambda[t] = E_t * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
             m->tet_mu[t] = E_t / (2.0 * (1.0 + nu));
         }
@@ -1977,14 +2112,17 @@ static void tmass__spring_forces(tmass_model *m, const tmass_real *u, const tmas
    be NULL):
    tensor:  out = -K (u + beta v)   (w is scratch)
    springs: out = eq. 7 plus axial damping. */
-static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tmass_real *v,
-                                  tmass_real *out, tmass_real *w)
+static void tmass__spring_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w)
+{
+    (void)w;
+    tmass__spring_forces(m, u, v, out, 0.0, 0.0, NULL, NULL, 0);
+}
+
+static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w)
 {
     int i, n3 = 3 * m->node_count;
-    if (m->kind == TMASS_MASS_SPRING) {
-        tmass__spring_forces(m, u, v, out, 0.0, 0.0, NULL, NULL, 0);
-        return;
-    }
     if (v && m->stiffness_damping != 0) {
         tmass_real beta = m->stiffness_damping;
         for (i = 0; i < n3; i++) w[i] = u[i] + beta * v[i];
@@ -1994,6 +2132,22 @@ static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tma
     }
     for (i = 0; i < n3; i++) out[i] = -out[i];
     m->stats.force_evaluations++;
+}
+
+static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tmass_real *v,
+                                  tmass_real *out, tmass_real *w)
+{
+    tmass__kinds[m->kind].force(m, u, v, out, w);
+}
+
+/* 1/2 u^T K u = -1/2 u . f (f into m->force) */
+static double tmass__tensor_energy(tmass_model *m, const tmass_real *u)
+{
+    int i, n3 = 3 * m->node_count;
+    double elastic = 0.0;
+    tmass__tensor_force(m, u, NULL, m->force, m->force_work);
+    for (i = 0; i < n3; i++) elastic -= 0.5 * (double)u[i] * (double)m->force[i];
+    return elastic;
 }
 
 /* Acceleration of the free nodes (zero elsewhere):
@@ -2106,22 +2260,23 @@ static double tmass__sum_partials(const tmass_model *m, int offset)
 /* Solves (D + c K) x = b on the free degrees of freedom by Jacobi-preconditioned CG
    (diag: D per degree of freedom, or NULL). x holds the initial guess; pinned and
    inactive entries are held at 0. Stops when |r| <= cg_tolerance |b| or after
-   cg_max_iterations. Scratch s[0..4]. Returns TMASS_OK, TMASS_ERR_NOT_FINITE (|b|^2 or the
+   cg_max_iterations. Works in the model's CG vectors (m->cg_r, cg_z, cg_p, cg_q, cg_pinv),
+   which nothing else uses; b and x must not be any of them. Returns TMASS_OK, TMASS_ERR_NOT_FINITE (|b|^2 or the
    residual not finite) or TMASS_ERR_NO_CONVERGENCE (the cap reached above the tolerance,
    or a direction of non-positive curvature: the caller fails, issue 18's policy). Adds
    its iterations to the stats and sets stats.cg_residual. */
 static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b,
-                     tmass_real *x, tmass_real **s)
+                     tmass_real *x)
 {
     tmass__cg_ctx k;
     int n3 = 3 * m->node_count, i, it, blocks = m->partial_count;
-    tmass_real *pinv = s[4];
+    tmass_real *pinv = m->cg_pinv;
     double bb = 0.0, rr, rz, tol2, pdp, rho_min = HUGE_VAL, rho_max = 0.0;
     k.m = m;
-    k.r = s[0];
-    k.z = s[1];
-    k.p = s[2];
-    k.q = s[3];
+    k.r = m->cg_r;
+    k.z = m->cg_z;
+    k.p = m->cg_p;
+    k.q = m->cg_q;
     k.x = x;
     k.pinv = pinv;
     k.diag = diag;
@@ -2210,6 +2365,41 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     return tmass__finite(rr) ? TMASS_ERR_NO_CONVERGENCE : TMASS_ERR_NOT_FINITE;
 }
 
+/* The linear solvers, one row per tmass_linear_solver (HOW TO EXTEND). Every linear
+   solve of this header goes through tmass__linear_solve (one system) or
+   tmass__linear_solve_block (TMASS__RHS systems with the same matrix, the quasi-static
+   precomputation); both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (iteration cap, or
+   non-positive curvature) or TMASS_ERR_NOT_FINITE. */
+typedef struct tmass__linear_solver_ops {
+    const char *name;
+    /* (D + c K) x = b on the free degrees of freedom, x the initial guess (see tmass__cg) */
+    int (*solve)(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b, tmass_real *x);
+    /* K X = B for TMASS__RHS interleaved columns; w four work arrays like X, pinv the
+       Jacobi inverse diagonal (see tmass__cg_block) */
+    int (*solve_block)(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                       const tmass_real *pinv, double tol, int max_iterations);
+} tmass__linear_solver_ops;
+
+static int tmass__cg_block(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                           const tmass_real *pinv, double tol, int max_iterations);
+
+static const tmass__linear_solver_ops tmass__linear_solvers[] = {
+    {"Jacobi-preconditioned CG", tmass__cg, tmass__cg_block}};
+typedef char tmass__linear_solvers_size_check[sizeof tmass__linear_solvers / sizeof tmass__linear_solvers[0] ==
+                                                      TMASS_LINEAR_SOLVER_COUNT ? 1 : -1];
+
+static int tmass__linear_solve(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b,
+                               tmass_real *x)
+{
+    return tmass__linear_solvers[m->linear_solver].solve(m, diag, c, b, x);
+}
+
+static int tmass__linear_solve_block(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                                     const tmass_real *pinv, double tol, int max_iterations)
+{
+    return tmass__linear_solvers[m->linear_solver].solve_block(m, B, X, w, pinv, tol, max_iterations);
+}
+
 /* >>integrators ----------------------------------------------------------------------- */
 
 static int tmass__all_finite(const tmass_real *a, size_t count)
@@ -2244,38 +2434,45 @@ static void tmass__commit(tmass_model *m, const tmass_real *u, const tmass_real 
     for (i = 0; i < n3; i++) m->pos[i] = m->rest[i] + u[i];
 }
 
-static void tmass__explicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                  const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+/* The integrators. Each step function reads the step's start (m->step_u0, m->step_v0:
+   displacements and velocities, pinned nodes at their targets) and writes its result to
+   m->step_u1, m->step_v1; tmass_step_ex checks and commits it. They are listed in
+   tmass__integrators (below), indexed by tmass_integrator. */
+static int tmass__explicit_euler(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count;
-    tmass_real *a = m->scratch[4];
-    tmass__acceleration(m, x0, v0, a, m->scratch[5]);
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1, *a = m->step_accel;
+    tmass__acceleration(m, x0, v0, a, m->force_work);
     for (i = 0; i < n3; i++) {
         x1[i] = x0[i] + dt * v0[i] * m->free_mask[i];
         v1[i] = v0[i] + dt * a[i];
     }
+    return TMASS_OK;
 }
 
-static void tmass__semi_implicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                       const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+static int tmass__semi_implicit_euler(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count;
-    tmass_real *a = m->scratch[4];
-    tmass__acceleration(m, x0, v0, a, m->scratch[5]);
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1, *a = m->step_accel;
+    tmass__acceleration(m, x0, v0, a, m->force_work);
     for (i = 0; i < n3; i++) {
         v1[i] = v0[i] + dt * a[i];
         x1[i] = x0[i] + dt * v1[i] * m->free_mask[i];
     }
+    return TMASS_OK;
 }
 
-static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, const tmass_real *v0,
-                       tmass_real *x1, tmass_real *v1)
+static int tmass__rk4(tmass_model *m, tmass_real dt)
 {
     /* k1 = f(y0), k2 = f(y0 + dt/2 k1), k3 = f(y0 + dt/2 k2), k4 = f(y0 + dt k3),
        y1 = y0 + dt/6 (k1 + 2 k2 + 2 k3 + k4); y = (x, v), f(y) = (v, a(x, v)).
        x1, v1 accumulate; (xs, vs) is the stage state, a its acceleration. */
     int i, stage, n3 = 3 * m->node_count;
-    tmass_real *xs = m->scratch[4], *vs = m->scratch[5], *a = m->scratch[6], *w = m->scratch[7];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1;
+    tmass_real *xs = m->rk4_u, *vs = m->rk4_v, *a = m->step_accel, *w = m->force_work;
     static const double weight[4] = {1.0, 2.0, 2.0, 1.0};
     static const double next[4] = {0.5, 0.5, 1.0, 0.0};
     memcpy(xs, x0, sizeof(tmass_real) * (size_t)n3);
@@ -2293,6 +2490,7 @@ static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, cons
             vs[i] = v0[i] + hn * a[i];
         }
     }
+    return TMASS_OK;
 }
 
 /* Backward Euler, linearised once (exact for the linear tensor model):
@@ -2303,44 +2501,49 @@ static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, cons
    their velocity (target - u) / dt: that velocity enters the damping forces only, never
    the elastic prediction x0 + dt v0 (which would count the pinned move twice, issue 18
    item 6). A CG that does not reach its tolerance fails the step (issue 18 item 9). */
-static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                 const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+/* tensor: f(x0, v0) - dt K v0_free = -K (u0 + beta v0 + dt v0_free); c = dt^2 + dt beta */
+static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f)
+{
+    int i, n3 = 3 * m->node_count;
+    tmass_real *w = m->force_work, beta = m->stiffness_damping;
+    for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
+    tmass__matvec(m, w, f);
+    for (i = 0; i < n3; i++) f[i] = -f[i];
+    m->stats.force_evaluations++;
+    return (double)dt * dt + (double)dt * m->stiffness_damping;
+}
+
+/* springs: the force (damping with the full v0), the tangent S = dt^2 K + dt D into the
+   tensors (c = 1), and K v0_free */
+static double tmass__spring_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f)
+{
+    int i, n3 = 3 * m->node_count;
+    tmass_real *vfree = m->implicit_vfree, *kv = m->implicit_kv;
+    for (i = 0; i < n3; i++) vfree[i] = v0[i] * m->free_mask[i];
+    tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, vfree, kv, 0);
+    for (i = 0; i < n3; i++) f[i] -= dt * kv[i];
+    return 1.0;
+}
+
+static int tmass__implicit_euler_linear(tmass_model *m, tmass_real dt)
 {
     int i, r, n = m->node_count, n3 = 3 * n, err;
-    tmass_real *f = m->scratch[4], *dmass = m->scratch[5], *dv = m->scratch[6], *w = m->scratch[7];
-    tmass_real *cg_scratch[5];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1;
+    tmass_real *f = m->implicit_rhs, *dmass = m->implicit_diag, *dv = m->implicit_dv;
     tmass_real alpha = m->mass_damping;
     double c;
-    /* x1, v1 and w are free while CG runs: lend them to it */
-    cg_scratch[0] = m->scratch[8];
-    cg_scratch[1] = m->scratch[9];
-    cg_scratch[2] = x1;
-    cg_scratch[3] = v1;
-    cg_scratch[4] = w;
     for (i = 0; i < n3; i++) dmass[i] = (tmass_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
-    if (m->kind == TMASS_TENSOR_MASS) {
-        /* f(x0, v0) - dt K v0_free = -K (u0 + beta v0 + dt v0_free) */
-        tmass_real beta = m->stiffness_damping;
-        for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
-        tmass__matvec(m, w, f);
-        for (i = 0; i < n3; i++) f[i] = -f[i];
-        m->stats.force_evaluations++;
-        c = (double)dt * dt + (double)dt * m->stiffness_damping;
-    } else {
-        /* spring force (damping with the full v0), tangent S = dt^2 K + dt D into the
-           tensors (c = 1), and K v0_free (x1 lends its memory to v0_free) */
-        for (i = 0; i < n3; i++) x1[i] = v0[i] * m->free_mask[i];
-        tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, x1, w, 0);
-        for (i = 0; i < n3; i++) f[i] -= dt * w[i];
-        c = 1.0;
-    }
+    c = tmass__kinds[m->kind].differential(m, dt, x0, v0, f);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
             f[j] = dt * (f[j] + m->ext[j] + m->mass[i] * (m->gravity[r] - alpha * v0[j]));
         }
     memcpy(dv, m->dv_prev, sizeof(tmass_real) * (size_t)n3);
-    err = tmass__cg(m, dmass, c, f, dv, cg_scratch);
+    err = tmass__linear_solve(m, dmass, c, f, dv);
     if (err) return err;
     for (i = 0; i < n3; i++) {
         tmass_real fm = m->free_mask[i];
@@ -2414,21 +2617,13 @@ static double tmass__spring_incremental_potential(const tmass_model *m, tmass_re
     return h2 * (tmass__spring_energy(m, x) - work) + inertia;
 }
 
-static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                         const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count, it, err, halvings;
-    tmass_real *R = m->scratch[4], *dmass = m->scratch[5], *dx = m->scratch[6], *xt = m->scratch[7];
-    tmass_real *cg_scratch[5];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1; /* v1 holds v(x) */
+    tmass_real *R = m->newton_residual, *dmass = m->implicit_diag, *dx = m->newton_dx, *xt = m->newton_trial;
     double rr, ref2, load2 = 0.0, tol2, h2 = (double)dt * dt;
-    /* CG scratch: scratch[8] and [9], the warm-start vector (unused by this integrator),
-       the force output array (recomputed by tmass_forces) and xt (free until the line
-       search); v1 holds v(x) */
-    cg_scratch[0] = m->scratch[8];
-    cg_scratch[1] = m->scratch[9];
-    cg_scratch[2] = m->dv_prev;
-    cg_scratch[3] = m->force;
-    cg_scratch[4] = xt;
     for (i = 0; i < n3; i++) {
         dmass[i] = (tmass_real)((1.0 + (double)dt * m->mass_damping) * (double)m->mass[i / 3]);
         x1[i] = x0[i] + dt * v0[i] * m->free_mask[i]; /* the predictor */
@@ -2447,7 +2642,7 @@ static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt, const tm
         if (it >= m->newton_iterations) return TMASS_ERR_NO_CONVERGENCE;
         m->stats.newton_iterations++;
         memset(dx, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, dmass, 1.0, R, dx, cg_scratch);
+        err = tmass__linear_solve(m, dmass, 1.0, R, dx);
         if (err) return err;
         for (i = 0; i < n3; i++) slope += (double)R[i] * dx[i];
         phi = tmass__spring_incremental_potential(m, dt, x0, v0, x1);
@@ -2528,44 +2723,63 @@ static int tmass__count_inverted(const tmass_model *m, const tmass_real *u)
     return count;
 }
 
+/* TMASS_IMPLICIT_EULER: the kind's Newton solve where it has one, else the linearised
+   step (exact for a linear kind). */
+static int tmass__implicit_euler(tmass_model *m, tmass_real dt)
+{
+    m->stats.increments = 1;
+    if (tmass__kinds[m->kind].implicit_newton) return tmass__kinds[m->kind].implicit_newton(m, dt);
+    m->stats.newton_iterations = 1;
+    return tmass__implicit_euler_linear(m, dt);
+}
+
+static int tmass__implicit_euler_linearized(tmass_model *m, tmass_real dt)
+{
+    m->stats.increments = 1;
+    m->stats.newton_iterations = 1;
+    return tmass__implicit_euler_linear(m, dt);
+}
+
+/* The integrators, one row per tmass_integrator (HOW TO EXTEND). is_explicit: the step
+   is checked for divergence (TMASS_ERR_DIVERGED) and does not count inverted tetrahedra. */
+typedef struct tmass__integrator_ops {
+    const char *name;
+    int (*step)(tmass_model *m, tmass_real dt); /* step_u0/v0 -> step_u1/v1 */
+    int is_explicit;
+} tmass__integrator_ops;
+
+static const tmass__integrator_ops tmass__integrators[] = {
+    {"explicit Euler", tmass__explicit_euler, 1},
+    {"semi-implicit Euler", tmass__semi_implicit_euler, 1},
+    {"RK4", tmass__rk4, 1},
+    {"implicit Euler", tmass__implicit_euler, 0},
+    {"implicit Euler, linearised", tmass__implicit_euler_linearized, 0}};
+typedef char tmass__integrators_size_check[sizeof tmass__integrators / sizeof tmass__integrators[0] ==
+                                                   TMASS_INTEGRATOR_COUNT ? 1 : -1];
+
 TMASSDEF int tmass_step_ex(tmass_model *m, tmass_real dt, tmass_integrator integrator)
 {
-    tmass_real *x0, *v0, *x1, *v1;
-    int n3, err = TMASS_OK, implicit;
+    const tmass__integrator_ops *ops;
+    tmass_real *x1, *v1;
+    int n3, err;
     if (!m) return TMASS_ERR_ARG;
     if (!(tmass__finite((double)dt) && dt > 0)) return TMASS_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 4) return TMASS_ERR_INTEGRATOR;
+    if ((unsigned)integrator >= TMASS_INTEGRATOR_COUNT) return TMASS_ERR_INTEGRATOR;
+    ops = &tmass__integrators[integrator];
     n3 = 3 * m->node_count;
-    x0 = m->scratch[0];
-    v0 = m->scratch[1];
-    x1 = m->scratch[2];
-    v1 = m->scratch[3];
+    x1 = m->step_u1;
+    v1 = m->step_v1;
     memset(&m->stats, 0, sizeof m->stats);
-    tmass__begin_step(m, dt, x0, v0);
-    switch (integrator) {
-    case TMASS_EXPLICIT_EULER: tmass__explicit_euler(m, dt, x0, v0, x1, v1); break;
-    case TMASS_SEMI_IMPLICIT_EULER: tmass__semi_implicit_euler(m, dt, x0, v0, x1, v1); break;
-    case TMASS_RK4: tmass__rk4(m, dt, x0, v0, x1, v1); break;
-    case TMASS_IMPLICIT_EULER:
-    case TMASS_IMPLICIT_EULER_LINEARIZED:
-        m->stats.increments = 1;
-        if (m->kind == TMASS_MASS_SPRING && integrator == TMASS_IMPLICIT_EULER) {
-            err = tmass__spring_implicit_newton(m, dt, x0, v0, x1, v1);
-        } else {
-            m->stats.newton_iterations = 1;
-            err = tmass__implicit_euler(m, dt, x0, v0, x1, v1);
-        }
-        break;
-    }
+    tmass__begin_step(m, dt, m->step_u0, m->step_v0);
+    err = ops->step(m, dt);
     if (!err && (!tmass__all_finite(x1, (size_t)n3) || !tmass__all_finite(v1, (size_t)n3))) err = TMASS_ERR_NOT_FINITE;
-    implicit = integrator == TMASS_IMPLICIT_EULER || integrator == TMASS_IMPLICIT_EULER_LINEARIZED;
-    if (!err && !implicit && tmass__stretched_past(m, x1)) err = TMASS_ERR_DIVERGED;
+    if (!err && ops->is_explicit && tmass__stretched_past(m, x1)) err = TMASS_ERR_DIVERGED;
     if (!err && tmass__imprecise(m, x1)) err = TMASS_ERR_PRECISION;
     if (err) {
         memset(m->dv_prev, 0, sizeof(tmass_real) * (size_t)n3);
         return err;
     }
-    if (implicit) m->stats.inverted = tmass__count_inverted(m, x1);
+    if (!ops->is_explicit) m->stats.inverted = tmass__count_inverted(m, x1);
     tmass__commit(m, x1, v1);
     return TMASS_OK;
 }
@@ -2642,10 +2856,9 @@ static double tmass__spring_potential(const tmass_model *m, const tmass_real *x)
 static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int cap)
 {
     int i, n3 = 3 * m->node_count, it, err = TMASS_OK;
-    tmass_real *f = m->scratch[1], *du = m->scratch[2], *xt = m->scratch[8], *cg_scratch[5];
+    tmass_real *f = m->newton_residual, *du = m->newton_dx, *xt = m->newton_trial;
     double ff, tol = m->newton_tolerance, tol2 = tol * tol * ref2;
     double eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
     ff = tmass__spring_residual(m, x, f, 1);
     for (it = 0; it < cap; it++) {
         double dn = 0.0, xn = 0.0, alpha = 1.0, fft = 0.0, slope, potential;
@@ -2655,13 +2868,13 @@ static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int 
         if (ff <= tol2 || ff <= tmass__roundoff_floor2(m, x, NULL)) return TMASS_OK;
         m->stats.newton_iterations++;
         memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
+        err = tmass__linear_solve(m, NULL, 1.0, f, du);
         slope = 0.0; /* f . du = minus the potential's slope along du */
         for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         if ((err && m->cg_indefinite) || (!err && !(slope > 0))) { /* on the PD part */
             tmass__spring_residual(m, x, f, 0);
             memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-            err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
+            err = tmass__linear_solve(m, NULL, 1.0, f, du);
             slope = 0.0;
             for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         }
@@ -2707,7 +2920,7 @@ static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int 
 static int tmass__spring_static(tmass_model *m, tmass_real *x)
 {
     int i, n3 = 3 * m->node_count, err = TMASS_OK, attempts = 0;
-    tmass_real *accepted = m->scratch[9], *f = m->scratch[1];
+    tmass_real *accepted = m->static_accepted, *f = m->newton_residual;
     double s = 0.0, ds = 1.0, ref2;
     for (i = 0; i < n3; i++) accepted[i] = m->pin_mask[i] * m->target[i];
     m->load_scale = 1.0;
@@ -2742,6 +2955,25 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
     return TMASS_OK;
 }
 
+/* Static equilibrium of the tensor model: one linear solve K du = f (it is linear: a
+   converged, finite solve is exact for the model). */
+static int tmass__tensor_static(tmass_model *m, tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count, err;
+    tmass_real *f = m->newton_residual, *du = m->newton_dx;
+    m->stats.newton_iterations = 1;
+    m->stats.increments = 1;
+    tmass__internal_force(m, x, NULL, f, m->force_work);
+    for (i = 0; i < n3; i++)
+        f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
+    memset(du, 0, sizeof(tmass_real) * (size_t)n3);
+    err = tmass__linear_solve(m, NULL, 1.0, f, du);
+    for (i = 0; i < n3; i++) x[i] += du[i];
+    return err;
+}
+
+static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u) { return tmass__spring_energy(m, u); }
+
 /* Static equilibrium: one CG solve K u = f_ext + M g for the tensor model (it is
    linear: a converged, finite solve is exact for the model), the continuation of
    tmass__spring_static for the spring model. Accepted only with finite values inside
@@ -2749,30 +2981,16 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
 TMASSDEF int tmass_solve_static(tmass_model *m)
 {
     int i, n3, err = TMASS_OK;
-    tmass_real *x, *f, *cg_scratch[5];
+    tmass_real *x;
     if (!m) return TMASS_ERR_ARG;
     n3 = 3 * m->node_count;
-    x = m->scratch[0];
-    f = m->scratch[1];
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
+    x = m->static_u;
     memset(&m->stats, 0, sizeof m->stats);
     for (i = 0; i < n3; i++) {
         tmass_real pin = m->pin_mask[i];
         x[i] = m->disp[i] + pin * (m->target[i] - m->disp[i]);
     }
-    if (m->kind == TMASS_TENSOR_MASS) {
-        tmass_real *du = m->scratch[2];
-        m->stats.newton_iterations = 1;
-        m->stats.increments = 1;
-        tmass__internal_force(m, x, NULL, f, m->scratch[8]);
-        for (i = 0; i < n3; i++)
-            f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
-        memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
-        for (i = 0; i < n3; i++) x[i] += du[i];
-    } else {
-        err = tmass__spring_static(m, x);
-    }
+    err = tmass__kinds[m->kind].static_solve(m, x);
     if (err) return err;
     if (!tmass__all_finite(x, n3)) return TMASS_ERR_NOT_FINITE;
     if (tmass__imprecise(m, x)) return TMASS_ERR_PRECISION;
@@ -3073,7 +3291,7 @@ TMASSDEF size_t tmass_memory_bytes(const tmass_model *m) { return m ? m->block_b
 TMASSDEF const tmass_real *tmass_forces(tmass_model *m)
 {
     if (!m) return NULL;
-    tmass__internal_force(m, m->disp, NULL, m->force, m->scratch[0]);
+    tmass__internal_force(m, m->disp, NULL, m->force, m->force_work);
     return m->force;
 }
 
@@ -3107,13 +3325,7 @@ TMASSDEF int tmass_energy(tmass_model *m, tmass_energies *out)
     double kinetic = 0.0, elastic = 0.0, grav = 0.0, ext = 0.0;
     if (!m || !out) return TMASS_ERR_ARG;
     n = m->node_count;
-    if (m->kind == TMASS_TENSOR_MASS) {
-        /* 1/2 u^T K u = -1/2 u . f */
-        tmass__internal_force(m, m->disp, NULL, m->force, m->scratch[0]);
-        for (i = 0; i < 3 * n; i++) elastic -= 0.5 * (double)m->disp[i] * (double)m->force[i];
-    } else {
-        elastic = tmass__spring_energy(m, m->disp);
-    }
+    elastic = tmass__kinds[m->kind].energy(m, m->disp);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             double v = m->vel[3 * i + r], u = m->disp[3 * i + r];
@@ -3132,7 +3344,7 @@ TMASSDEF int tmass_energy(tmass_model *m, tmass_energies *out)
 
 TMASSDEF int tmass_vertex_tensor(const tmass_model *m, int i, tmass_real out[9])
 {
-    if (!m || !out || m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_ARG;
+    if (!m || !out || !(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_ARG;
     if (i < 0 || i >= m->node_count) return TMASS_ERR_NODE_RANGE;
     memcpy(out, m->vertex_tensor + 9 * i, 9 * sizeof(tmass_real));
     return TMASS_OK;
@@ -3141,7 +3353,7 @@ TMASSDEF int tmass_vertex_tensor(const tmass_model *m, int i, tmass_real out[9])
 TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real out[9])
 {
     int k, s, r, c;
-    if (!m || !out || m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_ARG;
+    if (!m || !out || !(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_ARG;
     if (a < 0 || a >= m->node_count || b < 0 || b >= m->node_count) return TMASS_ERR_NODE_RANGE;
     for (k = 0; k < m->chunk_total; k++)
         for (s = m->chunk_start[k]; s < m->chunk_start[k] + m->chunk_live[k]; s++) {
@@ -3302,14 +3514,14 @@ static int tmass__qs_prepare(const tmass_model *m, const tmass_qs_desc *d, tmass
     *out = NULL;
     if (!m || !d) return TMASS_ERR_ARG;
     if (d->internal_cookie != TMASS__QS_COOKIE) return TMASS_ERR_DESC;
-    if (m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (!(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (d->max_contacts < 1 || d->max_contacts > 4096 || (d->nodes && d->node_count < 1) ||
         (d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return TMASS_ERR_ARG;
     if (!(tmass__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
         return TMASS_ERR_SOLVER;
     /* mark the precomputed nodes in a scratch vector of the model (3n reals) */
-    mark = m->scratch[9];
+    mark = m->qs_mark;
     memset(mark, 0, sizeof(tmass_real) * (size_t)m->node_count);
     if (d->nodes) {
         for (i = 0; i < d->node_count; i++) {
@@ -3503,7 +3715,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
 {
     enum { R = TMASS__RHS };
     tmass_qs *q;
-    tmass_real *b, *x, *cg_scratch[5], *block, *w[4], *B, *X, *pinv, saved_tol;
+    tmass_real *b, *x, *block, *w[4], *B, *X, *pinv, saved_tol;
     size_t vec, block_bytes;
     int err, i, j0, r, saved_iter, total, n3, o3, p3;
     if (!out) return TMASS_ERR_ARG;
@@ -3518,9 +3730,8 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     /* the preload: K g = f_ext + M g_vec - K u_pinned on the free nodes (one CG), the
        pinned nodes at their targets (pinned nodes away from rest are boundary conditions
        too, issue 18 item 7) */
-    b = m->scratch[0];
-    x = m->scratch[1];
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[2 + i];
+    b = m->qs_rhs;
+    x = m->qs_x;
     saved_tol = m->cg_tolerance;
     saved_iter = m->cg_max_iterations;
     m->cg_tolerance = d->cg_tolerance;
@@ -3532,7 +3743,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
         b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3] - b[i];
         x[i] = 0;
     }
-    err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
+    err = tmass__linear_solve(m, NULL, 1.0, b, x);
     m->cg_tolerance = saved_tol;
     m->cg_max_iterations = saved_iter;
     for (i = 0; i < n3; i++) x[i] += m->pin_mask[i] * m->target[i];
@@ -3558,7 +3769,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
             memset(B, 0, sizeof(tmass_real) * vec);
             for (r = 0; r < R && j0 + r < p3; r++)
                 B[(size_t)(3 * q->pre_nodes[(j0 + r) / 3] + (j0 + r) % 3) * R + r] = 1;
-            err = tmass__cg_block(m, B, X, w, pinv, (double)d->cg_tolerance, d->cg_max_iterations);
+            err = tmass__linear_solve_block(m, B, X, w, pinv, (double)d->cg_tolerance, d->cg_max_iterations);
             for (r = 0; r < R && j0 + r < p3 && !err; r++) {
                 tmass_real *col = q->compliance + (size_t)(j0 + r) * o3;
                 for (i = 0; i < q->out_count; i++) {
@@ -4246,7 +4457,7 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
     if (d->internal_cookie != TMASS__HY_COOKIE) return TMASS_ERR_DESC;
     err = tmass__validate(&d->model);
     if (err) return err;
-    if (d->model.kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (!(tmass__kinds[d->model.kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (!d->tet_dynamic || d->fixed_count < 0 || (d->fixed_count > 0 && !d->fixed_nodes))
         return TMASS_ERR_ARG;
     N = d->model.node_count;
