@@ -1580,7 +1580,9 @@ static int tmass__validate_material(const tmass_desc *d, double E, double nu, in
     return TMASS_OK;
 }
 
-static int tmass__validate(const tmass_desc *d)
+/* Stage 1 of tmass_create (and of tmass_hybrid_create): every check on the description,
+   before anything is allocated. */
+static int tmass__create_validate(const tmass_desc *d)
 {
     char msg[160];
     int i, t, err;
@@ -1715,62 +1717,69 @@ static void tmass__init_boundary(tmass_model *m)
         }
 }
 
-TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
+/* tmass_create in four stages that read top to bottom: validate the description, size
+   the model (the temporary edge and face tables, the edge count, every array's length),
+   lay out the one block (allocate and carve), precompute (copy the mesh and settings,
+   edges, tensors or springs, masses, chunks and colours, neighbours, boundary). */
+
+/* Temporary tables of creation: start[n+1], key[6T], payload[6T], tet_edge[6T]. */
+typedef struct tmass__create_tables {
+    char *block;
+    size_t bytes;
+    int *start, *key, *payload, *tet_edge;
+} tmass__create_tables;
+
+/* Allocates the temporary tables and counts the edges; sizes holds every array length
+   tmass__layout needs. */
+static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__create_tables *w)
 {
-    tmass_model tmp, *m;
+    int n = d->node_count, T = d->tet_count, E;
+    w->bytes = sizeof(int) * ((size_t)n + 1 + 18 * (size_t)T);
+    w->block = (char *)tmass__alloc(&d->allocator, w->bytes);
+    if (!w->block) return tmass__fail(d, TMASS_ERR_ALLOC, "temporary tables");
+    w->start = (int *)w->block;
+    w->key = w->start + n + 1;
+    w->payload = w->key + 6 * (size_t)T;
+    w->tet_edge = w->payload + 6 * (size_t)T;
+    E = tmass__build_edges(d->tets, T, n, w->start, w->key, w->payload, w->tet_edge, NULL, NULL);
+    memset(sizes, 0, sizeof *sizes);
+    sizes->node_count = n;
+    sizes->tet_count = T;
+    sizes->edge_total = E;
+    sizes->chunk_size = E / 32;
+    if (sizes->chunk_size < 256) sizes->chunk_size = 256;
+    if (sizes->chunk_size > 4096) sizes->chunk_size = 4096;
+    sizes->chunk_total = (E + sizes->chunk_size - 1) / sizes->chunk_size;
+    sizes->partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
+    return TMASS_OK;
+}
+
+/* Allocates the model's block (the struct first, then every array, 64-byte aligned) and
+   carves it; *out points at the zeroed model with its arrays in place. */
+static int tmass__create_layout(const tmass_desc *d, const tmass_model *sizes, tmass_model **out)
+{
+    tmass_model tmp = *sizes;
     tmass__carver carver;
-    int err, i, t, n, T, E;
-    int *start = NULL, *key = NULL, *payload = NULL, *tet_edge_tmp = NULL;
-    size_t tmp_bytes;
-    char *tmp_block = NULL;
-    tmass_allocator alloc;
-
-    if (!out) return TMASS_ERR_ARG;
-    *out = NULL;
-    if (!d) return TMASS_ERR_ARG;
-    err = tmass__validate(d);
-    if (err) return err;
-
-    n = d->node_count;
-    T = d->tet_count;
-    alloc = d->allocator;
-
-    /* temporary arrays for edge and face tables: start[n+1], key[6T], payload[6T],
-       tet_edge_tmp[6T] */
-    tmp_bytes = sizeof(int) * ((size_t)n + 1 + 18 * (size_t)T);
-    tmp_block = (char *)tmass__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return tmass__fail(d, TMASS_ERR_ALLOC, "temporary tables");
-    start = (int *)tmp_block;
-    key = start + n + 1;
-    payload = key + 6 * (size_t)T;
-    tet_edge_tmp = payload + 6 * (size_t)T;
-    E = tmass__build_edges(d->tets, T, n, start, key, payload, tet_edge_tmp, NULL, NULL);
-
-    memset(&tmp, 0, sizeof tmp);
-    tmp.node_count = n;
-    tmp.tet_count = T;
-    tmp.edge_total = E;
-    tmp.chunk_size = E / 32;
-    if (tmp.chunk_size < 256) tmp.chunk_size = 256;
-    if (tmp.chunk_size > 4096) tmp.chunk_size = 4096;
-    tmp.chunk_total = (E + tmp.chunk_size - 1) / tmp.chunk_size;
-    tmp.partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
     carver.base = NULL;
     carver.offset = sizeof(tmass_model);
     tmass__layout(&tmp, &carver);
     tmp.block_bytes = carver.offset;
-    tmp.block = tmass__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        tmass__free(&alloc, tmp_block, tmp_bytes);
-        return tmass__fail(d, TMASS_ERR_ALLOC, "model block");
-    }
+    tmp.block = tmass__alloc(&d->allocator, tmp.block_bytes);
+    if (!tmp.block) return TMASS_ERR_ALLOC;
     memset(tmp.block, 0, tmp.block_bytes);
     carver.base = (char *)tmp.block;
     carver.offset = sizeof(tmass_model);
     tmass__layout(&tmp, &carver);
-    m = (tmass_model *)tmp.block;
-    *m = tmp;
+    *out = (tmass_model *)tmp.block;
+    **out = tmp;
+    (*out)->allocator = d->allocator;
+    return TMASS_OK;
+}
 
+/* The description's settings into the model. */
+static void tmass__create_settings(const tmass_desc *d, tmass_model *m)
+{
+    int i;
     m->kind = d->kind;
     m->integrator = d->integrator;
     m->linear_solver = d->linear_solver;
@@ -1786,15 +1795,20 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
     m->load_scale = 1.0;
     m->precision_limit = (double)d->precision_limit;
     m->density = (double)d->density;
-    m->allocator = alloc;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = E >= TMASS_PARALLEL_MIN_EDGES;
+    m->parallel = m->edge_total >= TMASS_PARALLEL_MIN_EDGES;
+}
 
+/* The mesh, its edges and per-tetrahedron materials; rest lengths (springs, the
+   precision check). */
+static void tmass__create_mesh(const tmass_desc *d, tmass_model *m, tmass__create_tables *w)
+{
+    int i, t, n = m->node_count, T = m->tet_count, E;
     memcpy(m->rest, d->rest_positions, sizeof(tmass_real) * 3 * (size_t)n);
     memcpy(m->pos, d->rest_positions, sizeof(tmass_real) * 3 * (size_t)n);
     memcpy(m->tet_nodes, d->tets, sizeof(int) * 4 * (size_t)T);
-    E = tmass__build_edges(d->tets, T, n, start, key, payload, m->tet_edges, m->edge_a, m->edge_b);
+    E = tmass__build_edges(d->tets, T, n, w->start, w->key, w->payload, m->tet_edges, m->edge_a, m->edge_b);
     m->edge_count = E;
     for (i = 0; i < E; i++) {
         m->edge_id[i] = i;
@@ -1821,8 +1835,20 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         if (i == 0 || (double)m->edge_rest_length[i] < m->shortest_edge)
             m->shortest_edge = (double)m->edge_rest_length[i];
     }
-    for (t = 0; t < T; t++) tmass__apply_tet(m, t, 1.0);
-    for (i = 0; i < n; i++) {
+}
+
+/* Everything the rest state determines: the kind's per-tetrahedron assembly (tensors or
+   spring stiffnesses, lumped masses), node states, edge chunks and their colours, face
+   neighbours, boundary triangles. Returns TMASS_ERR_TET_DUPLICATE or _NONMANIFOLD from
+   the neighbour search. */
+static int tmass__create_precompute(const tmass_desc *d, tmass_model *m, tmass__create_tables *w)
+{
+    int i, t, err, E;
+    tmass__create_settings(d, m);
+    tmass__create_mesh(d, m, w);
+    E = m->edge_count;
+    for (t = 0; t < m->tet_count; t++) tmass__apply_tet(m, t, 1.0);
+    for (i = 0; i < m->node_count; i++) {
         m->node_state[i] = m->node_tets[i] > 0 ? TMASS__FREE : TMASS__INACTIVE;
         m->inv_mass[i] = m->mass[i] > 0 ? (tmass_real)(1.0 / (double)m->mass[i]) : (tmass_real)0;
         tmass__set_masks(m, i, m->node_state[i] == TMASS__FREE, 0);
@@ -1831,16 +1857,41 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         int b = i * m->chunk_size, e = b + m->chunk_size;
         m->chunk_live[i] = (e > E ? E : e) - b;
     }
-    tmass__colour_chunks(m, start, key);
-    err = tmass__build_neighbors(m, start, key, payload);
-    tmass__free(&alloc, tmp_block, tmp_bytes);
+    tmass__colour_chunks(m, w->start, w->key);
+    err = tmass__build_neighbors(m, w->start, w->key, w->payload);
+    if (err) return err;
+    tmass__init_boundary(m);
+    m->stats.newton_iterations = 1;
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
+{
+    tmass_model sizes, *m = NULL;
+    tmass__create_tables w;
+    tmass_allocator alloc;
+    int err;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!d) return TMASS_ERR_ARG;
+    err = tmass__create_validate(d);
+    if (err) return err;
+    alloc = d->allocator;
+    memset(&w, 0, sizeof w);
+    err = tmass__create_size(d, &sizes, &w);
+    if (err) return err;
+    err = tmass__create_layout(d, &sizes, &m);
+    if (err) {
+        tmass__free(&alloc, w.block, w.bytes);
+        return tmass__fail(d, err, "model block");
+    }
+    err = tmass__create_precompute(d, m, &w);
+    tmass__free(&alloc, w.block, w.bytes);
     if (err) {
         tmass__free(&alloc, m->block, m->block_bytes);
         return tmass__fail(d, err, err == TMASS_ERR_TET_DUPLICATE ? "a tetrahedron is listed twice"
                                    : "a triangle is shared by three or more tetrahedra");
     }
-    tmass__init_boundary(m);
-    m->stats.newton_iterations = 1;
     *out = m;
     return TMASS_OK;
 }
@@ -4455,7 +4506,7 @@ TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
     *out = NULL;
     if (!d) return TMASS_ERR_ARG;
     if (d->internal_cookie != TMASS__HY_COOKIE) return TMASS_ERR_DESC;
-    err = tmass__validate(&d->model);
+    err = tmass__create_validate(&d->model);
     if (err) return err;
     if (!(tmass__kinds[d->model.kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (!d->tet_dynamic || d->fixed_count < 0 || (d->fixed_count > 0 && !d->fixed_nodes))
