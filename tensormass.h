@@ -4484,254 +4484,308 @@ static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, const unsigned cha
     sub->tet_poisson_ratio = d->model.tet_poisson_ratio ? poisson : NULL;
 }
 
-TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
-{
-    tmass_hybrid tmp, *h;
-    tmass__hy_sizes z;
-    tmass__carver carver;
-    tmass_desc sub;
-    tmass_qs_desc qd;
-    tmass_model *dyn = NULL, *src = NULL;
-    tmass_qs *qs = NULL;
+/* tmass_hybrid_create in stages that read top to bottom: validate the description, size
+   the parts (which tetrahedra are dynamic, the node maps), create the two parts (the
+   dynamic model, the precomputed model and its compliance), find the interface faces and
+   size the hybrid block, lay it out, precompute the coupling (S = C_cc^-1) and the
+   rendering lists. tmass__hy_build carries the creation-time state between them. */
+typedef struct tmass__hy_build {
     tmass_allocator a;
-    int err, i, t, N, T, n_dyn = 0, n_qs = 0, t_dyn = 0, c0 = 0, faces = 0, k;
-    int *dyn_of = NULL, *qs_of = NULL, *itmp = NULL;
-    unsigned char *fixed = NULL, *dynamic = NULL;
-    tmass_real *rtmp = NULL;
-    tmass__face_key *keys = NULL;
+    char *tmp_block; /* temporary: face keys, a rest copy and per-tet materials of a part,
+                        node maps, tets of a part, fixed and dynamic flags */
     size_t tmp_bytes;
-    char *tmp_block;
+    tmass__face_key *keys;
+    tmass_real *rtmp;
+    int *dyn_of, *qs_of, *itmp;
+    unsigned char *fixed, *dynamic;
+    int n_dyn, n_qs, t_dyn, c0, faces;
+    tmass_model *dyn, *src; /* the dynamic part; the precomputed part's model (temporary) */
+    tmass_qs *qs;
+    tmass__hy_sizes z;
+} tmass__hy_build;
 
-    if (!out) return TMASS_ERR_ARG;
-    *out = NULL;
-    if (!d) return TMASS_ERR_ARG;
+static int tmass__hybrid_create_validate(const tmass_hybrid_desc *d)
+{
+    int i, err;
     if (d->internal_cookie != TMASS__HY_COOKIE) return TMASS_ERR_DESC;
     err = tmass__create_validate(&d->model);
     if (err) return err;
     if (!(tmass__kinds[d->model.kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (!d->tet_dynamic || d->fixed_count < 0 || (d->fixed_count > 0 && !d->fixed_nodes))
         return TMASS_ERR_ARG;
-    N = d->model.node_count;
-    T = d->model.tet_count;
-    a = d->model.allocator;
     for (i = 0; i < d->fixed_count; i++)
-        if (d->fixed_nodes[i] < 0 || d->fixed_nodes[i] >= N) return TMASS_ERR_NODE_RANGE;
+        if (d->fixed_nodes[i] < 0 || d->fixed_nodes[i] >= d->model.node_count) return TMASS_ERR_NODE_RANGE;
+    return TMASS_OK;
+}
 
-    /* temporary: two node maps, fixed flags, a rest copy, tets and per-tet materials of a
-       part, face keys of both boundaries */
-    tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N + (size_t)T +
-                sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
-                4 * TMASS__ALIGN;
-    tmp_block = (char *)tmass__alloc(&a, tmp_bytes);
-    if (!tmp_block) return TMASS_ERR_ALLOC;
-    carver.base = tmp_block;
+/* The temporary tables; which tetrahedra are dynamic (unsupported precomputed pieces
+   moved over, reported through the log); each part's node numbering. */
+static int tmass__hybrid_create_size(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, t, k, N = d->model.node_count, T = d->model.tet_count;
+    tmass__carver carver;
+    b->tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N + (size_t)T +
+                   sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
+                   4 * TMASS__ALIGN;
+    b->tmp_block = (char *)tmass__alloc(&b->a, b->tmp_bytes);
+    if (!b->tmp_block) return TMASS_ERR_ALLOC;
+    carver.base = b->tmp_block;
     carver.offset = 0;
-    keys = (tmass__face_key *)tmass__carve(&carver, sizeof(tmass__face_key) * 8 * (size_t)T);
-    rtmp = (tmass_real *)tmass__carve(&carver, sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T));
-    dyn_of = (int *)tmass__carve(&carver, sizeof(int) * (2 * (size_t)N + 4 * (size_t)T));
-    qs_of = dyn_of + N;
-    itmp = qs_of + N;
-    fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
-    dynamic = (unsigned char *)tmass__carve(&carver, (size_t)T);
-    memset(fixed, 0, (size_t)N);
-    for (i = 0; i < d->fixed_count; i++) fixed[d->fixed_nodes[i]] = 1;
-    for (t = 0; t < T; t++) dynamic[t] = d->tet_dynamic[t] != 0;
-    i = tmass__hybrid_support(&d->model, dynamic, fixed, keys, itmp);
+    b->keys = (tmass__face_key *)tmass__carve(&carver, sizeof(tmass__face_key) * 8 * (size_t)T);
+    b->rtmp = (tmass_real *)tmass__carve(&carver, sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T));
+    b->dyn_of = (int *)tmass__carve(&carver, sizeof(int) * (2 * (size_t)N + 4 * (size_t)T));
+    b->qs_of = b->dyn_of + N;
+    b->itmp = b->qs_of + N;
+    b->fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
+    b->dynamic = (unsigned char *)tmass__carve(&carver, (size_t)T);
+    memset(b->fixed, 0, (size_t)N);
+    for (i = 0; i < d->fixed_count; i++) b->fixed[d->fixed_nodes[i]] = 1;
+    for (t = 0; t < T; t++) b->dynamic[t] = d->tet_dynamic[t] != 0;
+    i = tmass__hybrid_support(&d->model, b->dynamic, b->fixed, b->keys, b->itmp);
     if (i && d->model.log) {
         char msg[160];
         snprintf(msg, sizeof msg, "%d tetrahedra of the precomputed part were not held by fixed nodes "
                  "and were moved to the dynamic part", i);
         d->model.log(TMASS_OK, msg, d->model.log_user);
     }
-    for (i = 0; i < N; i++) dyn_of[i] = qs_of[i] = -1;
+    for (i = 0; i < N; i++) b->dyn_of[i] = b->qs_of[i] = -1;
     for (t = 0; t < T; t++) {
-        int *map = dynamic[t] ? dyn_of : qs_of;
-        t_dyn += dynamic[t] != 0;
+        int *map = b->dynamic[t] ? b->dyn_of : b->qs_of;
+        b->t_dyn += b->dynamic[t] != 0;
         for (k = 0; k < 4; k++) map[d->model.tets[4 * t + k]] = 1;
     }
     for (i = 0; i < N; i++) {
-        if (dyn_of[i] >= 0) dyn_of[i] = n_dyn++;
-        if (qs_of[i] >= 0) qs_of[i] = n_qs++;
+        if (b->dyn_of[i] >= 0) b->dyn_of[i] = b->n_dyn++;
+        if (b->qs_of[i] >= 0) b->qs_of[i] = b->n_qs++;
     }
-    err = t_dyn == 0 || t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
-    /* the dynamic part */
+    return b->t_dyn == 0 || b->t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
+}
+
+/* The two parts: the dynamic model, the precomputed part's model and its compliance
+   (every node output), each with its fixed nodes pinned. */
+static int tmass__hybrid_create_parts(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, err, N = d->model.node_count, T = d->model.tet_count;
+    tmass_desc sub;
+    tmass_qs_desc qd;
+    tmass__hybrid_subdesc(d, b->dynamic, 1, b->dyn_of, b->n_dyn, b->rtmp, b->itmp, b->rtmp + 3 * N,
+                          b->rtmp + 3 * N + T, &sub);
+    err = tmass_create(&sub, &b->dyn);
+    for (i = 0; i < N && !err; i++)
+        if (b->fixed[i] && b->dyn_of[i] >= 0) err = tmass_fix_node(b->dyn, b->dyn_of[i]);
     if (!err) {
-        tmass__hybrid_subdesc(d, dynamic, 1, dyn_of, n_dyn, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
-        err = tmass_create(&sub, &dyn);
+        tmass__hybrid_subdesc(d, b->dynamic, 0, b->qs_of, b->n_qs, b->rtmp, b->itmp, b->rtmp + 3 * N,
+                              b->rtmp + 3 * N + T, &sub);
+        err = tmass_create(&sub, &b->src);
     }
     for (i = 0; i < N && !err; i++)
-        if (fixed[i] && dyn_of[i] >= 0) err = tmass_fix_node(dyn, dyn_of[i]);
-    /* the precomputed part */
-    if (!err) {
-        tmass__hybrid_subdesc(d, dynamic, 0, qs_of, n_qs, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
-        err = tmass_create(&sub, &src);
-    }
-    for (i = 0; i < N && !err; i++)
-        if (fixed[i] && qs_of[i] >= 0) err = tmass_fix_node(src, qs_of[i]);
+        if (b->fixed[i] && b->qs_of[i] >= 0) err = tmass_fix_node(b->src, b->qs_of[i]);
     if (!err) {
         qd = d->precompute;
         qd.nodes = NULL;
         qd.node_count = 0;
-        qd.allocator = a;
-        err = tmass_qs_create(src, &qd, &qs);
+        qd.allocator = b->a;
+        err = tmass_qs_create(b->src, &qd, &b->qs);
     }
-    if (!err) {
-        /* interface faces: triangles on both parts' boundaries (global numbering; itmp
-           holds each part's local -> global map in turn) */
-        int nk = 0, f;
-        for (i = 0; i < N; i++)
-            if (qs_of[i] >= 0) itmp[qs_of[i]] = i;
-        for (f = 0; f < src->tri_count; f++, nk++) {
-            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[src->tri[3 * f + k]];
-            keys[nk].source = 0;
-            keys[nk].owner = f;
-        }
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0) itmp[dyn_of[i]] = i;
-        for (f = 0; f < dyn->tri_count; f++, nk++) {
-            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[dyn->tri[3 * f + k]];
-            keys[nk].source = 1;
-            keys[nk].owner = dyn->tri_owner[f];
-        }
-        for (f = 0; f < nk; f++) tmass__sort3(keys[f].tri, keys[f].key);
-        qsort(keys, (size_t)nk, sizeof *keys, tmass__face_key_cmp);
-        faces = nk;
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) c0++;
+    return err;
+}
+
+/* Interface faces: the triangles of both parts' boundaries, sorted by their sorted nodes
+   (global numbering; itmp holds each part's local -> global map in turn), so a face on
+   both boundaries appears twice in a row. Counts the connection nodes and sizes the
+   hybrid block (b->z). */
+static void tmass__hybrid_create_faces(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, k, f, nk = 0, ifaces = 0, qs_tris = 0, N = d->model.node_count;
+    tmass__face_key *keys = b->keys;
+    for (i = 0; i < N; i++)
+        if (b->qs_of[i] >= 0) b->itmp[b->qs_of[i]] = i;
+    for (f = 0; f < b->src->tri_count; f++, nk++) {
+        for (k = 0; k < 3; k++) keys[nk].tri[k] = b->itmp[b->src->tri[3 * f + k]];
+        keys[nk].source = 0;
+        keys[nk].owner = f;
     }
-    if (!err) {
-        /* the hybrid block */
-        int ifaces = 0, qs_tris = 0;
-        for (i = 0; i < faces; i++) {
-            int shared = (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) ||
-                         (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0);
-            if (keys[i].source == 0) {
-                if (shared)
-                    ifaces++;
-                else
-                    qs_tris++;
-            }
-        }
-        memset(&tmp, 0, sizeof tmp);
-        z.N = N;
-        z.T = T;
-        z.c = c0;
-        z.K = d->precompute.max_contacts;
-        z.qs_tris = qs_tris;
-        z.ifaces = ifaces;
-        z.dyn_tets = t_dyn;
-        z.dyn_nodes = n_dyn;
-        z.tri_capacity = qs_tris + ifaces + 4 * t_dyn;
-        carver.base = NULL;
-        carver.offset = sizeof(tmass_hybrid);
-        tmass__hybrid_layout(&tmp, &z, &carver);
-        tmp.block_bytes = carver.offset;
-        tmp.block = tmass__alloc(&a, tmp.block_bytes);
-        if (!tmp.block) err = TMASS_ERR_ALLOC;
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0) b->itmp[b->dyn_of[i]] = i;
+    for (f = 0; f < b->dyn->tri_count; f++, nk++) {
+        for (k = 0; k < 3; k++) keys[nk].tri[k] = b->itmp[b->dyn->tri[3 * f + k]];
+        keys[nk].source = 1;
+        keys[nk].owner = b->dyn->tri_owner[f];
     }
+    for (f = 0; f < nk; f++) tmass__sort3(keys[f].tri, keys[f].key);
+    qsort(keys, (size_t)nk, sizeof *keys, tmass__face_key_cmp);
+    b->faces = nk;
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0 && b->qs_of[i] >= 0 && !b->fixed[i]) b->c0++;
+    for (i = 0; i < b->faces; i++) {
+        int shared = (i + 1 < b->faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) ||
+                     (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0);
+        if (keys[i].source == 0) {
+            if (shared)
+                ifaces++;
+            else
+                qs_tris++;
+        }
+    }
+    b->z.N = N;
+    b->z.T = d->model.tet_count;
+    b->z.c = b->c0;
+    b->z.K = d->precompute.max_contacts;
+    b->z.qs_tris = qs_tris;
+    b->z.ifaces = ifaces;
+    b->z.dyn_tets = b->t_dyn;
+    b->z.dyn_nodes = b->n_dyn;
+    b->z.tri_capacity = qs_tris + ifaces + 4 * b->t_dyn;
+}
+
+/* Allocates and carves the hybrid block; fills the maps between the whole mesh and the
+   parts. */
+static int tmass__hybrid_create_layout(const tmass__hy_build *b, tmass_hybrid **out)
+{
+    tmass_hybrid tmp, *h;
+    tmass__carver carver;
+    int i, t, N = b->z.N, T = b->z.T, nd = 0, nq = 0;
+    memset(&tmp, 0, sizeof tmp);
+    carver.base = NULL;
+    carver.offset = sizeof(tmass_hybrid);
+    tmass__hybrid_layout(&tmp, &b->z, &carver);
+    tmp.block_bytes = carver.offset;
+    tmp.block = tmass__alloc(&b->a, tmp.block_bytes);
+    if (!tmp.block) return TMASS_ERR_ALLOC;
+    memset(tmp.block, 0, tmp.block_bytes);
+    carver.base = (char *)tmp.block;
+    carver.offset = sizeof(tmass_hybrid);
+    tmass__hybrid_layout(&tmp, &b->z, &carver);
+    h = (tmass_hybrid *)tmp.block;
+    *h = tmp;
+    h->allocator = b->a;
+    h->node_count = N;
+    h->tet_count = T;
+    h->dyn_tets = b->t_dyn;
+    h->dyn = b->dyn;
+    h->qs = b->qs;
+    h->max_contacts = b->z.K;
+    h->tri_capacity = b->z.tri_capacity;
+    memcpy(h->dyn_of, b->dyn_of, sizeof(int) * (size_t)N);
+    memcpy(h->qs_of, b->qs_of, sizeof(int) * (size_t)N);
+    memcpy(h->fixed, b->fixed, (size_t)N);
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0) h->dyn_global[b->dyn_of[i]] = i;
+    for (t = 0; t < T; t++) {
+        h->tet_dynamic[t] = b->dynamic[t];
+        h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
+    }
+    *out = h;
+    return TMASS_OK;
+}
+
+/* The coupling block of the dynamic model (connection nodes, S = (C_cc)^-1 by Cholesky
+   column by column, exactly symmetric; freed with the model) and the connections'
+   preload. */
+static int tmass__hybrid_create_coupling(const tmass__hy_build *b, tmass_hybrid *h)
+{
+    tmass_model *dyn = b->dyn;
+    int i, k, err = TMASS_OK, c0 = b->c0, N = b->z.N;
+    tmass__carver cc;
+    size_t cb = sizeof(int) * (size_t)c0 + sizeof(double) * (9 * (size_t)c0 * c0 + 6 * (size_t)c0) + 2 * TMASS__ALIGN;
+    dyn->coupling_block = tmass__alloc(&b->a, cb);
+    if (!dyn->coupling_block) return TMASS_ERR_ALLOC;
+    dyn->coupling_bytes = cb;
+    cc.base = (char *)dyn->coupling_block;
+    cc.offset = 0;
+    dyn->coupling = (double *)tmass__carve(&cc, sizeof(double) * 9 * (size_t)c0 * c0);
+    dyn->coupling_x = (double *)tmass__carve(&cc, sizeof(double) * 6 * (size_t)c0);
+    dyn->coupling_nodes = (int *)tmass__carve(&cc, sizeof(int) * (size_t)c0);
+    for (i = 0, k = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0 && b->qs_of[i] >= 0 && !b->fixed[i]) {
+            h->conn_qs[k] = b->qs_of[i];
+            dyn->coupling_nodes[k] = b->dyn_of[i];
+            if (b->qs->col_of_node[b->qs_of[i]] < 0) err = TMASS_ERR_NOT_PRECOMPUTED;
+            k++;
+        }
+    h->conn_count = c0;
+    if (!err && c0 > 0) {
+        int c3 = 3 * c0, r, s;
+        double *L = dyn->coupling; /* scratch for the factor */
+        for (r = 0; r < c3; r++)
+            for (s = 0; s < c3; s++) L[(size_t)r * c3 + s] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->conn_qs[s / 3], s % 3);
+        if (tmass__cholesky(L, c3)) err = TMASS_ERR_SINGULAR;
+        for (s = 0; s < c3 && !err; s++) {
+            for (r = 0; r < c3; r++) h->work[r] = r == s;
+            tmass__cholesky_solve(L, c3, h->work);
+            for (r = 0; r < c3; r++) h->S[(size_t)r * c3 + s] = h->work[r];
+        }
+        for (r = 0; r < c3 && !err; r++) /* exact symmetry */
+            for (s = 0; s < r; s++) {
+                double v = 0.5 * (h->S[(size_t)r * c3 + s] + h->S[(size_t)s * c3 + r]);
+                h->S[(size_t)r * c3 + s] = h->S[(size_t)s * c3 + r] = v;
+            }
+        for (r = 0; r < c3; r++) h->g_conn[r] = (double)b->qs->preload[3 * h->conn_qs[r / 3] + r % 3];
+    }
+    return err;
+}
+
+/* The coupling, then the rendering lists (static faces of the precomputed part,
+   interface faces with the dynamic tet across, flags on the dynamic part's faces) and
+   the coupling stiffness in the dynamic model. */
+static int tmass__hybrid_create_precompute(const tmass__hy_build *b, tmass_hybrid *h)
+{
+    const tmass__face_key *keys = b->keys;
+    int i, nq = 0, ni = 0, faces = b->faces;
+    int err = tmass__hybrid_create_coupling(b, h);
+    if (err) return err;
+    for (i = 0; i < faces; i++) {
+        int partner = -1;
+        if (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) partner = i + 1;
+        if (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0) partner = i - 1;
+        if (keys[i].source == 0 && partner < 0) {
+            memcpy(h->qs_tri + 3 * nq++, keys[i].tri, 3 * sizeof(int));
+        } else if (keys[i].source == 0) {
+            memcpy(h->iface_tri + 3 * ni, keys[i].tri, 3 * sizeof(int));
+            h->iface_dyn_tet[ni++] = keys[partner].owner / 4;
+        } else if (partner >= 0) {
+            h->dyn_face_iface[keys[i].owner] = 1;
+        }
+    }
+    h->qs_tri_count = nq;
+    h->iface_count = ni;
+    h->contacts_dirty = 1;
+    return tmass__hybrid_coupling(h);
+}
+
+TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
+{
+    tmass__hy_build b;
+    tmass_hybrid *h = NULL;
+    int err;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!d) return TMASS_ERR_ARG;
+    err = tmass__hybrid_create_validate(d);
+    if (err) return err;
+    memset(&b, 0, sizeof b);
+    b.a = d->model.allocator;
+    err = tmass__hybrid_create_size(d, &b);
+    if (!b.tmp_block) return err;
+    if (!err) err = tmass__hybrid_create_parts(d, &b);
+    if (!err) tmass__hybrid_create_faces(d, &b);
+    if (!err) err = tmass__hybrid_create_layout(&b, &h);
     if (!err) {
-        size_t cb;
-        memset(tmp.block, 0, tmp.block_bytes);
-        carver.base = (char *)tmp.block;
-        carver.offset = sizeof(tmass_hybrid);
-        tmass__hybrid_layout(&tmp, &z, &carver);
-        h = (tmass_hybrid *)tmp.block;
-        *h = tmp;
-        h->allocator = a;
-        h->node_count = N;
-        h->tet_count = T;
-        h->dyn_tets = t_dyn;
-        h->dyn = dyn;
-        h->qs = qs;
-        h->max_contacts = z.K;
-        h->tri_capacity = z.tri_capacity;
-        memcpy(h->dyn_of, dyn_of, sizeof(int) * (size_t)N);
-        memcpy(h->qs_of, qs_of, sizeof(int) * (size_t)N);
-        memcpy(h->fixed, fixed, (size_t)N);
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0) h->dyn_global[dyn_of[i]] = i;
-        {
-            int nd = 0, nq = 0;
-            for (t = 0; t < T; t++) {
-                h->tet_dynamic[t] = dynamic[t];
-                h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
-            }
-        }
-        /* the coupling block lives in the dynamic model (freed with it) */
-        cb = sizeof(int) * (size_t)c0 + sizeof(double) * (9 * (size_t)c0 * c0 + 6 * (size_t)c0) + 2 * TMASS__ALIGN;
-        dyn->coupling_block = tmass__alloc(&a, cb);
-        if (!dyn->coupling_block) err = TMASS_ERR_ALLOC;
-        if (!err) {
-            tmass__carver cc;
-            dyn->coupling_bytes = cb;
-            cc.base = (char *)dyn->coupling_block;
-            cc.offset = 0;
-            dyn->coupling = (double *)tmass__carve(&cc, sizeof(double) * 9 * (size_t)c0 * c0);
-            dyn->coupling_x = (double *)tmass__carve(&cc, sizeof(double) * 6 * (size_t)c0);
-            dyn->coupling_nodes = (int *)tmass__carve(&cc, sizeof(int) * (size_t)c0);
-            for (i = 0, k = 0; i < N; i++)
-                if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) {
-                    h->conn_qs[k] = qs_of[i];
-                    dyn->coupling_nodes[k] = dyn_of[i];
-                    if (qs->col_of_node[qs_of[i]] < 0) err = TMASS_ERR_NOT_PRECOMPUTED;
-                    k++;
-                }
-            h->conn_count = c0;
-        }
-        if (!err && c0 > 0) {
-            /* S = (C_cc)^-1 by Cholesky, column by column */
-            int c3 = 3 * c0, r, s;
-            double *L = dyn->coupling; /* scratch for the factor */
-            for (r = 0; r < c3; r++)
-                for (s = 0; s < c3; s++) L[(size_t)r * c3 + s] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->conn_qs[s / 3], s % 3);
-            if (tmass__cholesky(L, c3)) err = TMASS_ERR_SINGULAR;
-            for (s = 0; s < c3 && !err; s++) {
-                for (r = 0; r < c3; r++) h->work[r] = r == s;
-                tmass__cholesky_solve(L, c3, h->work);
-                for (r = 0; r < c3; r++) h->S[(size_t)r * c3 + s] = h->work[r];
-            }
-            for (r = 0; r < c3 && !err; r++) /* exact symmetry */
-                for (s = 0; s < r; s++) {
-                    double v = 0.5 * (h->S[(size_t)r * c3 + s] + h->S[(size_t)s * c3 + r]);
-                    h->S[(size_t)r * c3 + s] = h->S[(size_t)s * c3 + r] = v;
-                }
-            for (r = 0; r < c3; r++) h->g_conn[r] = (double)qs->preload[3 * h->conn_qs[r / 3] + r % 3];
-        }
-        if (!err) {
-            /* rendering lists */
-            int nq = 0, ni = 0;
-            for (i = 0; i < faces; i++) {
-                int partner = -1;
-                if (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) partner = i + 1;
-                if (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0) partner = i - 1;
-                if (keys[i].source == 0 && partner < 0) {
-                    memcpy(h->qs_tri + 3 * nq++, keys[i].tri, 3 * sizeof(int));
-                } else if (keys[i].source == 0) {
-                    memcpy(h->iface_tri + 3 * ni, keys[i].tri, 3 * sizeof(int));
-                    h->iface_dyn_tet[ni++] = keys[partner].owner / 4;
-                } else if (partner >= 0) {
-                    h->dyn_face_iface[keys[i].owner] = 1;
-                }
-            }
-            h->qs_tri_count = nq;
-            h->iface_count = ni;
-            h->contacts_dirty = 1;
-            err = tmass__hybrid_coupling(h);
-        }
+        err = tmass__hybrid_create_precompute(&b, h);
         if (err) {
-            tmass__free(&a, tmp.block, tmp.block_bytes);
+            tmass__free(&b.a, h->block, h->block_bytes);
         } else {
             tmass__hybrid_loads(h);
             tmass__hybrid_finish(h);
             *out = h;
         }
     }
-    tmass_destroy(src);
+    tmass_destroy(b.src);
     if (err) {
-        tmass_destroy(dyn);
-        tmass_qs_destroy(qs);
+        tmass_destroy(b.dyn);
+        tmass_qs_destroy(b.qs);
     }
-    tmass__free(&a, tmp_block, tmp_bytes);
+    tmass__free(&b.a, b.tmp_block, b.tmp_bytes);
     return err;
 }
 
