@@ -81,6 +81,63 @@
        hd.tet_dynamic = which tets are dynamic, hd.fixed_nodes; tmass_hybrid_create, then
        tmass_hybrid_step / tmass_hybrid_set_displacement / tmass_hybrid_remove_tets.
 
+   HOW TO EXTEND (a new model kind, integrator or linear solver is a local change: one
+   enum value before its _COUNT sentinel, one row in one private table, the functions the
+   row names; nothing else dispatches on these enums)
+       Model kind (a "law": another force model on the same mesh). tmass_model_kind gets a
+         value before TMASS_MODEL_KIND_COUNT; tmass__kinds[] (section >>laws) gets a row:
+         name; assemble_tet (add or remove one tetrahedron's stiffness and lumped mass, at
+         creation and when cutting); force (internal force, elastic plus stiffness
+         damping, at u and v); differential (the linearised implicit Euler step: the force
+         term and the tangent left in the edge tensors, returning its factor c); energy;
+         implicit_newton (the full nonlinear implicit step, or NULL when the model is
+         linear); static_solve; flags (TMASS__KIND_LINEAR: constant tensors, so the
+         quasi-static and hybrid models and tmass_vertex_tensor accept it;
+         TMASS__KIND_POISSON: poisson_ratio is validated and lambda, mu stored). The
+         table's length is checked at compile time against the sentinel.
+       Integrator. tmass_integrator gets a value before TMASS_INTEGRATOR_COUNT;
+         tmass__integrators[] (section >>integrators) gets a row {name, step, is_explicit}.
+         step(m, dt) reads m->step_u0, m->step_v0 (pinned nodes already at their targets)
+         and writes m->step_u1, m->step_v1; tmass_step_ex does the rest (finiteness,
+         divergence check when is_explicit, precision check, inverted count when not,
+         commit, state kept on failure). Work vectors are named by role in tmass_model and
+         carved in tmass__layout: reuse one whose role cannot overlap yours (say so at the
+         aliasing in tmass__layout) or add one there (3n reals per node count).
+       Linear solver. tmass_linear_solver gets a value before TMASS_LINEAR_SOLVER_COUNT
+         (selected by desc.linear_solver); tmass__linear_solvers[] (section >>solver) gets
+         a row {name, solve, solve_block}. solve(m, diag, c, b, x) solves
+         (diag + c K) x = b on the free degrees of freedom (K applied by tmass__matvec,
+         including a hybrid's coupling block), x holding the initial guess; solve_block
+         solves K X = B for TMASS__RHS interleaved columns (the quasi-static
+         precomputation). Both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (cap reached or a
+         direction of non-positive curvature) or TMASS_ERR_NOT_FINITE, add to stats
+         (cg_iterations, cg_residual, stiffness_products, negative_curvature) and set
+         m->cg_indefinite when the matrix was not positive definite along a direction.
+         Every solve of the header calls tmass__linear_solve / tmass__linear_solve_block:
+         never call a solver directly.
+       Tests each must add (tests/test_tensormass.c, test_tensormass_qs.c for the
+         precomputed paths): a model kind, force = -gradient of its energy by finite
+         differences (as test_force_is_minus_energy_gradient and
+         test_spring_force_is_minus_energy_gradient), differential = derivative of the
+         force (test_stiffness_is_minus_force_gradient,
+         test_spring_incremental_potential_gradient), a closed form where one exists
+         (test_stiffness_equals_p1_fem, test_cantilever_r1, test_masses), the static and
+         implicit solves agreeing (test_springs_implicit_matches_static); an integrator,
+         its order of accuracy on the oscillator (test_integrator_order: halving dt
+         divides the error by 2^order) and its energy behaviour
+         (test_semi_implicit_energy_bounded, test_explicit_euler_grows_rk4_decays); a
+         linear solver, the same answers as CG within the tolerance on the static,
+         implicit and quasi-static tests, its failure codes (test_cg_cap_fails,
+         test_huge_load_not_finite); all three, determinism (test_threads_bit_identical:
+         bit-identical for 1 and 2 threads) and no allocation after creation
+         (test_no_allocation_after_create); test_extension_enums_validated covers the
+         sentinels.
+       Bench (bench/model_tensormass.c: a kind is a row of tm_models with its create
+         function; an integrator a BENCH_ id of bench/bench.h mapped in tm_step): the new
+         entry's speed/accuracy rows (R1-R5) and stability table next to the existing
+         ones, and the existing rows no slower (callgrind instruction counts of a step
+         loop per integrator, or make bench-quick, before and after, in the note).
+
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, time s, forces
    N, mass_damping 1/s, stiffness_damping s, gravity m/s^2 (default 9.81 along -z).
 
@@ -130,7 +187,8 @@
    static solve, the same fields in the same order as heml_stats and frm_stats:
    newton_iterations, cg_iterations, cg_residual, residual, increments, increment_cuts,
    line_search_cuts, negative_curvature, inverted, force_evaluations, stiffness_products.
-       Linear solves: Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
+       Linear solves (desc.linear_solver; TMASS_LINEAR_SOLVER_CG, the only one today):
+       Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
        1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS). Its
        dot products accumulate in double. A relative residual does not bound the error
        (error <= cond |r| / |b|): in float, nearly incompressible materials are refused at
@@ -347,6 +405,12 @@
          with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       unreleased (issue 20) explicit extension points, results bit-identical: the
+             private tables tmass__kinds, tmass__integrators, tmass__linear_solvers (see
+             HOW TO EXTEND); TMASS_MODEL_KIND_COUNT, TMASS_INTEGRATOR_COUNT,
+             tmass_linear_solver and desc.linear_solver; work vectors named by role, CG
+             with its own (the model block grows by 5 vectors of 3n reals, 120 bytes per
+             node in double); tmass_create and tmass_hybrid_create in named stages.
        unreleased (issue 18) no silent wrong answers: an implicit step after driving a node
              counted the node's move twice (free nodes 2x the static answer at long dt);
              the quasi-static preload ignored pinned nodes away from rest; CG at its cap,
