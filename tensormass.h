@@ -3635,7 +3635,7 @@ static int tmass__qs_prepare(const tmass_model *m, const tmass_qs_desc *d, tmass
         return TMASS_ERR_ARG;
     if (!(tmass__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
         return TMASS_ERR_SOLVER;
-    /* mark the precomputed nodes in a scratch vector of the model (3n reals) */
+    /* mark the precomputed nodes in the model's qs_mark work vector */
     mark = m->qs_mark;
     memset(mark, 0, sizeof(tmass_real) * (size_t)m->node_count);
     if (d->nodes) {
