@@ -868,7 +868,7 @@ typedef struct tmass_qs_desc {
 TMASSDEF tmass_qs_desc tmass_qs_default_desc(void);
 /* Precomputes the quasi-static model of the tensor-mass model m (its mesh, material, pinned
    nodes, gravity and external forces at this moment). Costs 3 * |nodes| + 1 CG solves,
-   run 8 at a time so that each K product serves eight; uses m's scratch memory and a
+   run 8 at a time so that each K product serves eight; uses m's work vectors and a
    temporary block of 6 x 8 vectors (freed before returning) and leaves m's state
    unchanged. */
 TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out);
