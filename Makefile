@@ -29,7 +29,8 @@
 
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 WARN := -Wall -Wextra -pedantic -Werror
-HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/test.h tests/compile_all.h
+HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/test.h tests/compile_all.h \
+           tests/fixtures.h
 FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
 
 CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
