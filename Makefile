@@ -120,11 +120,11 @@ BENCH_OBJS := $(foreach m,$(BENCH_MODELS),build/bench/$(m)_double.o build/bench/
 BENCH_GIT := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- . ':!bench/results' 2>/dev/null || echo -dirty)
 BENCH_DEFS := -DBENCH_FLAGS='"$(BENCH_CFLAGS)"' -DBENCH_GIT='"$(BENCH_GIT)"'
 
-build/bench/%_double.o: bench/%.c bench/bench.h bench/body_mesh.h $(HEADERS)
+build/bench/%_double.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_common.h $(HEADERS)
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -c -o $@ $<
 
-build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h $(HEADERS)
+build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_common.h $(HEADERS)
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -DBENCH_FLOAT -c -o $@ $<
 
