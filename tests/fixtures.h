@@ -7,22 +7,22 @@
    its own copy, so a test reads the same with the shared helper.
 
    What each helper gives:
-   - rnd(&state): deterministic pseudo-random numbers in [-1, 1] (a linear
-     congruential generator; the same sequence on every platform and compiler), for
-     perturbed states, random directions and seeds of the finite-difference checks.
-   - counting_allocator, count_alloc, count_free: an allocator for
-     a desc's allocator field (user = &a counting_allocator) that counts allocations,
-     frees and live bytes, honours the requested alignment, and returns NULL on every
-     call while .fail is set (out-of-memory tests). The tests that "nothing allocates
-     after creation" and "everything is freed" read its counters.
-   - log_capture, capture_log: a logger callback for a desc's log field
-     (user = &a log_capture) that counts the calls and keeps the last error code.
-   Needing examples/tetmesh.h (defined only when it was included before this file):
-   - box_mesh(mesh, nx, ny, nz, sx, sy, sz, split): the box [0, sx] x [0, sy] x
-     [0, sz] of nx x ny x nz cells split into tetrahedra (TETMESH_SPLIT5 or _SPLIT6).
+   - rnd(&state): deterministic pseudo-random numbers in [-1, 1] (a linear congruential
+     generator: the same sequence on every platform and compiler), for perturbed states,
+     random directions and the seeds of the finite-difference checks.
+   - counting_allocator, count_alloc, count_free: an allocator for a desc's allocator
+     field (user = &a counting_allocator) that counts allocations, frees and live bytes,
+     honours the requested alignment, and returns NULL on every call while .fail is set
+     (out-of-memory tests). The "nothing allocates after creation" and "everything is
+     freed" tests read its counters.
+   - log_capture, capture_log: a logger callback for a desc's log field (user = &a
+     log_capture) that counts the calls and keeps the last error code.
+   Only when examples/tetmesh.h was included before this file:
+   - box_mesh(mesh, nx, ny, nz, sx, sy, sz, split): the box [0, sx] x [0, sy] x [0, sz]
+     of nx x ny x nz cells, split into tetrahedra (TETMESH_SPLIT5 or TETMESH_SPLIT6).
    - fem_gradients(p, grad): the gradients of the barycentric coordinates of the
-     tetrahedron p[0..3] (the P1 shape functions of an independent linear FEM, for
-     comparison with the models), returning its signed volume. */
+     tetrahedron p[0..3] (the P1 shape functions of an independent linear FEM, to compare
+     the models with), returning its signed volume. */
 #ifndef FIXTURES_H
 #define FIXTURES_H
 
