@@ -42,7 +42,7 @@ static inline void bench_rest_position(const double *rest, int i, double p[3])
 }
 
 static inline void bench_displaced_position(const double *rest, const bench_real *x, const bench_real *x0, int i,
-                                     double p[3])
+                                            double p[3])
 {
     int k;
     for (k = 0; k < 3; k++) p[k] = rest[3 * i + k] + ((double)x[3 * i + k] - (double)x0[3 * i + k]);
