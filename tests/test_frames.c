@@ -9,6 +9,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -23,13 +24,6 @@
 static frm_real *alloc_reals(int count)
 {
     return (frm_real *)calloc(count > 0 ? (size_t)count : 1, sizeof(frm_real));
-}
-
-/* Deterministic pseudo-random numbers in [-1, 1]. */
-static double rnd(unsigned *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
 }
 
 /* Independent quaternion helpers in double (x, y, z, w). */
@@ -1898,32 +1892,6 @@ static void test_threads_bit_identical(void)
     CHECK(h1 == h4);
 }
 
-typedef struct counting_allocator {
-    int allocs, frees;
-    long long live;
-} counting_allocator;
-
-static void *count_alloc(size_t size, size_t align, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    char *raw = (char *)malloc(size + align + sizeof(void *)), *p;
-    if (!raw) return NULL;
-    p = raw + sizeof(void *);
-    p += (align - (size_t)p % align) % align;
-    ((void **)p)[-1] = raw;
-    c->allocs++;
-    c->live += (long long)size;
-    return p;
-}
-
-static void count_free(void *ptr, size_t size, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    c->frees++;
-    c->live -= (long long)size;
-    free(((void **)ptr)[-1]);
-}
-
 /* Nothing allocates after creation: steps, static solves, Newton steps, forces, energies,
    stiffness products and assembly; the sampling helpers free their temporaries; the
    model and the sampling free everything. */
@@ -1933,7 +1901,7 @@ static void test_no_allocation_after_create(void)
     frm_sampling s;
     frm_desc d = frm_model_default_desc();
     frm_model *m;
-    counting_allocator c = {0, 0, 0};
+    counting_allocator c = {0, 0, 0, 0};
     frm_allocator a;
     double lo[3] = {0, 0, 0}, hi[3] = {1, 0.4, 0.4};
     frm_real *x, *v, *out, res;
@@ -1994,18 +1962,6 @@ static void test_no_allocation_after_create(void)
 }
 
 /* ---- validation ---------------------------------------------------------------------- */
-
-typedef struct log_capture {
-    int calls, last_code;
-} log_capture;
-
-static void capture_log(int code, const char *message, void *user)
-{
-    log_capture *c = (log_capture *)user;
-    c->calls++;
-    c->last_code = code;
-    (void)message;
-}
 
 /* An allocator with nothing to give. */
 static void *failing_alloc(size_t size, size_t align, void *user)
