@@ -177,6 +177,10 @@
                                  shortest rest edge, u = x - X the displacement (see
                                  LIMITS: float bodies that travel far from their rest
                                  position).
+       TMASS_ERR_UNSTABLE        a spring model's static solve converged to a saddle, not
+                                 a minimum (the minimum check of tmass_solve_static: a
+                                 tetrahedron flattened through its base balances there);
+                                 nudge the state or change the pins and solve again.
    Creation refuses, besides bad numbers and indices: flat and inverted rest tetrahedra,
    a triangle shared by three tetrahedra (TMASS_ERR_NONMANIFOLD) and the same tetrahedron
    listed twice in any node order (TMASS_ERR_TET_DUPLICATE: it would double that
@@ -589,13 +593,14 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_FILE_TRUNCATED, -36, "precomputation file or buffer is truncated") \
     X(TMASS_ERR_TET_DUPLICATE, -37, "the same tetrahedron (same four nodes, any order) is listed twice") \
     X(TMASS_ERR_DIVERGED, -38, "explicit step diverged (an edge stretched past divergence_strain); the last valid state was kept") \
-    X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept")
+    X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept") \
+    X(TMASS_ERR_UNSTABLE, -40, "static solve (spring model) converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -40
+    TMASS_ERR_LAST_ = -41
 };
 
 typedef enum tmass_model_kind {
@@ -772,7 +777,10 @@ TMASSDEF int tmass_step_ex(tmass_model *m, tmass_real dt, tmass_integrator integ
    compressed springs make it indefinite) and a backtracking line search (see SOLVERS).
    On failure (TMASS_ERR_NO_CONVERGENCE: a CG cap, a singular problem such as nothing
    pinned, or the continuation giving up; TMASS_ERR_NOT_FINITE; TMASS_ERR_PRECISION) the
-   state is unchanged. */
+   state is unchanged. A spring model's answer must be a minimum: a probe CG solve with
+   the full tangent at it (to 1e-7, float 1e-5) that meets negative curvature beyond
+   round-off fails the solve with TMASS_ERR_UNSTABLE (a saddle; state unchanged). It costs
+   one more CG solve; the tensor model is linear and needs no probe (its K is constant). */
 TMASSDEF int tmass_solve_static(tmass_model *m);
 
 /* ---- state access (pointers into the model, valid until tmass_destroy) ---- */
@@ -1083,6 +1091,7 @@ struct tmass_model {
     tmass_real *newton_dx, *newton_trial; /* Newton step and line-search trial point */
     tmass_real *static_u;            /* static solve: the displacement solved for */
     tmass_real *static_accepted;     /* springs' continuation: last accepted state */
+    tmass_real *static_probe_rhs, *static_probe_x; /* springs' minimum check: probe solve */
     tmass_real *qs_rhs, *qs_x;       /* quasi-static preload solve */
     tmass_real *qs_mark;             /* quasi-static creation: precomputed-node marks (n) */
     tmass_real *cg_r, *cg_z, *cg_p, *cg_q, *cg_pinv; /* CG: residual, preconditioned
@@ -1324,6 +1333,8 @@ static void tmass__layout(tmass_model *m, tmass__carver *c)
     m->newton_dx = m->implicit_dv;
     m->static_u = m->step_u1;
     m->static_accepted = m->step_u0;
+    m->static_probe_rhs = m->implicit_rhs; /* after the continuation, its Newton is over */
+    m->static_probe_x = m->implicit_dv;
     m->qs_rhs = m->step_u0;
     m->qs_x = m->step_u1;
     m->qs_mark = m->step_v0;
@@ -1600,7 +1611,7 @@ static double tmass__tensor_energy(tmass_model *m, const tmass_real *u);
 static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u);
 static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt);
 static int tmass__tensor_static(tmass_model *m, tmass_real *u);
-static int tmass__spring_static(tmass_model *m, tmass_real *u);
+static int tmass__spring_static_solve(tmass_model *m, tmass_real *u);
 
 static const tmass__kind_ops tmass__kinds[] = {
     /* TMASS_TENSOR_MASS */
@@ -1608,7 +1619,7 @@ static const tmass__kind_ops tmass__kinds[] = {
      tmass__tensor_energy, NULL, tmass__tensor_static, TMASS__KIND_LINEAR | TMASS__KIND_POISSON},
     /* TMASS_MASS_SPRING */
     {"mass-spring", tmass__spring_assemble_tet, tmass__spring_force, tmass__spring_differential,
-     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static, 0}};
+     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static_solve, 0}};
 /* one row per kind (a negative array size stops the build otherwise) */
 typedef char tmass__kinds_size_check[sizeof tmass__kinds / sizeof tmass__kinds[0] == TMASS_MODEL_KIND_COUNT ? 1 : -1];
 
@@ -2487,7 +2498,9 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
    non-positive curvature) or TMASS_ERR_NOT_FINITE. */
 typedef struct tmass__linear_solver_ops {
     const char *name;
-    /* (D + c K) x = b on the free degrees of freedom, x the initial guess (see tmass__cg) */
+    /* (D + c K) x = b on the free degrees of freedom, x the initial guess (see tmass__cg).
+       Stopping on a direction p with p . A p <= 0, it sets m->cg_indefinite and leaves p
+       in m->cg_p and mask A p in m->cg_q (the springs' minimum check reads them). */
     int (*solve)(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b, tmass_real *x);
     /* K X = B for TMASS__RHS interleaved columns; w four work arrays like X, pinv the
        Jacobi inverse diagonal (see tmass__cg_block) */
@@ -3088,6 +3101,62 @@ static int tmass__tensor_static(tmass_model *m, tmass_real *x)
 }
 
 static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u) { return tmass__spring_energy(m, u); }
+
+/* Is the spring model's converged static state x a minimum? A zero residual holds at
+   saddles too (a tetrahedron flattened through its base: its compressed springs balance,
+   and either mirror image of the rest shape lies lower). A probe solve K_t y = b with the
+   full tangent at x (b a fixed pseudo-random vector on the free axes, CG to 1e-7, float
+   1e-5) meets a direction p of negative curvature where K_t is indefinite; p . K_t p below
+   -1e3 eps sum_k |p_k (K_t p)_k| (its round-off) is a saddle: TMASS_ERR_UNSTABLE. So is a
+   diagonal entry below -1e3 eps max |diagonal| (the Jacobi preconditioner hides those
+   axes from CG). A probe at its cap counts as a minimum. It reads the direction the
+   linear solver stopped on (m->cg_p, and m->cg_q = mask K_t p: the contract of a solver
+   that reports m->cg_indefinite, see tmass__linear_solver_ops). Works in the static
+   probe vectors (x is m->static_u). */
+static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count, err;
+    tmass_real *b = m->static_probe_rhs, *y = m->static_probe_x, *p = m->cg_p, *q = m->cg_q;
+    tmass_real tolerance = m->cg_tolerance;
+    double pq = 0.0, scale = 0.0, eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
+    double dmax = 0.0, dmin = 0.0;
+    tmass__spring_residual(m, x, b, 1); /* the full tangent at x */
+    /* a negative diagonal entry is negative curvature along that axis (and the Jacobi
+       preconditioner zeroes such axes, so CG would not see them) */
+    for (i = 0; i < n3; i++) {
+        double dg = (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)] * (double)m->free_mask[i];
+        if (fabs(dg) > dmax) dmax = fabs(dg);
+        if (dg < dmin) dmin = dg;
+    }
+    if (dmin < -1e3 * eps * dmax) return TMASS_ERR_UNSTABLE;
+    for (i = 0; i < n3; i++) {
+        unsigned h = (unsigned)i * 2654435761u;
+        h ^= h >> 15;
+        h *= 2246822519u;
+        h ^= h >> 13;
+        b[i] = (tmass_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
+        y[i] = 0;
+    }
+    m->cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-7);
+    err = tmass__linear_solve(m, NULL, 1.0, b, y);
+    m->cg_tolerance = tolerance;
+    if (err == TMASS_ERR_NOT_FINITE) return err;
+    if (!m->cg_indefinite) return TMASS_OK;
+    for (i = 0; i < n3; i++) { /* p: the direction CG stopped on, q = mask K_t p */
+        pq += (double)p[i] * (double)q[i] * (double)m->free_mask[i];
+        scale += fabs((double)p[i] * (double)q[i]) * (double)m->free_mask[i];
+    }
+    return pq < -1e3 * eps * scale ? TMASS_ERR_UNSTABLE : TMASS_OK;
+}
+
+/* The springs' static solve (their row of tmass__kinds): the load continuation, then the
+   minimum check. */
+static int tmass__spring_static_solve(tmass_model *m, tmass_real *x)
+{
+    int err = tmass__spring_static(m, x);
+    if (!err) err = tmass__spring_check_minimum(m, x);
+    return err;
+}
 
 /* Static equilibrium: one CG solve K u = f_ext + M g for the tensor model (it is
    linear: a converged, finite solve is exact for the model), the continuation of
