@@ -112,7 +112,9 @@
          precomputation). Both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (cap reached or a
          direction of non-positive curvature) or TMASS_ERR_NOT_FINITE, add to stats
          (cg_iterations, cg_residual, stiffness_products, negative_curvature) and set
-         m->cg_indefinite when the matrix was not positive definite along a direction.
+         m->cg_indefinite when the matrix was not positive definite along a direction,
+         leaving that direction in m->cg_p and mask A p in m->cg_q (the springs' static
+         minimum check, tmass__spring_check_minimum, reads them).
          Every solve of the header calls tmass__linear_solve / tmass__linear_solve_block:
          never call a solver directly.
        Tests each must add (tests/test_tensormass.c, test_tensormass_qs.c for the
