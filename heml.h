@@ -726,15 +726,17 @@ typedef enum heml_law {
     HEML_NEO_HOOKEAN_INCOMPRESSIBLE = 3,    /* table 3 + penalty: c1, kappa */
     HEML_MOONEY_RIVLIN_INCOMPRESSIBLE = 4,  /* table 3 + penalty: c1, c2, kappa */
     HEML_MASS_SPRING = 5,                   /* sec. 5.3: young_modulus */
-    HEML_USER = 6                           /* callbacks (heml_user_law) */
+    HEML_USER = 6,                          /* callbacks (heml_user_law) */
+    HEML_LAW_COUNT                          /* number of laws (not a law): validation only */
 } heml_law;
 
 typedef enum heml_integrator {
     HEML_SEMI_EXPLICIT_EULER = 0,      /* eq. 32 (default) */
     HEML_IMPLICIT_EULER = 1,           /* backward Euler: Newton minimisation of the incremental
                                           potential to newton_tolerance, matrix-free CG, line search */
-    HEML_IMPLICIT_EULER_LINEARIZED = 2 /* one linearised Newton iteration, no line search (fast,
+    HEML_IMPLICIT_EULER_LINEARIZED = 2, /* one linearised Newton iteration, no line search (fast,
                                           accurate only while the step is nearly linear) */
+    HEML_INTEGRATOR_COUNT               /* number of integrators (not one): validation only */
 } heml_integrator;
 
 typedef enum heml_stress_kind {
@@ -1116,12 +1118,11 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
 #define HEML__MAX_NODES 200000000
 
-/* kernel kinds: how a law is evaluated */
-#define HEML__K_RAW 0    /* c1 (I1-3) + c2 (I2-3) - p0 ln J + kappa/2 ln^2 J (NH, table 3) */
-#define HEML__K_SPLIT 1  /* split Mooney-Rivlin */
-#define HEML__K_SVK 2
-#define HEML__K_USER 3
-#define HEML__K_SPRING 4
+/* kernel kinds: which kernels evaluate a law (the law's row in heml__laws says) */
+#define HEML__K_INVARIANTS 0 /* a function w(I1, I2, J): the general path (and the fast one
+                                where the law's fast_path flag allows it) */
+#define HEML__K_USER 1       /* the same through user callbacks (checked at rest at create) */
+#define HEML__K_SPRING 2     /* mass-spring: link tensions, its own kernels (heml__spring_*) */
 
 /* what a law evaluation must produce besides the first derivatives */
 #define HEML__WANT_ENERGY 1
@@ -1138,15 +1139,46 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 /* A material in kernel form. */
 typedef struct heml__mat {
     int kind, uses_i2;
+    int fast;                    /* its law's fast_path flag, and no I2 term, and no Prony: the
+                                    vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
     heml_law law;
-    heml_real c1, c2, p0, kappa; /* K_RAW, K_SPLIT (c1, c2, kappa) */
-    heml_real mu, lambda, guard; /* K_SVK */
-    heml_real young;             /* K_SPRING */
+    const struct heml__law_ops *ops; /* its law's row of heml__laws */
+    heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
+    heml_real mu, lambda, guard; /* heml__law_svk */
+    heml_real young;             /* mass-spring */
     double density;
     double small_mu, small_lambda; /* small-strain moduli: preconditioner, time step */
     heml_user_law user;
     int prony_count, prony_first; /* its terms in the model's Prony arrays */
 } heml__mat;
+
+struct heml__blk;
+/* A law's evaluation on a block of HEML__W tetrahedra (see heml__law). */
+typedef void (*heml__law_fn)(const heml__mat *mt, struct heml__blk *b, int valid, int want);
+
+/* One row of heml__laws (>>laws-table), indexed by heml_law: everything the library knows
+   about a law. `energy`, `stress` and `differential` evaluate the law in invariants on a
+   block (heml__blk): each fills the stress terms (w_1, w_2, w_J, s0); `energy` also w
+   (called with HEML__WANT_ENERGY), `differential` also the second derivatives h (with
+   HEML__WANT_SECOND). The built-in laws share J, ln J and J^-2/3 between the three, so
+   each gives one function for all of them; NULL for mass-spring, whose kernels are the
+   heml__spring_* functions (kind HEML__K_SPRING). `make` fills the kernel constants from a
+   heml_material, `check` validates them (0, or an error code with a message).
+   `fast_path`: the vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) may
+   evaluate this law's forces and differentials; they compute w = c1 (I1 - 3) - p0 ln J +
+   kappa/2 ln^2 J from heml__mat's c1, p0, kappa and nothing else, so set it only for a law
+   that is exactly that (they also run only without an I2 term and without Prony). Default
+   0: a new law goes through the general path; tests/test_heml.c's
+   test_law_table_forces_and_differentials fails if a law is routed to the fast path
+   wrongly. */
+typedef struct heml__law_ops {
+    const char *name;
+    int kind; /* HEML__K_* */
+    heml__law_fn energy, stress, differential;
+    void (*make)(const heml_material *src, heml__mat *mt);
+    int (*check)(const heml_material *src, int index, char *msg, size_t msg_size);
+    int fast_path;
+} heml__law_ops;
 
 struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
@@ -1346,7 +1378,7 @@ static const int heml__link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3,
 /* The workspace of one block of HEML__W tetrahedra: every stage of a kernel is a loop
    over the lanes of these arrays. Everything that vanishes at rest is formed from the
    displacements without cancellation (see THE MODEL). */
-typedef struct heml__blk {
+struct heml__blk {
     heml_real e[9][HEML__W];  /* link displacements du_j = u_j - u_0: component r of j at [3 (j-1) + r] */
     heml_real H[9][HEML__W];  /* displacement gradient H = F - I = du V^-1, row-major */
     heml_real K[9][HEML__W];  /* cof F - I = tr H I - H^T + cof H, row-major */
@@ -1365,7 +1397,8 @@ typedef struct heml__blk {
     heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
     heml_real de[9][HEML__W]; /* differential: the links of dx */
     heml_real len[6][HEML__W]; /* springs: clamped link lengths */
-} heml__blk;
+};
+typedef struct heml__blk heml__blk;
 
 /* Kinematics of the block from its link displacements (e) and rest gradients (R): H, cof F - I,
    J - 1, C - I and the invariants, each a polynomial in H without a constant term (a
@@ -1451,15 +1484,16 @@ HEML__INLINE heml_real heml__log_jc(heml_real Jc, heml_real jc1, heml_real iJ)
     return heml__log(Jc) + (jc1 - (Jc - 1)) * iJ;
 }
 
-/* K_RAW: w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J (p0 = 2 c1 +
+/* heml__law_raw (Neo-Hookean eq. 26 and table 3 + penalty): w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J (p0 = 2 c1 +
    4 c2), U' = (kappa ln J - p0) / J, U'' = (kappa (1 - ln J) + p0) / J^2, continued below
    J0 by U(J0) + U'(J0) d + U''(J0) d^2 / 2 (d = J - J0): the tangent of the volumetric
    stress, sec. 4.4. Neo-Hookean eq. 26: c1 = mu/2, c2 = 0, p0 = mu, kappa = lambda.
    s0 = p0 + w_J = (kappa ln Jc + p0 (Jc - 1)) / Jc + U'' d. The energy uses
    c1 (I1 - 3) - 2 c1 ln J = c1 (q1 + 2 d + 2 (x - log1p x)), x = Jc - 1, and
    I2 - 3 - 4 ln J = 2 (I1 - 3 - 2 ln J) + ((I1 - 3)^2 - tr2) / 2. */
-static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_raw(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1486,13 +1520,14 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
         }
 }
 
-/* K_SPLIT (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
+/* heml__law_split, the compressible Mooney-Rivlin (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
    (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
    2 a + I1 a' = 2/3 a (3 (Jc - 1) - (I1 - 3)) / Jc and 4 b + I2 b' = 4/3 b (3 (Jc - 1) -
    (I2 - 3)) / Jc, plus the continuation terms in d. */
-static void heml__law_split(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1524,12 +1559,13 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int want)
     }
 }
 
-/* K_SVK (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
+/* heml__law_svk (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
    = lambda/8 (I1 - 3)^2 + mu/4 tr (C - I)^2, w_1 = lambda/4 (I1 - 3) + mu/2 (I1 - 1),
    w_2 = -mu/2, s0 = (lambda/2 + mu) (I1 - 3) + w_J, plus the guard (lambda + 2 mu)/2 d^2
    below J0. */
-static void heml__law_svk(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_svk(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real mu = mt->mu, lambda = mt->lambda, guard = mt->guard;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1545,7 +1581,7 @@ static void heml__law_svk(const heml__mat *mt, heml__blk *b, int want)
     }
 }
 
-/* K_USER: the callbacks at (I1, I2, Jc) for the `valid` lanes (padding lanes get zeros),
+/* heml__law_user: the callbacks at (I1, I2, Jc) for the `valid` lanes (padding lanes get zeros),
    continued below J0 to first order in J: w += w_J d + w_JJ d^2 / 2, w_1 += w_1J d,
    w_2 += w_2J d, w_J += w_JJ d (second derivatives held at J0); without `second`, w_J is
    held at its J0 value. s0 = 2 w_1 + 4 w_2 + w_J is formed from the callbacks' values, so
@@ -1599,14 +1635,15 @@ static void heml__law_user(const heml__mat *mt, heml__blk *b, int valid, int wan
     for (k = 0; k < HEML__W; k++) b->s0[k] = 2 * b->w1[k] + 4 * b->w2[k] + b->wJ[k];
 }
 
+/* The law of a material on a block, through its row of heml__laws (the one dispatch of
+   the general path): energy when asked for it, else the differential when asked for
+   second derivatives, else the stress. */
 static void heml__law(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
-    switch (mt->kind) {
-    case HEML__K_RAW: heml__law_raw(mt, b, want); break;
-    case HEML__K_SPLIT: heml__law_split(mt, b, want); break;
-    case HEML__K_SVK: heml__law_svk(mt, b, want); break;
-    default: heml__law_user(mt, b, valid, want); break;
-    }
+    const heml__law_ops *ops = mt->ops;
+    heml__law_fn fn = (want & HEML__WANT_ENERGY) ? ops->energy : (want & HEML__WANT_SECOND) ? ops->differential
+                                                                                             : ops->stress;
+    fn(mt, b, valid, want);
 }
 
 /* Evaluates a law at rest (I1 = I2 = 3, J = 1) for creation checks: fills w_1, w_2, w_J,
@@ -1907,7 +1944,7 @@ static void heml__p_times_grad(const heml_real *HEML__RESTRICT R, heml__blk *HEM
     }
 }
 
-/* The Neo-Hookean kernel (K_RAW without I2 and without Prony), in stages that are each a
+/* The Neo-Hookean kernel (heml__law_raw without I2 and without Prony: heml__mat.fast), in stages that are each a
    short loop over the lanes: H and J - 1; the volumetric scalars (w_J = U'(J), continued
    below J0, s0 = p0 + w_J); the stress
        P = s0 I + 2 c1 H + w_J (tr H I - H^T + cof H)   (times Vol, into b->K)
@@ -2090,7 +2127,7 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         heml__spring_forces(b, b->co, NULL);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count && !want_energy) {
+    if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
         heml__forces_nh(mt, m->jm1_0, R, b);
         return 0.0;
     }
@@ -2206,7 +2243,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     int k;
     heml__gather(idx, u, b->e);
     heml__gather(idx, dx, b->de);
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
+    if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
     }
@@ -2237,7 +2274,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         heml__spring_forces(b, b->co, dsig);
         return;
     }
-    /* (raw laws without I2 reach here only with Prony: the general path covers them, with
+    /* (fast-path laws reach here only with Prony: the general path covers them, with
        zero I-derivatives) */
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
@@ -2552,58 +2589,142 @@ static int heml__fail(const heml_desc *d, int code, const char *detail)
     return code;
 }
 
-/* A material in kernel form (no checks). */
+/* >>laws-table: each law's kernel constants (make), parameter checks (check) and its row
+   of heml__laws. */
+
+static void heml__make_svk(const heml_material *src, heml__mat *mt)
+{
+    mt->mu = src->mu;
+    mt->lambda = src->lambda;
+    mt->guard = src->lambda + 2 * src->mu;
+    mt->uses_i2 = 1;
+}
+
+static void heml__make_nh(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->mu / 2;
+    mt->p0 = src->mu;
+    mt->kappa = src->lambda;
+}
+
+static void heml__make_nh_incompressible(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->p0 = 2 * src->c1;
+    mt->kappa = src->bulk_modulus;
+}
+
+static void heml__make_mr_incompressible(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->c2 = src->c2;
+    mt->p0 = 2 * src->c1 + 4 * src->c2;
+    mt->kappa = src->bulk_modulus;
+    mt->uses_i2 = src->c2 != 0;
+}
+
+static void heml__make_mr(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->c2 = src->c2;
+    mt->kappa = src->bulk_modulus;
+    mt->uses_i2 = src->c2 != 0;
+}
+
+static void heml__make_spring(const heml_material *src, heml__mat *mt) { mt->young = src->young_modulus; }
+
+static void heml__make_user(const heml_material *src, heml__mat *mt)
+{
+    (void)src;
+    mt->uses_i2 = 1;
+}
+
+static int heml__check_lame(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite((double)src->mu) && heml__finite((double)src->lambda) && src->mu > 0 &&
+          3 * src->lambda + 2 * src->mu > 0)) {
+        snprintf(msg, msg_size, "material %d: mu %g, lambda %g (need mu > 0, 3 lambda + 2 mu > 0)", index,
+                 (double)src->mu, (double)src->lambda);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+static int heml__check_c1_c2_kappa(double c1, double c2, double kappa, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite(c1) && heml__finite(c2) && heml__finite(kappa) && c1 >= 0.0 && c2 >= 0.0 && c1 + c2 > 0.0 &&
+          kappa > 0.0)) {
+        snprintf(msg, msg_size, "material %d: c1 %g, c2 %g, kappa %g (need c1, c2 >= 0, c1 + c2 > 0, "
+                 "kappa > 0)", index, c1, c2, kappa);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+static int heml__check_nh_incompressible(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    return heml__check_c1_c2_kappa((double)src->c1, 0.0, (double)src->bulk_modulus, index, msg, msg_size);
+}
+
+static int heml__check_mr(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    return heml__check_c1_c2_kappa((double)src->c1, (double)src->c2, (double)src->bulk_modulus, index, msg, msg_size);
+}
+
+static int heml__check_spring(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite((double)src->young_modulus) && src->young_modulus > 0)) {
+        snprintf(msg, msg_size, "material %d: Young's modulus %g", index, (double)src->young_modulus);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+/* (the user law's rest-state checks need the law evaluated: heml__validate_material) */
+static int heml__check_user(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!src->user.first) {
+        snprintf(msg, msg_size, "material %d: user law without a first-derivative callback", index);
+        return HEML_ERR_USER_LAW;
+    }
+    return HEML_OK;
+}
+
+/* The laws, indexed by heml_law (see heml__law_ops and HOW TO EXTEND). fast_path is set
+   where heml__law_raw without an I2 term is the law: Neo-Hookean (eq. 26: c1 = mu/2,
+   p0 = mu, kappa = lambda), its table 3 + penalty form, and the incompressible
+   Mooney-Rivlin, which has an I2 term unless c2 = 0 (heml__mat.fast also needs no I2
+   term). */
+static const heml__law_ops heml__laws[] = {
+    {"St Venant-Kirchhoff", HEML__K_INVARIANTS, heml__law_svk, heml__law_svk, heml__law_svk, heml__make_svk,
+     heml__check_lame, 0},
+    {"Neo-Hookean", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw, heml__make_nh, heml__check_lame,
+     1},
+    {"Mooney-Rivlin", HEML__K_INVARIANTS, heml__law_split, heml__law_split, heml__law_split, heml__make_mr,
+     heml__check_mr, 0},
+    {"Neo-Hookean (incompressible)", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw,
+     heml__make_nh_incompressible, heml__check_nh_incompressible, 1},
+    {"Mooney-Rivlin (incompressible)", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw,
+     heml__make_mr_incompressible, heml__check_mr, 1},
+    {"mass-spring", HEML__K_SPRING, NULL, NULL, NULL, heml__make_spring, heml__check_spring, 0},
+    {"user", HEML__K_USER, heml__law_user, heml__law_user, heml__law_user, heml__make_user, heml__check_user, 0},
+};
+/* a law added to heml_law without its row (or the reverse) fails to compile here */
+typedef char heml__laws_has_a_row_per_law[sizeof heml__laws / sizeof heml__laws[0] == HEML_LAW_COUNT ? 1 : -1];
+
+/* A material in kernel form (no checks; src->law valid). */
 static void heml__make_mat(const heml_material *src, heml__mat *mt)
 {
+    const heml__law_ops *ops = heml__laws + src->law;
     memset(mt, 0, sizeof *mt);
     mt->law = src->law;
+    mt->ops = ops;
+    mt->kind = ops->kind;
     mt->density = (double)src->density;
     mt->user = src->user;
     mt->prony_count = src->prony_count;
-    switch (src->law) {
-    case HEML_STVK:
-        mt->kind = HEML__K_SVK;
-        mt->mu = src->mu;
-        mt->lambda = src->lambda;
-        mt->guard = src->lambda + 2 * src->mu;
-        mt->uses_i2 = 1;
-        break;
-    case HEML_NEO_HOOKEAN:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->mu / 2;
-        mt->p0 = src->mu;
-        mt->kappa = src->lambda;
-        break;
-    case HEML_NEO_HOOKEAN_INCOMPRESSIBLE:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->c1;
-        mt->p0 = 2 * src->c1;
-        mt->kappa = src->bulk_modulus;
-        break;
-    case HEML_MOONEY_RIVLIN_INCOMPRESSIBLE:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->c1;
-        mt->c2 = src->c2;
-        mt->p0 = 2 * src->c1 + 4 * src->c2;
-        mt->kappa = src->bulk_modulus;
-        mt->uses_i2 = src->c2 != 0;
-        break;
-    case HEML_MOONEY_RIVLIN:
-        mt->kind = HEML__K_SPLIT;
-        mt->c1 = src->c1;
-        mt->c2 = src->c2;
-        mt->kappa = src->bulk_modulus;
-        mt->uses_i2 = src->c2 != 0;
-        break;
-    case HEML_MASS_SPRING:
-        mt->kind = HEML__K_SPRING;
-        mt->young = src->young_modulus;
-        break;
-    default:
-        mt->kind = HEML__K_USER;
-        mt->uses_i2 = 1;
-        break;
-    }
+    ops->make(src, mt);
+    mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
 }
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
@@ -2637,8 +2758,8 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
 {
     heml__mat mt;
     double mu, lambda, sum = 0.0;
-    int i;
-    if ((int)src->law < 0 || (int)src->law > HEML_USER) {
+    int i, err;
+    if ((unsigned)src->law >= HEML_LAW_COUNT) {
         snprintf(msg, msg_size, "material %d: unknown law %d", index, (int)src->law);
         return HEML_ERR_LAW;
     }
@@ -2662,42 +2783,11 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
         snprintf(msg, msg_size, "material %d: Prony weights sum to %g (must be < 1)", index, sum);
         return HEML_ERR_PRONY;
     }
-    switch (src->law) {
-    case HEML_STVK:
-    case HEML_NEO_HOOKEAN:
-        if (!(heml__finite((double)src->mu) && heml__finite((double)src->lambda) && src->mu > 0 &&
-              3 * src->lambda + 2 * src->mu > 0)) {
-            snprintf(msg, msg_size, "material %d: mu %g, lambda %g (need mu > 0, 3 lambda + 2 mu > 0)",
-                     index, (double)src->mu, (double)src->lambda);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    case HEML_NEO_HOOKEAN_INCOMPRESSIBLE:
-    case HEML_MOONEY_RIVLIN_INCOMPRESSIBLE:
-    case HEML_MOONEY_RIVLIN: {
-        double c1 = (double)src->c1, c2 = src->law == HEML_NEO_HOOKEAN_INCOMPRESSIBLE ? 0.0 : (double)src->c2;
-        double kappa = (double)src->bulk_modulus;
-        if (!(heml__finite(c1) && heml__finite(c2) && heml__finite(kappa) && c1 >= 0.0 && c2 >= 0.0 &&
-              c1 + c2 > 0.0 && kappa > 0.0)) {
-            snprintf(msg, msg_size, "material %d: c1 %g, c2 %g, kappa %g (need c1, c2 >= 0, c1 + c2 > 0, "
-                     "kappa > 0)", index, c1, c2, kappa);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    }
-    case HEML_MASS_SPRING:
-        if (!(heml__finite((double)src->young_modulus) && src->young_modulus > 0)) {
-            snprintf(msg, msg_size, "material %d: Young's modulus %g", index, (double)src->young_modulus);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    default: {
+    err = heml__laws[src->law].check(src, index, msg, msg_size);
+    if (err) return err;
+    if (heml__laws[src->law].kind == HEML__K_USER) { /* stress-free and stable at rest */
         heml__blk b;
         double w1, w2, wJ, tol = HEML__FLOAT ? 1e-4 : 1e-9;
-        if (!src->user.first) {
-            snprintf(msg, msg_size, "material %d: user law without a first-derivative callback", index);
-            return HEML_ERR_USER_LAW;
-        }
         heml__make_mat(src, &mt);
         heml__law_at_rest(&mt, jm1_0, &b);
         w1 = (double)b.w1[0];
@@ -2710,8 +2800,6 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
                      "small-strain mu %g, lambda %g", index, 2 * w1 + 4 * w2 + wJ, mu, lambda);
             return HEML_ERR_USER_LAW;
         }
-        break;
-    }
     }
     return HEML_OK;
 }
@@ -2733,7 +2821,7 @@ static int heml__validate(const heml_desc *d)
         return heml__fail(d, HEML_ERR_TIME_STEP, "time_step");
     if (!(heml__finite((double)d->mass_damping) && d->mass_damping >= 0))
         return heml__fail(d, HEML_ERR_DAMPING, "mass_damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 2)
+    if ((unsigned)d->integrator >= HEML_INTEGRATOR_COUNT)
         return heml__fail(d, HEML_ERR_INTEGRATOR, "integrator");
     if (!(heml__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
         d->newton_iterations < 1 || d->static_max_iterations < 1 ||
@@ -3317,9 +3405,10 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
         tmp.chunk_count += (blocks + HEML__CHUNK - 1) / HEML__CHUNK;
         tmp.prony_total += src[i].prony_count;
         tmp.prony_reals += (size_t)blocks * HEML__W * HEML__NQ * (size_t)src[i].prony_count;
-        if (src[i].law == HEML_MASS_SPRING && counts[i]) tmp.has_springs = 1;
+        if (heml__laws[src[i].law].kind == HEML__K_SPRING && counts[i]) tmp.has_springs = 1;
         if (src[i].prony_count && counts[i]) tmp.has_prony = 1;
-        if (src[i].law == HEML_USER && !src[i].user.second && counts[i]) tmp.has_user_without_second = 1;
+        if (heml__laws[src[i].law].kind == HEML__K_USER && !src[i].user.second && counts[i])
+            tmp.has_user_without_second = 1;
     }
     tmp.slot_count = tmp.block_count * HEML__W;
     {
@@ -4140,7 +4229,7 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
     int err = HEML_OK;
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)dt) && dt > 0)) return HEML_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 2) return HEML_ERR_INTEGRATOR;
+    if ((unsigned)integrator >= HEML_INTEGRATOR_COUNT) return HEML_ERR_INTEGRATOR;
     if (integrator != HEML_SEMI_EXPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * (size_t)m->node_count;
     u0 = m->scratch[0];
