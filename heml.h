@@ -739,6 +739,13 @@ typedef enum heml_integrator {
     HEML_INTEGRATOR_COUNT               /* number of integrators (not one): validation only */
 } heml_integrator;
 
+/* Linear solvers of the implicit steps and the static solve (desc.linear_solver). */
+typedef enum heml_linear_solver {
+    HEML_LINEAR_SOLVER_CG = 0, /* Jacobi-preconditioned conjugate gradient (plus the coarse space
+                                  in static solves), MINRES where an indefinite system needs it */
+    HEML_LINEAR_SOLVER_COUNT   /* number of linear solvers (not one): validation only */
+} heml_linear_solver;
+
 typedef enum heml_stress_kind {
     HEML_STRESS_PK1 = 0,   /* first Piola-Kirchhoff P, force per rest area, Pa */
     HEML_STRESS_CAUCHY = 1 /* Cauchy (true) stress sigma = P F^T / J, Pa; needs J > 0 */
@@ -835,6 +842,8 @@ typedef struct heml_desc {
     heml_real cg_tolerance;          /* relative residual of the implicit step's CG, default 1e-6
                                         (1e-5 float) */
     int cg_max_iterations;           /* Krylov iterations per linear solve, default 1000 */
+    heml_linear_solver linear_solver; /* every linear solve (implicit steps, static solve and its
+                                        saddle probe), default HEML_LINEAR_SOLVER_CG */
     int static_max_iterations;       /* Newton iterations of heml_solve_static per load step,
                                         default 50 */
     heml_real static_tolerance;      /* its residual relative to the larger of the loads and the
@@ -1112,7 +1121,8 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
-#define HEML__SCRATCH 22    /* 3n scratch vectors */
+#define HEML__SCRATCH 22    /* 3n scratch vectors (heml__layout_scratch) */
+#define HEML__KRYLOV 8      /* of which the linear solvers' workspace */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
@@ -1186,6 +1196,7 @@ struct heml_model {
     int agg_count;                         /* aggregates of the coarse space (0: none) */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
+    heml_linear_solver linear_solver;
     heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
     heml_real newton_tolerance, min_increment, precision_limit;
     int cg_max_iterations, newton_iterations, static_max_iterations, max_increments, allow_inversion, leave_saddles;
@@ -1234,8 +1245,22 @@ struct heml_model {
     heml_real *prony_q, *prony_q_next;      /* committed state and the one being built */
     size_t prony_reals;
 
-    /* scratch */
-    heml_real *scratch[HEML__SCRATCH];
+    /* scratch vectors (3n reals each), named by role; heml__layout_scratch carves them and is
+       the one place where two roles share memory (the pairs named there never live at once) */
+    heml_real *step_u0, *step_v0, *step_u1, *step_v1; /* heml_step_ex: start and candidate */
+    heml_real *static_u, *static_saved, *static_dpin, *static_dfdpin; /* heml_solve_static: current,
+                                          last converged, the pins' move, df/du times it */
+    heml_real *work_f;                 /* forces at the current point (every integrator, Newton) */
+    heml_real *newton_R, *newton_delta; /* Newton: residual, direction */
+    heml_real *newton_ut, *newton_ft, *newton_Rt; /* Newton: the line search's trial point, its
+                                          forces and residual (also the saddle escape's) */
+    heml_real *newton_shift_diag;      /* Newton: D + shift diag K0 after negative curvature */
+    heml_real *probe_b, *probe_x;      /* saddle probe: K x = b */
+    heml_real *lin_dmass, *lin_du, *lin_rhs; /* linearised implicit step: D, du, dt^2 R */
+    heml_real *objective_load;         /* Newton's objective: f_ext + M g (static and implicit) */
+    heml_real *implicit_dmass, *implicit_warm; /* implicit Euler: D, the first solve's guess */
+    heml_real *static_rhs, *static_pred; /* static solve: the tangent predictor's K pred = rhs */
+    heml_real *krylov[HEML__KRYLOV];   /* the linear solvers' workspace (heml__cg, heml__minres) */
     heml_real *dv_prev; /* implicit warm start */
     const heml_real *lin_x; /* linearisation point of the CG operator */
 
@@ -2528,12 +2553,49 @@ static void *heml__carve(heml__carver *c, size_t bytes)
 
 #define HEML__CARVE(c, ptr, type, count) ((ptr) = (type *)heml__carve((c), sizeof(type) * (size_t)(count)))
 
+/* The scratch vectors, 3n reals each (HEML__SCRATCH of them), and the roles that share
+   memory: a static solve and a step never run at once (static_* = step_*, static_rhs and
+   static_pred = implicit_dmass and implicit_warm); the linearised implicit step does not
+   run Newton (lin_* = newton_R, newton_delta, newton_ut); the saddle probe runs between
+   Newton iterations, whose direction and shifted diagonal are then spent (probe_b =
+   newton_delta, probe_x = newton_shift_diag). */
+static void heml__layout_scratch(heml_model *m, heml__carver *c)
+{
+    size_t n3 = 3 * (size_t)m->node_count;
+    int i;
+    HEML__CARVE(c, m->step_u0, heml_real, n3);
+    HEML__CARVE(c, m->step_v0, heml_real, n3);
+    HEML__CARVE(c, m->step_u1, heml_real, n3);
+    HEML__CARVE(c, m->step_v1, heml_real, n3);
+    HEML__CARVE(c, m->work_f, heml_real, n3);
+    HEML__CARVE(c, m->newton_R, heml_real, n3);
+    HEML__CARVE(c, m->newton_delta, heml_real, n3);
+    HEML__CARVE(c, m->newton_ut, heml_real, n3);
+    HEML__CARVE(c, m->newton_ft, heml_real, n3);
+    HEML__CARVE(c, m->newton_Rt, heml_real, n3);
+    for (i = 0; i < HEML__KRYLOV; i++) HEML__CARVE(c, m->krylov[i], heml_real, n3);
+    HEML__CARVE(c, m->objective_load, heml_real, n3);
+    HEML__CARVE(c, m->implicit_dmass, heml_real, n3);
+    HEML__CARVE(c, m->implicit_warm, heml_real, n3);
+    HEML__CARVE(c, m->newton_shift_diag, heml_real, n3);
+    m->static_u = m->step_u0;
+    m->static_saved = m->step_v0;
+    m->static_dpin = m->step_u1;
+    m->static_dfdpin = m->step_v1;
+    m->static_rhs = m->implicit_dmass;
+    m->static_pred = m->implicit_warm;
+    m->lin_dmass = m->newton_R;
+    m->lin_du = m->newton_delta;
+    m->lin_rhs = m->newton_ut;
+    m->probe_b = m->newton_delta;
+    m->probe_x = m->newton_shift_diag;
+}
+
 /* Lays out every array of the model in the block at c->base (or measures it). */
 static void heml__layout(heml_model *m, heml__carver *c)
 {
     size_t n = (size_t)m->node_count, s = (size_t)m->slot_count, B = (size_t)m->block_count;
     size_t C = (size_t)m->chunk_count, P = (size_t)m->prony_total, M = (size_t)m->material_count;
-    int i;
     HEML__CARVE(c, m->rest, heml_real, 3 * n);
     HEML__CARVE(c, m->pos, heml_real, 3 * n);
     HEML__CARVE(c, m->disp, heml_real, 3 * n);
@@ -2570,7 +2632,7 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->prony_s, heml_real, M);
     HEML__CARVE(c, m->prony_q, heml_real, m->prony_reals);
     HEML__CARVE(c, m->prony_q_next, heml_real, m->prony_reals);
-    for (i = 0; i < HEML__SCRATCH; i++) HEML__CARVE(c, m->scratch[i], heml_real, 3 * n);
+    heml__layout_scratch(m, c);
     HEML__CARVE(c, m->dv_prev, heml_real, 3 * n);
     HEML__CARVE(c, m->div_u, heml_real, 3 * n);
     HEML__CARVE(c, m->div_f, heml_real, 3 * n);
@@ -2823,6 +2885,8 @@ static int heml__validate(const heml_desc *d)
         return heml__fail(d, HEML_ERR_DAMPING, "mass_damping");
     if ((unsigned)d->integrator >= HEML_INTEGRATOR_COUNT)
         return heml__fail(d, HEML_ERR_INTEGRATOR, "integrator");
+    if ((unsigned)d->linear_solver >= HEML_LINEAR_SOLVER_COUNT)
+        return heml__fail(d, HEML_ERR_SOLVER, "linear_solver");
     if (!(heml__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
         d->newton_iterations < 1 || d->static_max_iterations < 1 ||
         !(heml__finite((double)d->static_tolerance) && d->static_tolerance > 0) ||
@@ -3348,6 +3412,7 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.precision_limit = (heml_real)1e-4;
     d.cg_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-6);
     d.cg_max_iterations = 1000;
+    d.linear_solver = HEML_LINEAR_SOLVER_CG;
     d.static_max_iterations = 50;
     d.static_tolerance = (heml_real)(HEML__FLOAT ? 1e-4 : 1e-9);
     d.internal_cookie = HEML__COOKIE;
@@ -3432,6 +3497,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     *m = tmp;
 
     m->integrator = d->integrator;
+    m->linear_solver = d->linear_solver;
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
     for (i = 0; i < 3; i++) m->gravity[i] = d->gravity[i];
@@ -3564,6 +3630,12 @@ static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real 
 }
 
 #define HEML__NEGATIVE_CURVATURE 1 /* private result of heml__cg */
+/* heml__cg's workspace vectors that callers read after a solve: the last direction p, its
+   product q = A p, the Jacobi preconditioner; HEML__CG_FREE and the next are unused by CG */
+#define HEML__CG_P 2
+#define HEML__CG_Q 3
+#define HEML__CG_PINV 4
+#define HEML__CG_FREE 5
 
 /* Solves (D - c df/dx(x_lin)) x = b on the free degrees of freedom by Jacobi-
    preconditioned CG. x holds the initial guess; pinned entries are held at 0. Returns
@@ -3571,7 +3643,7 @@ static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real 
    the last iterate), HEML__NEGATIVE_CURVATURE at a direction of non-positive curvature
    (the system is not positive definite; x is the iterate before it). With `coarse` (the
    static problem, diag NULL and c = 1) the preconditioner adds the coarse correction.
-   Scratch s[0..4]. */
+   Workspace s[0..4]: r, z, p, q, pinv (HEML__CG_*; p, q and pinv are read after a solve). */
 static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
                     const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s)
 {
@@ -3634,7 +3706,8 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
    by the static solve (Newton iterates far from equilibrium, or beyond a buckling load,
    have an indefinite tangent, where CG would stop) and by the implicit step after CG met
    negative curvature. `coarse` as for heml__cg. Returns HEML_OK or
-   HEML_ERR_NO_CONVERGENCE. Scratch s[0..7]. */
+   HEML_ERR_NO_CONVERGENCE (or HEML_ERR_NOT_FINITE for a right-hand side whose norm
+   overflows). Workspace s[0..7]. */
 static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
                         const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s)
 {
@@ -3697,6 +3770,46 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (heml_real)(phibar / beta1);
     return phibar <= tol ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
+}
+
+/* >>linear-solvers: one row per heml_linear_solver, indexed by it (see HOW TO EXTEND).
+   `solve` is for systems expected to be positive definite, `solve_indefinite` for
+   symmetric indefinite ones. Both solve (D - c df/dx(x_lin)) x = b on the free degrees of
+   freedom (D a diagonal or NULL; with `coarse` the static solve's coarse correction) from
+   the guess in x, to |r| <= rtol |b|, in the model's Krylov workspace (m->krylov), and
+   return the same codes:
+       HEML_OK                   converged;
+       HEML_ERR_NO_CONVERGENCE   cg_max_iterations reached (x is the last iterate);
+       HEML_ERR_NOT_FINITE       |b|^2 or the residual is not finite;
+       HEML__NEGATIVE_CURVATURE  (private, positive; `solve` only) a direction of
+                                 non-positive curvature: the system is not positive
+                                 definite, x is the iterate before it. Callers decide: the
+                                 linearised step switches to solve_indefinite, Newton adds a
+                                 Levenberg-Marquardt shift, the saddle probe has found its
+                                 saddle, the static predictor drops the prediction. */
+typedef int (*heml__solve_fn)(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
+                              const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s);
+typedef struct heml__linear_solver_ops {
+    const char *name;
+    heml__solve_fn solve, solve_indefinite;
+} heml__linear_solver_ops;
+
+static const heml__linear_solver_ops heml__linear_solvers[] = {
+    {"conjugate gradient (MINRES if indefinite)", heml__cg, heml__minres},
+};
+typedef char heml__linear_solvers_has_a_row_per_solver
+    [sizeof heml__linear_solvers / sizeof heml__linear_solvers[0] == HEML_LINEAR_SOLVER_COUNT ? 1 : -1];
+
+#define HEML__SPD 0
+#define HEML__INDEFINITE 1
+
+/* Every linear solve of the library goes through here, to the model's linear solver. */
+static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, const heml_real *diag, double c,
+                              const heml_real *b, heml_real *x, double rtol, int coarse)
+{
+    const heml__linear_solver_ops *ops = heml__linear_solvers + m->linear_solver;
+    return (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
+                                                                            m->krylov);
 }
 
 /* >>integrators ----------------------------------------------------------------------- */
@@ -3801,7 +3914,7 @@ static int heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0,
                                heml_real *u1, heml_real *v1)
 {
     int i, r, n = m->node_count;
-    heml_real *f = m->scratch[4], alpha = m->mass_damping;
+    heml_real *f = m->work_f, alpha = m->mass_damping;
     double K1 = 0.0, work = 0.0;
     heml__forces(m, u0, f, 1);
     if (heml__all_finite(f, 3 * (size_t)n) && heml__diverged(m, u0, v0, f)) return HEML_ERR_DIVERGED;
@@ -3834,10 +3947,9 @@ static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_rea
                                      heml_real *u1, heml_real *v1)
 {
     int i, r, err, n = m->node_count, n3 = 3 * n;
-    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *du = m->scratch[6], *rhs = m->scratch[7];
-    heml_real *krylov[8], alpha = m->mass_damping;
+    heml_real *f = m->work_f, *dmass = m->lin_dmass, *du = m->lin_du, *rhs = m->lin_rhs;
+    heml_real alpha = m->mass_damping;
     double dt2 = (double)dt * dt;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[9 + i];
     for (i = 0; i < n3; i++) dmass[i] = (heml_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
     heml__forces(m, u0, f, 1);
     for (i = 0; i < n; i++)
@@ -3849,9 +3961,9 @@ static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_rea
             du[j] = dt * (v0[j] + m->dv_prev[j]);
         }
     if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-    err = heml__cg(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+    err = heml__linear_solve(m, HEML__SPD, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
     if (err == HEML__NEGATIVE_CURVATURE)
-        err = heml__minres(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+        err = heml__linear_solve(m, HEML__INDEFINITE, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
     if (err) return err;
     m->stats.newton_iterations = 1;
     for (i = 0; i < n3; i++) {
@@ -3977,18 +4089,17 @@ static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_re
    round-off, and Newton goes on from there. Returns HEML_OK (a minimum, as far as the
    probe sees), 1 (escaped: u, R, pt updated), HEML_ERR_ROUND_OFF (a saddle that no step
    lowers measurably: heml_real cannot tell it from a minimum) or HEML_ERR_NO_CONVERGENCE
-   (HEML__ESCAPES escapes already). Scratch 6, 7, 8, 9, 10-17, 21. */
+   (HEML__ESCAPES escapes already). Scratch: probe_b, probe_x, newton_ut/ft/Rt, krylov. */
 #define HEML__RAYLEIGH 40
 static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_real *u, heml_real *R, heml__point *pt,
                                int *escapes)
 {
-    heml_real *b = m->scratch[6], *ut = m->scratch[7], *ft = m->scratch[8], *Rt = m->scratch[9];
-    heml_real *x = m->scratch[21], *krylov[8], *v, *kv, *w, *kw, *pinv;
+    heml_real *b = m->probe_b, *ut = m->newton_ut, *ft = m->newton_ft, *Rt = m->newton_Rt;
+    heml_real *x = m->probe_x, *v, *kv, *w, *kw, *pinv;
     int i, n3 = 3 * m->node_count, kerr, ls, sgn, it;
     double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, rho = 0.0, vmax = 0.0, step, first, norm;
     heml__point tp;
     if (!ob->check_minimum) return HEML_OK;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
     for (i = 0; i < n3; i++) {
         unsigned h = (unsigned)i * 2654435761u;
         h ^= h >> 15;
@@ -3997,10 +4108,12 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
         b[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
         x[i] = 0;
     }
-    kerr = heml__cg(m, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse, krylov);
+    kerr = heml__linear_solve(m, HEML__SPD, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
     if (kerr == HEML_ERR_NOT_FINITE) return kerr;
     if (kerr != HEML__NEGATIVE_CURVATURE) return HEML_OK;
-    v = krylov[2], kv = krylov[3], pinv = krylov[4], w = krylov[5], kw = krylov[6];
+    /* the solve's last direction p and K p, its preconditioner, and two free vectors */
+    v = m->krylov[HEML__CG_P], kv = m->krylov[HEML__CG_Q], pinv = m->krylov[HEML__CG_PINV];
+    w = m->krylov[HEML__CG_FREE], kw = m->krylov[HEML__CG_FREE + 1];
     for (it = 0; it <= HEML__RAYLEIGH; it++) { /* v . K v / v . K0 v down, in span{v, P (K v - rho K0 v)} */
         double a11 = 0, a12 = 0, a22 = 0, b11 = 0, b12 = 0, b22 = 0, det, mid, mu, cx, cy;
         for (i = 0; i < n3; i++) {
@@ -4081,15 +4194,14 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
    Converged when |R| <= tol max(|load|, |f|, |inertia|) and, for the static solve
    (check_minimum), heml__saddle_escape finds no negative curvature. When neither |R| nor Phi made
    progress in HEML__STALL iterations, or the line search found no acceptable step, or
-   after max_iterations: heml__stalled decides. Scratch 4..17. */
+   after max_iterations: heml__stalled decides. Scratch: work_f, newton_*, krylov. */
 static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
 {
-    heml_real *f = m->scratch[4], *R = m->scratch[5], *delta = m->scratch[6], *ut = m->scratch[7];
-    heml_real *ft = m->scratch[8], *Rt = m->scratch[9], *reg = m->scratch[21], *krylov[8];
+    heml_real *f = m->work_f, *R = m->newton_R, *delta = m->newton_delta, *ut = m->newton_ut;
+    heml_real *ft = m->newton_ft, *Rt = m->newton_Rt, *reg = m->newton_shift_diag;
     int i, it, n3 = 3 * m->node_count, quiet = 0, escapes = 0, done;
     double best, prev = 0.0, eta = 1e-3, tol = ob->tol, shift = 0.0;
     heml__point pt, tp;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
     heml__eval(m, ob, u, f, R, &pt);
     ob->inverted_start = m->stats.inverted;
     best = pt.res;
@@ -4117,7 +4229,7 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
                 D = reg;
             }
             for (i = 0; i < n3; i++) delta[i] = it == 0 && ob->warm ? ob->warm[i] * m->free_mask[i] : 0;
-            kerr = heml__cg(m, u, D, 1.0, R, delta, eta, ob->coarse, krylov);
+            kerr = heml__linear_solve(m, HEML__SPD, u, D, 1.0, R, delta, eta, ob->coarse);
             if (kerr != HEML__NEGATIVE_CURVATURE || shift >= HEML__SHIFT_MAX) break;
             shift = shift > 0 ? 10.0 * shift : HEML__SHIFT_MIN;
         }
@@ -4125,7 +4237,7 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
         krylov_ok = kerr == HEML_OK && shift == 0.0;
         slope = heml__dot(R, delta, n3);
         if (!(slope > 0.0)) { /* still negative curvature, or a warm start that ascends */
-            const heml_real *pinv = krylov[4];
+            const heml_real *pinv = m->krylov[HEML__CG_PINV];
             for (i = 0; i < n3; i++) delta[i] = pinv[i] * R[i];
             slope = heml__dot(R, delta, n3);
             krylov_ok = 0;
@@ -4189,7 +4301,7 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, cons
                           heml_real *u1, heml_real *v1)
 {
     int i, r, err, n = m->node_count, n3 = 3 * n;
-    heml_real *dmass = m->scratch[19], *load = m->scratch[18], *warm = m->scratch[20];
+    heml_real *dmass = m->implicit_dmass, *load = m->objective_load, *warm = m->implicit_warm;
     heml__objective ob;
     double cm = (1.0 + (double)dt * (double)m->mass_damping) / ((double)dt * (double)dt);
     for (i = 0; i < n; i++)
@@ -4222,34 +4334,58 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, cons
     return HEML_OK;
 }
 
+/* >>integrators-table: one row per heml_integrator, indexed by it (see HOW TO EXTEND).
+   `step` advances the working copies: from the start (u0, v0: pinned axes already at their
+   targets, see heml__begin_step) to a candidate (u1, v1) in dt seconds, leaving the model's
+   state alone (heml_step_ex commits the candidate, or keeps the state on an error).
+   `is_explicit`: the step needs no force differential (so a user law without second
+   derivatives may use it) and keeps the semi-explicit divergence check's reference (an
+   implicit step resets it). */
+typedef int (*heml__step_fn)(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                             heml_real *u1, heml_real *v1);
+typedef struct heml__integrator_ops {
+    const char *name;
+    heml__step_fn step;
+    int is_explicit;
+} heml__integrator_ops;
+
+static const heml__integrator_ops heml__integrators[] = {
+    {"semi-explicit Euler", heml__semi_explicit, 1},
+    {"implicit Euler", heml__implicit, 0},
+    {"linearised implicit Euler", heml__implicit_linearized, 0},
+};
+/* an integrator added to heml_integrator without its row (or the reverse) fails to compile */
+typedef char heml__integrators_has_a_row_per_integrator
+    [sizeof heml__integrators / sizeof heml__integrators[0] == HEML_INTEGRATOR_COUNT ? 1 : -1];
+
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator)
 {
+    const heml__integrator_ops *ops;
     heml_real *u0, *v0, *u1, *v1;
     size_t n3;
     int err = HEML_OK;
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)dt) && dt > 0)) return HEML_ERR_TIME_STEP;
     if ((unsigned)integrator >= HEML_INTEGRATOR_COUNT) return HEML_ERR_INTEGRATOR;
-    if (integrator != HEML_SEMI_EXPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
+    ops = heml__integrators + integrator;
+    if (!ops->is_explicit && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * (size_t)m->node_count;
-    u0 = m->scratch[0];
-    v0 = m->scratch[1];
-    u1 = m->scratch[2];
-    v1 = m->scratch[3];
+    u0 = m->step_u0;
+    v0 = m->step_v0;
+    u1 = m->step_u1;
+    v1 = m->step_v1;
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, (double)dt);
     heml__begin_step(m, dt, u0, v0);
     if (!heml__precision_ok(m, u0)) return HEML_ERR_PRECISION;
-    if (integrator == HEML_SEMI_EXPLICIT_EULER) err = heml__semi_explicit(m, dt, u0, v0, u1, v1);
-    else if (integrator == HEML_IMPLICIT_EULER) err = heml__implicit(m, dt, u0, v0, u1, v1);
-    else err = heml__implicit_linearized(m, dt, u0, v0, u1, v1);
+    err = ops->step(m, dt, u0, v0, u1, v1);
     if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
     if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);
         return err;
     }
     heml__commit(m, u1, v1);
-    if (integrator != HEML_SEMI_EXPLICIT_EULER) m->div_valid = 0;
+    if (!ops->is_explicit) m->div_valid = 0;
     return HEML_OK;
 }
 
@@ -4272,26 +4408,25 @@ HEMLDEF int heml_step(heml_model *m)
    (allow_inversion = 0) no more tetrahedra are inverted than at the start; where the
    predictor inverts more, Newton starts from the pinned axes' move alone. Stops: max_increments attempts, an
    increment below min_increment, a round-off stall (HEML_ERR_ROUND_OFF: a smaller load
-   would not help), or a load whose norm is not finite (HEML_ERR_NOT_FINITE). Scratch: 0-4,
-   18-20 here, 4-17 Newton's. */
+   would not help), or a load whose norm is not finite (HEML_ERR_NOT_FINITE). Scratch:
+   static_*, objective_load and work_f here, Newton's (work_f, newton_*, krylov). */
 HEMLDEF int heml_solve_static(heml_model *m)
 {
-    heml_real *u, *saved, *dpin, *q, *load, *rhs, *pred, *f, *krylov[8];
+    heml_real *u, *saved, *dpin, *q, *load, *rhs, *pred, *f;
     int i, r, n3, err = HEML_OK, attempts = 0, inverted_start;
     double lambda = 0.0, increment = 1.0;
     heml__objective ob;
     if (!m) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * m->node_count;
-    u = m->scratch[0];
-    saved = m->scratch[1];
-    dpin = m->scratch[2];
-    q = m->scratch[3];
-    f = m->scratch[4];
-    load = m->scratch[18];
-    rhs = m->scratch[19];
-    pred = m->scratch[20];
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
+    u = m->static_u;
+    saved = m->static_saved;
+    dpin = m->static_dpin;
+    q = m->static_dfdpin;
+    f = m->work_f;
+    load = m->objective_load;
+    rhs = m->static_rhs;
+    pred = m->static_pred;
     memset(&m->stats, 0, sizeof m->stats);
     if (!heml__precision_ok(m, m->disp) || !heml__precision_ok(m, m->target)) return HEML_ERR_PRECISION;
     heml__prony_coefficients(m, -1.0);
@@ -4332,7 +4467,7 @@ HEMLDEF int heml_solve_static(heml_model *m)
             rhs[i] = (f[i] + load[i] + q[i]) * m->free_mask[i];
             pred[i] = 0;
         }
-        kerr = heml__cg(m, u, NULL, 1.0, rhs, pred, 1e-3, 1, krylov);
+        kerr = heml__linear_solve(m, HEML__SPD, u, NULL, 1.0, rhs, pred, 1e-3, 1);
         if (kerr == HEML_ERR_NOT_FINITE) {
             err = kerr;
             break;
@@ -4363,7 +4498,7 @@ HEMLDEF int heml_solve_static(heml_model *m)
     if (!heml__all_finite(u, (size_t)n3)) return HEML_ERR_NOT_FINITE;
     if (!heml__precision_ok(m, u)) return HEML_ERR_PRECISION;
     if (m->has_prony) { /* the Prony state of the last pass at u: make sure it is at u */
-        heml__forces(m, u, m->scratch[4], 1);
+        heml__forces(m, u, m->work_f, 1);
     }
     heml__commit(m, u, NULL);
     m->div_valid = 0;
