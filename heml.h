@@ -2866,7 +2866,9 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
     return HEML_OK;
 }
 
-static int heml__validate(const heml_desc *d)
+/* Creation stage 1 (see heml_create): every check of the description, before anything is
+   allocated. */
+static int heml__create_validate(const heml_desc *d)
 {
     char msg[200];
     int i, t, err, M;
@@ -3419,76 +3421,84 @@ HEMLDEF heml_desc heml_default_desc(void)
     return d;
 }
 
-HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
-{
-    heml_model tmp, *m;
-    heml__carver carver;
-    const heml_material *src;
-    int err, i, t, M, T, n, C_max, *counts, *fill, *bstart, *stamp, *colour_of, *order;
-    heml__order *order_of;
-    size_t tmp_bytes;
-    void *tmp_block;
-    double *mass_acc, *diag_acc;
-    heml_allocator alloc;
-    if (!out) return HEML_ERR_ARG;
-    *out = NULL;
-    if (!d) return HEML_ERR_ARG;
-    err = heml__validate(d);
-    if (err) return err;
-    M = d->materials ? d->material_count : 1;
-    src = d->materials ? d->materials : &d->material;
-    T = d->tet_count;
-    n = d->node_count;
-    alloc = d->allocator;
-    C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
-    /* temporary: mass and diagonal accumulators, the tetrahedra's order, per-material
-       counters, node stamps, chunk colours and reorder space */
-    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
-                sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
-    tmp_block = heml__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
-    mass_acc = (double *)tmp_block;
-    diag_acc = mass_acc + n;
-    order_of = (heml__order *)(diag_acc + 3 * (size_t)n);
-    counts = (int *)(order_of + T);
-    fill = counts + M;
-    bstart = fill + M;
-    stamp = bstart + M;
-    colour_of = stamp + n;
-    order = colour_of + C_max;
+/* Creation in four stages that read top to bottom: heml__create_validate (the description,
+   every check before anything is allocated), heml__create_size (counts: blocks, chunks,
+   Prony state, aggregates; the temporary workspace), heml__create_layout (the model's one
+   block carved, the settings copied), heml__create_precompute (materials, the tetrahedra's
+   order and rest constants, masses, chunks, colours, masks). */
 
-    memset(&tmp, 0, sizeof tmp);
-    tmp.node_count = n;
-    tmp.tet_count = T;
-    tmp.material_count = M;
-    for (i = 0; i < M; i++) counts[i] = fill[i] = 0;
-    for (t = 0; t < T; t++) counts[d->tet_material ? d->tet_material[t] : 0]++;
+/* Temporary workspace of heml_create (one allocation, freed before it returns): mass and
+   stiffness-diagonal accumulators, the tetrahedra's order, per-material counts, fills and
+   first blocks, node stamps (then the aggregate of each node), chunk colours and reorder
+   space. */
+typedef struct heml__create_tmp {
+    void *block;
+    size_t bytes;
+    double *mass_acc, *diag_acc;
+    heml__order *order_of;
+    int *counts, *fill, *bstart, *stamp, *colour_of, *order;
+} heml__create_tmp;
+
+/* Creation stage 2: sizes the model (in *tmp, a model not yet allocated) and allocates the
+   temporary workspace w. */
+static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_tmp *w)
+{
+    const heml_material *src = d->materials ? d->materials : &d->material;
+    int i, t, M = d->materials ? d->material_count : 1, T = d->tet_count, n = d->node_count;
+    int C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
+    w->bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
+               sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+    w->block = heml__alloc(&d->allocator, w->bytes);
+    if (!w->block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
+    w->mass_acc = (double *)w->block;
+    w->diag_acc = w->mass_acc + n;
+    w->order_of = (heml__order *)(w->diag_acc + 3 * (size_t)n);
+    w->counts = (int *)(w->order_of + T);
+    w->fill = w->counts + M;
+    w->bstart = w->fill + M;
+    w->stamp = w->bstart + M;
+    w->colour_of = w->stamp + n;
+    w->order = w->colour_of + C_max;
+
+    memset(tmp, 0, sizeof *tmp);
+    tmp->node_count = n;
+    tmp->tet_count = T;
+    tmp->material_count = M;
+    for (i = 0; i < M; i++) w->counts[i] = w->fill[i] = 0;
+    for (t = 0; t < T; t++) w->counts[d->tet_material ? d->tet_material[t] : 0]++;
     for (i = 0; i < M; i++) {
-        int blocks = (counts[i] + HEML__W - 1) / HEML__W;
-        bstart[i] = tmp.block_count;
-        tmp.block_count += blocks;
-        tmp.chunk_count += (blocks + HEML__CHUNK - 1) / HEML__CHUNK;
-        tmp.prony_total += src[i].prony_count;
-        tmp.prony_reals += (size_t)blocks * HEML__W * HEML__NQ * (size_t)src[i].prony_count;
-        if (heml__laws[src[i].law].kind == HEML__K_SPRING && counts[i]) tmp.has_springs = 1;
-        if (src[i].prony_count && counts[i]) tmp.has_prony = 1;
-        if (heml__laws[src[i].law].kind == HEML__K_USER && !src[i].user.second && counts[i])
-            tmp.has_user_without_second = 1;
+        int blocks = (w->counts[i] + HEML__W - 1) / HEML__W, used = w->counts[i] > 0;
+        w->bstart[i] = tmp->block_count;
+        tmp->block_count += blocks;
+        tmp->chunk_count += (blocks + HEML__CHUNK - 1) / HEML__CHUNK;
+        tmp->prony_total += src[i].prony_count;
+        tmp->prony_reals += (size_t)blocks * HEML__W * HEML__NQ * (size_t)src[i].prony_count;
+        if (heml__laws[src[i].law].kind == HEML__K_SPRING && used) tmp->has_springs = 1;
+        if (src[i].prony_count && used) tmp->has_prony = 1;
+        if (heml__laws[src[i].law].kind == HEML__K_USER && !src[i].user.second && used)
+            tmp->has_user_without_second = 1;
     }
-    tmp.slot_count = tmp.block_count * HEML__W;
+    tmp->slot_count = tmp->block_count * HEML__W;
     {
         int cells[HEML__MAX_AGG];
-        tmp.agg_count = heml__aggregate(d->rest_positions, n, stamp, cells);
+        tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
     }
+    return HEML_OK;
+}
+
+/* Creation stage 3: allocates the model's block, carves every array in it (heml__layout)
+   and copies the description's settings and rest positions. */
+static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml_model **out)
+{
+    heml_model tmp = *sized, *m;
+    heml__carver carver;
+    int i;
     carver.base = NULL;
     carver.offset = sizeof(heml_model);
     heml__layout(&tmp, &carver);
     tmp.block_bytes = carver.offset;
-    tmp.block = heml__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        heml__free(&alloc, tmp_block, tmp_bytes);
-        return heml__fail(d, HEML_ERR_ALLOC, "model block");
-    }
+    tmp.block = heml__alloc(&d->allocator, tmp.block_bytes);
+    if (!tmp.block) return heml__fail(d, HEML_ERR_ALLOC, "model block");
     memset(tmp.block, 0, tmp.block_bytes);
     carver.base = (char *)tmp.block;
     carver.offset = sizeof(heml_model);
@@ -3514,17 +3524,22 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->precision_limit = d->precision_limit;
     m->J0 = d->inversion_threshold;
     m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
-    m->allocator = alloc;
+    m->allocator = d->allocator;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = T >= HEML_PARALLEL_MIN_TETS;
+    m->parallel = d->tet_count >= HEML_PARALLEL_MIN_TETS;
+    memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
+    memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
+    *out = m;
+    return HEML_OK;
+}
 
-    memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
-    memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
-    /* materials and their Prony terms */
-    for (i = 0, t = 0; i < M; i++) {
+/* Materials in kernel form with their Prony terms and small-strain moduli. */
+static void heml__create_materials(heml_model *m, const heml_material *src)
+{
+    int i, k, t;
+    for (i = 0, t = 0; i < m->material_count; i++) {
         heml__mat *mt = m->mats + i;
-        int k;
         heml__make_mat(src + i, mt);
         mt->prony_first = t;
         for (k = 0; k < src[i].prony_count; k++, t++) {
@@ -3535,44 +3550,75 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
     }
-    /* slots: tetrahedra grouped by material, in node order (heml__node_order), each
-       material padded to whole blocks */
-    heml__node_order(d, order_of);
+}
+
+/* Chunks of consecutive blocks of one material, and each block's Prony state offset. */
+static void heml__create_chunks(heml_model *m, const heml_material *src, const heml__create_tmp *w)
+{
+    int i, c = 0;
+    size_t off = 0;
+    for (i = 0; i < m->material_count; i++) {
+        int blocks = (w->counts[i] + HEML__W - 1) / HEML__W, b;
+        for (b = 0; b < blocks; b++) {
+            m->blk_prony[w->bstart[i] + b] = off;
+            off += (size_t)HEML__W * HEML__NQ * (size_t)src[i].prony_count;
+        }
+        for (b = 0; b < blocks; b += HEML__CHUNK, c++) {
+            m->chunk_begin[c] = w->bstart[i] + b;
+            m->chunk_end[c] = w->bstart[i] + (b + HEML__CHUNK < blocks ? b + HEML__CHUNK : blocks);
+            m->chunk_material[c] = i;
+        }
+    }
+    HEML_ASSERT(c == m->chunk_count && off == m->prony_reals);
+}
+
+/* Creation stage 4: everything the rest state determines: materials, the tetrahedra's
+   slots (grouped by material, in node order: heml__node_order, each material padded to
+   whole blocks), rest constants, masses and the stiffness diagonal (heml__fill_tets),
+   chunks, aggregates, colours, masks, Prony coefficients, the shortest edge. */
+static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__create_tmp *w)
+{
+    const heml_material *src = d->materials ? d->materials : &d->material;
+    int i, t;
+    heml__create_materials(m, src);
+    heml__node_order(d, w->order_of);
     for (i = 0; i < m->slot_count; i++) m->slot_tet[i] = -1;
-    for (i = 0; i < T; i++) {
-        int mi = order_of[i].material, slot = bstart[mi] * HEML__W + fill[mi]++;
-        t = order_of[i].tet;
+    for (i = 0; i < m->tet_count; i++) {
+        int mi = w->order_of[i].material, slot = w->bstart[mi] * HEML__W + w->fill[mi]++;
+        t = w->order_of[i].tet;
         m->slot_tet[slot] = t;
         m->tet_slot[t] = slot;
     }
-    heml__fill_tets(m, d, mass_acc, diag_acc);
-    /* chunks, Prony offsets */
-    {
-        int c = 0;
-        size_t off = 0;
-        for (i = 0; i < M; i++) {
-            int blocks = (counts[i] + HEML__W - 1) / HEML__W, b;
-            for (b = 0; b < blocks; b++) {
-                m->blk_prony[bstart[i] + b] = off;
-                off += (size_t)HEML__W * HEML__NQ * (size_t)src[i].prony_count;
-            }
-            for (b = 0; b < blocks; b += HEML__CHUNK, c++) {
-                m->chunk_begin[c] = bstart[i] + b;
-                m->chunk_end[c] = bstart[i] + (b + HEML__CHUNK < blocks ? b + HEML__CHUNK : blocks);
-                m->chunk_material[c] = i;
-            }
-        }
-        HEML_ASSERT(c == m->chunk_count && off == m->prony_reals);
-    }
-    if (m->agg_count) memcpy(m->node_agg, stamp, sizeof(int) * (size_t)n);
+    heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
+    heml__create_chunks(m, src, w);
+    if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);
-    heml__colour_groups(m, stamp, colour_of, order);
-    for (i = 0; i < n; i++) heml__set_masks(m, i);
+    heml__colour_groups(m, w->stamp, w->colour_of, w->order);
+    for (i = 0; i < m->node_count; i++) heml__set_masks(m, i);
     m->coarse_version = m->pin_version - 1;
     heml__prony_coefficients(m, (double)m->time_step);
-    heml__free(&alloc, tmp_block, tmp_bytes);
     m->h_min = heml__shortest_edge(d);
     m->stats.newton_iterations = 0;
+}
+
+HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
+{
+    heml_model sized, *m = NULL;
+    heml__create_tmp w;
+    heml_allocator alloc;
+    int err;
+    if (!out) return HEML_ERR_ARG;
+    *out = NULL;
+    if (!d) return HEML_ERR_ARG;
+    err = heml__create_validate(d);
+    if (err) return err;
+    alloc = d->allocator;
+    err = heml__create_size(d, &sized, &w);
+    if (err) return err;
+    err = heml__create_layout(d, &sized, &m);
+    if (!err) heml__create_precompute(d, m, &w);
+    heml__free(&alloc, w.block, w.bytes);
+    if (err) return err;
     *out = m;
     return HEML_OK;
 }
