@@ -80,6 +80,53 @@
           diagnostics.
        6. heml_destroy(m).
 
+   HOW TO EXTEND (where a new law, integrator or linear solver goes; each kind is one enum
+   value, one row of one private table, and the functions that row names)
+       A constitutive law: a heml_law value before HEML_LAW_COUNT (validation uses the
+           count) and its row of heml__laws (>>laws-table; a static assert refuses a table
+           that does not have one row per law): `name`; `kind` (HEML__K_INVARIANTS for a
+           law w(I1, I2, J)); `stress`, `energy`, `differential`: functions of the form of
+           heml__law_svk that fill, for a block of tetrahedra (heml__blk), w_1, w_2, w_J and
+           s0 = 2 w_1 + 4 w_2 + w_J formed without cancellation at rest, plus w (energy) and
+           the six second derivatives h (differential), continued below J0 (FLAT AND
+           INVERTED TETRAHEDRA); `make` (its constants into heml__mat) and `check` (their
+           ranges, HEML_ERR_MATERIAL); heml_material_from_young's case. Leave `fast_path`
+           at 0: the vectorised kernels (heml__forces_nh, heml__diff_nh) compute
+           Neo-Hookean and nothing else; set it only for a law that is exactly heml__law_raw
+           without an I2 term, or write a kernel for the law and a flag for it. Everything
+           else (the general path's kinematics, stress coefficients, P1 forces and their
+           differential, Prony, energies, stresses, the small-strain moduli for the
+           preconditioner and heml_stable_time_step) comes from those functions.
+       An integrator: a heml_integrator value before HEML_INTEGRATOR_COUNT and its row of
+           heml__integrators (>>integrators-table): `name`, `step` (start state -> candidate,
+           no change of the model's state: heml_step_ex commits it or keeps the state),
+           `is_explicit` (needs no force differential). Its scratch vectors are named
+           fields of heml_model, carved in heml__layout_scratch (where any sharing with
+           another role is written down).
+       A linear solver (or a preconditioner: heml__precond is the one place): a
+           heml_linear_solver value before HEML_LINEAR_SOLVER_COUNT and its row of
+           heml__linear_solvers (>>linear-solvers): `solve` and `solve_indefinite`, with the
+           return codes listed there (HEML_OK, HEML_ERR_NO_CONVERGENCE, HEML_ERR_NOT_FINITE,
+           the private negative-curvature signal). Every solve goes through
+           heml__linear_solve; no solver calls heml__cg directly.
+       The tests it must add (tests/test_heml*.c): a law: forces = -gradient of its energy
+           and differential = derivative of the force by finite differences, at moderate
+           strain and below J0, through the model (the all-law loops of test_heml.c:
+           all_laws, test_law_table_forces_and_differentials), against an energy written
+           independently from F (fem_energy_forces), zero force at rest and under rigid
+           motions, and its closed form where there is one (uniaxial stretch: R4 for St
+           Venant-Kirchhoff, R5 for Neo-Hookean, of /work/shared/REFERENCES.md, in
+           test_uniaxial_closed_forms; Mooney-Rivlin has none there yet); an integrator: its order of accuracy on the linear oscillator
+           (test_integrator_order), a failed step keeping the state, no allocation, and
+           bit-identical results across thread counts (test_threads_bit_identical); a
+           linear solver: the static and implicit tests unchanged, the same return codes
+           (NO_CONVERGENCE at the cap, NOT_FINITE), determinism across threads.
+       What the bench must show (make bench, bench/model_heml.c): a law: its force and
+           differential ns per tetrahedron in kernels.csv next to Neo-Hookean's, and its
+           R1/R2/R4/R5 rows; an integrator or solver: the R2/R3 rows (error and time) and
+           the stability sweep; a change to an existing path: no row slower (callgrind
+           instruction counts where the machine is noisy) and every result bit-identical.
+
    UNITS: SI throughout. Positions m, moduli Pa, density kg/m^3, time s, forces N,
    mass_damping 1/s, gravity m/s^2 (default 9.81 along -z), Prony tau s.
 
@@ -560,6 +607,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 20) extension points: laws, integrators and linear solvers through
+             one private table each (heml__laws, heml__integrators, heml__linear_solvers;
+             see HOW TO EXTEND); HEML_LAW_COUNT, HEML_INTEGRATOR_COUNT, heml_linear_solver
+             and desc.linear_solver; the Neo-Hookean kernels run only for laws whose
+             fast_path flag is set; results bit-identical to 0.3.0.
        0.3.0 (2026-12-02) no silent wrong answers (issue 18): the static solve is a
              continuation with a tangent predictor, an energy line search, a
              Levenberg-Marquardt shift at negative curvature and an inversion acceptance
