@@ -2316,7 +2316,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    const heml_real sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
+    heml_real sp;
     int k;
     heml__gather(idx, u, b->e);
     heml__gather(idx, dx, b->de);
@@ -2324,6 +2324,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
     }
+    sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml_real dsig[6][HEML__W];
@@ -3662,6 +3663,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     if (!out) return HEML_ERR_ARG;
     *out = NULL;
     if (!d) return HEML_ERR_ARG;
+    memset(&w, 0, sizeof w);
     err = heml__create_validate(d);
     if (err) return err;
     alloc = d->allocator;
