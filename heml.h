@@ -1173,7 +1173,6 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
-#define HEML__SCRATCH 22    /* 3n scratch vectors (heml__layout_scratch) */
 #define HEML__KRYLOV 8      /* of which the linear solvers' workspace */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
@@ -2606,7 +2605,7 @@ static void *heml__carve(heml__carver *c, size_t bytes)
 
 #define HEML__CARVE(c, ptr, type, count) ((ptr) = (type *)heml__carve((c), sizeof(type) * (size_t)(count)))
 
-/* The scratch vectors, 3n reals each (HEML__SCRATCH of them), and the roles that share
+/* The scratch vectors, 3n reals each (22: 14 by role and 8 for Krylov), and the roles that share
    memory: a static solve and a step never run at once (static_* = step_*, static_rhs and
    static_pred = implicit_dmass and implicit_warm); the linearised implicit step does not
    run Newton (lin_* = newton_R, newton_delta, newton_ut); the saddle probe runs between
