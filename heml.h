@@ -1173,7 +1173,7 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
-#define HEML__KRYLOV 8      /* of which the linear solvers' workspace */
+#define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))

@@ -120,6 +120,10 @@
                                  shortest rest edge, u = x - X the displacement (see
                                  LIMITS: float bodies that travel far from their rest
                                  position).
+       TMASS_ERR_UNSTABLE        a spring model's static solve converged to a saddle, not
+                                 a minimum (the minimum check of tmass_solve_static: a
+                                 tetrahedron flattened through its base balances there);
+                                 nudge the state or change the pins and solve again.
    Creation refuses, besides bad numbers and indices: flat and inverted rest tetrahedra,
    a triangle shared by three tetrahedra (TMASS_ERR_NONMANIFOLD) and the same tetrahedron
    listed twice in any node order (TMASS_ERR_TET_DUPLICATE: it would double that
@@ -525,13 +529,14 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_FILE_TRUNCATED, -36, "precomputation file or buffer is truncated") \
     X(TMASS_ERR_TET_DUPLICATE, -37, "the same tetrahedron (same four nodes, any order) is listed twice") \
     X(TMASS_ERR_DIVERGED, -38, "explicit step diverged (an edge stretched past divergence_strain); the last valid state was kept") \
-    X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept")
+    X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept") \
+    X(TMASS_ERR_UNSTABLE, -40, "static solve (spring model) converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -40
+    TMASS_ERR_LAST_ = -41
 };
 
 typedef enum tmass_model_kind {
@@ -698,7 +703,10 @@ TMASSDEF int tmass_step_ex(tmass_model *m, tmass_real dt, tmass_integrator integ
    compressed springs make it indefinite) and a backtracking line search (see SOLVERS).
    On failure (TMASS_ERR_NO_CONVERGENCE: a CG cap, a singular problem such as nothing
    pinned, or the continuation giving up; TMASS_ERR_NOT_FINITE; TMASS_ERR_PRECISION) the
-   state is unchanged. */
+   state is unchanged. A spring model's answer must be a minimum: a probe CG solve with
+   the full tangent at it (to 1e-7, float 1e-5) that meets negative curvature beyond
+   round-off fails the solve with TMASS_ERR_UNSTABLE (a saddle; state unchanged). It costs
+   one more CG solve; the tensor model is linear and needs no probe (its K is constant). */
 TMASSDEF int tmass_solve_static(tmass_model *m);
 
 /* ---- state access (pointers into the model, valid until tmass_destroy) ---- */
@@ -2742,6 +2750,52 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
     return TMASS_OK;
 }
 
+/* Is the spring model's converged static state x a minimum? A zero residual holds at
+   saddles too (a tetrahedron flattened through its base: its compressed springs balance,
+   and either mirror image of the rest shape lies lower). A probe solve K_t y = b with the
+   full tangent at x (b a fixed pseudo-random vector on the free axes, CG to 1e-7, float
+   1e-5) meets a direction p of negative curvature where K_t is indefinite; p . K_t p below
+   -1e3 eps sum_k |p_k (K_t p)_k| (its round-off) is a saddle: TMASS_ERR_UNSTABLE. So is a
+   diagonal entry below -1e3 eps max |diagonal| (the Jacobi preconditioner hides those
+   axes from CG). A probe at its cap counts as a minimum. Scratch 1-7 (x may be scratch
+   0). */
+static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count, err;
+    tmass_real *b = m->scratch[1], *y = m->scratch[2], *p = m->scratch[5], *q = m->scratch[6], *cg_scratch[5];
+    tmass_real tolerance = m->cg_tolerance;
+    double pq = 0.0, scale = 0.0, eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
+    double dmax = 0.0, dmin = 0.0;
+    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
+    tmass__spring_residual(m, x, b, 1); /* the full tangent at x */
+    /* a negative diagonal entry is negative curvature along that axis (and the Jacobi
+       preconditioner zeroes such axes, so CG would not see them) */
+    for (i = 0; i < n3; i++) {
+        double dg = (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)] * (double)m->free_mask[i];
+        if (fabs(dg) > dmax) dmax = fabs(dg);
+        if (dg < dmin) dmin = dg;
+    }
+    if (dmin < -1e3 * eps * dmax) return TMASS_ERR_UNSTABLE;
+    for (i = 0; i < n3; i++) {
+        unsigned h = (unsigned)i * 2654435761u;
+        h ^= h >> 15;
+        h *= 2246822519u;
+        h ^= h >> 13;
+        b[i] = (tmass_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
+        y[i] = 0;
+    }
+    m->cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-7);
+    err = tmass__cg(m, NULL, 1.0, b, y, cg_scratch);
+    m->cg_tolerance = tolerance;
+    if (err == TMASS_ERR_NOT_FINITE) return err;
+    if (!m->cg_indefinite) return TMASS_OK;
+    for (i = 0; i < n3; i++) { /* p: the direction CG stopped on, q = mask K_t p */
+        pq += (double)p[i] * (double)q[i] * (double)m->free_mask[i];
+        scale += fabs((double)p[i] * (double)q[i]) * (double)m->free_mask[i];
+    }
+    return pq < -1e3 * eps * scale ? TMASS_ERR_UNSTABLE : TMASS_OK;
+}
+
 /* Static equilibrium: one CG solve K u = f_ext + M g for the tensor model (it is
    linear: a converged, finite solve is exact for the model), the continuation of
    tmass__spring_static for the spring model. Accepted only with finite values inside
@@ -2772,6 +2826,7 @@ TMASSDEF int tmass_solve_static(tmass_model *m)
         for (i = 0; i < n3; i++) x[i] += du[i];
     } else {
         err = tmass__spring_static(m, x);
+        if (!err) err = tmass__spring_check_minimum(m, x);
     }
     if (err) return err;
     if (!tmass__all_finite(x, n3)) return TMASS_ERR_NOT_FINITE;

@@ -7,6 +7,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -54,58 +55,7 @@ static tmass_model *make_model(const tetmesh *mesh, tmass_model_kind kind, doubl
     return m;
 }
 
-static void box_mesh(tetmesh *mesh, int nx, int ny, int nz, double sx, double sy, double sz,
-                     int split)
-{
-    double lo[3] = {0, 0, 0}, hi[3];
-    hi[0] = sx;
-    hi[1] = sy;
-    hi[2] = sz;
-    tetmesh_box(mesh, lo, hi, nx, ny, nz, split);
-}
-
-/* Deterministic pseudo-random numbers in [-1, 1]. */
-static double rnd(unsigned *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
-}
-
 /* ---- an independent P1 FEM (Voigt notation, 4x4 inverse) -------------------------- */
-
-/* Gradients of the barycentric coordinates from the inverse of [1 x y z] rows. */
-static double fem_gradients(const double *p[4], double grad[4][3])
-{
-    double a[4][8];
-    int i, j, k;
-    for (i = 0; i < 4; i++) {
-        a[i][0] = 1.0;
-        for (k = 0; k < 3; k++) a[i][1 + k] = p[i][k];
-        for (j = 0; j < 4; j++) a[i][4 + j] = (i == j);
-    }
-    for (i = 0; i < 4; i++) { /* Gauss-Jordan with partial pivoting */
-        int piv = i;
-        double s;
-        for (j = i + 1; j < 4; j++)
-            if (fabs(a[j][i]) > fabs(a[piv][i])) piv = j;
-        for (k = 0; k < 8; k++) {
-            s = a[i][k];
-            a[i][k] = a[piv][k];
-            a[piv][k] = s;
-        }
-        s = a[i][i];
-        for (k = 0; k < 8; k++) a[i][k] /= s;
-        for (j = 0; j < 4; j++)
-            if (j != i) {
-                s = a[j][i];
-                for (k = 0; k < 8; k++) a[j][k] -= s * a[i][k];
-            }
-    }
-    /* inverse C = a[.][4..7]; N_j = C[0][j] + C[1][j] x + C[2][j] y + C[3][j] z */
-    for (j = 0; j < 4; j++)
-        for (k = 0; k < 3; k++) grad[j][k] = a[1 + k][4 + j];
-    return tetmesh_tet_volume(p[0], p[1], p[2], p[3]);
-}
 
 /* Element stiffness K = V B^T D B (12 x 12). */
 static void fem_element_stiffness(const double *p[4], double E, double nu, double K[12][12])
@@ -1153,39 +1103,13 @@ static void test_threads_bit_identical(void)
     CHECK(h1 != 0);
 }
 
-typedef struct counting_allocator {
-    int allocs, frees;
-    size_t live;
-} counting_allocator;
-
-static void *count_alloc(size_t size, size_t align, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    char *raw = (char *)malloc(size + align + sizeof(void *)), *p;
-    if (!raw) return NULL;
-    p = raw + sizeof(void *);
-    p += (align - (size_t)p % align) % align;
-    ((void **)p)[-1] = raw;
-    c->allocs++;
-    c->live += size;
-    return p;
-}
-
-static void count_free(void *ptr, size_t size, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    c->frees++;
-    c->live -= size;
-    free(((void **)ptr)[-1]);
-}
-
 /* No allocation during steps, forces, solves, cutting or tearing; everything freed. */
 static void test_no_allocation_after_create(void)
 {
     tetmesh mesh;
     tmass_desc d = tmass_default_desc();
     tmass_model *m;
-    counting_allocator c = {0, 0, 0};
+    counting_allocator c = {0, 0, 0, 0};
     tmass_real *x;
     int allocs, i, kind, list[2] = {3, 4};
     tmass_tear_criteria tc = tmass_default_tear_criteria();
@@ -1221,18 +1145,6 @@ static void test_no_allocation_after_create(void)
 }
 
 /* ---- validation -------------------------------------------------------------------- */
-
-typedef struct log_capture {
-    int calls, last_code;
-} log_capture;
-
-static void capture_log(int code, const char *message, void *user)
-{
-    log_capture *c = (log_capture *)user;
-    c->calls++;
-    c->last_code = code;
-    (void)message;
-}
 
 static int try_create(const tmass_desc *d)
 {
@@ -1785,6 +1697,52 @@ static void test_stats_filled(void)
 /* Spring static continuation: a 150 degree twist of a soft beam's free end in one call,
    with at most 4 Newton iterations per increment, converges (increments and cuts in the
    stats) to the answer of six manual increments. */
+/* A spring model's static success must be a minimum (issue 18's acceptance test). One
+   regular tetrahedron (edge 1 m, springs), its base pinned, its apex driven to the base's
+   centroid and released there: the three compressed springs balance in the plane, so the
+   residual is zero, but the state is a saddle (along the normal each spring's stiffness
+   k (1 - l0 / l) is negative) and the two mirror shapes, apex 0.8165 m above or below
+   the base, have zero energy. Before the minimum check the solve returned success at the
+   flat state (3 x 1/2 k (0.577 - 1)^2 of energy). Checked against that closed form: a
+   success must end with the apex at |z| = 0.8165 m and no energy (1e-6 of the flat
+   state's); TMASS_ERR_UNSTABLE must keep the flat state. */
+static void test_springs_saddle_refused(void)
+{
+    double nodes[12] = {0, 0, 0, 1, 0, 0, 0.5, 0.8660254037844386, 0, 0.5, 0.28867513459481287, 0.816496580927726};
+    int tet[4] = {0, 1, 2, 3}, i, err;
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = to_real(nodes, 12), zero[3] = {0, 0, 0}, down[3] = {0, 0, (tmass_real)-0.816496580927726};
+    tmass_energies e0, e1;
+    d.rest_positions = x;
+    d.node_count = 4;
+    d.tets = tet;
+    d.tet_count = 1;
+    d.kind = TMASS_MASS_SPRING;
+    d.young_modulus = (tmass_real)1e5;
+    REQUIRE(tmass_create(&d, &m) == TMASS_OK);
+    free(x);
+    tmass_set_gravity(m, zero);
+    for (i = 0; i < 3; i++) REQUIRE(tmass_fix_node(m, i) == TMASS_OK);
+    REQUIRE(tmass_set_displacement(m, 3, down) == TMASS_OK);
+    REQUIRE(tmass_solve_static(m) == TMASS_OK); /* every node pinned: the flat state */
+    REQUIRE(tmass_release_node(m, 3) == TMASS_OK);
+    REQUIRE(tmass_energy(m, &e0) == TMASS_OK);
+    err = tmass_solve_static(m);
+    REQUIRE(tmass_energy(m, &e1) == TMASS_OK);
+    printf("    flat tetrahedron released: code %d, apex z %.4g m, energy %.4g J (flat %.4g J)\n", err,
+           (double)tmass_positions(m)[11], e1.elastic, e0.elastic);
+    CHECK(e0.elastic > 0);
+    if (err == TMASS_OK) {
+        CHECK(fabs(fabs((double)tmass_positions(m)[11]) - 0.816496580927726) < 1e-3);
+        CHECK(e1.elastic <= 1e-6 * e0.elastic);
+    } else {
+        CHECK_INT(TMASS_ERR_UNSTABLE, err);
+        CHECK(fabs((double)tmass_positions(m)[11]) < 1e-6 && e1.elastic == e0.elastic);
+    }
+    tmass_destroy(m);
+}
+
 static void test_springs_static_continuation(void)
 {
     tetmesh mesh;
@@ -2530,6 +2488,7 @@ static const test_case cases[] = {
     TEST(test_precision_far_from_origin),
     TEST(test_stats_filled),
     TEST(test_springs_static_continuation),
+    TEST(test_springs_saddle_refused),
     TEST(test_integrator_order),
     TEST(test_implicit_damped_recurrence),
     TEST(test_spring_incremental_potential_gradient),
