@@ -1380,7 +1380,7 @@ static void test_law_table_forces_and_differentials(void)
 {
     tetmesh mesh;
     int li, state;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS; li++) {
         heml_law law = all_laws[li];
         heml_material mt = material_of(law);
