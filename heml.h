@@ -1717,9 +1717,9 @@ static void heml__law_user(const heml__mat *mt, heml__blk *b, int valid, int wan
 static void heml__law(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
     const heml__law_ops *ops = mt->ops;
-    heml__law_fn fn = (want & HEML__WANT_ENERGY) ? ops->energy : (want & HEML__WANT_SECOND) ? ops->differential
-                                                                                             : ops->stress;
-    fn(mt, b, valid, want);
+    if (want & HEML__WANT_ENERGY) ops->energy(mt, b, valid, want);
+    else if (want & HEML__WANT_SECOND) ops->differential(mt, b, valid, want);
+    else ops->stress(mt, b, valid, want);
 }
 
 /* Evaluates a law at rest (I1 = I2 = 3, J = 1) for creation checks: fills w_1, w_2, w_J,
