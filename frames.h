@@ -739,12 +739,55 @@ enum {
     FRM_ERR_LAST_ = -36
 };
 
-/* Constitutive laws (per sample). Both are written in terms of the Green-Lagrange strain
-   E = (F^T F - I) / 2 and the second Piola-Kirchhoff stress S (total Lagrangian, eq. 3.37). */
+/* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
+   E = (F^T F - I) / 2 and the second Piola-Kirchhoff stress S (total Lagrangian, eq. 3.37).
+   Each law reads its own constants from frm_material (see there) into a block of
+   FRM_LAW_PARAMS reals per sample; see HOW TO EXTEND for adding one. */
 typedef enum frm_law {
-    FRM_LAW_SVK = 0,        /* St Venant-Kirchhoff, W = lambda/2 tr(E)^2 + mu E:E, S eq. 3.53 */
-    FRM_LAW_NEO_HOOKEAN = 1 /* compressible, W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2 */
+    FRM_LAW_SVK = 0,           /* St Venant-Kirchhoff, W = lambda/2 tr(E)^2 + mu E:E, S eq. 3.53
+                                  (young_modulus, poisson_ratio) */
+    FRM_LAW_NEO_HOOKEAN = 1,   /* compressible, W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2
+                                  (young_modulus, poisson_ratio) */
+    FRM_LAW_MOONEY_RIVLIN = 2, /* compressible isochoric/volumetric split, the energy of heml.h's
+                                  HEML_MOONEY_RIVLIN: W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3)
+                                  + kappa/2 (J - 1)^2 (c1, c2, bulk_modulus = kappa) */
+    FRM_LAW_USER = 3,          /* any isotropic W(I1, I2, J) through callbacks (frm_user_law) */
+    FRM_LAW_COUNT              /* sentinel: the number of laws (validation), not a law */
 } frm_law;
+
+/* Reals per sample of a law's parameter block (what each law reads, in order):
+   SVK, Neo-Hookean: mu, lambda (Pa, from young_modulus and poisson_ratio);
+   Mooney-Rivlin: c1, c2, kappa (Pa); user: mu, lambda (Pa, the small-strain moduli given
+   by young_modulus and poisson_ratio; the callbacks receive the material's `user`). */
+#define FRM_LAW_PARAMS 4
+
+/* Points at which a user law is evaluated: `count` values of each array (frames passes
+   one point per call). The inputs are the invariants I1 = tr C, I2 = (I1^2 - tr C^2) / 2
+   and J = det F (> 0: frames refuses inverted samples before calling); each callback
+   fills its outputs (Pa). The same structure as heml.h's heml_law_points. */
+typedef struct frm_law_points {
+    int count;
+    const frm_real *I1, *I2, *J;
+    frm_real *w;                                       /* energy density w, J/m^3 */
+    frm_real *w_1, *w_2, *w_J;                         /* dw/dI1, dw/dI2, dw/dJ */
+    frm_real *w_11, *w_12, *w_1J, *w_22, *w_2J, *w_JJ; /* second derivatives */
+} frm_law_points;
+
+/* An isotropic law given by its derivatives (as heml.h's heml_user_law). `first` and
+   `second` are required (frm_model_create refuses FRM_LAW_USER without them: every solver
+   of frames needs the tangent); `energy` (may be NULL: the energy then counts 0) feeds
+   frm_model_energy and the line searches of the static solve and the implicit step, so
+   give it. S = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1. The law should be stress-free at
+   rest (2 w_1 + 4 w_2 + w_J = 0 at I1 = I2 = 3, J = 1) and its small-strain moduli should
+   be those of the material's young_modulus and poisson_ratio (they scale the rotation
+   stabilisation and the frame coupling). Callbacks run on the calling thread or on worker
+   threads (parallel_for / OpenMP) and must be thread-safe and deterministic. */
+typedef struct frm_user_law {
+    void (*energy)(frm_law_points *points, void *user);
+    void (*first)(frm_law_points *points, void *user);
+    void (*second)(frm_law_points *points, void *user);
+    void *user;
+} frm_user_law;
 
 /* How K * v is evaluated inside CG (see PERFORMANCE). */
 typedef enum frm_stiffness_mode {
@@ -787,9 +830,15 @@ typedef void (*frm_parallel_for_fn)(int item_count, frm_task_fn task, void *task
 /* A material: law and parameters. */
 typedef struct frm_material {
     frm_law law;            /* default FRM_LAW_SVK (the thesis's law) */
-    frm_real young_modulus; /* Pa, default 1e4 */
-    frm_real poisson_ratio; /* in (-1, 0.5), default 0.3 */
+    frm_real young_modulus; /* Pa, default 1e4 (SVK, Neo-Hookean, user) */
+    frm_real poisson_ratio; /* in (-1, 0.5), default 0.3 (SVK, Neo-Hookean, user) */
     frm_real density;       /* kg/m^3, default 1000 */
+    frm_real c1, c2;        /* Pa, Mooney-Rivlin constants (>= 0, c1 + c2 > 0); default mu/4 each
+                               for the default E and nu (c1 = c2 = 961.5 Pa): small-strain
+                               shear modulus 2 (c1 + c2) */
+    frm_real bulk_modulus;  /* Pa, Mooney-Rivlin kappa (> 0), default E / (3 (1 - 2 nu)) of the
+                               default E and nu (8333.3 Pa) */
+    frm_user_law user;      /* FRM_LAW_USER: the callbacks (default all NULL) */
 } frm_material;
 
 typedef struct frm_desc {
@@ -1960,14 +2009,19 @@ struct frm_model {
     int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
 
     /* samples */
-    frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_rest, *s_volume, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_mu;         /* small-strain shear modulus (Pa): scales the stabilisation and the coupling */
+    frm_real *s_law_params; /* FRM_LAW_PARAMS: the law's parameter block (see frm_law, frm__laws) */
+    const frm_user_law **s_user; /* FRM_LAW_USER: the material's callbacks (in user_laws), else NULL */
+    frm_user_law *user_laws;     /* a copy of every material's callbacks (user_law_count) */
+    int user_law_count, law_cache; /* law_cache: lin_cache reals per sample, the largest cache_size in use */
     frm_real *s_hstab; /* g = gamma h^2 of the stabilisation's divergence term (m^2) */
     frm_real *s_stabY; /* 9: Y = sum of Z_k over the pairs of frames without unseen rotations, at the linearisation */
     frm_real *s_stabD; /* 1: D at the linearisation */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     unsigned char *s_inverted;     /* 1: det F <= 0 at the start of the step or solve */
     int *s_start;
-    frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
+    frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, law_cache at the linearisation */
     frm_real *s_pos, *s_F;               /* outputs: 3, 9 */
 
     /* pairs */
@@ -2147,6 +2201,351 @@ static void frm__quat_normalized(const frm_real *q, frm_real *out)
     for (k = 0; k < 4; k++) out[k] = (frm_real)(q[k] / n);
 }
 
+/* >>laws -------------------------------------------------------------------------------- */
+/* Every constitutive law is one row of frm__laws[], indexed by frm_law. A law reads its
+   parameter block (FRM_LAW_PARAMS reals per sample, filled by frm__law_params at creation)
+   and, for FRM_LAW_USER, the material's callbacks; it returns through:
+     energy        W at F = I + H (J/m^3); 0 or FRM_ERR_INVERTED
+     stress        S (6, Voigt), W and the tangent data (cache_size reals) differential reads
+     differential  dS for a strain variation dE (6) at the state stress cached
+     definite      NULL, or the change of the cached tangent data that keeps the material
+                   part of K positive where the law allows it (used by the definite
+                   linearisation of the static solve's first iterations, see SOLVERS)
+     fast_path     1: the model's loops may evaluate the law by the inlined kernels
+                   frm_material_stress / frm_material_dstress (the >>kernels section, shared
+                   with a CUDA build), which implement SVK and Neo-Hookean only. A law without
+                   the flag always goes through its own functions. The law tests compare
+                   the path the model uses (frm__law_stress, frm__law_dstress) with finite
+                   differences of each law's `energy`, so a flag set on the wrong law fails.
+   frm__law_stress and frm__law_dstress are the one place where the model picks a path. */
+
+#define FRM__LAW_CACHE_MAX 23 /* the largest cache_size of frm__laws (the invariant laws) */
+
+typedef struct frm__law_ops {
+    const char *name;
+    int cache_size;
+    int (*energy)(const frm_real *params, const frm_user_law *user, const frm_real H[9], frm_real *psi);
+    int (*stress)(const frm_real *params, const frm_user_law *user, const frm_real H[9], frm_real S[6], frm_real *psi,
+                  frm_real *cache);
+    void (*differential)(const frm_real *params, const frm_user_law *user, const frm_real *cache, const frm_real dE[6],
+                         frm_real dS[6]);
+    void (*definite)(const frm_real *params, frm_real *cache);
+    int fast_path;
+} frm__law_ops;
+
+/* SVK and Neo-Hookean: the kernels' formulas (frm_material_stress, frm_material_dstress),
+   params = (mu, lambda). */
+static int frm__svk_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                           frm_real *psi, frm_real *cache)
+{
+    (void)user;
+    return frm_material_stress(FRM_LAW_SVK, p[0], p[1], H, S, psi, cache);
+}
+
+static void frm__svk_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                  const frm_real dE[6], frm_real dS[6])
+{
+    (void)user;
+    frm_material_dstress(FRM_LAW_SVK, p[0], p[1], cache, dE, dS);
+}
+
+static int frm__nh_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                          frm_real *psi, frm_real *cache)
+{
+    (void)user;
+    return frm_material_stress(FRM_LAW_NEO_HOOKEAN, p[0], p[1], H, S, psi, cache);
+}
+
+static void frm__nh_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                 const frm_real dE[6], frm_real dS[6])
+{
+    (void)user;
+    frm_material_dstress(FRM_LAW_NEO_HOOKEAN, p[0], p[1], cache, dE, dS);
+}
+
+/* Neo-Hookean's tangent 2 (mu - lambda ln J) C^-1 dE C^-1 kept >= 0: ln J (cache[6]) capped
+   at mu / lambda. */
+static void frm__nh_definite(const frm_real *p, frm_real *cache)
+{
+    if (p[1] * cache[6] > p[0]) cache[6] = p[0] / p[1];
+}
+
+/* Invariant laws (Mooney-Rivlin, user): W(I1, I2, J) with I1 = tr C, I2 = (I1^2 - tr C^2)/2,
+   J = det F. Evaluated in double:
+       S  = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1
+       dS = 2 dw_1 I + 2 dw_2 (I1 I - C) + 2 w_2 (dI1 I - 2 dE) + (dJ w_J + J dw_J) C^-1
+            - 2 J w_J C^-1 dE C^-1,
+   dI1 = 2 tr dE, dI2 = 2 (I1 tr dE - C : dE), dJ = J C^-1 : dE, dw_a = sum_b w_ab dI_b.
+   Cache (23): C^-1 (6), C (6), I1, J, w_1, w_2, w_J, w_11, w_12, w_1J, w_22, w_2J, w_JJ.
+   Unlike the Neo-Hookean kernel, the stress at small strain is a difference of terms of
+   the size of the moduli (2 w_1 + 4 w_2 + J w_J = 0 at rest): relative round-off of the
+   stress is eps(double) of the moduli, then rounded to frm_real. */
+typedef struct frm__invariants {
+    double I1, I2, J, w, d1[3], d2[6]; /* d1: w_1, w_2, w_J; d2: w_11, w_12, w_1J, w_22, w_2J, w_JJ */
+} frm__invariants;
+
+/* C (6, Voigt), C^-1 (6), I1, I2, J from H; 0 or FRM_ERR_INVERTED. */
+static int frm__invariants_of(const frm_real H[9], double C[6], double Ci[6], frm__invariants *v)
+{
+    double F[9], J, tr2;
+    int r;
+    for (r = 0; r < 9; r++) F[r] = (double)H[r] + (r % 4 == 0 ? 1.0 : 0.0);
+    C[0] = F[0] * F[0] + F[3] * F[3] + F[6] * F[6];
+    C[1] = F[1] * F[1] + F[4] * F[4] + F[7] * F[7];
+    C[2] = F[2] * F[2] + F[5] * F[5] + F[8] * F[8];
+    C[3] = F[1] * F[2] + F[4] * F[5] + F[7] * F[8];
+    C[4] = F[0] * F[2] + F[3] * F[5] + F[6] * F[8];
+    C[5] = F[0] * F[1] + F[3] * F[4] + F[6] * F[7];
+    J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+    if (!(J > 0)) return FRM_ERR_INVERTED;
+    Ci[0] = (C[1] * C[2] - C[3] * C[3]) / (J * J);
+    Ci[1] = (C[0] * C[2] - C[4] * C[4]) / (J * J);
+    Ci[2] = (C[0] * C[1] - C[5] * C[5]) / (J * J);
+    Ci[3] = (C[4] * C[5] - C[0] * C[3]) / (J * J);
+    Ci[4] = (C[5] * C[3] - C[1] * C[4]) / (J * J);
+    Ci[5] = (C[3] * C[4] - C[2] * C[5]) / (J * J);
+    v->I1 = C[0] + C[1] + C[2];
+    tr2 = C[0] * C[0] + C[1] * C[1] + C[2] * C[2] + 2 * (C[3] * C[3] + C[4] * C[4] + C[5] * C[5]);
+    v->I2 = 0.5 * (v->I1 * v->I1 - tr2);
+    v->J = J;
+    return 0;
+}
+
+/* Mooney-Rivlin (heml.h's HEML_MOONEY_RIVLIN, eqs. 21-25 of the HEML paper), p = (c1, c2,
+   kappa): W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3) + kappa/2 (J - 1)^2,
+       w_1 = c1 J^-2/3, w_2 = c2 J^-4/3, w_J = -2/3 c1 I1 J^-5/3 - 4/3 c2 I2 J^-7/3 + kappa (J - 1),
+       w_11 = w_12 = w_22 = 0, w_1J = -2/3 c1 J^-5/3, w_2J = -4/3 c2 J^-7/3,
+       w_JJ = 10/9 c1 I1 J^-8/3 + 28/9 c2 I2 J^-10/3 + kappa. */
+static void frm__mr_derivatives(const frm_real *p, frm__invariants *v, int order)
+{
+    double c1 = (double)p[0], c2 = (double)p[1], kappa = (double)p[2], J = v->J;
+    double a = pow(J, -2.0 / 3.0), b = a * a; /* J^-2/3, J^-4/3 */
+    v->w = c1 * (v->I1 * a - 3) + c2 * (v->I2 * b - 3) + 0.5 * kappa * (J - 1) * (J - 1);
+    if (order < 1) return;
+    v->d1[0] = c1 * a;
+    v->d1[1] = c2 * b;
+    v->d1[2] = (-2.0 / 3.0 * c1 * v->I1 * a - 4.0 / 3.0 * c2 * v->I2 * b) / J + kappa * (J - 1);
+    if (order < 2) return;
+    v->d2[0] = v->d2[1] = v->d2[3] = 0;
+    v->d2[2] = -2.0 / 3.0 * c1 * a / J;
+    v->d2[4] = -4.0 / 3.0 * c2 * b / J;
+    v->d2[5] = (10.0 / 9.0 * c1 * v->I1 * a + 28.0 / 9.0 * c2 * v->I2 * b) / (J * J) + kappa;
+}
+
+/* The user's callbacks at one point: order 0 energy, 1 and first, 2 and second. */
+static void frm__user_derivatives(const frm_user_law *u, frm__invariants *v, int order)
+{
+    frm_real I1 = (frm_real)v->I1, I2 = (frm_real)v->I2, J = (frm_real)v->J, w = 0, d[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    frm_law_points pt;
+    int k;
+    pt.count = 1;
+    pt.I1 = &I1;
+    pt.I2 = &I2;
+    pt.J = &J;
+    pt.w = &w;
+    pt.w_1 = d;
+    pt.w_2 = d + 1;
+    pt.w_J = d + 2;
+    pt.w_11 = d + 3;
+    pt.w_12 = d + 4;
+    pt.w_1J = d + 5;
+    pt.w_22 = d + 6;
+    pt.w_2J = d + 7;
+    pt.w_JJ = d + 8;
+    if (u->energy) u->energy(&pt, u->user);
+    v->w = (double)w;
+    if (order >= 1) u->first(&pt, u->user);
+    if (order >= 2) u->second(&pt, u->user);
+    for (k = 0; k < 3; k++) v->d1[k] = (double)d[k];
+    for (k = 0; k < 6; k++) v->d2[k] = (double)d[3 + k];
+}
+
+static void frm__invariant_derivatives(const frm_real *p, const frm_user_law *user, frm__invariants *v, int order)
+{
+    if (user) frm__user_derivatives(user, v, order);
+    else frm__mr_derivatives(p, v, order);
+}
+
+static int frm__invariant_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    double C[6], Ci[6];
+    frm__invariants v;
+    int e = frm__invariants_of(H, C, Ci, &v);
+    if (e) return e;
+    frm__invariant_derivatives(p, user, &v, 0);
+    *psi = (frm_real)v.w;
+    return 0;
+}
+
+static int frm__invariant_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                                 frm_real *psi, frm_real *cache)
+{
+    double C[6], Ci[6], a, b, c;
+    frm__invariants v;
+    int k, e = frm__invariants_of(H, C, Ci, &v);
+    if (e) return e;
+    frm__invariant_derivatives(p, user, &v, cache ? 2 : 1);
+    a = 2 * v.d1[0] + 2 * v.d1[1] * v.I1; /* S = a I - b C + c C^-1 */
+    b = 2 * v.d1[1];
+    c = v.J * v.d1[2];
+    for (k = 0; k < 6; k++) S[k] = (frm_real)((k < 3 ? a : 0.0) - b * C[k] + c * Ci[k]);
+    *psi = (frm_real)v.w;
+    if (cache) {
+        for (k = 0; k < 6; k++) {
+            cache[k] = (frm_real)Ci[k];
+            cache[6 + k] = (frm_real)C[k];
+        }
+        cache[12] = (frm_real)v.I1;
+        cache[13] = (frm_real)v.J;
+        for (k = 0; k < 3; k++) cache[14 + k] = (frm_real)v.d1[k];
+        for (k = 0; k < 6; k++) cache[17 + k] = (frm_real)v.d2[k];
+    }
+    return 0;
+}
+
+static void frm__invariant_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                        const frm_real dE[6], frm_real dS[6])
+{
+    const frm_real *Ci = cache, *C = cache + 6, *w = cache + 14, *h = cache + 17;
+    double I1 = (double)cache[12], J = (double)cache[13], tr = (double)dE[0] + dE[1] + dE[2], CdE = 0, CidE = 0;
+    double dI1, dI2, dJ, dw1, dw2, dwJ, x[9], c[9], d[9], t[9], a, b, g, q;
+    int k, r;
+    (void)p;
+    (void)user;
+    for (k = 0; k < 6; k++) {
+        double f = k < 3 ? 1.0 : 2.0;
+        CdE += f * (double)C[k] * (double)dE[k];
+        CidE += f * (double)Ci[k] * (double)dE[k];
+    }
+    dI1 = 2 * tr;
+    dI2 = 2 * (I1 * tr - CdE);
+    dJ = J * CidE;
+    dw1 = (double)h[0] * dI1 + (double)h[1] * dI2 + (double)h[2] * dJ;
+    dw2 = (double)h[1] * dI1 + (double)h[3] * dI2 + (double)h[4] * dJ;
+    dwJ = (double)h[2] * dI1 + (double)h[4] * dI2 + (double)h[5] * dJ;
+    /* x = C^-1 dE C^-1 */
+    c[0] = Ci[0], c[4] = Ci[1], c[8] = Ci[2], c[5] = c[7] = Ci[3], c[2] = c[6] = Ci[4], c[1] = c[3] = Ci[5];
+    d[0] = dE[0], d[4] = dE[1], d[8] = dE[2], d[5] = d[7] = dE[3], d[2] = d[6] = dE[4], d[1] = d[3] = dE[5];
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) t[3 * r + k] = d[3 * r] * c[k] + d[3 * r + 1] * c[3 + k] + d[3 * r + 2] * c[6 + k];
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) x[3 * r + k] = c[3 * r] * t[k] + c[3 * r + 1] * t[3 + k] + c[3 * r + 2] * t[6 + k];
+    a = 2 * dw1 + 2 * dw2 * I1 + 2 * (double)w[1] * dI1; /* dS = a I - g C - 4 w_2 dE + q C^-1 - b x */
+    g = 2 * dw2;
+    q = dJ * (double)w[2] + J * dwJ;
+    b = 2 * J * (double)w[2];
+    dS[0] = (frm_real)(a - g * C[0] - 4 * (double)w[1] * dE[0] + q * Ci[0] - b * x[0]);
+    dS[1] = (frm_real)(a - g * C[1] - 4 * (double)w[1] * dE[1] + q * Ci[1] - b * x[4]);
+    dS[2] = (frm_real)(a - g * C[2] - 4 * (double)w[1] * dE[2] + q * Ci[2] - b * x[8]);
+    dS[3] = (frm_real)(-g * C[3] - 4 * (double)w[1] * dE[3] + q * Ci[3] - b * 0.5 * (x[5] + x[7]));
+    dS[4] = (frm_real)(-g * C[4] - 4 * (double)w[1] * dE[4] + q * Ci[4] - b * 0.5 * (x[2] + x[6]));
+    dS[5] = (frm_real)(-g * C[5] - 4 * (double)w[1] * dE[5] + q * Ci[5] - b * 0.5 * (x[1] + x[3]));
+}
+
+/* The energy of the built-in kernels alone (the stress discarded). */
+static int frm__svk_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    frm_real S[6];
+    (void)user;
+    return frm_material_stress(FRM_LAW_SVK, p[0], p[1], H, S, psi, NULL);
+}
+
+/* Neo-Hookean's energy written out on its own (not through the kernel), so that the law
+   tests check the kernel's stress against an independent energy:
+   W = mu (tr E - ln J) + lambda/2 ln^2 J, tr E = (I1 - 3)/2. */
+static int frm__nh_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    double C[6], Ci[6], lnJ;
+    frm__invariants v;
+    int e = frm__invariants_of(H, C, Ci, &v);
+    (void)user;
+    if (e) return e;
+    lnJ = log(v.J);
+    *psi = (frm_real)((double)p[0] * (0.5 * (v.I1 - 3) - lnJ) + 0.5 * (double)p[1] * lnJ * lnJ);
+    return 0;
+}
+
+static const frm__law_ops frm__laws[FRM_LAW_COUNT] = {
+    /* name, cache_size, energy, stress, differential, definite, fast_path */
+    {"St Venant-Kirchhoff", 0, frm__svk_energy, frm__svk_stress, frm__svk_differential, NULL, 1},
+    {"Neo-Hookean", FRM_LAW_CACHE, frm__nh_energy, frm__nh_stress, frm__nh_differential, frm__nh_definite, 1},
+    {"Mooney-Rivlin", FRM__LAW_CACHE_MAX, frm__invariant_energy, frm__invariant_stress, frm__invariant_differential,
+     NULL, 0},
+    {"user", FRM__LAW_CACHE_MAX, frm__invariant_energy, frm__invariant_stress, frm__invariant_differential, NULL, 0}};
+
+/* One entry per law, no more, no less (negative array size otherwise). */
+typedef char frm__laws_cover_every_law[(sizeof frm__laws / sizeof frm__laws[0] == FRM_LAW_COUNT) ? 1 : -1];
+
+/* The model's path: the inlined kernels for a law with fast_path, its own functions
+   otherwise. user is the material's callbacks for FRM_LAW_USER, NULL for the others. */
+static inline int frm__law_stress(int law, const frm_real *params, const frm_user_law *user, const frm_real H[9],
+                                  frm_real S[6], frm_real *psi, frm_real *cache)
+{
+    if (frm__laws[law].fast_path) return frm_material_stress(law, params[0], params[1], H, S, psi, cache);
+    return frm__laws[law].stress(params, user, H, S, psi, cache);
+}
+
+static inline void frm__law_dstress(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                                    const frm_real dE[6], frm_real dS[6])
+{
+    if (frm__laws[law].fast_path) frm_material_dstress(law, params[0], params[1], cache, dE, dS);
+    else frm__laws[law].differential(params, user, cache, dE, dS);
+}
+
+/* dP = dF S + F dS, dS = dS/dE : sym(F^T dF) (frm_sample_dP through the law table). */
+static inline void frm__law_dP(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                               const frm_real F[9], const frm_real S[6], const frm_real dF[9], frm_real dP[9])
+{
+    frm_real dE[6], dS[6], t[9];
+    int r, c;
+    for (r = 0; r < 3; r++) /* t = F^T dF */
+        for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
+    dE[0] = t[0];
+    dE[1] = t[4];
+    dE[2] = t[8];
+    dE[3] = (frm_real)0.5 * (t[5] + t[7]);
+    dE[4] = (frm_real)0.5 * (t[2] + t[6]);
+    dE[5] = (frm_real)0.5 * (t[1] + t[3]);
+    frm__law_dstress(law, params, user, cache, dE, dS);
+    frm_first_piola(dF, S, dP);
+    frm_first_piola(F, dS, t);
+    for (r = 0; r < 9; r++) dP[r] += t[r];
+}
+
+/* The 6 tangent columns of one pair (frm_pair_tangent_columns through the law table). */
+static void frm__law_tangent_columns(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                                     const frm_real F[9], const frm_real S[6], const frm_real grad[3],
+                                     const frm_real G[9], frm_real cols[54])
+{
+    int c, k;
+    for (c = 0; c < 6; c++) {
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9];
+        for (k = 0; k < 9; k++) dF[k] = 0;
+        dq[c] = 1;
+        frm_pair_dF(dq, grad, G, dF);
+        frm__law_dP(law, params, user, cache, F, S, dF, cols + 9 * c);
+    }
+}
+
+/* A material's parameter block (FRM_LAW_PARAMS reals) and its small-strain shear modulus
+   (which scales the rotation stabilisation and the frame coupling). */
+static void frm__law_params(const frm_material *mat, frm_real *params, frm_real *shear_modulus)
+{
+    double E = (double)mat->young_modulus, nu = (double)mat->poisson_ratio;
+    int k;
+    for (k = 0; k < FRM_LAW_PARAMS; k++) params[k] = 0;
+    if (mat->law == FRM_LAW_MOONEY_RIVLIN) {
+        params[0] = mat->c1;
+        params[1] = mat->c2;
+        params[2] = mat->bulk_modulus;
+        *shear_modulus = (frm_real)(2.0 * ((double)mat->c1 + (double)mat->c2));
+        return;
+    }
+    params[0] = (frm_real)(E / (2.0 * (1.0 + nu)));
+    params[1] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
+    *shear_modulus = params[0];
+}
+
 /* >>parallel --------------------------------------------------------------------------- */
 
 typedef void (*frm__range_fn)(void *ctx, int begin, int end);
@@ -2267,7 +2666,9 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_rest, frm_real, 3 * S);
     FRM__CARVE(c, m->s_volume, frm_real, S);
     FRM__CARVE(c, m->s_mu, frm_real, S);
-    FRM__CARVE(c, m->s_lambda, frm_real, S);
+    FRM__CARVE(c, m->s_law_params, frm_real, FRM_LAW_PARAMS * S);
+    FRM__CARVE(c, m->s_user, const frm_user_law *, S);
+    FRM__CARVE(c, m->user_laws, frm_user_law, m->user_law_count);
     FRM__CARVE(c, m->s_couple, frm_real, S);
     FRM__CARVE(c, m->s_hstab, frm_real, S);
     if (m->stab_on) {
@@ -2280,7 +2681,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_start, int, S + 1);
     FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
     FRM__CARVE(c, m->lin_S, frm_real, 6 * S);
-    FRM__CARVE(c, m->lin_cache, frm_real, FRM_LAW_CACHE * S);
+    FRM__CARVE(c, m->lin_cache, frm_real, (size_t)m->law_cache * S);
     FRM__CARVE(c, m->s_pos, frm_real, 3 * S);
     FRM__CARVE(c, m->s_F, frm_real, 9 * S);
     FRM__CARVE(c, m->p_frame, int, P);
@@ -2312,15 +2713,31 @@ static int frm__fail(const frm_desc *d, int code, const char *detail)
 
 static int frm__validate_material(const frm_material *mat, int index, char *msg, size_t size)
 {
-    if ((int)mat->law != FRM_LAW_SVK && (int)mat->law != FRM_LAW_NEO_HOOKEAN) {
+    if ((unsigned)mat->law >= FRM_LAW_COUNT) {
         snprintf(msg, size, "material %d: unknown law %d", index, (int)mat->law);
         return FRM_ERR_MATERIAL;
     }
-    if (!(frm__finite((double)mat->young_modulus) && mat->young_modulus > 0)) {
+    if (mat->law == FRM_LAW_USER && (!mat->user.first || !mat->user.second)) {
+        snprintf(msg, size, "material %d: a user law needs its first and second callbacks", index);
+        return FRM_ERR_MATERIAL;
+    }
+    if (mat->law == FRM_LAW_MOONEY_RIVLIN) {
+        if (!(frm__finite((double)mat->c1) && frm__finite((double)mat->c2) && mat->c1 >= 0 && mat->c2 >= 0 &&
+              mat->c1 + mat->c2 > 0)) {
+            snprintf(msg, size, "material %d: Mooney-Rivlin c1 %g, c2 %g", index, (double)mat->c1, (double)mat->c2);
+            return FRM_ERR_MATERIAL;
+        }
+        if (!(frm__finite((double)mat->bulk_modulus) && mat->bulk_modulus > 0)) {
+            snprintf(msg, size, "material %d: bulk modulus %g", index, (double)mat->bulk_modulus);
+            return FRM_ERR_MATERIAL;
+        }
+    }
+    if (mat->law != FRM_LAW_MOONEY_RIVLIN && !(frm__finite((double)mat->young_modulus) && mat->young_modulus > 0)) {
         snprintf(msg, size, "material %d: Young's modulus %g", index, (double)mat->young_modulus);
         return FRM_ERR_YOUNG_MODULUS;
     }
-    if (!(frm__finite((double)mat->poisson_ratio) && mat->poisson_ratio > -1 && mat->poisson_ratio < 0.5)) {
+    if (mat->law != FRM_LAW_MOONEY_RIVLIN &&
+        !(frm__finite((double)mat->poisson_ratio) && mat->poisson_ratio > -1 && mat->poisson_ratio < 0.5)) {
         snprintf(msg, size, "material %d: Poisson ratio %g", index, (double)mat->poisson_ratio);
         return FRM_ERR_POISSON_RATIO;
     }
@@ -2487,6 +2904,12 @@ static frm_material frm__default_material(void)
     mat.young_modulus = (frm_real)1e4;
     mat.poisson_ratio = (frm_real)0.3;
     mat.density = (frm_real)1000;
+    mat.c1 = mat.c2 = (frm_real)(1e4 / (8 * 1.3)); /* mu / 4 of E = 1e4 Pa, nu = 0.3 */
+    mat.bulk_modulus = (frm_real)(1e4 / (3 * 0.4));  /* E / (3 (1 - 2 nu)) */
+    mat.user.energy = NULL;
+    mat.user.first = NULL;
+    mat.user.second = NULL;
+    mat.user.user = NULL;
     return mat;
 }
 
@@ -2800,6 +3223,12 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
         }
     tmp.stab_on = tmp.stab_frames > 0 || tmp.stab_gamma > 0;
+    tmp.user_law_count = d->materials ? d->material_count : 1;
+    for (s = 0; s < S; s++) {
+        const frm_material *mat =
+            d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
+        if (frm__laws[mat->law].cache_size > tmp.law_cache) tmp.law_cache = frm__laws[mat->law].cache_size;
+    }
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
     frm__layout(&tmp, &carver);
@@ -2867,10 +3296,14 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     for (s = 0; s < S; s++) {
         const frm_material *mat =
             d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
-        double E = (double)mat->young_modulus, nu = (double)mat->poisson_ratio;
-        m->s_mu[s] = (frm_real)(E / (2.0 * (1.0 + nu)));
-        m->s_lambda[s] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
+        frm__law_params(mat, m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_mu + s);
         m->s_law[s] = (unsigned char)mat->law;
+        m->s_user[s] = NULL;
+        if (mat->law == FRM_LAW_USER) {
+            int u = d->materials ? (int)(mat - d->materials) : 0;
+            m->user_laws[u] = mat->user;
+            m->s_user[s] = m->user_laws + u;
+        }
     }
 
     /* pairs: lbar = Rbar^T (pbar_s - xbar_i) (eq. 3.33), in double */
@@ -3109,12 +3542,13 @@ static void frm__force_chunks(void *vctx, int begin, int end)
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
-            frm_real F[9], H[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
+            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
             frm_real offset[3 * FRM_MAX_NEIGHBORS], sT[9 * FRM_MAX_NEIGHBORS], stq[3 * FRM_MAX_NEIGHBORS];
             frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
                                    m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
                                    ctx->outputs ? m->s_pos + 3 * s : NULL);
-            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], H, S, &psi, cache);
+            const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+            e = frm__law_stress(m->s_law[s], prm, m->s_user[s], H, S, &psi, cache);
             memcpy(F, H, sizeof F);
             F[0] += 1; /* F = I + H */
             F[4] += 1;
@@ -3143,16 +3577,15 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
                 if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
-                                              Neo-Hookean tangent's 2 (mu - lambda ln J) kept >= 0 */
+                                              law's tangent data made definite where it has a rule */
                     double Sd[6];
                     for (r = 0; r < 6; r++) Sd[r] = (double)S[r];
                     frm__positive_part3(Sd);
                     for (r = 0; r < 6; r++) S[r] = (frm_real)Sd[r];
-                    if (m->s_law[s] == FRM_LAW_NEO_HOOKEAN && m->s_lambda[s] * cache[6] > m->s_mu[s])
-                        cache[6] = m->s_mu[s] / m->s_lambda[s];
+                    if (frm__laws[m->s_law[s]].definite) frm__laws[m->s_law[s]].definite(prm, cache);
                 }
                 memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
-                memcpy(m->lin_cache + FRM_LAW_CACHE * (size_t)s, cache, sizeof cache);
+                memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
                 for (k = 0; k < n; k++) {
                     frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
@@ -3346,8 +3779,8 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
             frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
             for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
-            frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
+            frm__law_dP(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
+                        m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
             if (m->s_stab[s]) {
                 frm_real dPx[9];
                 const frm_real *dth[FRM_MAX_NEIGHBORS];
@@ -3513,9 +3946,9 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                 int p = m->rev_pair[e], s = m->p_sample[p], a = p - m->s_start[s];
                 frm_real cols[54], K[36], rows[18 * FRM_MAX_NEIGHBORS];
                 for (k = 0; k < 36; k++) K[k] = 0;
-                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
-                                         m->p_G + 9 * (size_t)p, cols);
+                frm__law_tangent_columns(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
+                                         m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                         m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
                 if (m->s_stab[s])
@@ -3567,9 +4000,9 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
             for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
                 int p = m->rev_pair[e], s = m->p_sample[p], b = m->s_start[s], n = m->s_start[s + 1] - b, a = p - b, q;
                 frm_real cols[54], rows[18 * FRM_MAX_NEIGHBORS];
-                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
-                                         m->p_G + 9 * (size_t)p, cols);
+                frm__law_tangent_columns(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
+                                         m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                         m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 for (q = 0; q < n; q++) {
                     frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
