@@ -796,6 +796,21 @@ typedef enum frm_stiffness_mode {
     FRM_STIFFNESS_BLOCKS = 2 /* 6x6 blocks between neighbouring frames, assembled once */
 } frm_stiffness_mode;
 
+/* Time integrators of frm_model_step (see SOLVERS; HOW TO EXTEND for adding one). */
+typedef enum frm_integrator {
+    FRM_IMPLICIT_EULER = 0,            /* backward Euler: Newton minimisation of the step's incremental
+                                          potential to newton_tolerance, line search (default) */
+    FRM_IMPLICIT_EULER_LINEARIZED = 1, /* one linearised iteration per step (the thesis's eq. 3.64;
+                                          cheaper, accurate only while the step moves little) */
+    FRM_INTEGRATOR_COUNT               /* sentinel: the number of integrators, not one */
+} frm_integrator;
+
+/* Linear solvers of every Newton iteration (static solve and implicit steps). */
+typedef enum frm_linear_solver {
+    FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
+} frm_linear_solver;
+
 /* Meshless shape functions (sec. 4.1). */
 typedef enum frm_shape {
     FRM_SHAPE_SHEPARD = 0, /* inverse distance, eqs. 4.8-4.9; any point layout, zero order */
@@ -904,10 +919,14 @@ typedef struct frm_desc {
                                   default 1e-6 (1e-4 float) */
     int newton_max_iterations; /* Newton iterations per static increment or implicit step,
                                   default 30 */
-    int implicit_linearized;   /* 0 (default): implicit Euler minimises the step's incremental
-                                  potential by Newton iterations with a line search; 1: one
-                                  linearised iteration per step (the thesis's eq. 3.64; cheaper,
-                                  accurate only while the step moves little, see SOLVERS) */
+    frm_integrator integrator; /* default FRM_IMPLICIT_EULER: implicit Euler minimises the step's
+                                  incremental potential by Newton iterations with a line search;
+                                  FRM_IMPLICIT_EULER_LINEARIZED: one linearised iteration per step
+                                  (the thesis's eq. 3.64; cheaper, accurate only while the step
+                                  moves little, see SOLVERS) */
+    int implicit_linearized;   /* the older spelling of integrator = FRM_IMPLICIT_EULER_LINEARIZED:
+                                  0 (default) or 1, which selects the linearised integrator */
+    frm_linear_solver linear_solver; /* default FRM_LINEAR_SOLVER_CG */
     int max_increments;        /* static solve: load increments at most (continuation), default 64 */
     frm_real min_increment;    /* static solve: smallest load fraction of an increment before the
                                   solve gives up, default 1e-4 */
@@ -1966,7 +1985,9 @@ struct frm_model {
     /* settings */
     frm_real gravity[3], time_step, mass_damping, stiffness_damping;
     frm_real cg_tolerance, newton_tolerance;
-    int cg_max_iterations, newton_max_iterations, implicit_linearized, max_increments;
+    int cg_max_iterations, newton_max_iterations, max_increments;
+    int integrator;    /* frm_integrator: the row of frm__integrators frm_model_step runs */
+    int linear_solver; /* frm_linear_solver: the solver frm__linear_solve runs */
     double min_increment, precision_limit, h_min; /* h_min: smallest rest lever (see precision_limit) */
     double load_scale;                            /* continuation: fraction of gravity and external loads */
     int stiffness_mode, has_blocks;
@@ -2765,6 +2786,8 @@ static int frm__validate_settings(const frm_desc *d)
         !(frm__finite((double)d->precision_limit) && d->precision_limit >= 0) || d->implicit_linearized < 0 ||
         d->implicit_linearized > 1)
         return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
+    if ((unsigned)d->integrator >= FRM_INTEGRATOR_COUNT) return frm__fail(d, FRM_ERR_SOLVER, "integrator");
+    if ((unsigned)d->linear_solver >= FRM_LINEAR_SOLVER_COUNT) return frm__fail(d, FRM_ERR_SOLVER, "linear_solver");
     if (!(frm__finite((double)d->frame_coupling) && d->frame_coupling >= 0))
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
     if (!(frm__finite((double)d->rotation_stabilization) && d->rotation_stabilization >= 0))
@@ -2924,7 +2947,9 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.cg_max_iterations = 1000;
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
+    d.integrator = FRM_IMPLICIT_EULER;
     d.implicit_linearized = 0;
+    d.linear_solver = FRM_LINEAR_SOLVER_CG;
     d.max_increments = 64;
     d.min_increment = (frm_real)1e-4;
     d.precision_limit = (frm_real)1e-4;
@@ -3257,7 +3282,9 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->cg_max_iterations = d->cg_max_iterations;
     m->newton_tolerance = d->newton_tolerance;
     m->newton_max_iterations = d->newton_max_iterations;
-    m->implicit_linearized = d->implicit_linearized;
+    /* implicit_linearized = 1 is the older spelling of the linearised integrator */
+    m->integrator = d->implicit_linearized ? FRM_IMPLICIT_EULER_LINEARIZED : (int)d->integrator;
+    m->linear_solver = (int)d->linear_solver;
     m->max_increments = d->max_increments;
     m->min_increment = (double)d->min_increment;
     m->precision_limit = (double)d->precision_limit;
@@ -4344,6 +4371,21 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     return status;
 }
 
+/* Every linear solve of the header goes through here: (a_mass M + a_stiff K) x = b over
+   the free components to |r| <= tolerance |b|, by the model's linear_solver. Returns the
+   FRM__CG_* statuses (OK, CAP, NEGATIVE, NOT_FINITE), which the Newton loops map to
+   FRM_OK, FRM_ERR_NO_CONVERGENCE (cap; negative curvature when no retry helps) and
+   FRM_ERR_NOT_FINITE. A new solver (e.g. issue 15's block-tridiagonal one) adds a
+   frm_linear_solver value and a case here, with the same statuses. */
+static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
+{
+    switch (m->linear_solver) {
+    case FRM_LINEAR_SOLVER_CG:
+    default:
+        return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+    }
+}
+
 static void frm__copy_state(const frm_model *m, frm_real *dst)
 {
     int i;
@@ -4554,7 +4596,7 @@ static int frm__newton_iteration(frm_model *m, int first, double tol, int *conve
                                                                                               : m->regularization;
         frm__build_precond(m, 0.0, 1.0);
         memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
-        cg = frm__cg(m, 0.0, 1.0, eta, f, dq);
+        cg = frm__linear_solve(m, 0.0, 1.0, eta, f, dq);
         m->solve_regularization = 0;
         if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
         if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE; /* one CG policy: capped is not converged */
@@ -4829,7 +4871,7 @@ static int frm__implicit_linearized(frm_model *m, double dt)
             for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
         }
         memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
-        cg = frm__cg(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
+        cg = frm__linear_solve(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
         if (attempt || cg != FRM__CG_NEGATIVE) break;
         /* M + dt^2 K is indefinite here (compressed samples, the rotations' second-order terms,
            gravity, at a large dt): the step uses K's positive-definite part instead, which
@@ -4957,7 +4999,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
                 for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->vec[FRM__V_DV][k];
             else
                 memset(dv, 0, sizeof(frm_real) * (size_t)n6);
-            cg = frm__cg(m, a_mass, a_stiff, eta, b, dv);
+            cg = frm__linear_solve(m, a_mass, a_stiff, eta, b, dv);
             if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
             if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE;
             if (cg == FRM__CG_OK || attempt) break;
@@ -5039,13 +5081,10 @@ static int frm__implicit_newton(frm_model *m, double dt)
     return FRM_OK;
 }
 
-static int frm__implicit_step(frm_model *m, double dt)
+/* The Newton implicit Euler step (FRM_IMPLICIT_EULER): minimise, accept or restore. */
+static int frm__implicit_euler(frm_model *m, double dt)
 {
-    int err = frm__check_precision(m);
-    if (err) return err;
-    frm__inversions(m, 1);
-    if (m->implicit_linearized) return frm__implicit_linearized(m, dt);
-    err = frm__implicit_newton(m, dt);
+    int err = frm__implicit_newton(m, dt);
     if (!err) err = frm__accept(m);
     if (err) {
         frm__paste_state(m, m->inc_state);
@@ -5054,6 +5093,31 @@ static int frm__implicit_step(frm_model *m, double dt)
     frm__update_frames(m);
     m->lin_valid = 0;
     return FRM_OK;
+}
+
+/* Every integrator is one row, indexed by frm_integrator. step(m, dt) advances the state
+   by dt (s) from a state whose precision and inversions frm__implicit_step has checked,
+   and leaves the state of the step's start on failure. */
+typedef struct frm__integrator_ops {
+    const char *name;
+    int (*step)(frm_model *m, double dt);
+    int is_explicit; /* 1: needs no linear solve (none yet) */
+} frm__integrator_ops;
+
+static const frm__integrator_ops frm__integrators[FRM_INTEGRATOR_COUNT] = {
+    {"implicit Euler", frm__implicit_euler, 0},
+    {"implicit Euler, linearised", frm__implicit_linearized, 0}};
+
+/* One entry per integrator (negative array size otherwise). */
+typedef char frm__integrators_cover_every_integrator[(sizeof frm__integrators / sizeof frm__integrators[0] ==
+                                                      FRM_INTEGRATOR_COUNT) ? 1 : -1];
+
+static int frm__implicit_step(frm_model *m, double dt)
+{
+    int err = frm__check_precision(m);
+    if (err) return err;
+    frm__inversions(m, 1);
+    return frm__integrators[m->integrator].step(m, dt);
 }
 
 FRMDEF int frm_model_step(frm_model *m)

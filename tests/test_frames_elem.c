@@ -1246,6 +1246,68 @@ static void test_law_validation(void)
     frm_sampling_free(&s);
 }
 
+/* ---- issue 20: integrators and linear solvers chosen by enums with sentinels ------- */
+
+/* integrator = FRM_IMPLICIT_EULER_LINEARIZED is bit for bit the older implicit_linearized
+   = 1; the default integrator is the Newton implicit Euler; values at or past the
+   sentinels are refused. */
+static void test_integrator_choice(void)
+{
+    frm_real nodes[24];
+    int hex[8], k, variant;
+    frm_real state[3][8 * 13];
+    frm_sampling s;
+    for (k = 0; k < 8; k++) {
+        hex[k] = k;
+        nodes[3 * k] = (frm_real)(k & 1);
+        nodes[3 * k + 1] = (frm_real)(0.2 * ((k >> 1) & 1));
+        nodes[3 * k + 2] = (frm_real)(0.2 * ((k >> 2) & 1));
+    }
+    REQUIRE(frm_sampling_hexes(&s, nodes, 8, hex, 1, 2, FRM_QUADRATURE_GAUSS, NULL) == FRM_OK);
+    for (variant = 0; variant < 3; variant++) { /* 0: implicit_linearized = 1, 1: integrator, 2: default */
+        frm_desc d = frm_model_default_desc();
+        frm_model *m = NULL;
+        int step, i;
+        frm_sampling_apply(&s, &d);
+        d.material.young_modulus = (frm_real)1e5;
+        if (variant == 0) d.implicit_linearized = 1;
+        if (variant == 1) d.integrator = FRM_IMPLICIT_EULER_LINEARIZED;
+        REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+        for (i = 0; i < 8; i++)
+            if (i % 2 == 0) frm_model_fix_frame(m, i);
+        for (step = 0; step < 5; step++) CHECK_INT(FRM_OK, frm_model_step(m));
+        memcpy(state[variant], frm_model_positions(m), sizeof(frm_real) * 24);
+        memcpy(state[variant] + 24, frm_model_orientations(m), sizeof(frm_real) * 32);
+        memcpy(state[variant] + 56, frm_model_velocities(m), sizeof(frm_real) * 48);
+        frm_model_destroy(m);
+    }
+    CHECK(memcmp(state[0], state[1], sizeof state[0]) == 0);
+    CHECK(memcmp(state[0], state[2], sizeof state[0]) != 0);
+    {
+        frm_desc d = frm_model_default_desc();
+        frm_model *m = NULL;
+        frm_sampling_apply(&s, &d);
+        d.integrator = FRM_INTEGRATOR_COUNT;
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_create(&d, &m));
+        d.integrator = (frm_integrator)-1;
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_create(&d, &m));
+        d.integrator = FRM_IMPLICIT_EULER;
+        d.linear_solver = FRM_LINEAR_SOLVER_COUNT;
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_create(&d, &m));
+        d.linear_solver = FRM_LINEAR_SOLVER_CG;
+        CHECK_INT(FRM_OK, frm_model_create(&d, &m));
+        frm_model_destroy(m);
+    }
+    frm_sampling_free(&s);
+    /* the tables cover their enums (also a compile-time assert in frames.h) */
+    CHECK_INT(FRM_INTEGRATOR_COUNT, (int)(sizeof frm__integrators / sizeof frm__integrators[0]));
+    CHECK_INT(FRM_LAW_COUNT, (int)(sizeof frm__laws / sizeof frm__laws[0]));
+    for (k = 0; k < FRM_INTEGRATOR_COUNT; k++) CHECK(frm__integrators[k].name && frm__integrators[k].step);
+    for (k = 0; k < FRM_LAW_COUNT; k++)
+        CHECK(frm__laws[k].name && frm__laws[k].energy && frm__laws[k].stress && frm__laws[k].differential &&
+              frm__laws[k].cache_size <= FRM__LAW_CACHE_MAX);
+}
+
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
@@ -1261,6 +1323,7 @@ static const test_case cases[] = {
     TEST(test_law_uniaxial_closed_forms),
     TEST(test_law_model_path),
     TEST(test_law_validation),
+    TEST(test_integrator_choice),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
