@@ -1947,7 +1947,6 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
-#define FRM__VECS 10          /* 6n scratch vectors */
 #define FRM__IS_FLOAT (sizeof(frm_real) == sizeof(float))
 /* tolerance on sum w = 1 and sum grad w = 0 (relative to sum |grad w|): a few roundings
    of 16 terms in frm_real */
@@ -1962,16 +1961,6 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__DRIVEN 2
 
 /* scratch vector roles (6 per frame each) */
-#define FRM__V_R 0     /* CG residual */
-#define FRM__V_Z 1     /* CG preconditioned residual */
-#define FRM__V_P 2     /* CG direction */
-#define FRM__V_Q 3     /* CG A p */
-#define FRM__V_X 4     /* solution (Newton step, velocity change) */
-#define FRM__V_B 5     /* right-hand side */
-#define FRM__V_F 6     /* total generalized force */
-#define FRM__V_T 7     /* temporary */
-#define FRM__V_DV 8    /* previous velocity change (warm start) */
-#define FRM__V_DRIVE 9 /* driven frames' velocity change */
 
 struct frm_model {
     int frame_count, sample_count, pair_count, block_count, sq_total;
@@ -2059,7 +2048,14 @@ struct frm_model {
     int *chunk_err;
 
     /* scratch */
-    frm_real *vec[FRM__VECS];
+    /* 6 reals per frame each, named by role */
+    frm_real *cg_r, *cg_z, *cg_p, *cg_q; /* CG residual, preconditioned residual, direction, A p */
+    frm_real *newton_dx;                 /* a Newton iteration's solution (step, velocity change) */
+    frm_real *newton_rhs;                /* its right-hand side */
+    frm_real *total_force;               /* total generalized force */
+    frm_real *work;                      /* temporary: a load, a trial force, K v */
+    frm_real *warm_dv;                   /* the previous step's velocity change (CG warm start) */
+    frm_real *drive_dv;                  /* driven frames' velocity change (Newton step: their dq) */
     frm_real *backup;      /* 13 per frame: position, orientation, velocity */
     frm_real *start_state; /* 13 per frame: the state a static solve started from */
 
@@ -2644,7 +2640,6 @@ static void frm__layout(frm_model *m, frm__carver *c)
 {
     size_t n = (size_t)m->frame_count, S = (size_t)m->sample_count, P = (size_t)m->pair_count;
     size_t B = (size_t)m->block_count, sq = (size_t)m->sq_total;
-    int k;
     FRM__CARVE(c, m->disp, frm_real, 3 * n);
     FRM__CARVE(c, m->pos, frm_real, 3 * n);
     FRM__CARVE(c, m->quat, frm_real, 4 * n);
@@ -2719,7 +2714,16 @@ static void frm__layout(frm_model *m, frm__carver *c)
     if (m->stab_on) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
-    for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_r, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_z, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_p, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_q, frm_real, 6 * n);
+    FRM__CARVE(c, m->newton_dx, frm_real, 6 * n);
+    FRM__CARVE(c, m->newton_rhs, frm_real, 6 * n);
+    FRM__CARVE(c, m->total_force, frm_real, 6 * n);
+    FRM__CARVE(c, m->work, frm_real, 6 * n);
+    FRM__CARVE(c, m->warm_dv, frm_real, 6 * n);
+    FRM__CARVE(c, m->drive_dv, frm_real, 6 * n);
     FRM__CARVE(c, m->backup, frm_real, 13 * n);
     FRM__CARVE(c, m->start_state, frm_real, 13 * n);
 }
@@ -4316,7 +4320,7 @@ static double frm__dot(const frm_model *m, const frm_real *a, const frm_real *b)
    fixed order. */
 static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
-    frm_real *r = m->vec[FRM__V_R], *z = m->vec[FRM__V_Z], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
+    frm_real *r = m->cg_r, *z = m->cg_z, *p = m->cg_p, *q = m->cg_q;
     int k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
     double bb, rr, rz, tol2;
     frm__mask(m, b);
@@ -4537,7 +4541,7 @@ static double frm__potential_change(const frm_model *m, double W, double W0, con
    (f: the total force, m->force the internal one). */
 static double frm__static_scale(const frm_model *m, const frm_real *f, double *load_norm)
 {
-    frm_real *load = m->vec[FRM__V_T];
+    frm_real *load = m->work;
     double l, reaction;
     int k;
     for (k = 0; k < 6 * m->frame_count; k++) load[k] = f[k] - m->force[k];
@@ -4554,7 +4558,7 @@ static double frm__static_scale(const frm_model *m, const frm_real *f, double *l
    |f| after, *scale the residual's scale. */
 static int frm__newton_iteration(frm_model *m, int first, double tol, int *converged, double *res, double *scale)
 {
-    frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X], *trial_f = m->vec[FRM__V_T];
+    frm_real *f = m->total_force, *dq = m->newton_dx, *trial_f = m->work;
     double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta, ref;
     int err, h, attempt, accepted = 0;
     *converged = 0;
@@ -4803,7 +4807,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     memcpy(m->ext, m->ext_full, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     m->stats.residual_force = (frm_real)res;
     m->stats.residual = (frm_real)(scale > 0 ? res / scale : (res > 0 ? HUGE_VAL : 0));
-    memset(m->vec[FRM__V_DV], 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    memset(m->warm_dv, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     if (err) {
         memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
         frm__restore_state(m);
@@ -4845,8 +4849,8 @@ static int frm__drive_velocities(frm_model *m, double dt, frm_real *drive)
    targets, which enter the right-hand side through K. */
 static int frm__implicit_linearized(frm_model *m, double dt)
 {
-    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
-    frm_real *drive = m->vec[FRM__V_DRIVE];
+    frm_real *f = m->total_force, *b = m->newton_rhs, *dv = m->newton_dx, *t = m->work;
+    frm_real *drive = m->drive_dv;
     double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
     int err, i, k, cg, attempt, any_driven;
     frm__save_state(m);
@@ -4870,7 +4874,7 @@ static int frm__implicit_linearized(frm_model *m, double dt)
             frm__stiffness_product(m, drive, t, 0);
             for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
         }
-        memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
+        memcpy(dv, m->warm_dv, sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
         cg = frm__linear_solve(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
         if (attempt || cg != FRM__CG_NEGATIVE) break;
         /* M + dt^2 K is indefinite here (compressed samples, the rotations' second-order terms,
@@ -4907,7 +4911,7 @@ static int frm__implicit_linearized(frm_model *m, double dt)
         frm__restore_state(m);
         return err;
     }
-    memcpy(m->vec[FRM__V_DV], dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    memcpy(m->warm_dv, dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     frm__update_frames(m);
     m->lin_valid = 0;
     m->stats.newton_iterations = 1;
@@ -4940,12 +4944,14 @@ static void frm__step_displacement(const frm_model *m, frm_real *dq)
    their targets from the first iteration. */
 static int frm__implicit_newton(frm_model *m, double dt)
 {
-    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X];
-    frm_real *dq = m->vec[FRM__V_DRIVE], *kd = m->vec[FRM__V_P];
+    frm_real *f = m->total_force, *b = m->newton_rhs, *dv = m->newton_dx;
+    /* kd and kq share CG's direction and residual: they are used between CG solves only
+       and recomputed after each (the one place these roles alias) */
+    frm_real *dq = m->drive_dv, *kd = m->cg_p;
     double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
     double a_mass = 1.0 + dt * alpha_d, a_stiff = dt * dt + dt * beta_d, ref = 0, norm = 0, previous = 0;
     int err, i, k, it, cg = FRM__CG_CAP, attempt, converged = 0, n6 = 6 * m->frame_count;
-    frm_real *kq = m->vec[FRM__V_R]; /* K dq; CG overwrites it, so it is recomputed after */
+    frm_real *kq = m->cg_r; /* K dq; CG overwrites it, so it is recomputed after */
     frm__copy_state(m, m->inc_state);
     frm__mass_update(m);
     frm__apply_driven(m);
@@ -4996,7 +5002,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
             if (eta > 1e-3) eta = 1e-3;
             if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
             if (it == 0) /* warm start: the new velocity, about the start one plus the last step's change */
-                for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->vec[FRM__V_DV][k];
+                for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->warm_dv[k];
             else
                 memset(dv, 0, sizeof(frm_real) * (size_t)n6);
             cg = frm__linear_solve(m, a_mass, a_stiff, eta, b, dv);
@@ -5075,7 +5081,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
         }
         for (k = 0; k < 6; k++) {
             if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
-            m->vec[FRM__V_DV][6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
+            m->warm_dv[6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
         }
     }
     return FRM_OK;
@@ -5355,8 +5361,8 @@ FRMDEF int frm_model_total_forces(frm_model *m, const frm_real **out)
     if (!m || !out) return FRM_ERR_ARG;
     err = frm__force_pass(m, 0, 0, NULL);
     if (err) return err;
-    frm__total_force(m, m->vec[FRM__V_F]);
-    *out = m->vec[FRM__V_F];
+    frm__total_force(m, m->total_force);
+    *out = m->total_force;
     return FRM_OK;
 }
 
