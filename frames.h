@@ -3174,19 +3174,25 @@ static int frm__invisible_rotations(const frm_desc *d, const int *rev_start, con
 static void frm__update_frames(frm_model *m);
 static void frm__rest_diagonal(frm_model *m);
 
-FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
-{
-    frm_model tmp, *m;
-    frm__carver carver;
-    frm_allocator alloc;
-    int err, i, s, p, k, n, S, P, *marker, *rev_start, *rev_pair, *pair_sample, *cursor;
-    size_t tmp_bytes;
-    char *tmp_block;
-    char msg[120];
+/* Creation reads top to bottom: validate the description, size the model (temporary
+   frame -> pair tables, block pattern and stabilisation counts), lay out its one block of
+   memory, precompute what the rest state determines. */
 
-    if (!out) return FRM_ERR_ARG;
-    *out = NULL;
-    if (!d) return FRM_ERR_ARG;
+/* The temporary tables of creation, one allocation: marker[n], cursor[n], rev_start[n+1],
+   rev_pair[P], pair_sample[P]. */
+typedef struct frm__create_tables {
+    char *block;
+    size_t bytes;
+    int *marker, *cursor, *rev_start, *rev_pair, *pair_sample;
+} frm__create_tables;
+
+/* Stage 1: every check of the description (counts, settings, materials, neighbour table). */
+static int frm__create_validate(const frm_desc *d)
+{
+    frm_allocator alloc;
+    size_t bytes;
+    char *block;
+    int err;
     /* not made by frm_model_default_desc: every field, the log callback included, may be
        garbage, so refuse without calling it */
     if (d->internal_cookie != FRM__COOKIE) return FRM_ERR_DESC;
@@ -3198,86 +3204,107 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, "the four neighbour arrays are required");
     err = frm__validate_settings(d);
     if (err) return err;
-    n = d->frame_count;
-    S = d->sample_count;
     alloc = d->allocator;
+    bytes = sizeof(int) * (size_t)d->frame_count;
+    block = (char *)frm__alloc(&alloc, bytes);
+    if (!block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    err = frm__validate(d, (int *)block);
+    frm__free(&alloc, block, bytes);
+    return err;
+}
 
-    tmp_bytes = sizeof(int) * (size_t)n;
-    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
-    err = frm__validate(d, (int *)tmp_block);
-    frm__free(&alloc, tmp_block, tmp_bytes);
-    if (err) return err;
+static void frm__create_free_tables(const frm_desc *d, frm__create_tables *t)
+{
+    frm_allocator alloc = d->allocator;
+    frm__free(&alloc, t->block, t->bytes);
+    t->block = NULL;
+}
 
-    /* temporary tables: marker[n], cursor[n], rev_start[n+1], rev_pair[P], pair_sample[P] */
-    P = d->neighbor_start[S];
-    tmp_bytes = sizeof(int) * (3 * (size_t)n + 1 + 2 * (size_t)P);
-    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
-    marker = (int *)tmp_block;
-    cursor = marker + n;
-    rev_start = cursor + n;
-    rev_pair = rev_start + n + 1;
-    pair_sample = rev_pair + P;
-    frm__build_reverse(n, S, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample, cursor);
+/* Stage 2: the temporary tables and every count the layout needs, into *tmp. */
+static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_tables *t)
+{
+    frm_allocator alloc = d->allocator;
+    int n = d->frame_count, S = d->sample_count, P = d->neighbor_start[S], i, s;
+    t->bytes = sizeof(int) * (3 * (size_t)n + 1 + 2 * (size_t)P);
+    t->block = (char *)frm__alloc(&alloc, t->bytes);
+    if (!t->block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    t->marker = (int *)t->block;
+    t->cursor = t->marker + n;
+    t->rev_start = t->cursor + n;
+    t->rev_pair = t->rev_start + n + 1;
+    t->pair_sample = t->rev_pair + P;
+    frm__build_reverse(n, S, d->neighbor_start, d->neighbor_frames, t->rev_start, t->rev_pair, t->pair_sample,
+                       t->cursor);
 
-    memset(&tmp, 0, sizeof tmp);
-    tmp.frame_count = n;
-    tmp.sample_count = S;
-    tmp.pair_count = P;
-    tmp.sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
-    tmp.frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
-    tmp.has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
-    if (tmp.has_blocks) {
+    memset(tmp, 0, sizeof *tmp);
+    tmp->frame_count = n;
+    tmp->sample_count = S;
+    tmp->pair_count = P;
+    tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
+    tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
+    tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    if (tmp->has_blocks) {
         long long blocks, sq = 0;
-        for (i = 0; i < n; i++) marker[i] = -1;
-        blocks = frm__block_pattern(n, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample,
-                                    marker, NULL, NULL);
+        for (i = 0; i < n; i++) t->marker[i] = -1;
+        blocks = frm__block_pattern(n, d->neighbor_start, d->neighbor_frames, t->rev_start, t->rev_pair,
+                                    t->pair_sample, t->marker, NULL, NULL);
         for (s = 0; s < S; s++) {
             long long c = d->neighbor_start[s + 1] - d->neighbor_start[s];
             sq += c * c;
         }
         if (blocks > 200000000 || sq > 2000000000) {
-            frm__free(&alloc, tmp_block, tmp_bytes);
+            frm__create_free_tables(d, t);
             return frm__fail(d, FRM_ERR_ALLOC, "block pattern too large; use FRM_STIFFNESS_PAIRS");
         }
-        tmp.block_count = (int)blocks;
-        tmp.sq_total = (int)sq;
+        tmp->block_count = (int)blocks;
+        tmp->sq_total = (int)sq;
     }
-    tmp.stab_beta = d->rotation_stabilization;
-    tmp.stab_gamma = d->rotation_divergence;
-    if (tmp.stab_beta > 0)
+    tmp->stab_beta = d->rotation_stabilization;
+    tmp->stab_gamma = d->rotation_divergence;
+    if (tmp->stab_beta > 0)
         for (i = 0; i < n; i++) {
             double N[6];
-            tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+            tmp->stab_frames += frm__invisible_rotations(d, t->rev_start, t->rev_pair, t->pair_sample, i, N);
         }
-    tmp.stab_on = tmp.stab_frames > 0 || tmp.stab_gamma > 0;
-    tmp.user_law_count = d->materials ? d->material_count : 1;
+    tmp->stab_on = tmp->stab_frames > 0 || tmp->stab_gamma > 0;
+    tmp->user_law_count = d->materials ? d->material_count : 1;
     for (s = 0; s < S; s++) {
         const frm_material *mat =
             d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
-        if (frm__laws[mat->law].cache_size > tmp.law_cache) tmp.law_cache = frm__laws[mat->law].cache_size;
+        if (frm__laws[mat->law].cache_size > tmp->law_cache) tmp->law_cache = frm__laws[mat->law].cache_size;
     }
+    return FRM_OK;
+}
+
+/* Stage 3: measure, allocate (zeroed) and carve the model's one block; the model struct
+   sits at its start. */
+static int frm__create_layout(const frm_desc *d, frm_model *tmp, frm_model **out)
+{
+    frm__carver carver;
+    frm_allocator alloc = d->allocator;
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
-    frm__layout(&tmp, &carver);
-    tmp.block_bytes = carver.offset;
-    tmp.block = frm__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        frm__free(&alloc, tmp_block, tmp_bytes);
-        return frm__fail(d, FRM_ERR_ALLOC, "model block");
-    }
-    memset(tmp.block, 0, tmp.block_bytes);
-    carver.base = (char *)tmp.block;
+    frm__layout(tmp, &carver);
+    tmp->block_bytes = carver.offset;
+    tmp->block = frm__alloc(&alloc, tmp->block_bytes);
+    if (!tmp->block) return frm__fail(d, FRM_ERR_ALLOC, "model block");
+    memset(tmp->block, 0, tmp->block_bytes);
+    carver.base = (char *)tmp->block;
     carver.offset = sizeof(frm_model);
-    frm__layout(&tmp, &carver);
-    m = (frm_model *)tmp.block;
-    *m = tmp;
+    frm__layout(tmp, &carver);
+    *out = (frm_model *)tmp->block;
+    **out = *tmp;
+    (*out)->allocator = alloc;
+    return FRM_OK;
+}
 
-    m->allocator = alloc;
+/* Stage 4a: the settings the solvers read. */
+static void frm__create_settings(frm_model *m, const frm_desc *d)
+{
+    int k;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = P >= d->parallel_min_pairs;
+    m->parallel = m->pair_count >= d->parallel_min_pairs;
     for (k = 0; k < 3; k++) m->gravity[k] = d->gravity[k];
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
@@ -3295,8 +3322,12 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->load_scale = 1;
     m->stiffness_mode = d->stiffness_mode;
     m->regularization = (double)d->static_regularization;
+}
 
-    /* frames */
+/* Stage 4b: frames' rest poses, the reverse table, the frames with unseen rotations. */
+static void frm__create_frames(frm_model *m, const frm_desc *d, const frm__create_tables *t)
+{
+    int n = m->frame_count, P = m->pair_count, i, k;
     memcpy(m->rest_pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
     memcpy(m->pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
     for (i = 0; i < n; i++) {
@@ -3308,19 +3339,23 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         memcpy(m->target + 7 * i, m->rest_pos + 3 * i, 3 * sizeof(frm_real));
         memcpy(m->target + 7 * i + 3, q, 4 * sizeof(frm_real));
     }
-    memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
-    memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
-    memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
+    memcpy(m->rev_start, t->rev_start, sizeof(int) * ((size_t)n + 1));
+    memcpy(m->rev_pair, t->rev_pair, sizeof(int) * (size_t)P);
+    memcpy(m->p_sample, t->pair_sample, sizeof(int) * (size_t)P);
     if (m->stab_frames) /* beta N: the unseen rotations of frames with collinear samples */
         for (i = 0; i < n; i++) {
             double N[6];
-            m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+            m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, t->rev_start, t->rev_pair, t->pair_sample, i, N);
             for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)(N[k] * (double)m->stab_beta);
-            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
+            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++)
+                m->s_stab[t->pair_sample[m->rev_pair[k]]] = 1;
         }
+}
 
-
-    /* samples */
+/* Stage 4c: samples' rest data and laws (parameter blocks, user callbacks). */
+static void frm__create_samples(frm_model *m, const frm_desc *d)
+{
+    int S = m->sample_count, s;
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
     memcpy(m->s_volume, d->sample_volumes, sizeof(frm_real) * (size_t)S);
     memcpy(m->s_start, d->neighbor_start, sizeof(int) * ((size_t)S + 1));
@@ -3336,8 +3371,14 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             m->s_user[s] = m->user_laws + u;
         }
     }
+}
 
-    /* pairs: lbar = Rbar^T (pbar_s - xbar_i) (eq. 3.33), in double */
+/* Stage 4d: pairs' weights, gradients and rest levers lbar = Rbar^T (pbar_s - xbar_i)
+   (eq. 3.33, in double); per sample the coupling constant, the stabilisation's h^2 and
+   the smallest lever h_min. */
+static void frm__create_pairs(frm_model *m, const frm_desc *d)
+{
+    int S = m->sample_count, P = m->pair_count, s, p;
     memcpy(m->p_frame, d->neighbor_frames, sizeof(int) * (size_t)P);
     memcpy(m->p_weight, d->neighbor_weights, sizeof(frm_real) * (size_t)P);
     memcpy(m->p_grad, d->neighbor_gradients, sizeof(frm_real) * 3 * (size_t)P);
@@ -3378,32 +3419,72 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             else m->s_hstab[s] = 0; /* zero-order (Shepard): left to the thesis's model */
         }
     }
+}
+
+/* Stage 4e: the block pattern and the block index of every (pair, other slot of its
+   sample). */
+static void frm__create_blocks(frm_model *m, int *marker)
+{
+    int n = m->frame_count, S = m->sample_count, i, s;
+    if (!m->has_blocks) return;
+    for (i = 0; i < n; i++) marker[i] = -1;
+    frm__block_pattern(n, m->s_start, m->p_frame, m->rev_start, m->rev_pair, m->p_sample, marker, m->blk_start,
+                       m->blk_col);
+    m->sq_start[0] = 0;
+    for (s = 0; s < S; s++) {
+        int b = m->s_start[s], c = m->s_start[s + 1] - b, a, q;
+        m->sq_start[s + 1] = m->sq_start[s] + c * c;
+        for (a = 0; a < c; a++)
+            for (q = 0; q < c; q++)
+                m->pair_blk[m->sq_start[s] + a * c + q] = frm__find_block(m, m->p_frame[b + a], m->p_frame[b + q]);
+    }
+}
+
+/* Stage 4: everything the rest state determines; fails only on a frame without mass. */
+static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_tables *t)
+{
+    char msg[120];
+    int i;
+    frm__create_settings(m, d);
+    frm__create_frames(m, d, t);
+    frm__create_samples(m, d);
+    frm__create_pairs(m, d);
     i = frm__compute_masses(m, d);
     if (i >= 0) {
-        frm__free(&alloc, tmp_block, tmp_bytes);
-        frm__free(&alloc, m->block, m->block_bytes);
         snprintf(msg, sizeof msg, "frame %d carries no mass", i);
         return frm__fail(d, FRM_ERR_FRAME_UNUSED, msg);
     }
-
-    /* block pattern and the block index of every (pair, other slot of its sample) */
-    if (m->has_blocks) {
-        for (i = 0; i < n; i++) marker[i] = -1;
-        frm__block_pattern(n, m->s_start, m->p_frame, m->rev_start, m->rev_pair, m->p_sample, marker, m->blk_start,
-                           m->blk_col);
-        m->sq_start[0] = 0;
-        for (s = 0; s < S; s++) {
-            int b = m->s_start[s], c = m->s_start[s + 1] - b, a, q;
-            m->sq_start[s + 1] = m->sq_start[s] + c * c;
-            for (a = 0; a < c; a++)
-                for (q = 0; q < c; q++)
-                    m->pair_blk[m->sq_start[s] + a * c + q] = frm__find_block(m, m->p_frame[b + a], m->p_frame[b + q]);
-        }
-    }
-    frm__free(&alloc, tmp_block, tmp_bytes);
+    frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
+{
+    frm_model tmp, *m = NULL;
+    frm__create_tables tables;
+    frm_allocator alloc;
+    int err;
+    if (!out) return FRM_ERR_ARG;
+    *out = NULL;
+    if (!d) return FRM_ERR_ARG;
+    memset(&tables, 0, sizeof tables);
+    err = frm__create_validate(d);
+    if (err) return err;
+    err = frm__create_size(d, &tmp, &tables);
+    if (err) return err;
+    err = frm__create_layout(d, &tmp, &m);
+    if (!err) err = frm__create_precompute(m, d, &tables);
+    frm__create_free_tables(d, &tables);
+    if (err) {
+        if (m) {
+            alloc = m->allocator;
+            frm__free(&alloc, m->block, m->block_bytes);
+        }
+        return err;
+    }
     *out = m;
     return FRM_OK;
 }
