@@ -6,8 +6,9 @@
    position and a unit quaternion), and integrated at samples, points that know their
    neighbouring frames through shape functions. Mesh-based (tetrahedral barycentric or
    hexahedral trilinear) and meshless (Shepard, linear moving least squares) shape
-   functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff and
-   compressible Neo-Hookean samples, exact forces and stiffness (material and geometric),
+   functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
+   compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
+   samples, exact forces and stiffness (material and geometric),
    a static Newton solver and implicit Euler, both with block-Jacobi conjugate gradient,
    matrix-free or by assembled 6x6 blocks. The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
@@ -95,6 +96,48 @@
           frm_model_sample_positions / _deformation_gradients, to render or measure.
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
+   HOW TO EXTEND (each kind of extension has one table or switch; add a row, not a branch)
+       A constitutive law: a value before FRM_LAW_COUNT in frm_law (public, documented
+          with its energy and the frm_material fields it reads); in frm__law_params what
+          its FRM_LAW_PARAMS block holds (and the small-strain shear modulus that scales
+          the stabilisation and the coupling); one row of frm__laws[] (>>laws) with its
+          name, cache_size (raise FRM__LAW_CACHE_MAX if needed), energy, stress (S, energy,
+          tangent data; FRM_ERR_INVERTED where the law is undefined), differential (dS for
+          dE), definite (NULL, or how the tangent data keep the material term >= 0 for the
+          static solve's definite linearisation) and fast_path = 0. An isotropic law in
+          invariants only needs its w and derivatives next to frm__mr_derivatives. Set
+          fast_path only if frm_material_stress / frm_material_dstress (>>kernels, shared
+          with a CUDA build) implement the law, and validation in frm__validate_material
+          for its fields. The model's loops call frm__law_stress, frm__law_dstress,
+          frm__law_dP and the law's definite rule, never the law by name.
+          Tests (tests/test_frames_elem.c, test_law_*): add the law's material to
+          law_material; then force = -gradient of the table's energy and differential =
+          derivative of the stress at the law level and through the model (force and K v
+          against finite differences) run for it by themselves; add its uniaxial closed
+          form to test_law_uniaxial_closed_forms where it has one (REFERENCES R4, R5).
+       An integrator: a value before FRM_INTEGRATOR_COUNT in frm_integrator and one row of
+          frm__integrators[] (>>integrator) with name, step(m, dt) (restores the step's start
+          state on failure) and is_explicit. Linear solves go through frm__linear_solve.
+          Tests: its order of accuracy on an oscillator (halve dt, the error falls by
+          2^order), energy behaviour on a free body, bit-identical results for 1 and 2
+          threads (the determinism test of tests/test_frames.c), refusal of bad values.
+       A linear solver: a value before FRM_LINEAR_SOLVER_COUNT in frm_linear_solver and a
+          case in frm__linear_solve (>>solver) returning the FRM__CG_* statuses (OK, CAP,
+          NEGATIVE, NOT_FINITE), which the Newton loops map to FRM_ERR_NO_CONVERGENCE and
+          FRM_ERR_NOT_FINITE. Scratch vectors are named by role in frm_model (cg_r, ...,
+          newton_dx) and carved in frm__layout. Tests: the same solutions as CG to the
+          tolerance on the static and implicit scenes of tests/test_frames.c, the cap and
+          non-finite policies (issue 18).
+       A shape function: a frm__*_functions evaluator (>>shape-functions) returning weights
+          and gradients, a public frm_shape_* wrapper (with a float rename, and listed in
+          tests/test_frames_elem.c's test_float_renames) and a frm_shape value used by
+          frm_sampling_meshless. Tests: partition of unity and zero-sum gradients, linear
+          reproduction where claimed, gradients against finite differences.
+       The bench (make bench, bench/model_frames.c) must show no loss on the existing
+       scenes (or callgrind instruction counts of the force and K v loop, which are
+       deterministic on a busy machine) and, for a new law or solver, its cost and
+       accuracy on the bench's scenes next to the existing ones.
+
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, volumes m^3,
    time s, forces N, torques N m, rotations rad (world axes), gravity m/s^2 (default 9.81
    along -z), mass_damping 1/s, stiffness_damping s.
@@ -168,9 +211,12 @@
        (g_ij, p_j the columns of G_i and P). The printed eq. 3.49 repeats [B]^4 where
        [B]^3 belongs, and the cross-product matrix of eq. A.3 has its last row's middle
        sign wrong ((-v1, v0, 0) is right); the finite-difference tests decided.
-       Laws (per sample): St Venant-Kirchhoff S = lambda tr(E) I + 2 mu E (eq. 3.53) and
+       Laws (per sample): St Venant-Kirchhoff S = lambda tr(E) I + 2 mu E (eq. 3.53),
        compressible Neo-Hookean W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
-       S = mu (I - C^-1) + lambda ln J C^-1.
+       S = mu (I - C^-1) + lambda ln J C^-1, compressible Mooney-Rivlin (heml.h's
+       HEML_MOONEY_RIVLIN) W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3) + kappa/2 (J - 1)^2,
+       and user laws W(I1, I2, J) by callbacks; the last two through
+       S = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1 (see >>laws).
        Stiffness, K = -df/dq (the thesis writes K = df/dq). Differentiating f:
            K v = sum_s v_s B^T vec(dP) + H dtheta,  dP = dF S + F dS,  dS = C : sym(F^T dF)
        where F dS is the material part (eqs. 3.67-3.70), dF S the geometric part of
@@ -355,7 +401,8 @@
        the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
        far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
        K's positive-definite part K+: the material term (positive for SVK; Neo-Hookean with
-       2 (mu - lambda ln J) kept >= 0), the geometric term dF S with the positive part of
+       2 (mu - lambda ln J) kept >= 0; Mooney-Rivlin and user laws as they are, so their
+       first static iterations may meet negative curvature), the geometric term dF S with the positive part of
        S, each frame's own rotational term (its pairs' derivative of B through the frame's
        rotation, gravity's torque, the coupling's and the stabilisation's second-order
        parts, summed) replaced by its positive part, and the stabilisation's Gauss-Newton
@@ -548,6 +595,13 @@
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
    HISTORY
+       unreleased (issue 20): extension points. Laws through one table (frm__laws) with a
+             per-sample parameter block (FRM_LAW_PARAMS) and FRM_LAW_COUNT; new laws
+             FRM_LAW_MOONEY_RIVLIN (frm_material.c1, c2, bulk_modulus) and FRM_LAW_USER
+             (frm_material.user, frm_user_law / frm_law_points as in heml.h); integrators by
+             desc.integrator (frm_integrator, FRM_INTEGRATOR_COUNT; implicit_linearized = 1
+             still selects the linearised one); desc.linear_solver (frm_linear_solver, CG);
+             HOW TO EXTEND. Results of existing models bit-identical.
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
@@ -2509,12 +2563,17 @@ static inline void frm__law_dstress(int law, const frm_real *params, const frm_u
     else frm__laws[law].differential(params, user, cache, dE, dS);
 }
 
-/* dP = dF S + F dS, dS = dS/dE : sym(F^T dF) (frm_sample_dP through the law table). */
+/* dP = dF S + F dS, dS = dS/dE : sym(F^T dF): frm_sample_dP for a fast_path law,
+   otherwise the same steps with the law's differential. */
 static inline void frm__law_dP(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
                                const frm_real F[9], const frm_real S[6], const frm_real dF[9], frm_real dP[9])
 {
     frm_real dE[6], dS[6], t[9];
     int r, c;
+    if (frm__laws[law].fast_path) {
+        frm_sample_dP(law, params[0], params[1], cache, F, S, dF, dP);
+        return;
+    }
     for (r = 0; r < 3; r++) /* t = F^T dF */
         for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
     dE[0] = t[0];
@@ -2523,7 +2582,7 @@ static inline void frm__law_dP(int law, const frm_real *params, const frm_user_l
     dE[3] = (frm_real)0.5 * (t[5] + t[7]);
     dE[4] = (frm_real)0.5 * (t[2] + t[6]);
     dE[5] = (frm_real)0.5 * (t[1] + t[3]);
-    frm__law_dstress(law, params, user, cache, dE, dS);
+    frm__laws[law].differential(params, user, cache, dE, dS);
     frm_first_piola(dF, S, dP);
     frm_first_piola(F, dS, t);
     for (r = 0; r < 9; r++) dP[r] += t[r];
@@ -2535,6 +2594,10 @@ static void frm__law_tangent_columns(int law, const frm_real *params, const frm_
                                      const frm_real G[9], frm_real cols[54])
 {
     int c, k;
+    if (frm__laws[law].fast_path) {
+        frm_pair_tangent_columns(law, params[0], params[1], cache, F, S, grad, G, cols);
+        return;
+    }
     for (c = 0; c < 6; c++) {
         frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9];
         for (k = 0; k < 9; k++) dF[k] = 0;
