@@ -5075,6 +5075,48 @@ static void frm__step_displacement(const frm_model *m, frm_real *dq)
     frm__mask(m, dq);
 }
 
+/* The implicit Newton's residual r = dt f - M (v - v_t) - dt D v (momentum, N s), with
+   dq = dt v the step's displacement and kq = K dq (zero without stiffness damping). */
+static void frm__implicit_residual(const frm_model *m, double dt, const frm_real *f, const frm_real *dq,
+                                   const frm_real *kq, frm_real *b)
+{
+    double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        double mq[6], mv[6];
+        frm__mass_apply(m, i, dq + 6 * i, mq);
+        frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
+        for (k = 0; k < 6; k++)
+            b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
+                                      beta_d * (double)kq[6 * i + k]);
+    }
+    frm__mask(m, b);
+}
+
+/* After a converged implicit step: velocities are the step's displacement over dt (driven
+   frames: the same, fixed: zero); their change is the next step's CG warm start. */
+static void frm__implicit_velocities(frm_model *m, double dt)
+{
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *s = m->inc_state + 13 * (size_t)i;
+        frm_real *v = m->vel + 6 * i, w[3];
+        if (m->state[i] == FRM__FIXED) {
+            for (k = 0; k < 6; k++) v[k] = 0;
+            continue;
+        }
+        frm__quat_delta(s + 3, m->quat + 4 * i, w);
+        for (k = 0; k < 3; k++) {
+            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
+            v[3 + k] = (frm_real)((double)w[k] / dt);
+        }
+        for (k = 0; k < 6; k++) {
+            if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
+            m->warm_dv[6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
+        }
+    }
+}
+
 /* Implicit Euler as the minimisation of the step's incremental potential (our form of eq.
    3.64 taken to convergence). With dq the step's displacement, v = dq / dt, v_t the start
    velocity, M the mass at the start of the step and D = alpha M + beta K:
@@ -5111,16 +5153,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
             frm__step_displacement(m, dq);
             if (beta_d != 0) frm__stiffness_product(m, dq, kq, 0);
             else memset(kq, 0, sizeof(frm_real) * (size_t)n6);
-            /* r = dt f - M (v - v_t) - dt D v, with dq = dt v */
-            for (i = 0; i < m->frame_count; i++) {
-                double mq[6], mv[6];
-                frm__mass_apply(m, i, dq + 6 * i, mq);
-                frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
-                for (k = 0; k < 6; k++)
-                    b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
-                                              beta_d * (double)kq[6 * i + k]);
-            }
-            frm__mask(m, b);
+            frm__implicit_residual(m, dt, f, dq, kq, b);
             norm = sqrt(frm__dot(m, b, b));
             if (!frm__finite(norm)) return FRM_ERR_NOT_FINITE;
             if (it == 0 && attempt == 0) {
@@ -5210,24 +5243,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
     m->stats.residual_force = (frm_real)norm;
     m->stats.residual = (frm_real)(ref > 0 ? norm / ref : 0);
     if (!converged) return FRM_ERR_NO_CONVERGENCE;
-    /* velocities: the step's displacement over dt (driven frames: the same, fixed: zero) */
-    for (i = 0; i < m->frame_count; i++) {
-        const frm_real *s = m->inc_state + 13 * (size_t)i;
-        frm_real *v = m->vel + 6 * i, w[3];
-        if (m->state[i] == FRM__FIXED) {
-            for (k = 0; k < 6; k++) v[k] = 0;
-            continue;
-        }
-        frm__quat_delta(s + 3, m->quat + 4 * i, w);
-        for (k = 0; k < 3; k++) {
-            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
-            v[3 + k] = (frm_real)((double)w[k] / dt);
-        }
-        for (k = 0; k < 6; k++) {
-            if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
-            m->warm_dv[6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
-        }
-    }
+    frm__implicit_velocities(m, dt);
     return FRM_OK;
 }
 
