@@ -29,7 +29,8 @@
 
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 WARN := -Wall -Wextra -pedantic -Werror
-HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/test.h tests/compile_all.h
+HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/test.h tests/compile_all.h \
+           tests/fixtures.h
 FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
 
 CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
@@ -119,11 +120,11 @@ BENCH_OBJS := $(foreach m,$(BENCH_MODELS),build/bench/$(m)_double.o build/bench/
 BENCH_GIT := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)$(shell git diff --quiet HEAD -- . ':!bench/results' 2>/dev/null || echo -dirty)
 BENCH_DEFS := -DBENCH_FLAGS='"$(BENCH_CFLAGS)"' -DBENCH_GIT='"$(BENCH_GIT)"'
 
-build/bench/%_double.o: bench/%.c bench/bench.h bench/body_mesh.h $(HEADERS)
+build/bench/%_double.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_common.h $(HEADERS)
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -c -o $@ $<
 
-build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h $(HEADERS)
+build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_common.h $(HEADERS)
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -DBENCH_FLOAT -c -o $@ $<
 

@@ -176,7 +176,8 @@
    cap, a CG solve at cg_max_iterations above its tolerance, a line search that finds no
    decrease, a continuation cut below min_increment or past max_increments; FRM_ERR_STALLED
    when its last increment stopped because the residual had not halved in 15 Newton
-   iterations, see LIMITS), or starts or ends with a state too far from rest for frm_real
+   iterations, see LIMITS), converges to a saddle rather than a minimum (FRM_ERR_UNSTABLE,
+   static solves: see SOLVERS), or starts or ends with a state too far from rest for frm_real
    (FRM_ERR_PRECISION: eps(frm_real) max|u| > precision_limit h_min, see LIMITS) leaves
    positions, orientations and velocities exactly as they were.
 
@@ -359,7 +360,16 @@
        once (smaller increments do not help it). Acceptance before success: the residual
        test above, every value finite, no sample inverted (det F <= 0: both laws refuse it), the
        precision check; frm_stats.negative_curvature counts the CG solves that met
-       non-positive curvature (each then redone with K+, below). Held axes' values (and
+       non-positive curvature (each then redone with K+, below). And the answer must be a
+       minimum (issue 18): a zero residual holds at saddles too, such as a squashed cube's
+       symmetric state past its bifurcation (LIMITS). A probe solve K x = b with the full
+       tangent at the answer (b a fixed pseudo-random vector on the free components, CG to
+       1e-7, float 1e-5) meets a direction p of negative curvature where K is indefinite;
+       p . K p below -1e3 eps sum_k |p_k (K p)_k| (its round-off) fails the solve with
+       FRM_ERR_UNSTABLE, state kept. It costs one more CG solve per static solve (R1's
+       25 x 5 x 5 frames: 2,574 CG iterations before, 6,263 with the probe; a probe at its
+       cap counts as a minimum). Hold the symmetric components (frm_model_set_frame_axes)
+       or nudge the state and solve again to reach a minimum. Held axes' values (and
        the rest of the state) are the starting point: they are not continued.
        static_regularization (default 1e-10; 1e-6 at least in the positive-definite
        attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
@@ -531,30 +541,32 @@
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
        - Spurious frame-rotation branch of coarse hexahedral frames in strong compression
-         (issue 18, measured; not fixed, not detected). The bench sweep's cube (1 m, 2 x 2 x
-         2 trilinear cells, 8 sub-cell samples each, bottom fixed, top driven down, nu =
-         0.45): squashed by half, Neo-Hookean, its symmetric equilibrium (the mirror
-         symmetries the continuum's unique answer has; frames' rotations held at zero) has W
-         = 348.09 J at E = 1 kPa, but an unstable one of the frames' model (the solves leave
-         it): two mirror images with the middle layer's frames turned up to 0.87 rad (0.67
-         rad from the mean material rotation of their samples) have W = 290.90 J, 16 % less,
-         and are the model's minima. The solves end there with success, in double too (8
-         increments), and which mirror they pick is round-off (float: one call and 8
-         increments 10-25 % of the largest displacement apart at every E from 1 Pa to 200
-         GPa; double: one call FRM_ERR_STALLED at the saddle). St Venant-Kirchhoff squashed
-         by a quarter: symmetric 0.038211 J (E = 1 Pa), a shallow branch 0.038210 J (0.06
-         rad, positions symmetric to 1e-5) and a deep one 0.033747 J (0.54 rad).
-         rotation_divergence moves it (16: 293.4 J, 0.80 rad; 64: every solve stalls) but
-         does not remove it at the default. No acceptance check separates it: the angle
-         between a free frame and the mean material rotation of its samples is 0.43-0.67 rad
-         on the branch and up to 0.62 rad in correct solves (tests/test_frames.c's uniaxial
-         cube). At 4 x 4 x 4 cells the same squash returns FRM_ERR_STALLED in one call and
-         in 8 increments (float; the symmetric state 280.50 J). Holding the free frames'
-         rotations (frm_model_set_frame_axes, rotation mask 7; zero is what the symmetries
-         impose here) gives the symmetric answer in 11 Newton iterations, one call and 8
-         increments 2e-5 apart in float; the sweep finds no wrong success with tetrahedral
-         frames. tests/test_frames.c test_i18_squashed_cube measures it; its strict checks
-         run with FRM_TEST_KNOWN_LIMITS set (and fail).
+         (issue 18, measured). The bench sweep's cube (1 m, 2 x 2 x 2 trilinear cells, 8
+         sub-cell samples each, bottom fixed, top driven down, nu = 0.45): squashed by
+         half, Neo-Hookean, its symmetric equilibrium (the mirror symmetries the
+         continuum's unique answer has; frames' rotations held at zero) has W = 348.09 J at
+         E = 1 kPa, but it is a saddle of the frames model: two mirror images with the
+         middle layer's frames turned up to 0.87 rad (0.67 rad from the mean material
+         rotation of their samples) have W = 290.90 J, 16 % less, and are the model's
+         minima (the minimum check finds no negative curvature there). St Venant-Kirchhoff
+         squashed by a quarter: the symmetric state 0.038211 J is a saddle too, a tilted
+         minimum 0.033747 J (0.54 rad). Before the minimum check (SOLVERS) the solves
+         returned the symmetric saddles with success (SVK in one call, Neo-Hookean in 8
+         increments in double); now they fail with FRM_ERR_UNSTABLE at the increment that
+         reaches one, and a one-call Neo-Hookean solve in float ends on a tilted minimum
+         with success: an answer of the model, mirror-asymmetric (25 % of the largest
+         displacement), not of the continuum; no acceptance check separates it (the angle
+         between a free frame and the mean material rotation of its samples is 0.43-0.67
+         rad there and up to 0.62 rad in correct solves: tests/test_frames.c's uniaxial
+         cube). rotation_divergence moves the branch (16: 293.4 J, 0.80 rad; 64: every
+         solve stalls) but does not remove it at the default. At 4 x 4 x 4 cells the same
+         squash returns FRM_ERR_STALLED in one call and in 8 increments (float; the
+         symmetric state 280.50 J). Holding the free frames' rotations
+         (frm_model_set_frame_axes, rotation mask 7; zero is what the symmetries impose
+         here) gives the symmetric answer in 11 Newton iterations, one call and 8
+         increments 2e-5 apart in float. tests/test_frames.c test_i18_squashed_cube
+         measures it (its symmetry checks run with FRM_TEST_KNOWN_LIMITS set, and fail in
+         float); test_i18_saddle_refused checks the saddle is refused.
        - Hexahedral frames with Gauss points lock in bending near incompressibility, like
          trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
@@ -784,13 +796,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_SAMPLING, -32, "sampling settings invalid (spacing, Gauss order, support) or too many points") \
     X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume") \
     X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept") \
-    X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept")
+    X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept") \
+    X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -36
+    FRM_ERR_LAST_ = -37
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -4899,6 +4912,49 @@ static void frm__set_load(frm_model *m, double lambda, const frm_real g_full[3])
     m->lin_valid = 0;
 }
 
+/* Is the converged static state a minimum? A zero residual holds at saddles too (a
+   squashed cube's symmetric state, which the model's tilted branches lie below: LIMITS).
+   A probe solve K x = b (b a fixed pseudo-random vector on the free components, K the
+   full tangent at the state, block-Jacobi CG to 1e-10, float 1e-5) meets a direction p of
+   negative curvature where K is indefinite. A saddle is reported when p . K p is below
+   -1e3 eps sum_k |p_k (K p)_k| (the round-off of that sum: a singular or nearly singular
+   positive semi-definite K, e.g. rotations held only by static_regularization, stays
+   within it). FRM_OK (a minimum as far as the probe sees, including a probe at its cap),
+   FRM_ERR_UNSTABLE or a force pass's error. */
+static int frm__check_minimum(frm_model *m)
+{
+    /* p, q: CG's direction and its product, which the probe reads after CG stops */
+    frm_real *b = m->newton_rhs, *x = m->newton_dx, *p = m->cg_p, *q = m->cg_q;
+    int k, cg, err, n6 = 6 * m->frame_count;
+    double pq = 0, scale = 0, eps = FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON;
+    err = frm__force_pass(m, 1, 0, NULL);
+    if (err) return err;
+    frm__prepare_mode(m, frm__choose_mode(m));
+    m->solve_regularization = m->regularization;
+    frm__build_precond(m, 0.0, 1.0);
+    for (k = 0; k < n6; k++) {
+        unsigned h = (unsigned)k * 2654435761u;
+        h ^= h >> 15;
+        h *= 2246822519u;
+        h ^= h >> 13;
+        b[k] = (frm_real)((double)(h & 0xffffu) / 32768.0 - 1.0);
+        x[k] = 0;
+    }
+    /* a curvature probe, not a linear solve: it needs CG's own direction of negative
+       curvature, so it calls CG whatever desc.linear_solver chose (the one direct call) */
+    cg = frm__cg(m, 0.0, 1.0, FRM__IS_FLOAT ? 1e-5 : 1e-7, b, x);
+    m->solve_regularization = 0;
+    if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
+    if (cg != FRM__CG_NEGATIVE) return FRM_OK;
+    frm__mask(m, p);
+    frm__mask(m, q);
+    for (k = 0; k < n6; k++) {
+        pq += (double)p[k] * (double)q[k];
+        scale += fabs((double)p[k] * (double)q[k]);
+    }
+    return pq < -1e3 * eps * scale ? FRM_ERR_UNSTABLE : FRM_OK;
+}
+
 FRMDEF int frm_model_solve_static(frm_model *m)
 {
     frm_real g_full[3];
@@ -4949,6 +5005,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     }
     for (r = 0; r < 3; r++) m->gravity[r] = g_full[r];
     memcpy(m->ext, m->ext_full, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    if (!err) err = frm__check_minimum(m);
     m->stats.residual_force = (frm_real)res;
     m->stats.residual = (frm_real)(scale > 0 ? res / scale : (res > 0 ? HUGE_VAL : 0));
     memset(m->warm_dv, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);

@@ -18,6 +18,7 @@
 #include "../examples/tetmesh.h"
 #include "bench.h"
 #include "body_mesh.h"
+#include "model_common.h"
 #include <math.h>
 #include <stdlib.h>
 
@@ -46,7 +47,7 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
         n = mesh.node_count;
         x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
         if (!x) return hexmesh_free(&mesh), FRM_ERR_ALLOC;
-        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)mesh.nodes[i];
+        bench_to_reals(mesh.nodes, x, 3 * n);
         err = frm_sampling_hexes(s, x, n, mesh.hexes, mesh.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
         nodes = mesh.nodes;
         free(mesh.hexes);
@@ -56,7 +57,7 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
         n = mesh.node_count;
         x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
         if (!x) return tetmesh_free(&mesh), FRM_ERR_ALLOC;
-        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)mesh.nodes[i];
+        bench_to_reals(mesh.nodes, x, 3 * n);
         err = frm_sampling_tets(s, x, n, mesh.tets, mesh.tet_count, 1, NULL, NULL);
         nodes = mesh.nodes;
         free(mesh.tets);
@@ -109,7 +110,7 @@ static int fr_create(const bench_body *b, int hex, frm_law law, void **out)
     }
     s->frames = frm_model_frame_count(s->m);
     s->rest = rest;
-    for (i = 0; i < 6 * s->frames; i++) s->v[i] = (frm_real)(1e-3 * ((i * 7919) % 13 - 6)); /* any direction */
+    bench_kernel_direction(s->v, 6 * s->frames);
     if (b->clamp)
         for (i = 0; i < s->frames; i++)
             if (bench_body_clamped(b, s->rest, i)) frm_model_fix_frame(s->m, i);
@@ -133,12 +134,7 @@ static void fr_destroy(void *v)
 static int fr_dof(void *v) { return 6 * ((fr_sim *)v)->frames; }
 static int fr_node_count(void *v) { return ((fr_sim *)v)->frames; }
 
-static void fr_rest(void *v, int i, double p[3])
-{
-    fr_sim *s = (fr_sim *)v;
-    int k;
-    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
-}
+static void fr_rest(void *v, int i, double p[3]) { bench_rest_position(((fr_sim *)v)->rest, i, p); }
 
 static void fr_position(void *v, int i, double p[3])
 {
@@ -184,8 +180,7 @@ static int fr_release(void *v, int i) { return frm_model_release_frame(((fr_sim 
 static int fr_set_gravity(void *v, const double g[3])
 {
     frm_real w[3];
-    int k;
-    for (k = 0; k < 3; k++) w[k] = (frm_real)g[k];
+    bench_to_reals(g, w, 3);
     return frm_model_set_gravity(((fr_sim *)v)->m, w);
 }
 

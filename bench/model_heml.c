@@ -16,6 +16,7 @@
 #include "../examples/tetmesh.h"
 #include "bench.h"
 #include "body_mesh.h"
+#include "model_common.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -49,10 +50,8 @@ static int hm_create(const bench_body *b, heml_law law, void **out)
         tetmesh_free(&mesh);
         return HEML_ERR_ALLOC;
     }
-    for (i = 0; i < 3 * mesh.node_count; i++) {
-        x[i] = (heml_real)mesh.nodes[i];
-        s->dx[i] = (heml_real)(1e-3 * ((i * 7919) % 13 - 6)); /* any fixed direction */
-    }
+    bench_to_reals(mesh.nodes, x, 3 * mesh.node_count);
+    bench_kernel_direction(s->dx, 3 * mesh.node_count);
     d.rest_positions = x;
     d.node_count = mesh.node_count;
     d.tets = mesh.tets;
@@ -100,28 +99,19 @@ static void hm_destroy(void *v)
 static int hm_dof(void *v) { return 3 * ((hm_sim *)v)->nodes; }
 static int hm_node_count(void *v) { return ((hm_sim *)v)->nodes; }
 
-static void hm_rest(void *v, int i, double p[3])
-{
-    hm_sim *s = (hm_sim *)v;
-    int k;
-    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
-}
+static void hm_rest(void *v, int i, double p[3]) { bench_rest_position(((hm_sim *)v)->rest, i, p); }
 
-/* Double rest plus the model's displacement (see model_tensormass.c). */
 static void hm_position(void *v, int i, double p[3])
 {
     hm_sim *s = (hm_sim *)v;
-    const heml_real *x = heml_positions(s->m), *x0 = heml_rest_positions(s->m);
-    int k;
-    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k] + ((double)x[3 * i + k] - (double)x0[3 * i + k]);
+    bench_displaced_position(s->rest, heml_positions(s->m), heml_rest_positions(s->m), i, p);
 }
 
 static int hm_pin(void *v, int i, const double u[3], const double *rotation)
 {
     heml_real w[3];
-    int k;
     (void)rotation;
-    for (k = 0; k < 3; k++) w[k] = (heml_real)u[k];
+    bench_to_reals(u, w, 3);
     return heml_set_displacement(((hm_sim *)v)->m, i, w);
 }
 
@@ -130,8 +120,7 @@ static int hm_release(void *v, int i) { return heml_release_node(((hm_sim *)v)->
 static int hm_set_gravity(void *v, const double g[3])
 {
     heml_real w[3];
-    int k;
-    for (k = 0; k < 3; k++) w[k] = (heml_real)g[k];
+    bench_to_reals(g, w, 3);
     return heml_set_gravity(((hm_sim *)v)->m, w);
 }
 
@@ -149,9 +138,8 @@ static int hm_forces(void *v, double *f)
 {
     hm_sim *s = (hm_sim *)v;
     const heml_real *g = heml_compute_forces(s->m);
-    int i;
     if (!g) return HEML_ERR_ARG;
-    for (i = 0; i < 3 * s->nodes; i++) f[i] = g[i];
+    bench_to_doubles(g, f, 3 * s->nodes);
     return 0;
 }
 

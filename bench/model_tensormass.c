@@ -18,6 +18,7 @@
 #include "../examples/tetmesh.h"
 #include "bench.h"
 #include "body_mesh.h"
+#include "model_common.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,7 +49,7 @@ static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
         tetmesh_free(&mesh);
         return TMASS_ERR_ALLOC;
     }
-    for (i = 0; i < 3 * mesh.node_count; i++) x[i] = (tmass_real)mesh.nodes[i];
+    bench_to_reals(mesh.nodes, x, 3 * mesh.node_count);
     d.rest_positions = x;
     d.node_count = mesh.node_count;
     d.tets = mesh.tets;
@@ -97,29 +98,19 @@ static void tm_destroy(void *v)
 static int tm_dof(void *v) { return 3 * ((tm_sim *)v)->nodes; }
 static int tm_node_count(void *v) { return ((tm_sim *)v)->nodes; }
 
-static void tm_rest(void *v, int i, double p[3])
-{
-    tm_sim *s = (tm_sim *)v;
-    int k;
-    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k];
-}
+static void tm_rest(void *v, int i, double p[3]) { bench_rest_position(((tm_sim *)v)->rest, i, p); }
 
-/* The model's position minus its rest plus the double rest, so a float model far from
-   the origin reports its displacement, not the rounding of its coordinates. */
 static void tm_position(void *v, int i, double p[3])
 {
     tm_sim *s = (tm_sim *)v;
-    const tmass_real *x = tmass_positions(s->m), *x0 = tmass_rest_positions(s->m);
-    int k;
-    for (k = 0; k < 3; k++) p[k] = s->rest[3 * i + k] + ((double)x[3 * i + k] - (double)x0[3 * i + k]);
+    bench_displaced_position(s->rest, tmass_positions(s->m), tmass_rest_positions(s->m), i, p);
 }
 
 static int tm_pin(void *v, int i, const double u[3], const double *rotation)
 {
     tmass_real w[3];
-    int k;
     (void)rotation;
-    for (k = 0; k < 3; k++) w[k] = (tmass_real)u[k];
+    bench_to_reals(u, w, 3);
     return tmass_set_displacement(((tm_sim *)v)->m, i, w);
 }
 
@@ -128,8 +119,7 @@ static int tm_release(void *v, int i) { return tmass_release_node(((tm_sim *)v)-
 static int tm_set_gravity(void *v, const double g[3])
 {
     tmass_real w[3];
-    int k;
-    for (k = 0; k < 3; k++) w[k] = (tmass_real)g[k];
+    bench_to_reals(g, w, 3);
     return tmass_set_gravity(((tm_sim *)v)->m, w);
 }
 
@@ -146,9 +136,7 @@ static int tm_step(void *v, double dt, int integrator)
 static int tm_forces(void *v, double *f)
 {
     tm_sim *s = (tm_sim *)v;
-    const tmass_real *g = tmass_forces(s->m);
-    int i;
-    for (i = 0; i < 3 * s->nodes; i++) f[i] = g[i];
+    bench_to_doubles(tmass_forces(s->m), f, 3 * s->nodes);
     return 0;
 }
 

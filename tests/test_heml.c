@@ -12,6 +12,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #define IS_FLOAT (sizeof(heml_real) == sizeof(float))
 /* Unit round-off of the model's real type. */
@@ -33,21 +34,6 @@ static const char *law_name[NLAWS] = {"svk", "neo-hookean", "mooney-rivlin", "nh
 static heml_real *alloc_reals(int count)
 {
     return (heml_real *)calloc(count > 0 ? (size_t)count : 1, sizeof(heml_real));
-}
-
-static double rnd(unsigned *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
-}
-
-static void box_mesh(tetmesh *mesh, int nx, int ny, int nz, double sx, double sy, double sz)
-{
-    double lo[3] = {0, 0, 0}, hi[3];
-    hi[0] = sx;
-    hi[1] = sy;
-    hi[2] = sz;
-    tetmesh_box(mesh, lo, hi, nx, ny, nz, TETMESH_SPLIT6);
 }
 
 /* ---- the user law: a compressible Yeoh material through callbacks ----------------- */
@@ -166,39 +152,6 @@ static double max_abs(const double *a, int n)
 }
 
 /* ---- an independent continuum model (double): P1 FEM from F -------------------------- */
-
-/* Gradients of the barycentric coordinates from the inverse of [1 x y z] rows. */
-static double fem_gradients(const double *p[4], double grad[4][3])
-{
-    double a[4][8];
-    int i, j, k;
-    for (i = 0; i < 4; i++) {
-        a[i][0] = 1.0;
-        for (k = 0; k < 3; k++) a[i][1 + k] = p[i][k];
-        for (j = 0; j < 4; j++) a[i][4 + j] = (i == j);
-    }
-    for (i = 0; i < 4; i++) { /* Gauss-Jordan with partial pivoting */
-        int piv = i;
-        double s;
-        for (j = i + 1; j < 4; j++)
-            if (fabs(a[j][i]) > fabs(a[piv][i])) piv = j;
-        for (k = 0; k < 8; k++) {
-            s = a[i][k];
-            a[i][k] = a[piv][k];
-            a[piv][k] = s;
-        }
-        s = a[i][i];
-        for (k = 0; k < 8; k++) a[i][k] /= s;
-        for (j = 0; j < 4; j++)
-            if (j != i) {
-                s = a[j][i];
-                for (k = 0; k < 8; k++) a[j][k] -= s * a[i][k];
-            }
-    }
-    for (j = 0; j < 4; j++)
-        for (k = 0; k < 3; k++) grad[j][k] = a[1 + k][4 + j];
-    return tetmesh_tet_volume(p[0], p[1], p[2], p[3]);
-}
 
 static double det3(double F[3][3])
 {
@@ -451,7 +404,7 @@ static void test_forces_are_energy_gradient(void)
 {
     tetmesh mesh;
     int li;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS; li++) {
         heml_material mt = material_of(all_laws[li]);
         heml_model *m = make_model(&mesh, all_laws[li]);
@@ -500,7 +453,7 @@ static void test_forces_equal_p1_fem(void)
     heml_material mats[NLAWS];
     int *tm, i, li, state;
     heml_model *m;
-    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 1);
+    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 1, TETMESH_SPLIT6);
     tm = (int *)malloc(sizeof(int) * mesh.tet_count);
     for (li = 0; li < NLAWS; li++) mats[li] = material_of(all_laws[li]);
     for (i = 0; i < mesh.tet_count; i++) tm[i] = (i * 5 + i / 7) % NLAWS;
@@ -695,7 +648,7 @@ static void test_differential_is_force_derivative(void)
 {
     tetmesh mesh;
     int li, state;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS; li++)
         for (state = 0; state < 2; state++) {
             heml_material mt = material_of(all_laws[li]);
@@ -772,7 +725,7 @@ static void test_differential_with_prony(void)
     terms[0].tau = (heml_real)0.02;
     terms[1].alpha = (heml_real)0.2;
     terms[1].tau = (heml_real)0.2;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < 4; li++) {
         heml_material mt = material_of(laws[li]);
         heml_model *m;
@@ -839,7 +792,7 @@ static void test_rest_and_small_strains(void)
     static const double Edir[3][3] = {{0.8, 0.3, -0.2}, {0.1, -0.5, 0.4}, {-0.3, 0.2, 0.6}};
     tetmesh mesh;
     int li, si;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS - 2; li++) { /* the built-in continuum laws */
         heml_material mt = material_of(all_laws[li]);
         heml_desc d = heml_default_desc();
@@ -915,7 +868,7 @@ static void test_rigid_motion_zero_force(void)
 {
     tetmesh mesh;
     int li, axis, offset;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS; li++) {
         heml_model *m = make_model(&mesh, all_laws[li]);
         int n3 = 3 * mesh.node_count, i;
@@ -973,7 +926,7 @@ static void test_mass_spring_is_classical_springs(void)
     double *x, *f, *k, err = 0.0, fmax;
     const heml_real *fh;
     heml_material mt = material_of(HEML_MASS_SPRING);
-    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 1);
+    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 1, TETMESH_SPLIT6);
     m = make_model(&mesh, HEML_MASS_SPRING);
     REQUIRE(m != NULL);
     n3 = 3 * mesh.node_count;
@@ -1122,7 +1075,7 @@ static void test_uniaxial_closed_forms(void)
     tetmesh mesh;
     heml_law laws[2] = {HEML_STVK, HEML_NEO_HOOKEAN};
     int li;
-    box_mesh(&mesh, 3, 3, 3, 1, 1, 1);
+    box_mesh(&mesh, 3, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < 2; li++) {
         heml_material mt = heml_material_from_young(laws[li], 1e4, 0.3);
         heml_model *m;
@@ -1217,7 +1170,7 @@ static void test_prony_relaxation(void)
     terms[0].tau = (heml_real)0.05;
     terms[1].alpha = (heml_real)0.25;
     terms[1].tau = (heml_real)0.4;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < 2; li++) {
         heml_material mt = material_of(laws[li]);
         heml_model *m;
@@ -1279,7 +1232,7 @@ static void test_stresses_homogeneous(void)
     tetmesh mesh;
     double F[3][3] = {{1.1, 0.05, 0.0}, {-0.02, 0.95, 0.1}, {0.03, 0.0, 1.2}}, P[3][3], J = det3(F);
     int li;
-    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5);
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS - 2; li++) { /* the continuum laws with closed forms here */
         heml_material mt = material_of(all_laws[li]);
         heml_model *m = make_model(&mesh, all_laws[li]);

@@ -12,6 +12,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -32,15 +33,6 @@ static heml_real *to_real(const double *src, int count)
     int i;
     for (i = 0; i < count; i++) dst[i] = (heml_real)src[i];
     return dst;
-}
-
-static void box_mesh(tetmesh *mesh, int nx, int ny, int nz, double sx, double sy, double sz)
-{
-    double lo[3] = {0, 0, 0}, hi[3];
-    hi[0] = sx;
-    hi[1] = sy;
-    hi[2] = sz;
-    tetmesh_box(mesh, lo, hi, nx, ny, nz, TETMESH_SPLIT6);
 }
 
 static heml_desc mesh_desc(const tetmesh *mesh, const heml_real *x)
@@ -67,12 +59,6 @@ static heml_model *make_model(const tetmesh *mesh, heml_law law, double E, doubl
     return m;
 }
 
-static double rnd(unsigned *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
-}
-
 static double total_energy(heml_model *m)
 {
     heml_energies e;
@@ -93,7 +79,7 @@ static void test_lumped_masses(void)
     heml_model *m;
     double *ref, total = 0.0, worst = 0.0;
     int *tm, t, j, i;
-    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 0.8);
+    box_mesh(&mesh, 3, 2, 2, 1.5, 1, 0.8, TETMESH_SPLIT6);
     x = to_real(mesh.nodes, 3 * mesh.node_count);
     tm = (int *)malloc(sizeof(int) * mesh.tet_count);
     ref = (double *)calloc((size_t)mesh.node_count, sizeof(double));
@@ -141,7 +127,7 @@ static void test_semi_explicit_is_eq32(void)
     unsigned seed = 5;
     heml_desc d;
     heml_real *X;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     X = to_real(mesh.nodes, 3 * mesh.node_count);
     d = mesh_desc(&mesh, X);
     d.mass_damping = (heml_real)alpha;
@@ -191,7 +177,7 @@ static void test_semi_explicit_energy_and_time_step(void)
 {
     tetmesh mesh;
     int law;
-    box_mesh(&mesh, 6, 3, 3, 1, 0.5, 0.5);
+    box_mesh(&mesh, 6, 3, 3, 1, 0.5, 0.5, TETMESH_SPLIT6);
     for (law = 0; law < 2; law++) {
         heml_model *m = make_model(&mesh, law ? HEML_STVK : HEML_NEO_HOOKEAN, 1e5, 0.3, 1000);
         heml_real g[3] = {0, 0, 0}, *v = alloc_reals(3 * mesh.node_count);
@@ -297,7 +283,7 @@ static void test_implicit_newton_iterations(void)
     tetmesh mesh;
     double res[2];
     int k;
-    box_mesh(&mesh, 4, 2, 2, 1, 0.5, 0.5);
+    box_mesh(&mesh, 4, 2, 2, 1, 0.5, 0.5, TETMESH_SPLIT6);
     for (k = 0; k < 2; k++) {
         heml_model *m = make_model(&mesh, HEML_NEO_HOOKEAN, 1e5, 0.45, 1000);
         int n3 = 3 * mesh.node_count, i, r;
@@ -350,7 +336,7 @@ static void test_static_equilibrium(void)
     heml_real fe[3] = {0, 40, -25};
     double sum[3] = {0, 0, 0}, load[3] = {0, 0, 0}, free_res = 0.0;
     int i, r;
-    box_mesh(&mesh, 4, 2, 2, 1, 0.3, 0.3);
+    box_mesh(&mesh, 4, 2, 2, 1, 0.3, 0.3, TETMESH_SPLIT6);
     m = make_model(&mesh, HEML_MOONEY_RIVLIN, 5e5, 0.4, 1100);
     REQUIRE(m != NULL);
     clamp_x0(m, &mesh);
@@ -637,7 +623,7 @@ static void test_pinned_and_imposed(void)
     heml_model *m;
     heml_real u[3] = {0.05, -0.02, 0.1}, fixed[3];
     int s, r, n;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     m = make_model(&mesh, HEML_NEO_HOOKEAN, 1e4, 0.3, 1000);
     REQUIRE(m != NULL);
     n = mesh.node_count;
@@ -678,7 +664,7 @@ static void test_failed_step_keeps_state(void)
     heml_desc d;
     int s, n3, err = HEML_OK, i, same = 1;
     double e_before, e_after;
-    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5);
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
     X = to_real(mesh.nodes, 3 * mesh.node_count);
     d = mesh_desc(&mesh, X);
     d.material = heml_material_from_young(HEML_NEO_HOOKEAN, 1e9, 0.3);
@@ -746,7 +732,7 @@ static void test_user_law_without_second(void)
     heml_model *m;
     heml_energies e;
     static double mu_lambda[2] = {4e3, 6e3};
-    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5);
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
     X = to_real(mesh.nodes, 3 * mesh.node_count);
     dx = alloc_reals(3 * mesh.node_count);
     out = alloc_reals(3 * mesh.node_count);
@@ -849,34 +835,6 @@ static void test_threads_bit_identical(void)
     CHECK(h1 != 0);
 }
 
-typedef struct counting_allocator {
-    int allocs, frees, fail;
-    size_t live;
-} counting_allocator;
-
-static void *count_alloc(size_t size, size_t align, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    char *raw, *p;
-    if (c->fail) return NULL;
-    raw = (char *)malloc(size + align + sizeof(void *));
-    if (!raw) return NULL;
-    p = raw + sizeof(void *);
-    p += (align - (size_t)p % align) % align;
-    ((void **)p)[-1] = raw;
-    c->allocs++;
-    c->live += size;
-    return p;
-}
-
-static void count_free(void *ptr, size_t size, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    c->frees++;
-    c->live -= size;
-    free(((void **)ptr)[-1]);
-}
-
 /* No allocation during steps, solves, force and stiffness passes or diagnostics, with
    every law and Prony on; everything freed by heml_destroy. */
 static void test_no_allocation_after_create(void)
@@ -891,7 +849,7 @@ static void test_no_allocation_after_create(void)
     heml_energies e;
     int *tm, i, allocs;
     size_t rd, wr;
-    box_mesh(&mesh, 3, 2, 2, 1, 1, 1);
+    box_mesh(&mesh, 3, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     X = to_real(mesh.nodes, 3 * mesh.node_count);
     dx = alloc_reals(3 * mesh.node_count);
     out = alloc_reals(3 * mesh.node_count);
@@ -952,7 +910,7 @@ static void test_kernel_bytes(void)
     tetmesh mesh;
     heml_model *m;
     size_t rd, wr, slots;
-    box_mesh(&mesh, 4, 4, 4, 1, 1, 1); /* 384 tetrahedra: 24 blocks of 16, no padding */
+    box_mesh(&mesh, 4, 4, 4, 1, 1, 1, TETMESH_SPLIT6); /* 384 tetrahedra: 24 blocks of 16, no padding */
     m = make_model(&mesh, HEML_NEO_HOOKEAN, 1e4, 0.3, 1000);
     REQUIRE(m != NULL);
     slots = 384;
@@ -975,18 +933,6 @@ static int note(int code)
 {
     if (code <= 0 && code > -64) seen[-code] = 1;
     return code;
-}
-
-typedef struct log_capture {
-    int calls, last_code;
-} log_capture;
-
-static void capture_log(int code, const char *message, void *user)
-{
-    log_capture *c = (log_capture *)user;
-    c->calls++;
-    c->last_code = code;
-    (void)message;
 }
 
 static int try_create(const heml_desc *d)

@@ -7,6 +7,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -54,58 +55,7 @@ static tmass_model *make_model(const tetmesh *mesh, tmass_model_kind kind, doubl
     return m;
 }
 
-static void box_mesh(tetmesh *mesh, int nx, int ny, int nz, double sx, double sy, double sz,
-                     int split)
-{
-    double lo[3] = {0, 0, 0}, hi[3];
-    hi[0] = sx;
-    hi[1] = sy;
-    hi[2] = sz;
-    tetmesh_box(mesh, lo, hi, nx, ny, nz, split);
-}
-
-/* Deterministic pseudo-random numbers in [-1, 1]. */
-static double rnd(unsigned *state)
-{
-    *state = *state * 1664525u + 1013904223u;
-    return ((*state >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0;
-}
-
 /* ---- an independent P1 FEM (Voigt notation, 4x4 inverse) -------------------------- */
-
-/* Gradients of the barycentric coordinates from the inverse of [1 x y z] rows. */
-static double fem_gradients(const double *p[4], double grad[4][3])
-{
-    double a[4][8];
-    int i, j, k;
-    for (i = 0; i < 4; i++) {
-        a[i][0] = 1.0;
-        for (k = 0; k < 3; k++) a[i][1 + k] = p[i][k];
-        for (j = 0; j < 4; j++) a[i][4 + j] = (i == j);
-    }
-    for (i = 0; i < 4; i++) { /* Gauss-Jordan with partial pivoting */
-        int piv = i;
-        double s;
-        for (j = i + 1; j < 4; j++)
-            if (fabs(a[j][i]) > fabs(a[piv][i])) piv = j;
-        for (k = 0; k < 8; k++) {
-            s = a[i][k];
-            a[i][k] = a[piv][k];
-            a[piv][k] = s;
-        }
-        s = a[i][i];
-        for (k = 0; k < 8; k++) a[i][k] /= s;
-        for (j = 0; j < 4; j++)
-            if (j != i) {
-                s = a[j][i];
-                for (k = 0; k < 8; k++) a[j][k] -= s * a[i][k];
-            }
-    }
-    /* inverse C = a[.][4..7]; N_j = C[0][j] + C[1][j] x + C[2][j] y + C[3][j] z */
-    for (j = 0; j < 4; j++)
-        for (k = 0; k < 3; k++) grad[j][k] = a[1 + k][4 + j];
-    return tetmesh_tet_volume(p[0], p[1], p[2], p[3]);
-}
 
 /* Element stiffness K = V B^T D B (12 x 12). */
 static void fem_element_stiffness(const double *p[4], double E, double nu, double K[12][12])
@@ -1153,39 +1103,13 @@ static void test_threads_bit_identical(void)
     CHECK(h1 != 0);
 }
 
-typedef struct counting_allocator {
-    int allocs, frees;
-    size_t live;
-} counting_allocator;
-
-static void *count_alloc(size_t size, size_t align, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    char *raw = (char *)malloc(size + align + sizeof(void *)), *p;
-    if (!raw) return NULL;
-    p = raw + sizeof(void *);
-    p += (align - (size_t)p % align) % align;
-    ((void **)p)[-1] = raw;
-    c->allocs++;
-    c->live += size;
-    return p;
-}
-
-static void count_free(void *ptr, size_t size, void *user)
-{
-    counting_allocator *c = (counting_allocator *)user;
-    c->frees++;
-    c->live -= size;
-    free(((void **)ptr)[-1]);
-}
-
 /* No allocation during steps, forces, solves, cutting or tearing; everything freed. */
 static void test_no_allocation_after_create(void)
 {
     tetmesh mesh;
     tmass_desc d = tmass_default_desc();
     tmass_model *m;
-    counting_allocator c = {0, 0, 0};
+    counting_allocator c = {0, 0, 0, 0};
     tmass_real *x;
     int allocs, i, kind, list[2] = {3, 4};
     tmass_tear_criteria tc = tmass_default_tear_criteria();
@@ -1221,18 +1145,6 @@ static void test_no_allocation_after_create(void)
 }
 
 /* ---- validation -------------------------------------------------------------------- */
-
-typedef struct log_capture {
-    int calls, last_code;
-} log_capture;
-
-static void capture_log(int code, const char *message, void *user)
-{
-    log_capture *c = (log_capture *)user;
-    c->calls++;
-    c->last_code = code;
-    (void)message;
-}
 
 static int try_create(const tmass_desc *d)
 {

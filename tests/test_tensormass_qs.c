@@ -7,6 +7,7 @@
 #define TETMESH_IMPLEMENTATION
 #include "../examples/tetmesh.h"
 #include "test.h"
+#include "fixtures.h"
 
 #define IS_FLOAT (sizeof(tmass_real) == sizeof(float))
 /* Agreement expected between two solves of the same linear problem: CG tolerances are
@@ -298,28 +299,6 @@ static void test_qs_save_load(void)
     tetmesh_free(&mesh);
 }
 
-typedef struct counting_allocator {
-    int allocs, frees;
-} counting_allocator;
-
-static void *count_alloc(size_t size, size_t align, void *user)
-{
-    char *raw = (char *)malloc(size + align + sizeof(void *)), *p;
-    if (!raw) return NULL;
-    p = raw + sizeof(void *);
-    p += (align - (size_t)p % align) % align;
-    ((void **)p)[-1] = raw;
-    ((counting_allocator *)user)->allocs++;
-    return p;
-}
-
-static void count_free(void *ptr, size_t size, void *user)
-{
-    (void)size;
-    ((counting_allocator *)user)->frees++;
-    free(((void **)ptr)[-1]);
-}
-
 /* Refusals and validation of the quasi-static model; no allocation per update. */
 static void test_qs_validation(void)
 {
@@ -328,7 +307,7 @@ static void test_qs_validation(void)
     tmass_model *m;
     tmass_qs *qs;
     tmass_qs_desc qd = tmass_qs_default_desc(), bad;
-    counting_allocator c = {0, 0};
+    counting_allocator c = {0, 0, 0, 0};
     int nodes[3], twice[2], fixed_node = 0, interior, list[1], allocs, i;
     double centre[3] = {0.15, 0.0, 0.0};
     beam_mesh(&mesh);
