@@ -2301,7 +2301,8 @@ static void frm__quat_normalized(const frm_real *q, frm_real *out)
                    the flag always goes through its own functions. The law tests compare
                    the path the model uses (frm__law_stress, frm__law_dstress) with finite
                    differences of each law's `energy`, so a flag set on the wrong law fails.
-   frm__law_stress and frm__law_dstress are the one place where the model picks a path. */
+   frm__law_stress, frm__law_dstress, frm__law_dP and frm__law_tangent_columns (below) are
+   the only readers of fast_path: the model's loops call them, never a law by name. */
 
 #define FRM__LAW_CACHE_MAX 23 /* the largest cache_size of frm__laws (the invariant laws) */
 
