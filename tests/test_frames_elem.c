@@ -1260,8 +1260,8 @@ static void test_integrator_choice(void)
     for (k = 0; k < 8; k++) {
         hex[k] = k;
         nodes[3 * k] = (frm_real)(k & 1);
-        nodes[3 * k + 1] = (frm_real)(0.2 * ((k >> 1) & 1));
-        nodes[3 * k + 2] = (frm_real)(0.2 * ((k >> 2) & 1));
+        nodes[3 * k + 1] = (frm_real)((k >> 1) & 1);
+        nodes[3 * k + 2] = (frm_real)((k >> 2) & 1);
     }
     REQUIRE(frm_sampling_hexes(&s, nodes, 8, hex, 1, 2, FRM_QUADRATURE_GAUSS, NULL) == FRM_OK);
     for (variant = 0; variant < 3; variant++) { /* 0: implicit_linearized = 1, 1: integrator, 2: default */
