@@ -2301,8 +2301,10 @@ static void frm__quat_normalized(const frm_real *q, frm_real *out)
                    the flag always goes through its own functions. The law tests compare
                    the path the model uses (frm__law_stress, frm__law_dstress) with finite
                    differences of each law's `energy`, so a flag set on the wrong law fails.
-   frm__law_stress, frm__law_dstress, frm__law_dP and frm__law_tangent_columns (below) are
-   the only readers of fast_path: the model's loops call them, never a law by name. */
+   frm__law_stress, frm__law_dstress, frm__law_dP, frm__law_tangent_columns (below) and the
+   pair-mode K v loop (frm__apply_chunks, which tests the flag before the call to keep the
+   old instruction count) are the only readers of fast_path; the model's loops never name
+   a law. */
 
 #define FRM__LAW_CACHE_MAX 23 /* the largest cache_size of frm__laws (the invariant laws) */
 
@@ -3968,8 +3970,16 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
             frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
             for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
-            frm__law_dP(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
-                        m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
+            {
+                int law = m->s_law[s];
+                const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+                if (frm__laws[law].fast_path)
+                    frm_sample_dP(law, prm[0], prm[1], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                  m->lin_S + 6 * (size_t)s, dF, dP);
+                else
+                    frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                m->lin_S + 6 * (size_t)s, dF, dP);
+            }
             if (m->s_stab[s]) {
                 frm_real dPx[9];
                 const frm_real *dth[FRM_MAX_NEIGHBORS];
