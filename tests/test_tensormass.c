@@ -1697,6 +1697,52 @@ static void test_stats_filled(void)
 /* Spring static continuation: a 150 degree twist of a soft beam's free end in one call,
    with at most 4 Newton iterations per increment, converges (increments and cuts in the
    stats) to the answer of six manual increments. */
+/* A spring model's static success must be a minimum (issue 18's acceptance test). One
+   regular tetrahedron (edge 1 m, springs), its base pinned, its apex driven to the base's
+   centroid and released there: the three compressed springs balance in the plane, so the
+   residual is zero, but the state is a saddle (along the normal each spring's stiffness
+   k (1 - l0 / l) is negative) and the two mirror shapes, apex 0.8165 m above or below
+   the base, have zero energy. Before the minimum check the solve returned success at the
+   flat state (3 x 1/2 k (0.577 - 1)^2 of energy). Checked against that closed form: a
+   success must end with the apex at |z| = 0.8165 m and no energy (1e-6 of the flat
+   state's); TMASS_ERR_UNSTABLE must keep the flat state. */
+static void test_springs_saddle_refused(void)
+{
+    double nodes[12] = {0, 0, 0, 1, 0, 0, 0.5, 0.8660254037844386, 0, 0.5, 0.28867513459481287, 0.816496580927726};
+    int tet[4] = {0, 1, 2, 3}, i, err;
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = to_real(nodes, 12), zero[3] = {0, 0, 0}, down[3] = {0, 0, (tmass_real)-0.816496580927726};
+    tmass_energies e0, e1;
+    d.rest_positions = x;
+    d.node_count = 4;
+    d.tets = tet;
+    d.tet_count = 1;
+    d.kind = TMASS_MASS_SPRING;
+    d.young_modulus = (tmass_real)1e5;
+    REQUIRE(tmass_create(&d, &m) == TMASS_OK);
+    free(x);
+    tmass_set_gravity(m, zero);
+    for (i = 0; i < 3; i++) REQUIRE(tmass_fix_node(m, i) == TMASS_OK);
+    REQUIRE(tmass_set_displacement(m, 3, down) == TMASS_OK);
+    REQUIRE(tmass_solve_static(m) == TMASS_OK); /* every node pinned: the flat state */
+    REQUIRE(tmass_release_node(m, 3) == TMASS_OK);
+    REQUIRE(tmass_energy(m, &e0) == TMASS_OK);
+    err = tmass_solve_static(m);
+    REQUIRE(tmass_energy(m, &e1) == TMASS_OK);
+    printf("    flat tetrahedron released: code %d, apex z %.4g m, energy %.4g J (flat %.4g J)\n", err,
+           (double)tmass_positions(m)[11], e1.elastic, e0.elastic);
+    CHECK(e0.elastic > 0);
+    if (err == TMASS_OK) {
+        CHECK(fabs(fabs((double)tmass_positions(m)[11]) - 0.816496580927726) < 1e-3);
+        CHECK(e1.elastic <= 1e-6 * e0.elastic);
+    } else {
+        CHECK_INT(TMASS_ERR_UNSTABLE, err);
+        CHECK(fabs((double)tmass_positions(m)[11]) < 1e-6 && e1.elastic == e0.elastic);
+    }
+    tmass_destroy(m);
+}
+
 static void test_springs_static_continuation(void)
 {
     tetmesh mesh;
@@ -2408,6 +2454,54 @@ static void test_float_ill_conditioned_beam(void)
     tetmesh_free(&mesh);
 }
 
+/* Issue 20: the extension points' enums end in a _COUNT sentinel that validation uses
+   (every value below it accepted, it and negative values refused with their own code),
+   and every integrator of the table steps both model kinds through the one dispatch. */
+static void test_extension_enums_validated(void)
+{
+    tmass_real nodes[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+    int tets[6 * 4] = {0, 1, 3, 7, 0, 5, 1, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 6, 4, 7};
+    tmass_desc base = tmass_default_desc(), d;
+    int kind, integ, i;
+    base.rest_positions = nodes;
+    base.node_count = 8;
+    base.tets = tets;
+    base.tet_count = 6;
+    CHECK_INT(TMASS_LINEAR_SOLVER_CG, base.linear_solver);
+    CHECK_INT(2, TMASS_MODEL_KIND_COUNT);
+    CHECK_INT(5, TMASS_INTEGRATOR_COUNT);
+    CHECK_INT(1, TMASS_LINEAR_SOLVER_COUNT);
+    d = base; d.kind = TMASS_MODEL_KIND_COUNT;                 CHECK_INT(TMASS_ERR_MODEL_KIND, try_create(&d));
+    d = base; d.kind = (tmass_model_kind)-1;                   CHECK_INT(TMASS_ERR_MODEL_KIND, try_create(&d));
+    d = base; d.integrator = TMASS_INTEGRATOR_COUNT;           CHECK_INT(TMASS_ERR_INTEGRATOR, try_create(&d));
+    d = base; d.integrator = (tmass_integrator)-1;             CHECK_INT(TMASS_ERR_INTEGRATOR, try_create(&d));
+    d = base; d.linear_solver = TMASS_LINEAR_SOLVER_COUNT;     CHECK_INT(TMASS_ERR_SOLVER, try_create(&d));
+    d = base; d.linear_solver = (tmass_linear_solver)-1;       CHECK_INT(TMASS_ERR_SOLVER, try_create(&d));
+    for (kind = 0; kind < TMASS_MODEL_KIND_COUNT; kind++) {
+        tmass_model *m = NULL;
+        d = base;
+        d.kind = (tmass_model_kind)kind;
+        d.linear_solver = TMASS_LINEAR_SOLVER_CG;
+        CHECK_INT(TMASS_OK, tmass_create(&d, &m));
+        if (!m) continue;
+        for (i = 4; i < 8; i++) tmass_fix_node(m, i);
+        CHECK_INT(TMASS_ERR_INTEGRATOR, tmass_step_ex(m, (tmass_real)1e-3, TMASS_INTEGRATOR_COUNT));
+        CHECK_INT(TMASS_ERR_INTEGRATOR, tmass_step_ex(m, (tmass_real)1e-3, (tmass_integrator)-1));
+        for (integ = 0; integ < TMASS_INTEGRATOR_COUNT; integ++) {
+            const tmass_stats *st;
+            CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)1e-4, (tmass_integrator)integ));
+            st = tmass_last_stats(m);
+            /* explicit schemes solve nothing; implicit ones count their one increment (the
+               springs' Newton may converge at the predictor, in float, with no solve) */
+            if (integ <= TMASS_RK4) CHECK_INT(0, st->cg_iterations + st->increments);
+            else CHECK_INT(1, st->increments);
+        }
+        CHECK(tmass_positions(m)[2] < 0); /* node 0 sags under gravity */
+        CHECK_INT(TMASS_OK, tmass_solve_static(m));
+        tmass_destroy(m);
+    }
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_float_ill_conditioned_beam),
@@ -2442,10 +2536,12 @@ static const test_case cases[] = {
     TEST(test_precision_far_from_origin),
     TEST(test_stats_filled),
     TEST(test_springs_static_continuation),
+    TEST(test_springs_saddle_refused),
     TEST(test_integrator_order),
     TEST(test_implicit_damped_recurrence),
     TEST(test_spring_incremental_potential_gradient),
     TEST(test_stress_sweep),
+    TEST(test_extension_enums_validated),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
