@@ -709,6 +709,7 @@ typedef FRM_REAL frm_real;
 #define frm_model_clear_external frm_model_clear_external_f32
 #define frm_model_set_gravity frm_model_set_gravity_f32
 #define frm_model_set_solver frm_model_set_solver_f32
+#define frm_model_set_damping frm_model_set_damping_f32
 #define frm_model_set_stiffness_mode frm_model_set_stiffness_mode_f32
 #define frm_model_step frm_model_step_f32
 #define frm_model_step_ex frm_model_step_ex_f32
@@ -720,6 +721,8 @@ typedef FRM_REAL frm_real;
 #define frm_model_positions frm_model_positions_f32
 #define frm_model_orientations frm_model_orientations_f32
 #define frm_model_velocities frm_model_velocities_f32
+#define frm_model_displacements frm_model_displacements_f32
+#define frm_model_rest_positions frm_model_rest_positions_f32
 #define frm_model_set_poses frm_model_set_poses_f32
 #define frm_model_set_velocities frm_model_set_velocities_f32
 #define frm_model_sample_positions frm_model_sample_positions_f32
@@ -869,6 +872,10 @@ typedef enum frm_integrator {
                                           potential to newton_tolerance, line search (default) */
     FRM_IMPLICIT_EULER_LINEARIZED = 1, /* one linearised iteration per step (the thesis's eq. 3.64;
                                           cheaper, accurate only while the step moves little) */
+    FRM_BDF2 = 2,                      /* second-order backward differentiation (issue 19): the same
+                                          Newton minimisation with (2 dt / 3, xbar, vbar) for
+                                          (dt, x_n, v_n); the first step after a discontinuity is
+                                          implicit Euler (see SOLVERS, BDF2) */
     FRM_INTEGRATOR_COUNT               /* sentinel: the number of integrators, not one */
 } frm_integrator;
 
@@ -1224,6 +1231,10 @@ FRMDEF int frm_model_set_external(frm_model *m, int i, const frm_real force[3], 
 FRMDEF void frm_model_clear_external(frm_model *m);
 /* Gravity, m/s^2. */
 FRMDEF int frm_model_set_gravity(frm_model *m, const frm_real g[3]);
+/* Rayleigh damping after creation: mass_damping alpha (1/s) and stiffness_damping beta (s),
+   both finite and >= 0 (FRM_ERR_DAMPING otherwise, nothing changed); the next step uses
+   them (as desc.mass_damping / stiffness_damping). No allocation. */
+FRMDEF int frm_model_set_damping(frm_model *m, frm_real mass_damping, frm_real stiffness_damping);
 /* CG tolerance (> 0) and cap (>= 1), Newton tolerance (> 0) and cap (>= 1). */
 FRMDEF int frm_model_set_solver(frm_model *m, frm_real cg_tolerance, int cg_max_iterations,
                                 frm_real newton_tolerance, int newton_max_iterations);
@@ -1260,6 +1271,8 @@ FRMDEF int frm_model_pair_count(const frm_model *m); /* (sample, neighbour) entr
 FRMDEF const frm_real *frm_model_positions(const frm_model *m);    /* 3 per frame, m */
 FRMDEF const frm_real *frm_model_orientations(const frm_model *m); /* 4 per frame (x, y, z, w) */
 FRMDEF const frm_real *frm_model_velocities(const frm_model *m);   /* 6 per frame: m/s, rad/s (world) */
+FRMDEF const frm_real *frm_model_displacements(const frm_model *m); /* 3 per frame: x - xbar, m (the state) */
+FRMDEF const frm_real *frm_model_rest_positions(const frm_model *m); /* 3 per frame, m */
 /* Overwrites every frame's pose (3 + 4 values per frame; quaternions must be unit) or
    velocities (6 per frame). Finite values only. */
 FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const frm_real *orientations);
@@ -2125,6 +2138,13 @@ struct frm_model {
     frm_real *drive_dv;                  /* driven frames' velocity change (Newton step: their dq) */
     frm_real *backup;      /* 13 per frame: position, orientation, velocity */
     frm_real *start_state; /* 13 per frame: the state a static solve started from */
+    /* BDF2 (carved only for it) */
+    frm_real *history;       /* 13 per frame: the state one step back (x_{n-1}, q_{n-1}, v_{n-1}) */
+    frm_real *step_offset;   /* 6 per frame: xbar - x_n in the step's tangent coordinates */
+    frm_real *step_velocity; /* 6 per frame: vbar, the step's reference velocity */
+    int history_valid;       /* 0: the next BDF2 step is implicit Euler (after creation, a
+                                discontinuity or a change of dt) */
+    double history_dt;       /* the step length the history was made with */
 
     int lin_valid, lin_mode, lin_iterations;
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
@@ -2805,6 +2825,11 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->drive_dv, frm_real, 6 * n);
     FRM__CARVE(c, m->backup, frm_real, 13 * n);
     FRM__CARVE(c, m->start_state, frm_real, 13 * n);
+    if (m->integrator == FRM_BDF2) {
+        FRM__CARVE(c, m->history, frm_real, 13 * n);
+        FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
+        FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
+    }
 }
 
 /* >>validation ------------------------------------------------------------------------- */
@@ -3322,6 +3347,8 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
     tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
     tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
     tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    /* the layout carves BDF2's history only for it (frm__create_settings sets it again) */
+    tmp->integrator = d->implicit_linearized ? FRM_IMPLICIT_EULER_LINEARIZED : (int)d->integrator;
     if (tmp->has_blocks) {
         long long blocks, sq = 0;
         for (i = 0; i < n; i++) t->marker[i] = -1;
@@ -4860,6 +4887,7 @@ FRMDEF int frm_model_newton_step(frm_model *m, frm_real *residual)
     if (!m) return FRM_ERR_ARG;
     err = frm__begin_solve(m);
     if (err) return err;
+    m->history_valid = 0;
     frm__apply_driven(m);
     err = frm__newton_iteration(m, 1, (double)m->newton_tolerance, &converged, &res, &scale);
     if (err) {
@@ -4974,6 +5002,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     if (!m) return FRM_ERR_ARG;
     err = frm__begin_solve(m);
     if (err) return err;
+    m->history_valid = 0; /* a static solve moves the state (velocities to zero) */
     frm__inversions(m, 1);
     for (r = 0; r < 3; r++) g_full[r] = m->gravity[r];
     memcpy(m->ext_full, m->ext, sizeof(frm_real) * 6 * (size_t)m->frame_count);
@@ -5143,17 +5172,40 @@ static void frm__step_displacement(const frm_model *m, frm_real *dq)
     frm__mask(m, dq);
 }
 
-/* The implicit Newton's residual r = dt f - M (v - v_t) - dt D v (momentum, N s), with
-   dq = dt v the step's displacement and kq = K dq (zero without stiffness damping). */
-static void frm__implicit_residual(const frm_model *m, double dt, const frm_real *f, const frm_real *dq,
+/* What the implicit Newton minimises towards: implicit Euler's (dt, x_n, v_n) or BDF2's
+   (2 dt / 3, xbar, vbar). The Newton variable is z = q - xbar (the step's displacement
+   from x_n less the offset xbar - x_n, tangent coordinates at the step's start), and the
+   new velocity is v = z / h. */
+typedef struct frm__step_target {
+    double h;                /* s: dt (implicit Euler) or 2 dt / 3 (BDF2) */
+    const frm_real *offset;  /* 6 per frame: xbar - x_n; NULL: zero (implicit Euler) */
+    const frm_real *vref;    /* the reference velocity v_n (in inc_state) or vbar */
+    int vref_stride;         /* reals between frames in vref: 13 (inc_state + 7) or 6 */
+    double warm_scale;       /* the first CG's start: warm_scale (v + last change) */
+} frm__step_target;
+
+/* z = q - xbar of every free frame (frm__step_displacement less the target's offset). */
+static void frm__step_variable(const frm_model *m, const frm__step_target *t, frm_real *z)
+{
+    frm__step_displacement(m, z);
+    if (t->offset) {
+        int k;
+        for (k = 0; k < 6 * m->frame_count; k++) z[k] -= t->offset[k];
+        frm__mask(m, z);
+    }
+}
+
+/* The implicit Newton's residual r = h f - M (v - v_ref) - h D v (momentum, N s), with
+   dq = h v the step's variable z and kq = K z (zero without stiffness damping). */
+static void frm__implicit_residual(const frm_model *m, const frm__step_target *t, const frm_real *f, const frm_real *dq,
                                    const frm_real *kq, frm_real *b)
 {
-    double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
+    double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping, dt = t->h;
     int i, k;
     for (i = 0; i < m->frame_count; i++) {
         double mq[6], mv[6];
         frm__mass_apply(m, i, dq + 6 * i, mq);
-        frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
+        frm__mass_apply(m, i, t->vref + (size_t)t->vref_stride * (size_t)i, mv);
         for (k = 0; k < 6; k++)
             b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
                                       beta_d * (double)kq[6 * i + k]);
@@ -5161,10 +5213,12 @@ static void frm__implicit_residual(const frm_model *m, double dt, const frm_real
     frm__mask(m, b);
 }
 
-/* After a converged implicit step: velocities are the step's displacement over dt (driven
-   frames: the same, fixed: zero); their change is the next step's CG warm start. */
-static void frm__implicit_velocities(frm_model *m, double dt)
+/* After a converged implicit step: velocities are the step's variable over h, (q - xbar) / h
+   (implicit Euler: the step's displacement over dt; driven frames: the same, fixed: zero);
+   their change is the next step's CG warm start. */
+static void frm__implicit_velocities(frm_model *m, const frm__step_target *t)
 {
+    double dt = t->h;
     int i, k;
     for (i = 0; i < m->frame_count; i++) {
         const frm_real *s = m->inc_state + 13 * (size_t)i;
@@ -5174,10 +5228,17 @@ static void frm__implicit_velocities(frm_model *m, double dt)
             continue;
         }
         frm__quat_delta(s + 3, m->quat + 4 * i, w);
-        for (k = 0; k < 3; k++) {
-            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
-            v[3 + k] = (frm_real)((double)w[k] / dt);
-        }
+        if (t->offset) {
+            const frm_real *e = t->offset + 6 * i;
+            for (k = 0; k < 3; k++) {
+                v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k] - (double)e[k]) / dt);
+                v[3 + k] = (frm_real)(((double)w[k] - (double)e[3 + k]) / dt);
+            }
+        } else
+            for (k = 0; k < 3; k++) {
+                v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
+                v[3 + k] = (frm_real)((double)w[k] / dt);
+            }
         for (k = 0; k < 6; k++) {
             if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
             m->warm_dv[6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
@@ -5195,9 +5256,11 @@ static void frm__implicit_velocities(frm_model *m, double dt)
    with a backtracking Armijo line search on Psi (the damping's K frozen per iteration),
    until |r| <= newton_tolerance * max(|r_0|, dt |load|, dt |reactions|), r_0 the residual
    at the step's start (the first iteration is the linearised step). Driven frames are at
-   their targets from the first iteration. */
-static int frm__implicit_newton(frm_model *m, double dt)
+   their targets from the first iteration. BDF2 runs the same iterations on its target
+   (frm__step_target): h for dt, z = q - xbar for dq, vbar for v_t. */
+static int frm__implicit_newton(frm_model *m, const frm__step_target *target)
 {
+    double dt = target->h;
     frm_real *f = m->total_force, *b = m->newton_rhs, *dv = m->newton_dx;
     /* kd and kq share CG's direction and residual: they are used between CG solves only
        and recomputed after each (the one place these roles alias) */
@@ -5218,10 +5281,10 @@ static int frm__implicit_newton(frm_model *m, double dt)
             err = cheap ? frm__force_pass(m, 0, 0, &W0) : frm__linearize(m, &W0, attempt);
             if (err) return err;
             frm__total_force(m, f);
-            frm__step_displacement(m, dq);
+            frm__step_variable(m, target, dq);
             if (beta_d != 0) frm__stiffness_product(m, dq, kq, 0);
             else memset(kq, 0, sizeof(frm_real) * (size_t)n6);
-            frm__implicit_residual(m, dt, f, dq, kq, b);
+            frm__implicit_residual(m, target, f, dq, kq, b);
             norm = sqrt(frm__dot(m, b, b));
             if (!frm__finite(norm)) return FRM_ERR_NOT_FINITE;
             if (it == 0 && attempt == 0) {
@@ -5246,8 +5309,10 @@ static int frm__implicit_newton(frm_model *m, double dt)
             if (eta < 0.1 * (double)m->newton_tolerance * ref / norm) eta = 0.1 * (double)m->newton_tolerance * ref / norm;
             if (eta > 1e-3) eta = 1e-3;
             if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
-            if (it == 0) /* warm start: the new velocity, about the start one plus the last step's change */
+            if (it == 0 && target->warm_scale == 1) /* warm start: the new velocity, about the start one plus the last step's change */
                 for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->warm_dv[k];
+            else if (it == 0)
+                for (k = 0; k < n6; k++) dv[k] = (frm_real)(target->warm_scale * ((double)m->vel[k] + (double)m->warm_dv[k]));
             else
                 memset(dv, 0, sizeof(frm_real) * (size_t)n6);
             cg = frm__linear_solve(m, a_mass, a_stiff, eta, b, dv);
@@ -5273,7 +5338,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
         eMd = qMd = dMd = 0;
         for (i = 0; i < m->frame_count; i++) {
             double md[6];
-            const frm_real *vt = m->inc_state + 13 * (size_t)i + 7;
+            const frm_real *vt = target->vref + (size_t)target->vref_stride * (size_t)i;
             frm__mass_apply(m, i, dv + 6 * i, md);
             for (k = 0; k < 6; k++) {
                 double ek = (double)dq[6 * i + k] - dt * (double)vt[k];
@@ -5311,14 +5376,14 @@ static int frm__implicit_newton(frm_model *m, double dt)
     m->stats.residual_force = (frm_real)norm;
     m->stats.residual = (frm_real)(ref > 0 ? norm / ref : 0);
     if (!converged) return FRM_ERR_NO_CONVERGENCE;
-    frm__implicit_velocities(m, dt);
+    frm__implicit_velocities(m, target);
     return FRM_OK;
 }
 
-/* The Newton implicit Euler step (FRM_IMPLICIT_EULER): minimise, accept or restore. */
-static int frm__implicit_euler(frm_model *m, double dt)
+/* Minimise towards target, accept or restore the step's start. */
+static int frm__implicit_solve(frm_model *m, const frm__step_target *target)
 {
-    int err = frm__implicit_newton(m, dt);
+    int err = frm__implicit_newton(m, target);
     if (!err) err = frm__accept(m);
     if (err) {
         frm__paste_state(m, m->inc_state);
@@ -5326,6 +5391,58 @@ static int frm__implicit_euler(frm_model *m, double dt)
     }
     frm__update_frames(m);
     m->lin_valid = 0;
+    return FRM_OK;
+}
+
+/* The Newton implicit Euler step (FRM_IMPLICIT_EULER). */
+static int frm__implicit_euler(frm_model *m, double dt)
+{
+    frm__step_target t;
+    t.h = dt;
+    t.offset = NULL;
+    t.vref = m->inc_state + 7; /* frm__implicit_newton copies the start state there first */
+    t.vref_stride = 13;
+    t.warm_scale = 1;
+    return frm__implicit_solve(m, &t);
+}
+
+/* BDF2 (FRM_BDF2; see SOLVERS, BDF2). With beta = 2 dt / 3, xbar = (4 x_n - x_{n-1}) / 3 and
+   vbar = (4 v_n - v_{n-1}) / 3 the step is implicit Euler's minimisation with (beta, xbar,
+   vbar) for (dt, x_n, v_n), then v_{n+1} = (x_{n+1} - xbar) / beta. Orientations: in the
+   step's tangent coordinates at q_n (world-axis rotation vectors, as implicit Euler's),
+   x_{n-1} is phi = log(q_{n-1} q_n^*), so xbar - x_n = -phi / 3 and the world angular
+   velocities serve as the coordinate velocities (they differ by phi x omega / 2 at q_{n-1},
+   of second order in the rotation over a step: neglected, as implicit Euler neglects the
+   gyroscopic terms). Without a history made with the same dt, one implicit Euler step.
+   The history is the start state of the last successful step; a failed step keeps it. */
+static int frm__bdf2(frm_model *m, double dt)
+{
+    frm__step_target t;
+    int i, k, err;
+    if (!m->history_valid || m->history_dt != dt) {
+        err = frm__implicit_euler(m, dt);
+    } else {
+        for (i = 0; i < m->frame_count; i++) {
+            const frm_real *p = m->history + 13 * (size_t)i;
+            frm_real *e = m->step_offset + 6 * i, *vb = m->step_velocity + 6 * i, phi[3];
+            frm__quat_delta(m->quat + 4 * i, p + 3, phi);
+            for (k = 0; k < 3; k++) {
+                e[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)p[k]) / 3);
+                e[3 + k] = (frm_real)(-(double)phi[k] / 3);
+            }
+            for (k = 0; k < 6; k++) vb[k] = (frm_real)((4 * (double)m->vel[6 * i + k] - (double)p[7 + k]) / 3);
+        }
+        t.h = 2 * dt / 3;
+        t.offset = m->step_offset;
+        t.vref = m->step_velocity;
+        t.vref_stride = 6;
+        t.warm_scale = 1.5;
+        err = frm__implicit_solve(m, &t);
+    }
+    if (err) return err;
+    memcpy(m->history, m->inc_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
+    m->history_valid = 1;
+    m->history_dt = dt;
     return FRM_OK;
 }
 
@@ -5340,7 +5457,8 @@ typedef struct frm__integrator_ops {
 
 static const frm__integrator_ops frm__integrators[FRM_INTEGRATOR_COUNT] = {
     {"implicit Euler", frm__implicit_euler, 0},
-    {"implicit Euler, linearised", frm__implicit_linearized, 0}};
+    {"implicit Euler, linearised", frm__implicit_linearized, 0},
+    {"BDF2", frm__bdf2, 0}};
 
 /* One entry per integrator (negative array size otherwise). */
 typedef char frm__integrators_cover_every_integrator[(sizeof frm__integrators / sizeof frm__integrators[0] ==
@@ -5399,6 +5517,7 @@ FRMDEF int frm_model_fix_frame(frm_model *m, int i)
     m->state[i] = FRM__FIXED;
     m->axes[i] = 0;
     memset(m->vel + 6 * i, 0, 6 * sizeof(frm_real));
+    m->history_valid = 0;
     return FRM_OK;
 }
 
@@ -5408,6 +5527,7 @@ FRMDEF int frm_model_drive_frame(frm_model *m, int i, const frm_real position[3]
     if (err) return err;
     if (!position || !orientation || !frm__vec3_finite(position)) return FRM_ERR_ARG;
     if (!frm__quat_valid(orientation)) return FRM_ERR_QUATERNION;
+    if (m->state[i] != FRM__DRIVEN) m->history_valid = 0; /* a new target of a driven frame keeps it */
     m->state[i] = FRM__DRIVEN;
     m->axes[i] = 0;
     memcpy(m->target + 7 * i, position, 3 * sizeof(frm_real));
@@ -5421,6 +5541,7 @@ FRMDEF int frm_model_release_frame(frm_model *m, int i)
     if (err) return err;
     m->state[i] = FRM__FREE;
     m->axes[i] = 0;
+    m->history_valid = 0;
     return FRM_OK;
 }
 
@@ -5430,6 +5551,7 @@ FRMDEF int frm_model_set_frame_axes(frm_model *m, int i, unsigned translation_ax
     if (err) return err;
     if (translation_axes > 7 || rotation_axes > 7 || m->state[i] != FRM__FREE) return FRM_ERR_ARG;
     m->axes[i] = (unsigned char)(translation_axes | rotation_axes << 3);
+    m->history_valid = 0;
     for (k = 0; k < 6; k++)
         if ((m->axes[i] >> k) & 1) m->vel[6 * i + k] = 0;
     return FRM_OK;
@@ -5486,6 +5608,17 @@ FRMDEF int frm_model_set_solver(frm_model *m, frm_real cg_tolerance, int cg_max_
     return FRM_OK;
 }
 
+FRMDEF int frm_model_set_damping(frm_model *m, frm_real mass_damping, frm_real stiffness_damping)
+{
+    if (!m) return FRM_ERR_ARG;
+    if (!(frm__finite((double)mass_damping) && mass_damping >= 0) ||
+        !(frm__finite((double)stiffness_damping) && stiffness_damping >= 0))
+        return FRM_ERR_DAMPING;
+    m->mass_damping = mass_damping;
+    m->stiffness_damping = stiffness_damping;
+    return FRM_OK;
+}
+
 FRMDEF int frm_model_set_stiffness_mode(frm_model *m, frm_stiffness_mode mode)
 {
     if (!m) return FRM_ERR_ARG;
@@ -5503,6 +5636,8 @@ FRMDEF int frm_model_pair_count(const frm_model *m) { return m ? m->pair_count :
 FRMDEF const frm_real *frm_model_positions(const frm_model *m) { return m ? m->pos : NULL; }
 FRMDEF const frm_real *frm_model_orientations(const frm_model *m) { return m ? m->quat : NULL; }
 FRMDEF const frm_real *frm_model_velocities(const frm_model *m) { return m ? m->vel : NULL; }
+FRMDEF const frm_real *frm_model_displacements(const frm_model *m) { return m ? m->disp : NULL; }
+FRMDEF const frm_real *frm_model_rest_positions(const frm_model *m) { return m ? m->rest_pos : NULL; }
 FRMDEF const frm_stats *frm_model_last_stats(const frm_model *m) { return m ? &m->stats : NULL; }
 
 FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const frm_real *orientations)
@@ -5516,6 +5651,7 @@ FRMDEF int frm_model_set_poses(frm_model *m, const frm_real *positions, const fr
     for (i = 0; i < m->frame_count; i++) frm__quat_normalized(orientations + 4 * i, m->quat + 4 * i);
     frm__update_frames(m);
     m->lin_valid = 0;
+    m->history_valid = 0;
     return FRM_OK;
 }
 
@@ -5523,6 +5659,7 @@ FRMDEF int frm_model_set_velocities(frm_model *m, const frm_real *velocities)
 {
     if (!m || !velocities || !frm__all_finite(velocities, 6 * (size_t)m->frame_count)) return FRM_ERR_ARG;
     memcpy(m->vel, velocities, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    m->history_valid = 0;
     return FRM_OK;
 }
 

@@ -2476,7 +2476,7 @@ static void frame_displacements(const frm_model *m, const frm_sampling *s, doubl
 
 /* A small hexahedral beam with Rayleigh damping, clamped at x = 0, started at rest with a
    non-zero velocity (small amplitude: the linear regime, no gravity). */
-static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
+static void damped_beam_with(scene *sc, double alpha, double beta, double amplitude, frm_integrator integrator)
 {
     double lo[3] = {0, -0.25, -0.25}, hi[3] = {1, 0.25, 0.25};
     frm_real g[3] = {0, 0, 0}, *v;
@@ -2485,6 +2485,7 @@ static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
     frm_model_destroy(sc->m);
     sc->d.mass_damping = (frm_real)alpha;
     sc->d.stiffness_damping = (frm_real)beta;
+    sc->d.integrator = integrator;
     REQUIRE(frm_model_create(&sc->d, &sc->m) == FRM_OK);
     n = frm_model_frame_count(sc->m);
     clamp_beam(sc->m, &sc->s);
@@ -2499,6 +2500,11 @@ static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
                                                                                      : k == 4 ? -1.0 : 0.1 * (k == 1)));
     REQUIRE(frm_model_set_velocities(sc->m, v) == FRM_OK);
     free(v);
+}
+
+static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
+{
+    damped_beam_with(sc, alpha, beta, amplitude, FRM_IMPLICIT_EULER);
 }
 
 /* Implicit Euler with Rayleigh damping (alpha M + beta K) and a non-zero start velocity
@@ -3244,6 +3250,245 @@ static void test_i18_settings_validation(void)
     scene_free(&sc);
 }
 
+
+/* ---- issue 19: BDF2 ---------------------------------------------------------------------- */
+
+/* The assembled K (symmetric part) and the mass blocks of the free frames, dense, N = 6 nf. */
+static int dense_system(frm_model *m, int *map, double **K, double **M)
+{
+    int n = frm_model_frame_count(m), nf = 0, i, j, a, b, N;
+    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(m, i) ? -1 : nf++;
+    N = 6 * nf;
+    *K = (double *)calloc((size_t)N * N, sizeof(double));
+    *M = (double *)calloc((size_t)N * N, sizeof(double));
+    if (frm_model_assemble_stiffness(m) != FRM_OK) return 0;
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++) {
+            frm_real B[36];
+            if (map[i] < 0 || map[j] < 0) continue;
+            if (frm_model_stiffness_block(m, i, j, B) != FRM_OK) continue;
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) (*K)[(6 * map[i] + a) * N + 6 * map[j] + b] = (double)B[6 * a + b];
+        }
+    for (i = 0; i < n; i++) {
+        frm_real B[36];
+        if (map[i] < 0) continue;
+        if (frm_model_mass_block(m, i, B) != FRM_OK) return 0;
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) (*M)[(6 * map[i] + a) * N + 6 * map[i] + b] = (double)B[6 * a + b];
+    }
+    return N;
+}
+
+/* BDF2 with Rayleigh damping and a non-zero start velocity against its discrete recurrence
+   on the assembled K and M (linear regime): the first step implicit Euler, then with
+   b = 2 dt / 3, ubar = (4 u_n - u_{n-1}) / 3, vbar = (4 v_n - v_{n-1}) / 3,
+       (M (1 + alpha b) + (b^2 + beta b) K) v_{n+1} = M vbar - b K ubar,  u_{n+1} = ubar + b v_{n+1}
+   (a wrong history weight, damping term or offset shows at once); then the order of
+   accuracy: the changes of u(T) between dt, dt/2 and dt/4 fall by 4 (second order). */
+static void test_i19_bdf2_recurrence(void)
+{
+    scene sc;
+    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err = 0, top = 0;
+    int n, i, a, b, step, steps = 20, N, *map;
+    double *K, *M, *A, *u, *v, *up, *vp, *rhs, *uf;
+    damped_beam_with(&sc, alpha, beta, amp, FRM_BDF2);
+    n = frm_model_frame_count(sc.m);
+    map = (int *)malloc(sizeof(int) * (size_t)n);
+    N = dense_system(sc.m, map, &K, &M);
+    REQUIRE(N > 0);
+    A = (double *)calloc((size_t)N * N, sizeof(double));
+    u = (double *)calloc((size_t)N, sizeof(double));
+    v = (double *)calloc((size_t)N, sizeof(double));
+    up = (double *)calloc((size_t)N, sizeof(double));
+    vp = (double *)calloc((size_t)N, sizeof(double));
+    rhs = (double *)calloc((size_t)N, sizeof(double));
+    uf = (double *)calloc((size_t)6 * n, sizeof(double));
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) v[6 * map[i] + a] = (double)frm_model_velocities(sc.m)[6 * i + a];
+    for (step = 0; step < steps; step++) {
+        double h = step == 0 ? dt : 2 * dt / 3;
+        REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
+        for (a = 0; a < N; a++) { /* ubar, vbar (the first step: u_n, v_n) into up, vp */
+            double ub = step == 0 ? u[a] : (4 * u[a] - up[a]) / 3, vb = step == 0 ? v[a] : (4 * v[a] - vp[a]) / 3;
+            up[a] = u[a], vp[a] = v[a];
+            u[a] = ub, v[a] = vb;
+        }
+        for (a = 0; a < N; a++) {
+            double t = 0;
+            for (b = 0; b < N; b++) {
+                t += M[a * N + b] * v[b] - h * K[a * N + b] * u[b];
+                A[a * N + b] = M[a * N + b] * (1 + alpha * h) + (h * h + beta * h) * K[a * N + b];
+            }
+            rhs[a] = t;
+        }
+        dense_solve(A, rhs, N);
+        for (a = 0; a < N; a++) {
+            v[a] = rhs[a];
+            u[a] += h * v[a];
+        }
+    }
+    frame_displacements(sc.m, &sc.s, uf);
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) {
+                double d = uf[6 * i + a] - u[6 * map[i] + a];
+                err += d * d;
+                top += u[6 * map[i] + a] * u[6 * map[i] + a];
+            }
+    err = sqrt(err / top);
+    printf("    BDF2, %d steps of %.2f s, alpha %.2f, beta %.2f: frames against the recurrence %.2e (relative)\n", steps, dt,
+           alpha, beta, err);
+    CHECK(err < (IS_FLOAT ? 2e-2 : 1e-4));
+    scene_free(&sc);
+    { /* order: u(T) at dt, dt/2, dt/4 */
+        double *uT[3], d1 = 0, d2 = 0, T = 2.0;
+        int r;
+        for (r = 0; r < 3; r++) {
+            double h = 0.02 / (1 << r);
+            uT[r] = (double *)calloc((size_t)6 * n, sizeof(double));
+            damped_beam_with(&sc, alpha, beta, amp, FRM_BDF2);
+            for (step = 0; step < (int)(T / h + 0.5); step++) REQUIRE(frm_model_step_ex(sc.m, (frm_real)h) == FRM_OK);
+            frame_displacements(sc.m, &sc.s, uT[r]);
+            scene_free(&sc);
+        }
+        for (a = 0; a < 6 * n; a++) {
+            d1 += (uT[0][a] - uT[1][a]) * (uT[0][a] - uT[1][a]);
+            d2 += (uT[1][a] - uT[2][a]) * (uT[1][a] - uT[2][a]);
+        }
+        printf("    BDF2 order: changes %.3e, %.3e, ratio %.3f (second order: 4)\n", sqrt(d1), sqrt(d2), sqrt(d1 / d2));
+        if (IS_FLOAT) /* float's rounding (amplitude 1e-3) blurs the small changes */
+            CHECK(sqrt(d1 / d2) > 2.5 && sqrt(d1 / d2) < 6);
+        else
+            CHECK(sqrt(d1 / d2) > 3.5 && sqrt(d1 / d2) < 4.5);
+        for (r = 0; r < 3; r++) free(uT[r]);
+    }
+    free(map), free(K), free(M), free(A), free(u), free(v), free(up), free(vp), free(rhs), free(uf);
+}
+
+/* The principal root zeta = r e^{i theta} of a scheme on x'' = -w^2 x at eps = w dt:
+   implicit Euler 1 / (1 - i eps); BDF2 (2 + sqrt(1 + 2 i eps)) / (3 - 2 i eps). */
+static void scheme_root(int bdf2, double eps, double *r, double *theta)
+{
+    double re, im;
+    if (!bdf2) {
+        re = 1 / (1 + eps * eps);
+        im = eps / (1 + eps * eps);
+    } else {
+        double mod = sqrt(1 + 4 * eps * eps), sa = sqrt((mod + 1) / 2), sb = sqrt((mod - 1) / 2);
+        double nr = 2 + sa, ni = sb, dr = 3, di = -2 * eps, d2 = dr * dr + di * di;
+        re = (nr * dr + ni * di) / d2;
+        im = (ni * dr - nr * di) / d2;
+    }
+    *r = sqrt(re * re + im * im);
+    *theta = atan2(im, re);
+}
+
+/* A one-degree-of-freedom oscillator made of frames: one hexahedral cell, the face x = 0
+   fixed, the face x = 1 free to translate along x only (held axes), all four moving alike
+   (the symmetric mode, an eigenvector by symmetry). Released from a small stretch; x_n
+   (their mean displacement) is fitted with the recurrence x_{n+1} = 2 r cos(theta) x_n -
+   r^2 x_{n-1} of a damped sinusoid after the start (BDF2's parasitic root, 1/3 a step,
+   gone), and r, theta per step are compared with the scheme's closed-form root at
+   eps = w dt, w^2 the Rayleigh quotient of the mode (K and M of the model). Prints the
+   amplitude decay per period 1 - r^(2 pi / theta) and the period error eps / theta - 1
+   at dt = T/20, T/50, T/100, T/400 for implicit Euler and BDF2, and checks the decay
+   to 3 digits (1e-3 relative) and the orders (period error / 4 or / 2 from T/50 to T/100). */
+static void test_i19_oscillator_decay(void)
+{
+    static const int per_period[4] = {20, 50, 100, 400};
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, amp = IS_FLOAT ? 1e-3 : 1e-6, w, T, perr[2][4], dec[2][4];
+    int integ, c, counts = TEST_IS_QUICK ? 3 : 4;
+    for (integ = 0; integ < 2; integ++)
+        for (c = 0; c < counts; c++) {
+            scene sc;
+            frm_real *pos, *vv, g[3] = {0, 0, 0};
+            double num = 0, den = 0, *x, S11 = 0, S12 = 0, S22 = 0, R1 = 0, R2 = 0, fa, fc, r, th, r0, th0, dt, decay, decay0;
+            int n, i, k, steps, free_count = 0, start = 30;
+            REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 2, FRM_LAW_SVK, 1e4, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+            frm_model_destroy(sc.m);
+            sc.d.integrator = integ ? FRM_BDF2 : FRM_IMPLICIT_EULER;
+            REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+            n = frm_model_frame_count(sc.m);
+            REQUIRE(frm_model_set_gravity(sc.m, g) == FRM_OK);
+            REQUIRE(frm_model_set_solver(sc.m, (frm_real)(IS_FLOAT ? 1e-6 : 1e-13), 1000, (frm_real)(IS_FLOAT ? 1e-5 : 1e-11), 30) ==
+                    FRM_OK);
+            pos = alloc_reals(3 * n);
+            vv = alloc_reals(6 * n);
+            for (i = 0; i < n; i++) {
+                for (k = 0; k < 6; k++) vv[6 * i + k] = 0;
+                for (k = 0; k < 3; k++) pos[3 * i + k] = sc.s.frame_positions[3 * i + k];
+                if (sc.s.frame_positions[3 * i] == 0) REQUIRE(frm_model_fix_frame(sc.m, i) == FRM_OK);
+                else {
+                    REQUIRE(frm_model_set_frame_axes(sc.m, i, 6, 7) == FRM_OK);
+                    vv[6 * i] = 1; /* the mode shape, for its Rayleigh quotient */
+                    free_count++;
+                }
+            }
+            { /* w^2 = v.Kv / v.Mv of the mode at rest */
+                frm_real *kv = alloc_reals(6 * n), B[36];
+                REQUIRE(frm_model_prepare_stiffness(sc.m) == FRM_OK);
+                REQUIRE(frm_model_apply_stiffness(sc.m, vv, kv, 1) == FRM_OK);
+                for (i = 0; i < n; i++)
+                    if (vv[6 * i] != 0) {
+                        REQUIRE(frm_model_mass_block(sc.m, i, B) == FRM_OK);
+                        num += (double)kv[6 * i];
+                        den += (double)B[0];
+                    }
+                free(kv);
+            }
+            w = sqrt(num / den);
+            T = 2 * 3.14159265358979323846 / w;
+            dt = T / per_period[c];
+            for (i = 0; i < n; i++) {
+                if (vv[6 * i] != 0) pos[3 * i] += (frm_real)amp;
+                vv[6 * i] = 0;
+            }
+            REQUIRE(frm_model_set_poses(sc.m, pos, frm_model_orientations(sc.m)) == FRM_OK);
+            steps = start + 3 * per_period[c];
+            x = (double *)calloc((size_t)steps + 1, sizeof(double));
+            for (k = 1; k <= steps; k++) {
+                REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
+                for (i = 0; i < n; i++)
+                    if (sc.s.frame_positions[3 * i] != 0) x[k] += ((double)frm_model_positions(sc.m)[3 * i] - 1) / free_count;
+            }
+            for (k = start + 1; k < steps; k++) { /* least squares x_{k+1} = a x_k + c x_{k-1} */
+                S11 += x[k] * x[k], S12 += x[k] * x[k - 1], S22 += x[k - 1] * x[k - 1];
+                R1 += x[k + 1] * x[k], R2 += x[k + 1] * x[k - 1];
+            }
+            fa = (R1 * S22 - R2 * S12) / (S11 * S22 - S12 * S12);
+            fc = (S11 * R2 - S12 * R1) / (S11 * S22 - S12 * S12);
+            r = sqrt(-fc);
+            th = acos(fa / (2 * r));
+            scheme_root(integ, w * dt, &r0, &th0);
+            decay = 1 - pow(r, 2 * 3.14159265358979323846 / th);
+            decay0 = 1 - pow(r0, 2 * 3.14159265358979323846 / th0);
+            perr[integ][c] = w * dt / th - 1;
+            dec[integ][c] = decay;
+            printf("    %s dt = T/%d: decay a period %.4e (theory %.4e), period error %+.4e (theory %+.4e)\n",
+                   integ ? "BDF2          " : "implicit Euler", per_period[c], decay, decay0, perr[integ][c], w * dt / th0 - 1);
+            if (!IS_FLOAT && per_period[c] <= 100) {
+                CHECK_REL(decay0, decay, 1e-3);
+                CHECK_REL(w * dt / th0 - 1, perr[integ][c], 1e-3);
+            } else if (per_period[c] <= 50) {
+                CHECK_REL(decay0, decay, 0.05);
+            }
+            free(x), free(pos), free(vv);
+            scene_free(&sc);
+        }
+    /* implicit Euler's phase is second order too (arg 1 / (1 - i eps) = eps - eps^3 / 3), its
+       amplitude first order (decay a period about pi eps); BDF2's decay a period goes as eps^3 */
+    printf("    T/50 -> T/100: period error / %.2f (implicit Euler), / %.2f (BDF2); decay a period / %.2f (implicit "
+           "Euler), / %.2f (BDF2)\n", perr[0][1] / perr[0][2], perr[1][1] / perr[1][2], dec[0][1] / dec[0][2],
+           dec[1][1] / dec[1][2]);
+    CHECK(perr[0][1] / perr[0][2] > 3.6 && perr[0][1] / perr[0][2] < 4.4);
+    CHECK(perr[1][1] / perr[1][2] > 3.6 && perr[1][1] / perr[1][2] < 4.4);
+    CHECK(dec[0][1] / dec[0][2] > 1.6 && dec[0][1] / dec[0][2] < 2.2);
+    CHECK(dec[1][1] / dec[1][2] > 6.5 && dec[1][1] / dec[1][2] < 8.5);
+    CHECK(perr[0][1] > 0 && perr[1][1] > 0); /* both lengthen the period */
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -3282,6 +3527,8 @@ static const test_case cases[] = {
     TEST(test_i18_squashed_cube),
     TEST(test_i18_saddle_refused),
     TEST(test_i18_settings_validation),
+    TEST(test_i19_bdf2_recurrence),
+    TEST(test_i19_oscillator_decay),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
