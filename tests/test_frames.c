@@ -3489,6 +3489,144 @@ static void test_i19_oscillator_decay(void)
     CHECK(perr[0][1] > 0 && perr[1][1] > 0); /* both lengthen the period */
 }
 
+
+/* The history: the first BDF2 step is implicit Euler (bit-identical to an implicit Euler
+   model's), so is the first after set_velocities (and the other discontinuities); the
+   second is not. A failed step (a different dt, refused) keeps the state and the history:
+   the next step at the old dt is bit-identical to the same run without the failure. */
+static void test_i19_bdf2_history(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5};
+    scene a, b, c;
+    frm_real g[3] = {0, 0, (frm_real)-1e5}, dt = (frm_real)1e-4;
+    int n, run, err;
+    for (run = 0; run < 3; run++) {
+        scene *sc = run == 0 ? &a : run == 1 ? &b : &c;
+        REQUIRE(scene_hex(sc, lo, hi, 2, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, 1e3, 0.3, 1000, FRM_STIFFNESS_PAIRS) == FRM_OK);
+        frm_model_destroy(sc->m);
+        sc->d.integrator = run == 2 ? FRM_IMPLICIT_EULER : FRM_BDF2;
+        REQUIRE(frm_model_create(&sc->d, &sc->m) == FRM_OK);
+        REQUIRE(frm_model_fix_frame(sc->m, 0) == FRM_OK);
+        REQUIRE(frm_model_set_gravity(sc->m, g) == FRM_OK);
+        REQUIRE(frm_model_step_ex(sc->m, dt) == FRM_OK);
+    }
+    n = frm_model_frame_count(a.m);
+    CHECK(memcmp(frm_model_positions(a.m), frm_model_positions(c.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(frm_model_velocities(a.m), frm_model_velocities(c.m), sizeof(frm_real) * 6 * (size_t)n) == 0);
+    /* b and c restart their history (c has none), a does not */
+    REQUIRE(frm_model_set_velocities(b.m, frm_model_velocities(b.m)) == FRM_OK);
+    REQUIRE(frm_model_set_velocities(c.m, frm_model_velocities(c.m)) == FRM_OK);
+    REQUIRE(frm_model_step_ex(a.m, dt) == FRM_OK);
+    REQUIRE(frm_model_step_ex(b.m, dt) == FRM_OK);
+    REQUIRE(frm_model_step_ex(c.m, dt) == FRM_OK);
+    CHECK(memcmp(frm_model_positions(b.m), frm_model_positions(c.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(frm_model_positions(a.m), frm_model_positions(c.m), sizeof(frm_real) * 3 * (size_t)n) != 0);
+    scene_free(&b);
+    scene_free(&c);
+    /* a failed step between two steps of a second BDF2 run changes nothing */
+    REQUIRE(scene_hex(&b, lo, hi, 2, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, 1e3, 0.3, 1000, FRM_STIFFNESS_PAIRS) == FRM_OK);
+    frm_model_destroy(b.m);
+    b.d.integrator = FRM_BDF2;
+    REQUIRE(frm_model_create(&b.d, &b.m) == FRM_OK);
+    REQUIRE(frm_model_fix_frame(b.m, 0) == FRM_OK);
+    REQUIRE(frm_model_set_gravity(b.m, g) == FRM_OK);
+    REQUIRE(frm_model_step_ex(b.m, dt) == FRM_OK);
+    REQUIRE(frm_model_step_ex(b.m, dt) == FRM_OK);
+    err = frm_model_step_ex(b.m, (frm_real)10);
+    CHECK(err == FRM_ERR_INVERTED || err == FRM_ERR_NO_CONVERGENCE || err == FRM_ERR_NOT_FINITE);
+    REQUIRE(frm_model_step_ex(a.m, dt) == FRM_OK);
+    REQUIRE(frm_model_step_ex(b.m, dt) == FRM_OK);
+    CHECK(memcmp(frm_model_positions(a.m), frm_model_positions(b.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(frm_model_orientations(a.m), frm_model_orientations(b.m), sizeof(frm_real) * 4 * (size_t)n) == 0);
+    CHECK(memcmp(frm_model_velocities(a.m), frm_model_velocities(b.m), sizeof(frm_real) * 6 * (size_t)n) == 0);
+    scene_free(&a);
+    scene_free(&b);
+}
+
+/* BDF2 in the stress sweep (test_i18_stress_sweep's tetrahedral beam under gravity):
+   stiff, soft and near-incompressible Neo-Hookean, dt from 1e-2 to 1 s, three steps (one
+   implicit Euler, two BDF2); every run returns an error code or agrees with the same run
+   at a 100 times finer tolerance: never success with a wrong answer. */
+static void test_i19_bdf2_sweep(void)
+{
+    static const double youngs[3] = {1, 1e6, 2e11}, nus[2] = {0.3, 0.4999}, steps[2] = {1e-2, 1};
+    int e, j, t, fine, runs = 0, ok_runs = 0, errors = 0;
+    double worst = 0;
+    for (e = 0; e < 3; e += TEST_IS_QUICK ? 2 : 1)
+        for (j = TEST_IS_QUICK ? 1 : 0; j < 2; j++)
+            for (t = 0; t < 2; t++) {
+                double result[2] = {0, 0}, scale = steps[t] * steps[t] * 9.81;
+                int err[2] = {0, 0};
+                for (fine = 0; fine < 2; fine++) {
+                    scene sc;
+                    int k;
+                    double ntol = (double)frm_model_default_desc().newton_tolerance * (fine ? 0.01 : 1);
+                    double ctol = (double)frm_model_default_desc().cg_tolerance * (fine ? 0.01 : 1);
+                    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 4, 1, 1, FRM_LAW_NEO_HOOKEAN, youngs[e], nus[j], 1000, FRM_STIFFNESS_AUTO) ==
+                            FRM_OK);
+                    frm_model_destroy(sc.m);
+                    sc.d.integrator = FRM_BDF2;
+                    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+                    REQUIRE(frm_model_set_solver(sc.m, (frm_real)ctol, 20000, (frm_real)ntol, 30) == FRM_OK);
+                    clamp_beam(sc.m, &sc.s);
+                    for (k = 0; k < 3 && !err[fine]; k++) err[fine] = frm_model_step_ex(sc.m, (frm_real)steps[t]);
+                    result[fine] = end_face_z(sc.m, &sc.s, 1);
+                    scene_free(&sc);
+                    if (err[0]) break;
+                }
+                runs++;
+                if (err[0]) {
+                    errors++;
+                    continue;
+                }
+                ok_runs++;
+                if (err[1] == FRM_OK) {
+                    double d = fabs(result[0] - result[1]) / scale;
+                    if (d > worst) worst = d;
+                    if (!(d < (IS_FLOAT ? 1e-2 : 1e-3)))
+                        printf("    E %g nu %g dt %g: %.9g against %.9g (fine)\n", youngs[e], nus[j], steps[t], result[0], result[1]);
+                    CHECK(d < (IS_FLOAT ? 1e-2 : 1e-3));
+                }
+            }
+    printf("    BDF2: %d runs: %d converged (worst difference to the 100 x finer run %.2g of its scale), %d error codes\n",
+           runs, ok_runs, worst, errors);
+}
+
+
+/* frm_model_set_damping after creation gives the steps of a model created with the same
+   damping (bit-identical) and refuses negative or non-finite values (FRM_ERR_DAMPING,
+   nothing changed); frm_model_displacements and _rest_positions match positions - rest. */
+static void test_i19_set_damping(void)
+{
+    scene a, b;
+    int n, i, k, step;
+    double worst = 0;
+    damped_beam_with(&a, 0.5, 0.02, 1e-3, FRM_BDF2);
+    damped_beam_with(&b, 0, 0, 1e-3, FRM_BDF2);
+    CHECK_INT(FRM_ERR_DAMPING, frm_model_set_damping(b.m, (frm_real)-1, 0));
+    CHECK_INT(FRM_ERR_DAMPING, frm_model_set_damping(b.m, 0, (frm_real)NAN));
+    CHECK_INT(FRM_ERR_ARG, frm_model_set_damping(NULL, 0, 0));
+    REQUIRE(frm_model_set_damping(b.m, (frm_real)0.5, (frm_real)0.02) == FRM_OK);
+    n = frm_model_frame_count(a.m);
+    for (step = 0; step < 3; step++) {
+        REQUIRE(frm_model_step_ex(a.m, (frm_real)0.05) == FRM_OK);
+        REQUIRE(frm_model_step_ex(b.m, (frm_real)0.05) == FRM_OK);
+    }
+    CHECK(memcmp(frm_model_positions(a.m), frm_model_positions(b.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+    CHECK(memcmp(frm_model_velocities(a.m), frm_model_velocities(b.m), sizeof(frm_real) * 6 * (size_t)n) == 0);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) {
+            double d = (double)frm_model_positions(a.m)[3 * i + k] - (double)frm_model_rest_positions(a.m)[3 * i + k] -
+                       (double)frm_model_displacements(a.m)[3 * i + k];
+            if (fabs(d) > worst) worst = fabs(d);
+            CHECK(frm_model_rest_positions(a.m)[3 * i + k] == a.s.frame_positions[3 * i + k]);
+        }
+    CHECK(worst <= 4 * EPS);
+    CHECK(frm_model_displacements(NULL) == NULL && frm_model_rest_positions(NULL) == NULL);
+    scene_free(&a);
+    scene_free(&b);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -3529,6 +3667,9 @@ static const test_case cases[] = {
     TEST(test_i18_settings_validation),
     TEST(test_i19_bdf2_recurrence),
     TEST(test_i19_oscillator_decay),
+    TEST(test_i19_bdf2_history),
+    TEST(test_i19_bdf2_sweep),
+    TEST(test_i19_set_damping),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
