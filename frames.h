@@ -710,6 +710,7 @@ typedef FRM_REAL frm_real;
 #define frm_model_set_gravity frm_model_set_gravity_f32
 #define frm_model_set_solver frm_model_set_solver_f32
 #define frm_model_set_damping frm_model_set_damping_f32
+#define frm_model_set_integrator frm_model_set_integrator_f32
 #define frm_model_set_stiffness_mode frm_model_set_stiffness_mode_f32
 #define frm_model_step frm_model_step_f32
 #define frm_model_step_ex frm_model_step_ex_f32
@@ -1235,6 +1236,10 @@ FRMDEF int frm_model_set_gravity(frm_model *m, const frm_real g[3]);
    both finite and >= 0 (FRM_ERR_DAMPING otherwise, nothing changed); the next step uses
    them (as desc.mass_damping / stiffness_damping). No allocation. */
 FRMDEF int frm_model_set_damping(frm_model *m, frm_real mass_damping, frm_real stiffness_damping);
+/* The integrator of later steps (as desc.integrator; heml.h and tensormass.h take it per
+   step in *_step_ex). BDF2's history restarts: the next step is implicit Euler.
+   FRM_ERR_SOLVER for a value outside frm_integrator. No allocation. */
+FRMDEF int frm_model_set_integrator(frm_model *m, frm_integrator integrator);
 /* CG tolerance (> 0) and cap (>= 1), Newton tolerance (> 0) and cap (>= 1). */
 FRMDEF int frm_model_set_solver(frm_model *m, frm_real cg_tolerance, int cg_max_iterations,
                                 frm_real newton_tolerance, int newton_max_iterations);
@@ -2138,7 +2143,7 @@ struct frm_model {
     frm_real *drive_dv;                  /* driven frames' velocity change (Newton step: their dq) */
     frm_real *backup;      /* 13 per frame: position, orientation, velocity */
     frm_real *start_state; /* 13 per frame: the state a static solve started from */
-    /* BDF2 (carved only for it) */
+    /* BDF2 (carved for every model: frm_model_set_integrator may choose it later) */
     frm_real *history;       /* 13 per frame: the state one step back (x_{n-1}, q_{n-1}, v_{n-1}) */
     frm_real *step_offset;   /* 6 per frame: xbar - x_n in the step's tangent coordinates */
     frm_real *step_velocity; /* 6 per frame: vbar, the step's reference velocity */
@@ -2825,11 +2830,9 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->drive_dv, frm_real, 6 * n);
     FRM__CARVE(c, m->backup, frm_real, 13 * n);
     FRM__CARVE(c, m->start_state, frm_real, 13 * n);
-    if (m->integrator == FRM_BDF2) {
-        FRM__CARVE(c, m->history, frm_real, 13 * n);
-        FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
-        FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
-    }
+    FRM__CARVE(c, m->history, frm_real, 13 * n);
+    FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
+    FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
 }
 
 /* >>validation ------------------------------------------------------------------------- */
@@ -3347,8 +3350,6 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
     tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
     tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
     tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
-    /* the layout carves BDF2's history only for it (frm__create_settings sets it again) */
-    tmp->integrator = d->implicit_linearized ? FRM_IMPLICIT_EULER_LINEARIZED : (int)d->integrator;
     if (tmp->has_blocks) {
         long long blocks, sq = 0;
         for (i = 0; i < n; i++) t->marker[i] = -1;
@@ -5616,6 +5617,15 @@ FRMDEF int frm_model_set_damping(frm_model *m, frm_real mass_damping, frm_real s
         return FRM_ERR_DAMPING;
     m->mass_damping = mass_damping;
     m->stiffness_damping = stiffness_damping;
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_set_integrator(frm_model *m, frm_integrator integrator)
+{
+    if (!m) return FRM_ERR_ARG;
+    if ((unsigned)integrator >= FRM_INTEGRATOR_COUNT) return FRM_ERR_SOLVER;
+    m->integrator = (int)integrator;
+    m->history_valid = 0;
     return FRM_OK;
 }
 

@@ -25,6 +25,7 @@
 typedef struct fr_sim {
     frm_model *m;
     int frames, prepared; /* prepared: the stiffness is linearised at the current state */
+    int integrator;       /* frm_integrator of the model (FRM_IMPLICIT_EULER at creation) */
     double *rest;         /* 3 per frame, with the offset, in double */
     frm_real *v, *out;    /* K*v kernel vectors, 6 per frame */
 } fr_sim;
@@ -192,8 +193,15 @@ static int fr_solve_static(void *v)
 
 static int fr_step(void *v, double dt, int integrator)
 {
-    if (integrator != BENCH_IMPLICIT_EULER) return BENCH_UNSUPPORTED;
-    ((fr_sim *)v)->prepared = 0;
+    frm_integrator want = integrator == BENCH_BDF2 ? FRM_BDF2 : FRM_IMPLICIT_EULER;
+    fr_sim *s = (fr_sim *)v;
+    if (integrator != BENCH_IMPLICIT_EULER && integrator != BENCH_BDF2) return BENCH_UNSUPPORTED;
+    if (s->integrator != (int)want) { /* switching restarts BDF2's history */
+        int err = frm_model_set_integrator(s->m, want);
+        if (err) return err;
+        s->integrator = (int)want;
+    }
+    s->prepared = 0;
     return frm_model_step_ex(((fr_sim *)v)->m, (frm_real)dt);
 }
 
@@ -238,7 +246,7 @@ static int fr_kernel(void *v, int kernel)
     return frm_model_apply_stiffness(s->m, s->v, s->out, 1);
 }
 
-#define FR_ALL ((1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+#define FR_ALL ((1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_BDF2) | (1u << BENCH_STATIC))
 #define FR_FUNCTIONS                                                                                          \
     fr_destroy, fr_dof, fr_node_count, fr_rest, fr_position, fr_pin, fr_release, fr_set_gravity, fr_solve_static, \
         fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL

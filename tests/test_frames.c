@@ -1825,6 +1825,9 @@ static void reversed_parallel_for(int count, frm_task_fn task, void *ctx, void *
     }
 }
 
+/* The integrator of run_hashed's steps (issue 19's determinism test sets BDF2). */
+static frm_integrator hashed_integrator = FRM_IMPLICIT_EULER;
+
 /* Static solve, then implicit steps, in both stiffness modes; hashes the poses. */
 static unsigned long long run_hashed(int threads, int workers)
 {
@@ -1852,6 +1855,7 @@ static unsigned long long run_hashed(int threads, int workers)
     d.parallel_for = workers ? reversed_parallel_for : NULL;
     d.parallel_user = &workers;
     d.parallel_min_pairs = 256; /* this small model takes the parallel path */
+    d.integrator = hashed_integrator;
     for (mode = 1; mode <= 2; mode++) {
         d.stiffness_mode = (frm_stiffness_mode)mode;
         if (frm_model_create(&d, &m) != FRM_OK) break;
@@ -3627,6 +3631,38 @@ static void test_i19_set_damping(void)
     scene_free(&b);
 }
 
+
+/* BDF2 bit-identical whatever the threads or the partition (run_hashed's static solve and
+   five steps: one implicit Euler, four BDF2), and not the implicit Euler run;
+   frm_model_set_integrator switches (BDF2 after creation gives the desc's BDF2 run) and
+   refuses values outside frm_integrator. */
+static void test_i19_bdf2_threads(void)
+{
+    unsigned long long euler = run_hashed(1, 0), h1, h2, h3;
+    hashed_integrator = FRM_BDF2;
+    h1 = run_hashed(1, 0), h2 = run_hashed(2, 0), h3 = run_hashed(1, 3);
+    hashed_integrator = FRM_IMPLICIT_EULER;
+    printf("    BDF2 hashes: 1 thread %016llx, 2 threads %016llx, 3 tasks %016llx\n", h1, h2, h3);
+    CHECK(h1 != 0 && h1 == h2 && h1 == h3);
+    CHECK(h1 != euler);
+    {
+        scene a, b;
+        int n;
+        damped_beam_with(&a, 0, 0, 1e-3, FRM_BDF2);
+        damped_beam_with(&b, 0, 0, 1e-3, FRM_IMPLICIT_EULER);
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_set_integrator(b.m, FRM_INTEGRATOR_COUNT));
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_set_integrator(b.m, (frm_integrator)-1));
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_integrator(NULL, FRM_BDF2));
+        REQUIRE(frm_model_set_integrator(b.m, FRM_BDF2) == FRM_OK);
+        n = frm_model_frame_count(a.m);
+        REQUIRE(frm_model_step_ex(a.m, (frm_real)0.05) == FRM_OK && frm_model_step_ex(a.m, (frm_real)0.05) == FRM_OK);
+        REQUIRE(frm_model_step_ex(b.m, (frm_real)0.05) == FRM_OK && frm_model_step_ex(b.m, (frm_real)0.05) == FRM_OK);
+        CHECK(memcmp(frm_model_positions(a.m), frm_model_positions(b.m), sizeof(frm_real) * 3 * (size_t)n) == 0);
+        scene_free(&a);
+        scene_free(&b);
+    }
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -3670,6 +3706,7 @@ static const test_case cases[] = {
     TEST(test_i19_bdf2_history),
     TEST(test_i19_bdf2_sweep),
     TEST(test_i19_set_damping),
+    TEST(test_i19_bdf2_threads),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }

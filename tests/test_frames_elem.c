@@ -86,7 +86,7 @@ static void test_float_renames(void)
         NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_prepare_stiffness),
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
-        NAME(frm_model_set_damping), NAME(frm_model_displacements), NAME(frm_model_rest_positions)};
+        NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions)};
     int count = (int)(sizeof names / sizeof names[0]), i, declared = 0, renamed = 0;
     char line[1024];
     FILE *f;
