@@ -742,6 +742,13 @@ typedef FRM_REAL frm_real;
 #define frm_model_stiffness_block frm_model_stiffness_block_f32
 #define frm_model_set_frame_axes frm_model_set_frame_axes_f32
 #define frm_model_frame_axes frm_model_frame_axes_f32
+#define frm_probe_default_desc frm_probe_default_desc_f32
+#define frm_probe_create frm_probe_create_f32
+#define frm_probe_positions frm_probe_positions_f32
+#define frm_probe_displacements frm_probe_displacements_f32
+#define frm_probe_velocities frm_probe_velocities_f32
+#define frm_probe_count frm_probe_count_f32
+#define frm_probe_destroy frm_probe_destroy_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
@@ -1330,6 +1337,58 @@ FRMDEF const frm_real *frm_model_stiffness_blocks(const frm_model *m, const int 
                                                   const int **cols);
 /* Copies the block between frames i and j (after assembling). */
 FRMDEF int frm_model_stiffness_block(const frm_model *m, int i, int j, frm_real out[36]);
+
+/* ---- point probes (issue 19): a material point's position, displacement and velocity
+   from the frames through the shape functions at its rest position, p = sum_i w_i (x_i +
+   R_i lbar_i) (eq. 3.34), the weights found once at frm_probe_create. The model keeps no
+   mesh, so the description says which shape functions the samples came from. ---- */
+
+typedef enum frm_probe_kind {
+    FRM_PROBE_TETS = 0,    /* mesh-based tetrahedra (frm_sampling_tets): `elements` holds 4 frame
+                              indices per tetrahedron; barycentric weights in the containing one */
+    FRM_PROBE_HEXES = 1,   /* mesh-based hexahedra (frm_sampling_hexes): 8 frame indices per
+                              hexahedron in frm_shape_hex's corner order; trilinear weights at the
+                              point's parametric coordinates in the containing one (Newton) */
+    FRM_PROBE_MESHLESS = 2 /* the meshless shape functions of `shape` (as given to
+                              frm_sampling_meshless / _box / _surface) on the model's frames */
+} frm_probe_kind;
+
+typedef struct frm_probe_desc {
+    frm_probe_kind kind;   /* default FRM_PROBE_MESHLESS */
+    const int *elements;   /* TETS, HEXES: frame indices (as the mesh's node indices: the mesh-based
+                              samplings put frame i at node i), read during frm_probe_create only */
+    int element_count;
+    frm_shape_desc shape;  /* MESHLESS: default frm_shape_default_desc() */
+    frm_real tolerance;    /* dimensionless, default 1e-6: a point at most this far outside an element
+                              (barycentric or parametric coordinate down to -tolerance) counts as
+                              in it (the element most inside wins); farther: FRM_ERR_ARG */
+    unsigned int internal_cookie; /* set by frm_probe_default_desc; do not touch */
+} frm_probe_desc;
+
+typedef struct frm_probe frm_probe;
+
+/* Defaults as documented in the fields. */
+FRMDEF frm_probe_desc frm_probe_default_desc(void);
+/* Finds each of the `count` rest points (3 each, m) in the description's elements (or its
+   meshless neighbours among the model's rest frames) and keeps its frames, weights and rest
+   levers pbar - xbar_i. Allocates one block (the model's allocator). Errors: FRM_ERR_DESC
+   (no cookie), FRM_ERR_ARG (NULL, count < 1, non-finite point, a point in no element),
+   FRM_ERR_INDEX_RANGE (an element's frame index), FRM_ERR_SAMPLING (shape settings),
+   FRM_ERR_NO_NEIGHBOR / FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
+FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
+                            frm_probe **out);
+/* 3 values per point into out (m, m, m/s) for the model's current state: positions
+   pbar + sum_i w_i (u_i + (Q_i - I) abar_i) (the displacement form of eq. 3.34, exact for
+   small motions in float), displacements (the same less pbar), velocities sum_i w_i (v_i +
+   omega_i x Q_i abar_i). No allocation; FRM_ERR_ARG for NULL or a probe made for a model
+   with another frame count. */
+FRMDEF int frm_probe_positions(const frm_probe *p, const frm_model *m, frm_real *out);
+FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_real *out);
+FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out);
+/* Points of the probe. */
+FRMDEF int frm_probe_count(const frm_probe *p);
+/* Frees the probe. NULL is allowed. */
+FRMDEF void frm_probe_destroy(frm_probe *p);
 
 #endif /* FRAMES_H */
 
@@ -2029,6 +2088,7 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__COOKIE 0x46524D53u         /* "FRMS" */
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
+#define FRM__PROBE_COOKIE 0x46524D51u   /* "FRMQ" */
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
@@ -7055,6 +7115,296 @@ FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int
     if (!err) err = frm__sampling_poisson(out, S.lo, S.hi, &S, p->volume > 0 ? (double)p->volume : vol, p, shape, &alloc);
     if (S.start) frm__free(&alloc, S.start, S.bytes);
     return err;
+}
+
+/* >>probes ----------------------------------------------------------------------------- */
+
+struct frm_probe {
+    int count, pair_count, frame_count;
+    int *start;       /* count + 1: point -> its pairs */
+    int *frame;       /* per pair */
+    double *weight;   /* per pair */
+    double *lever;    /* 3 per pair: abar = pbar - xbar_i (rest, world axes) */
+    double *rest;     /* 3 per point: pbar */
+    frm_allocator allocator;
+    size_t bytes;
+};
+
+FRMDEF frm_probe_desc frm_probe_default_desc(void)
+{
+    frm_probe_desc d;
+    memset(&d, 0, sizeof d);
+    d.kind = FRM_PROBE_MESHLESS;
+    d.shape = frm_shape_default_desc();
+    d.tolerance = (frm_real)1e-6;
+    d.internal_cookie = FRM__PROBE_COOKIE;
+    return d;
+}
+
+/* Trilinear functions of the parametric point xi (corner a + 2 b + 4 c at (a, b, c)) and
+   their derivatives d/dxi (8 x 3). */
+static void frm__trilinear(const double xi[3], double N[8], double dN[8][3])
+{
+    int a, k;
+    for (a = 0; a < 8; a++) {
+        double f[3], df[3];
+        for (k = 0; k < 3; k++) {
+            int bit = (a >> k) & 1;
+            f[k] = bit ? xi[k] : 1 - xi[k];
+            df[k] = bit ? 1 : -1;
+        }
+        N[a] = f[0] * f[1] * f[2];
+        dN[a][0] = df[0] * f[1] * f[2];
+        dN[a][1] = f[0] * df[1] * f[2];
+        dN[a][2] = f[0] * f[1] * df[2];
+    }
+}
+
+/* The parametric coordinates of p in the hexahedron X by Newton from its centre; 0 when
+   it converged (|dxi| < 1e-13), else FRM_ERR_SHAPE_DEGENERATE. */
+static int frm__hex_invert(double X[8][3], const double p[3], double xi[3])
+{
+    int it, a, r, c;
+    xi[0] = xi[1] = xi[2] = 0.5;
+    for (it = 0; it < 40; it++) {
+        double N[8], dN[8][3], J[3][3], res[3], inv[3][3], det, step = 0;
+        frm__trilinear(xi, N, dN);
+        for (r = 0; r < 3; r++) {
+            res[r] = -p[r];
+            for (c = 0; c < 3; c++) J[r][c] = 0;
+            for (a = 0; a < 8; a++) {
+                res[r] += N[a] * X[a][r];
+                for (c = 0; c < 3; c++) J[r][c] += X[a][r] * dN[a][c];
+            }
+        }
+        det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+              J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+        if (!(fabs(det) > 0) || !frm__finite(det)) return FRM_ERR_SHAPE_DEGENERATE;
+        inv[0][0] = (J[1][1] * J[2][2] - J[1][2] * J[2][1]) / det;
+        inv[0][1] = (J[0][2] * J[2][1] - J[0][1] * J[2][2]) / det;
+        inv[0][2] = (J[0][1] * J[1][2] - J[0][2] * J[1][1]) / det;
+        inv[1][0] = (J[1][2] * J[2][0] - J[1][0] * J[2][2]) / det;
+        inv[1][1] = (J[0][0] * J[2][2] - J[0][2] * J[2][0]) / det;
+        inv[1][2] = (J[0][2] * J[1][0] - J[0][0] * J[1][2]) / det;
+        inv[2][0] = (J[1][0] * J[2][1] - J[1][1] * J[2][0]) / det;
+        inv[2][1] = (J[0][1] * J[2][0] - J[0][0] * J[2][1]) / det;
+        inv[2][2] = (J[0][0] * J[1][1] - J[0][1] * J[1][0]) / det;
+        for (r = 0; r < 3; r++) {
+            double d = -(inv[r][0] * res[0] + inv[r][1] * res[1] + inv[r][2] * res[2]);
+            xi[r] += d;
+            if (fabs(d) > step) step = fabs(d);
+        }
+        if (!frm__finite(xi[0] + xi[1] + xi[2]) || fabs(xi[0]) + fabs(xi[1]) + fabs(xi[2]) > 1e3)
+            return FRM_ERR_SHAPE_DEGENERATE;
+        if (step < 1e-13) return FRM_OK;
+    }
+    return FRM_ERR_SHAPE_DEGENERATE;
+}
+
+/* The frames and weights of one point p: n (<= FRM_MAX_NEIGHBORS) into idx, w. */
+static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const frm__grid *grid, const double *X,
+                            const double p[3], int *idx, double *w, int *n)
+{
+    double tol = (double)d->tolerance, best = -HUGE_VAL;
+    int e, a, r, nodes = d->kind == FRM_PROBE_TETS ? 4 : 8;
+    *n = 0;
+    if (d->kind == FRM_PROBE_MESHLESS) {
+        const frm_shape_desc *sh = &d->shape;
+        double dist[FRM_MAX_NEIGHBORS + 1], Xn[3 * FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS], R;
+        int k = sh->support == FRM_SUPPORT_NEAREST ? (sh->nearest < m->frame_count ? sh->nearest : m->frame_count) : 0, i,
+            err;
+        int c = frm__grid_query(grid, X, p, k, sh->support == FRM_SUPPORT_RADIUS ? (double)sh->radius : 0.0,
+                                FRM_MAX_NEIGHBORS, idx, dist);
+        if (c == 0) return FRM_ERR_NO_NEIGHBOR;
+        if (c > FRM_MAX_NEIGHBORS) return FRM_ERR_TOO_MANY_NEIGHBORS;
+        for (i = 0; i < c; i++)
+            for (r = 0; r < 3; r++) Xn[3 * i + r] = X[3 * idx[i] + r];
+        if (sh->shape == FRM_SHAPE_MLS) { /* as frm_sampling_meshless */
+            R = sh->support == FRM_SUPPORT_RADIUS ? (double)sh->radius : 1.5 * dist[c - 1];
+            err = frm__mls_functions(Xn, c, p, R, w, g);
+        } else
+            err = frm__shepard_functions(Xn, c, p, (double)sh->power, sh->support == FRM_SUPPORT_RADIUS ? (double)sh->radius : 0.0,
+                                         w, g);
+        if (err) return err;
+        *n = c;
+        return FRM_OK;
+    }
+    for (e = 0; e < d->element_count; e++) {
+        const int *el = d->elements + (size_t)nodes * (size_t)e;
+        double E[8][3], lo[3], hi[3], size = 0, ww[8], inside;
+        int out = 0;
+        for (a = 0; a < nodes; a++)
+            for (r = 0; r < 3; r++) {
+                E[a][r] = X[3 * el[a] + r];
+                if (a == 0 || E[a][r] < lo[r]) lo[r] = E[a][r];
+                if (a == 0 || E[a][r] > hi[r]) hi[r] = E[a][r];
+            }
+        for (r = 0; r < 3; r++)
+            if (hi[r] - lo[r] > size) size = hi[r] - lo[r];
+        for (r = 0; r < 3; r++) out |= p[r] < lo[r] - 1e-3 * size || p[r] > hi[r] + 1e-3 * size;
+        if (out) continue; /* the bounding box, with room for the tolerance */
+        if (nodes == 4) {
+            double g4[4][3];
+            if (!frm__tet_functions(E, p, ww, g4)) continue; /* a flat tetrahedron holds no point */
+            inside = ww[0];
+            for (a = 1; a < 4; a++)
+                if (ww[a] < inside) inside = ww[a];
+        } else {
+            double xi[3], dN[8][3];
+            if (frm__hex_invert(E, p, xi)) continue;
+            frm__trilinear(xi, ww, dN);
+            inside = HUGE_VAL;
+            for (r = 0; r < 3; r++) {
+                if (xi[r] < inside) inside = xi[r];
+                if (1 - xi[r] < inside) inside = 1 - xi[r];
+            }
+        }
+        if (inside >= -tol && inside > best) {
+            best = inside;
+            *n = nodes;
+            for (a = 0; a < nodes; a++) idx[a] = el[a], w[a] = ww[a];
+        }
+    }
+    return *n ? FRM_OK : FRM_ERR_ARG;
+}
+
+FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
+                            frm_probe **out)
+{
+    frm__carver c;
+    frm__grid grid;
+    frm_probe tmp, *p;
+    double *X;
+    size_t xbytes;
+    int err = FRM_OK, i, k, r, pass, pairs = 0, nodes;
+    if (out) *out = NULL;
+    if (!m || !d || !out) return FRM_ERR_ARG;
+    if (d->internal_cookie != FRM__PROBE_COOKIE) return FRM_ERR_DESC;
+    if (!rest_points || count < 1 || count > 100000000 || !frm__all_finite(rest_points, 3 * (size_t)count) ||
+        !(frm__finite((double)d->tolerance) && d->tolerance >= 0))
+        return FRM_ERR_ARG;
+    if ((int)d->kind < FRM_PROBE_TETS || (int)d->kind > FRM_PROBE_MESHLESS) return FRM_ERR_ARG;
+    nodes = d->kind == FRM_PROBE_TETS ? 4 : 8;
+    if (d->kind == FRM_PROBE_MESHLESS) {
+        err = frm__check_shape(&d->shape);
+        if (err) return err;
+    } else {
+        if (!d->elements || d->element_count < 1) return FRM_ERR_ARG;
+        for (i = 0; i < nodes * d->element_count; i++)
+            if (d->elements[i] < 0 || d->elements[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
+    }
+    xbytes = sizeof(double) * 3 * (size_t)m->frame_count;
+    X = (double *)frm__alloc(&m->allocator, xbytes);
+    if (!X) return FRM_ERR_ALLOC;
+    for (i = 0; i < 3 * m->frame_count; i++) X[i] = (double)m->rest_pos[i];
+    memset(&grid, 0, sizeof grid);
+    if (d->kind == FRM_PROBE_MESHLESS)
+        err = frm__grid_build(&grid, X, m->frame_count, d->shape.support == FRM_SUPPORT_RADIUS ? (double)d->shape.radius : 0.0,
+                              &m->allocator);
+    memset(&tmp, 0, sizeof tmp);
+    p = NULL;
+    /* pass 0 counts the pairs, pass 1 fills the block */
+    for (pass = 0; pass < 2 && !err; pass++) {
+        if (pass == 1) {
+            tmp.count = count;
+            tmp.pair_count = pairs;
+            tmp.frame_count = m->frame_count;
+            c.base = NULL;
+            c.offset = sizeof(frm_probe);
+            FRM__CARVE(&c, tmp.start, int, count + 1);
+            FRM__CARVE(&c, tmp.frame, int, pairs);
+            FRM__CARVE(&c, tmp.weight, double, pairs);
+            FRM__CARVE(&c, tmp.lever, double, 3 * (size_t)pairs);
+            FRM__CARVE(&c, tmp.rest, double, 3 * (size_t)count);
+            tmp.bytes = c.offset;
+            tmp.allocator = m->allocator;
+            p = (frm_probe *)frm__alloc(&m->allocator, tmp.bytes);
+            if (!p) {
+                err = FRM_ERR_ALLOC;
+                break;
+            }
+            c.base = (char *)p;
+            c.offset = sizeof(frm_probe);
+            FRM__CARVE(&c, tmp.start, int, count + 1);
+            FRM__CARVE(&c, tmp.frame, int, pairs);
+            FRM__CARVE(&c, tmp.weight, double, pairs);
+            FRM__CARVE(&c, tmp.lever, double, 3 * (size_t)pairs);
+            FRM__CARVE(&c, tmp.rest, double, 3 * (size_t)count);
+            *p = tmp;
+            pairs = 0;
+        }
+        for (i = 0; i < count && !err; i++) {
+            double pt[3], w[FRM_MAX_NEIGHBORS];
+            int idx[FRM_MAX_NEIGHBORS + 1], n;
+            for (r = 0; r < 3; r++) pt[r] = (double)rest_points[3 * i + r];
+            err = frm__probe_point(m, d, &grid, X, pt, idx, w, &n);
+            if (err) break;
+            if (pass == 1) {
+                p->start[i] = pairs;
+                for (r = 0; r < 3; r++) p->rest[3 * i + r] = pt[r];
+                for (k = 0; k < n; k++) {
+                    p->frame[pairs + k] = idx[k];
+                    p->weight[pairs + k] = w[k];
+                    for (r = 0; r < 3; r++) p->lever[3 * (pairs + k) + r] = pt[r] - X[3 * idx[k] + r];
+                }
+            }
+            pairs += n;
+        }
+        if (pass == 1 && !err) p->start[count] = pairs;
+    }
+    if (grid.start) frm__free(&m->allocator, grid.start, grid.bytes);
+    frm__free(&m->allocator, X, xbytes);
+    if (err) {
+        if (p) frm__free(&m->allocator, p, p->bytes);
+        return err;
+    }
+    *out = p;
+    return FRM_OK;
+}
+
+/* what: 0 positions, 1 displacements, 2 velocities. */
+static int frm__probe_eval(const frm_probe *p, const frm_model *m, frm_real *out, int what)
+{
+    int i, k, r;
+    if (!p || !m || !out || p->frame_count != m->frame_count) return FRM_ERR_ARG;
+    for (i = 0; i < p->count; i++) {
+        double acc[3] = {0, 0, 0};
+        for (k = p->start[i]; k < p->start[i + 1]; k++) {
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            int f = p->frame[k];
+            if (what < 2) { /* u_i + (Q_i - I) abar */
+                const frm_real *Qm = m->relm + 9 * f;
+                for (r = 0; r < 3; r++)
+                    acc[r] += w * ((double)m->disp[3 * f + r] + (double)Qm[3 * r] * a[0] + (double)Qm[3 * r + 1] * a[1] +
+                                   (double)Qm[3 * r + 2] * a[2]);
+            } else { /* v_i + omega_i x Q_i abar */
+                const frm_real *Q = m->rel + 9 * f, *v = m->vel + 6 * f;
+                double l[3];
+                for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+                acc[0] += w * ((double)v[0] + (double)v[4] * l[2] - (double)v[5] * l[1]);
+                acc[1] += w * ((double)v[1] + (double)v[5] * l[0] - (double)v[3] * l[2]);
+                acc[2] += w * ((double)v[2] + (double)v[3] * l[1] - (double)v[4] * l[0]);
+            }
+        }
+        for (r = 0; r < 3; r++) out[3 * i + r] = (frm_real)(what == 0 ? p->rest[3 * i + r] + acc[r] : acc[r]);
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_probe_positions(const frm_probe *p, const frm_model *m, frm_real *out) { return frm__probe_eval(p, m, out, 0); }
+FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_real *out)
+{
+    return frm__probe_eval(p, m, out, 1);
+}
+FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out) { return frm__probe_eval(p, m, out, 2); }
+FRMDEF int frm_probe_count(const frm_probe *p) { return p ? p->count : 0; }
+
+FRMDEF void frm_probe_destroy(frm_probe *p)
+{
+    frm_allocator a;
+    if (!p) return;
+    a = p->allocator;
+    frm__free(&a, p, p->bytes);
 }
 
 #if defined(FRM_STATIC) && defined(__GNUC__)

@@ -86,7 +86,9 @@ static void test_float_renames(void)
         NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_prepare_stiffness),
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
-        NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions)};
+        NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions),
+        NAME(frm_probe_default_desc), NAME(frm_probe_create), NAME(frm_probe_positions), NAME(frm_probe_displacements),
+        NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_destroy)};
     int count = (int)(sizeof names / sizeof names[0]), i, declared = 0, renamed = 0;
     char line[1024];
     FILE *f;
@@ -1309,6 +1311,259 @@ static void test_integrator_choice(void)
               frm__laws[k].cache_size <= FRM__LAW_CACHE_MAX);
 }
 
+
+/* ---- issue 19: point probes ---------------------------------------------------------- */
+
+/* The body [0, 1] x [0, 0.5] x [0, 0.5] as a model of each kind: 0 tetrahedra (4 Gauss
+   samples each), 1 hexahedra (8 sub-cell samples), 2 Shepard and 3 MLS meshless frames
+   at the grid's nodes with samples at the cell centres; the probe description to match. */
+static int probe_scene(int kind, frm_model **m, frm_sampling *s, frm_probe_desc *pd, int **elements)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5};
+    frm_desc d = frm_model_default_desc();
+    frm_real *x;
+    hexmesh h;
+    int i, err, count;
+    *pd = frm_probe_default_desc();
+    *elements = NULL;
+    if (kind == 0) {
+        tetmesh t;
+        if (tetmesh_box(&t, lo, hi, 3, 2, 2, TETMESH_SPLIT5) != TETMESH_OK) return -1;
+        x = alloc_reals(3 * t.node_count);
+        for (i = 0; i < 3 * t.node_count; i++) x[i] = (frm_real)t.nodes[i];
+        err = frm_sampling_tets(s, x, t.node_count, t.tets, t.tet_count, 4, NULL, NULL);
+        count = 4 * t.tet_count;
+        *elements = (int *)malloc(sizeof(int) * (size_t)count);
+        memcpy(*elements, t.tets, sizeof(int) * (size_t)count);
+        pd->kind = FRM_PROBE_TETS;
+        pd->element_count = t.tet_count;
+        tetmesh_free(&t);
+    } else {
+        if (hexmesh_grid(&h, lo, hi, 3, 2, 2) != TETMESH_OK) return -1;
+        x = alloc_reals(3 * h.node_count);
+        for (i = 0; i < 3 * h.node_count; i++) x[i] = (frm_real)h.nodes[i];
+        if (kind == 1) {
+            err = frm_sampling_hexes(s, x, h.node_count, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
+            *elements = (int *)malloc(sizeof(int) * 8 * (size_t)h.hex_count);
+            memcpy(*elements, h.hexes, sizeof(int) * 8 * (size_t)h.hex_count);
+            pd->kind = FRM_PROBE_HEXES;
+            pd->element_count = h.hex_count;
+        } else {
+            frm_real *c = alloc_reals(3 * 8 * h.hex_count);
+            int e, a, r, k = 0;
+            for (e = 0; e < h.hex_count; e++) /* 8 points a cell, at the sub-cell centres */
+                for (k = 0; k < 8; k++)
+                    for (r = 0; r < 3; r++) {
+                        double lo_c = h.nodes[3 * h.hexes[8 * e] + r], hi_c = h.nodes[3 * h.hexes[8 * e + 7] + r];
+                        a = (k >> r) & 1;
+                        c[3 * (8 * e + k) + r] = (frm_real)(lo_c + (hi_c - lo_c) * (a ? 0.75 : 0.25));
+                    }
+            pd->kind = FRM_PROBE_MESHLESS;
+            if (kind == 3) {
+                pd->shape.shape = FRM_SHAPE_MLS;
+                pd->shape.nearest = 12;
+            }
+            err = frm_sampling_meshless(s, x, h.node_count, c, 8 * h.hex_count, (frm_real)0.25, &pd->shape, NULL);
+            free(c);
+        }
+        hexmesh_free(&h);
+    }
+    free(x);
+    if (err) return err;
+    pd->elements = *elements;
+    frm_sampling_apply(s, &d);
+    d.material.young_modulus = (frm_real)1e5;
+    return frm_model_create(&d, m);
+}
+
+/* Probes on every kind of model: at the samples' rest positions they give the model's
+   sample positions (the same shape functions) in a random deformed state; under a rigid
+   motion (rotation 0.7 rad, translation) any interior point moves rigidly, its velocity
+   the rigid field's; the mid-points of the body's faces are found (boundary), points
+   outside refused. */
+static void test_probe_kinds(void)
+{
+    static const char *names[4] = {"tetrahedra", "hexahedra", "Shepard", "MLS"};
+    double tol = IS_FLOAT ? 2e-6 : 1e-12, th = 0.7, n[3] = {1 / sqrt(14.0), 2 / sqrt(14.0), 3 / sqrt(14.0)}, R[9];
+    double t[3] = {0.3, -0.2, 0.1}, w[3] = {0.2, -0.5, 0.3}, v0[3] = {1, 2, -1};
+    int kind, i, r;
+    { /* Rodrigues */
+        double c = cos(th), sn = sin(th);
+        for (i = 0; i < 3; i++)
+            for (r = 0; r < 3; r++) {
+                double k = i == r ? c : 0, e = 0;
+                if ((i + 1) % 3 == r) e = -n[(i + 2) % 3];
+                if ((i + 2) % 3 == r) e = n[(i + 1) % 3];
+                R[3 * i + r] = k + (1 - c) * n[i] * n[r] + sn * e;
+            }
+    }
+    for (kind = 0; kind < 4; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = NULL;
+        int *elements = NULL, nf, ns, k;
+        frm_real *pos, *quat, *vel, *out, pts[3 * 24], outside[3] = {(frm_real)1.2, (frm_real)0.25, (frm_real)0.25};
+        double worst_s = 0, worst_r = 0, worst_v = 0, worst_a = 0;
+        unsigned seed = 7;
+        REQUIRE(probe_scene(kind, &m, &s, &pd, &elements) == FRM_OK);
+        nf = frm_model_frame_count(m);
+        ns = frm_model_sample_count(m);
+        pos = alloc_reals(3 * nf), quat = alloc_reals(4 * nf), vel = alloc_reals(6 * nf), out = alloc_reals(3 * ns);
+        /* (a) the samples, random state */
+        REQUIRE(frm_probe_create(m, &pd, s.sample_positions, ns, &p) == FRM_OK);
+        CHECK_INT(ns, frm_probe_count(p));
+        for (i = 0; i < nf; i++) {
+            double a[3], an = 0;
+            for (r = 0; r < 3; r++) {
+                seed = seed * 1664525u + 1013904223u;
+                pos[3 * i + r] = (frm_real)(s.frame_positions[3 * i + r] + 0.02 * (((seed >> 8) & 1023) / 512.0 - 1));
+                seed = seed * 1664525u + 1013904223u;
+                a[r] = 0.1 * (((seed >> 8) & 1023) / 512.0 - 1);
+                an += a[r] * a[r];
+            }
+            an = sqrt(an);
+            for (r = 0; r < 3; r++) quat[4 * i + r] = (frm_real)(an > 0 ? sin(an / 2) * a[r] / an : 0);
+            quat[4 * i + 3] = (frm_real)cos(an / 2);
+        }
+        REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+        REQUIRE(frm_probe_positions(p, m, out) == FRM_OK);
+        {
+            const frm_real *sp = frm_model_sample_positions(m);
+            for (i = 0; i < 3 * ns; i++)
+                if (fabs((double)out[i] - (double)sp[i]) > worst_s) worst_s = fabs((double)out[i] - (double)sp[i]);
+        }
+        CHECK(worst_s < 10 * tol);
+        frm_probe_destroy(p);
+        p = NULL;
+        /* (b) rigid motion at interior points and the faces' mid-points */
+        for (i = 0; i < 18; i++) {
+            seed = seed * 1664525u + 1013904223u;
+            pts[3 * i] = (frm_real)(0.05 + 0.9 * ((seed >> 8) & 1023) / 1023.0);
+            seed = seed * 1664525u + 1013904223u;
+            pts[3 * i + 1] = (frm_real)(0.025 + 0.45 * ((seed >> 8) & 1023) / 1023.0);
+            seed = seed * 1664525u + 1013904223u;
+            pts[3 * i + 2] = (frm_real)(0.025 + 0.45 * ((seed >> 8) & 1023) / 1023.0);
+        }
+        for (i = 18; i < 24; i++) { /* face centres */
+            int axis = (i - 18) / 2, hiside = (i - 18) % 2;
+            double ext[3] = {1, 0.5, 0.5};
+            for (r = 0; r < 3; r++) pts[3 * i + r] = (frm_real)(r == axis ? hiside * ext[r] : ext[r] / 2);
+        }
+        REQUIRE(frm_probe_create(m, &pd, pts, 24, &p) == FRM_OK);
+        {
+            double qv[4];
+            qv[3] = cos(th / 2);
+            for (r = 0; r < 3; r++) qv[r] = sin(th / 2) * n[r];
+            for (i = 0; i < nf; i++) {
+                const frm_real *xb = s.frame_positions + 3 * i;
+                double x[3];
+                for (r = 0; r < 3; r++) x[r] = R[3 * r] * xb[0] + R[3 * r + 1] * xb[1] + R[3 * r + 2] * xb[2] + t[r];
+                for (r = 0; r < 3; r++) pos[3 * i + r] = (frm_real)x[r];
+                for (r = 0; r < 4; r++) quat[4 * i + r] = (frm_real)qv[r];
+                vel[6 * i] = (frm_real)(v0[0] + w[1] * x[2] - w[2] * x[1]);
+                vel[6 * i + 1] = (frm_real)(v0[1] + w[2] * x[0] - w[0] * x[2]);
+                vel[6 * i + 2] = (frm_real)(v0[2] + w[0] * x[1] - w[1] * x[0]);
+                for (r = 0; r < 3; r++) vel[6 * i + 3 + r] = (frm_real)w[r];
+            }
+        }
+        REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+        REQUIRE(frm_model_set_velocities(m, vel) == FRM_OK);
+        {
+            frm_real P[3 * 24], U[3 * 24], V[3 * 24];
+            REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+            REQUIRE(frm_probe_displacements(p, m, U) == FRM_OK);
+            REQUIRE(frm_probe_velocities(p, m, V) == FRM_OK);
+            for (i = 0; i < 24; i++) {
+                double x[3], vv[3];
+                for (r = 0; r < 3; r++)
+                    x[r] = R[3 * r] * pts[3 * i] + R[3 * r + 1] * pts[3 * i + 1] + R[3 * r + 2] * pts[3 * i + 2] + t[r];
+                vv[0] = v0[0] + w[1] * x[2] - w[2] * x[1];
+                vv[1] = v0[1] + w[2] * x[0] - w[0] * x[2];
+                vv[2] = v0[2] + w[0] * x[1] - w[1] * x[0];
+                for (r = 0; r < 3; r++) {
+                    k = 3 * i + r;
+                    if (fabs((double)P[k] - x[r]) > worst_r) worst_r = fabs((double)P[k] - x[r]);
+                    if (fabs((double)U[k] - (x[r] - (double)pts[k])) > worst_r) worst_r = fabs((double)U[k] - (x[r] - (double)pts[k]));
+                    if (fabs((double)V[k] - vv[r]) > worst_v) worst_v = fabs((double)V[k] - vv[r]);
+                }
+            }
+        }
+        if (kind != 2) { /* (c) an affine field x = A xbar + b of the frames' positions, no rotation: the
+                            weights reproduce it at any point (Shepard does not: zero order) */
+            static const double A[9] = {1.1, 0.2, -0.1, 0.05, 0.9, 0.3, -0.2, 0.1, 1.2}, b[3] = {0.1, 0.2, 0.3};
+            frm_real P[3 * 24];
+            for (i = 0; i < nf; i++) {
+                const frm_real *xb = s.frame_positions + 3 * i;
+                for (r = 0; r < 3; r++) {
+                    pos[3 * i + r] = (frm_real)(A[3 * r] * xb[0] + A[3 * r + 1] * xb[1] + A[3 * r + 2] * xb[2] + b[r]);
+                    quat[4 * i + r] = 0;
+                }
+                quat[4 * i + 3] = 1;
+            }
+            REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+            REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+            for (i = 0; i < 24; i++)
+                for (r = 0; r < 3; r++) {
+                    double x = A[3 * r] * pts[3 * i] + A[3 * r + 1] * pts[3 * i + 1] + A[3 * r + 2] * pts[3 * i + 2] + b[r];
+                    if (fabs((double)P[3 * i + r] - x) > worst_a) worst_a = fabs((double)P[3 * i + r] - x);
+                }
+            CHECK(worst_a < 10 * tol);
+        }
+        printf("    %-10s: samples %.1e m, rigid motion %.1e m, rigid velocity %.1e m/s, affine field %.1e m\n", names[kind],
+               worst_s, worst_r, worst_v, worst_a);
+        CHECK(worst_r < 10 * tol);
+        CHECK(worst_v < 10 * tol);
+        frm_probe_destroy(p);
+        p = NULL;
+        if (kind < 2) CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, outside, 1, &p));
+        CHECK(p == NULL);
+        free(pos), free(quat), free(vel), free(out), free(elements);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+}
+
+/* Probe refusals: a description not made by its default function, NULL and counts,
+   non-finite points, element indices out of range, a probe used with another model. */
+static void test_probe_refusals(void)
+{
+    frm_model *m = NULL, *other = NULL;
+    frm_sampling s, s2;
+    frm_probe_desc pd, garbage;
+    frm_probe *p = (frm_probe *)&p;
+    int *elements = NULL, *el2 = NULL, saved;
+    frm_real pt[3] = {(frm_real)0.5, (frm_real)0.25, (frm_real)0.25}, nan_pt[3] = {0, 0, 0}, out[3];
+    REQUIRE(probe_scene(1, &m, &s, &pd, &elements) == FRM_OK);
+    memset(&garbage, 0xA5, sizeof garbage);
+    CHECK_INT(FRM_ERR_DESC, frm_probe_create(m, &garbage, pt, 1, &p));
+    CHECK(p == NULL);
+    CHECK_INT(FRM_ERR_ARG, frm_probe_create(NULL, &pd, pt, 1, &p));
+    CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, pt, 0, &p));
+    CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, NULL, 1, &p));
+    nan_pt[1] = (frm_real)NAN;
+    CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, nan_pt, 1, &p));
+    saved = elements[5];
+    elements[5] = frm_model_frame_count(m);
+    CHECK_INT(FRM_ERR_INDEX_RANGE, frm_probe_create(m, &pd, pt, 1, &p));
+    elements[5] = saved;
+    pd.shape.nearest = 0;
+    pd.kind = FRM_PROBE_MESHLESS;
+    CHECK_INT(FRM_ERR_SAMPLING, frm_probe_create(m, &pd, pt, 1, &p));
+    pd.kind = FRM_PROBE_HEXES;
+    REQUIRE(frm_probe_create(m, &pd, pt, 1, &p) == FRM_OK);
+    REQUIRE(probe_scene(0, &other, &s2, &pd, &el2) == FRM_OK);
+    if (frm_model_frame_count(other) != frm_model_frame_count(m)) CHECK_INT(FRM_ERR_ARG, frm_probe_positions(p, other, out));
+    CHECK_INT(FRM_ERR_ARG, frm_probe_velocities(p, m, NULL));
+    CHECK_INT(FRM_OK, frm_probe_displacements(p, m, out));
+    CHECK(out[0] == 0 && out[1] == 0 && out[2] == 0); /* the rest state */
+    frm_probe_destroy(p);
+    frm_probe_destroy(NULL);
+    free(elements), free(el2);
+    frm_model_destroy(m), frm_model_destroy(other);
+    frm_sampling_free(&s), frm_sampling_free(&s2);
+}
+
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
@@ -1325,6 +1580,8 @@ static const test_case cases[] = {
     TEST(test_law_model_path),
     TEST(test_law_validation),
     TEST(test_integrator_choice),
+    TEST(test_probe_kinds),
+    TEST(test_probe_refusals),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
