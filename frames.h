@@ -9,8 +9,9 @@
    functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
    compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
    samples, exact forces and stiffness (material and geometric),
-   a static Newton solver and implicit Euler, both with block-Jacobi conjugate gradient,
-   matrix-free or by assembled 6x6 blocks. The per-sample and per-frame math are
+   a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
+   gradient, matrix-free or by assembled 6x6 blocks, and point probes (a material point's
+   position, displacement and velocity through the shape functions). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
    gathers them through a reverse table.
@@ -90,10 +91,14 @@
           prescribed pose), frm_model_release_frame, frm_model_set_frame_axes (some
           translation and rotation axes held: symmetry planes, rollers, plane strain),
           frm_model_set_external (force and torque), frm_model_set_gravity.
-       5. frm_model_step (implicit Euler) or frm_model_solve_static (Newton), or
-          frm_model_newton_step to watch a solve; frm_model_last_stats for iterations.
-       6. Read frm_model_positions / _orientations / _velocities, and
-          frm_model_sample_positions / _deformation_gradients, to render or measure.
+       5. frm_model_step (implicit Euler, or desc.integrator: FRM_BDF2 for second order)
+          or frm_model_solve_static (Newton), or frm_model_newton_step to watch a solve;
+          frm_model_last_stats for iterations. frm_model_set_damping, _set_integrator
+          change the dynamics' settings after creation.
+       6. Read frm_model_positions / _orientations / _velocities / _displacements, and
+          frm_model_sample_positions / _deformation_gradients, to render or measure; any
+          material point through a probe (frm_probe_create once, then frm_probe_positions
+          / _displacements / _velocities; see PROBES).
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
    HOW TO EXTEND (each kind of extension has one table or switch; add a row, not a branch)
@@ -117,7 +122,13 @@
           form to test_law_uniaxial_closed_forms where it has one (REFERENCES R4, R5).
        An integrator: a value before FRM_INTEGRATOR_COUNT in frm_integrator and one row of
           frm__integrators[] (>>integrator) with name, step(m, dt) (restores the step's start
-          state on failure) and is_explicit. Linear solves go through frm__linear_solve.
+          state on failure) and is_explicit. Linear solves go through frm__linear_solve. A
+          scheme whose step minimises implicit Euler's incremental potential about other
+          data (as BDF2: step length, offset xbar - x_n, reference velocity) fills a
+          frm__step_target and calls frm__implicit_solve (Newton, line search, acceptance);
+          a multistep scheme keeps its history in the model (as m->history, carved in
+          frm__layout) and resets it where frm_model_set_poses and the others clear
+          history_valid.
           Tests: its order of accuracy on an oscillator (halve dt, the error falls by
           2^order), energy behaviour on a free body, bit-identical results for 1 and 2
           threads (the determinism test of tests/test_frames.c), refusal of bad values.
@@ -151,7 +162,9 @@
    buffer; 24 more with the rotation stabilisation's divergence term, the default), per
    block 292 when block storage is reserved (every stiffness mode but
    FRM_STIFFNESS_PAIRS), per sample about 200 (290 with the divergence term), per frame
-   about 1 kB; frm_model_memory_bytes tells. The description's arrays are read during frm_model_create only. The samplings
+   about 1 kB (BDF2's history included: 25 reals); frm_model_memory_bytes tells. A probe
+   makes one allocation at frm_probe_create (through the model's allocator: about 40 bytes
+   per (point, frame) pair) plus temporaries freed before it returns. The description's arrays are read during frm_model_create only. The samplings
    allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
@@ -640,7 +653,24 @@
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
+   PROBES (issue 19): frm_probe_create(m, &desc, rest_points, count, &p) finds each point
+   once: FRM_PROBE_TETS the tetrahedron of desc.elements (frame indices) containing it
+   (barycentric coordinates >= -tolerance; the one most inside wins, so points on shared
+   faces and on the boundary are found), FRM_PROBE_HEXES the hexahedron whose trilinear
+   map reaches it (Newton from the centre, parametric coordinates in [-tol, 1 + tol]),
+   FRM_PROBE_MESHLESS the frames and weights frm_sampling_meshless would give a sample
+   there (desc.shape: Shepard or MLS, nearest or radius support). A point in no element
+   is FRM_ERR_ARG (no nearest-element fallback beyond the tolerance). Then, per point,
+   p = pbar + sum_i w_i (u_i + (Q_i - I) abar_i), abar_i = pbar - xbar_i (eq. 3.34 in the
+   kernels' displacement form), and its velocity sum_i w_i (v_i + omega_i x Q_i abar_i):
+   exact for rigid motions with any weights, and for affine fields of the frames'
+   positions with tetrahedral, hexahedral and MLS weights (tests/test_frames_elem.c).
+
    HISTORY
+       unreleased (issue 19): FRM_BDF2 (see SOLVERS), frm_model_set_integrator,
+             frm_model_set_damping, frm_model_displacements, frm_model_rest_positions,
+             point probes (frm_probe_*). Results of existing models bit-identical; the
+             model block grows by 25 reals a frame.
        unreleased (issue 20): extension points. Laws through one table (frm__laws) with a
              per-sample parameter block (FRM_LAW_PARAMS) and FRM_LAW_COUNT; new laws
              FRM_LAW_MOONEY_RIVLIN (frm_material.c1, c2, bulk_modulus) and FRM_LAW_USER
