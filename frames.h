@@ -813,6 +813,13 @@ typedef FRM_REAL frm_real;
 #define frm_probe_velocities frm_probe_velocities_f32
 #define frm_probe_count frm_probe_count_f32
 #define frm_probe_destroy frm_probe_destroy_f32
+#define frm_modal_default_desc frm_modal_default_desc_f32
+#define frm_modal_create frm_modal_create_f32
+#define frm_modal_solve frm_modal_solve_f32
+#define frm_modal_count frm_modal_count_f32
+#define frm_modal_frequency frm_modal_frequency_f32
+#define frm_modal_shape frm_modal_shape_f32
+#define frm_modal_destroy frm_modal_destroy_f32
 #endif
 
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
@@ -1453,6 +1460,49 @@ FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real
 FRMDEF int frm_probe_count(const frm_probe *p);
 /* Frees the probe. NULL is allowed. */
 FRMDEF void frm_probe_destroy(frm_probe *p);
+
+/* ---- modal analysis (issue 19): the lowest natural frequencies and mode shapes of the
+   model linearised about its current state, with its constraints (fixed and driven frames,
+   held axes), K x = lambda M x with K the stiffness's symmetric part and M the frames'
+   mass (see MASS). Matrix-free: block shift-invert subspace iteration, each solve of
+   (K + shift M) y = M x by the model's linear solver (frm__linear_solve), Rayleigh-Ritz
+   on the block, until every wanted mode's residual |K x - lambda M x| / ((|lambda| +
+   shift) |M x|) <= tolerance. ---- */
+
+typedef struct frm_modal_desc {
+    int count;          /* modes wanted, >= 1, default 6 */
+    int max_iterations; /* subspace iterations, default 100 */
+    frm_real tolerance; /* each wanted mode's relative residual, default 1e-8 (float 1e-4) */
+    frm_real shift;     /* 1/s^2: K + shift M must be positive definite; <= 0 (default): automatic,
+                           1e-4 times the mean of the free frames' K_ii / m_i (translational), so
+                           free bodies' rigid modes (0 Hz) work */
+    unsigned int internal_cookie; /* set by frm_modal_default_desc; do not touch */
+} frm_modal_desc;
+
+typedef struct frm_modal frm_modal;
+
+FRMDEF frm_modal_desc frm_modal_default_desc(void);
+/* Sizes the workspace for model m (three blocks of count + max(count, 8) vectors of 6 reals
+   a frame, and small dense matrices): one allocation through the model's allocator.
+   FRM_ERR_DESC, FRM_ERR_ARG (count < 1, max_iterations < 1, tolerance not > 0, shift not
+   finite), FRM_ERR_ALLOC. */
+FRMDEF int frm_modal_create(const frm_model *m, const frm_modal_desc *d, frm_modal **out);
+/* Linearises m at its current state and computes the modes. No allocation; the model's
+   state is untouched (its linearisation and last stats are the solve's). Fewer free
+   degrees of freedom than count: that many modes. FRM_ERR_NO_CONVERGENCE (iterations
+   spent, or K + shift M not positive definite: a stressed or unstable state, raise
+   shift), FRM_ERR_NOT_FINITE, FRM_ERR_INVERTED; FRM_ERR_ARG for a modal made for another
+   frame count. Deterministic (fixed start vectors). */
+FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m);
+/* Modes computed by the last successful solve (0 before). */
+FRMDEF int frm_modal_count(const frm_modal *md);
+/* Frequency of mode i in Hz, ascending (sqrt(max(lambda, 0)) / 2 pi; rigid modes 0 to
+   round-off); -1 for i out of range. */
+FRMDEF double frm_modal_frequency(const frm_modal *md, int i);
+/* Mode i's shape, 6 per frame (translation, rotation about world axes), M-orthonormal,
+   zero on held components; NULL for i out of range. Valid until the next solve. */
+FRMDEF const frm_real *frm_modal_shape(const frm_modal *md, int i);
+FRMDEF void frm_modal_destroy(frm_modal *md);
 
 #endif /* FRAMES_H */
 
@@ -2153,6 +2203,7 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__PROBE_COOKIE 0x46524D51u   /* "FRMQ" */
+#define FRM__MODAL_COOKIE 0x46524D4Du   /* "FRMM" */
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
@@ -7469,6 +7520,273 @@ FRMDEF void frm_probe_destroy(frm_probe *p)
     if (!p) return;
     a = p->allocator;
     frm__free(&a, p, p->bytes);
+}
+
+/* >>modal ------------------------------------------------------------------------------ */
+
+struct frm_modal {
+    int count, block, frame_count, max_iterations, found;
+    double tolerance, shift;
+    frm_real *X, *Y, *Z; /* block vectors of 6 n: the basis, the solves, K Y */
+    frm_real *b;         /* one right-hand side */
+    double *Kr, *Mr, *V, *ev, *lambda, *work; /* block x block (ev, lambda: block) */
+    frm_allocator allocator;
+    size_t bytes;
+};
+
+FRMDEF frm_modal_desc frm_modal_default_desc(void)
+{
+    frm_modal_desc d;
+    memset(&d, 0, sizeof d);
+    d.count = 6;
+    d.max_iterations = 100;
+    d.tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-8);
+    d.shift = 0;
+    d.internal_cookie = FRM__MODAL_COOKIE;
+    return d;
+}
+
+static void frm__modal_layout(frm_modal *t, frm__carver *c, int n6)
+{
+    size_t B = (size_t)t->block;
+    FRM__CARVE(c, t->X, frm_real, B * (size_t)n6);
+    FRM__CARVE(c, t->Y, frm_real, B * (size_t)n6);
+    FRM__CARVE(c, t->Z, frm_real, B * (size_t)n6);
+    FRM__CARVE(c, t->b, frm_real, n6);
+    FRM__CARVE(c, t->Kr, double, B * B);
+    FRM__CARVE(c, t->Mr, double, B * B);
+    FRM__CARVE(c, t->V, double, B * B);
+    FRM__CARVE(c, t->work, double, B * B);
+    FRM__CARVE(c, t->ev, double, B);
+    FRM__CARVE(c, t->lambda, double, B);
+}
+
+FRMDEF int frm_modal_create(const frm_model *m, const frm_modal_desc *d, frm_modal **out)
+{
+    frm_modal tmp, *md;
+    frm__carver c;
+    int n6;
+    if (out) *out = NULL;
+    if (!m || !d || !out) return FRM_ERR_ARG;
+    if (d->internal_cookie != FRM__MODAL_COOKIE) return FRM_ERR_DESC;
+    if (d->count < 1 || d->count > 512 || d->max_iterations < 1 || !(frm__finite((double)d->tolerance) && d->tolerance > 0) ||
+        !frm__finite((double)d->shift))
+        return FRM_ERR_ARG;
+    n6 = 6 * m->frame_count;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.count = d->count < n6 ? d->count : n6;
+    tmp.block = tmp.count + (tmp.count > 8 ? tmp.count : 8);
+    if (tmp.block > n6) tmp.block = n6;
+    tmp.frame_count = m->frame_count;
+    tmp.max_iterations = d->max_iterations;
+    tmp.tolerance = (double)d->tolerance;
+    tmp.shift = (double)d->shift;
+    tmp.allocator = m->allocator;
+    c.base = NULL;
+    c.offset = sizeof(frm_modal);
+    frm__modal_layout(&tmp, &c, n6);
+    tmp.bytes = c.offset;
+    md = (frm_modal *)frm__alloc(&m->allocator, tmp.bytes);
+    if (!md) return FRM_ERR_ALLOC;
+    memset(md, 0, tmp.bytes);
+    c.base = (char *)md;
+    c.offset = sizeof(frm_modal);
+    frm__modal_layout(&tmp, &c, n6);
+    *md = tmp;
+    *out = md;
+    return FRM_OK;
+}
+
+/* Rayleigh-Ritz on the block Y (bs vectors, K Y in Z): the generalized eigenproblem of
+   (Y^T K Y, Y^T M Y) by Cholesky and Jacobi, ascending; X = Y Q (M-orthonormal), Z = K X.
+   0, or FRM_ERR_NO_CONVERGENCE when Y^T M Y is not positive definite (a dependent block). */
+static int frm__modal_ritz(frm_modal *md, frm_model *m, int bs)
+{
+    int n6 = 6 * m->frame_count, i, j, k, a;
+    double *L = md->Mr, *C = md->work;
+    for (i = 0; i < bs; i++)
+        for (j = 0; j <= i; j++) {
+            const frm_real *yi = md->Y + (size_t)i * n6, *yj = md->Y + (size_t)j * n6, *zj = md->Z + (size_t)j * n6,
+                           *zi = md->Z + (size_t)i * n6;
+            double mm = 0;
+            for (a = 0; a < m->frame_count; a++) {
+                double mv[6];
+                frm__mass_apply(m, a, yj + 6 * a, mv);
+                for (k = 0; k < 6; k++) mm += (double)yi[6 * a + k] * mv[k];
+            }
+            md->Kr[bs * i + j] = md->Kr[bs * j + i] = 0.5 * (frm__dot(m, yi, zj) + frm__dot(m, yj, zi));
+            L[bs * i + j] = L[bs * j + i] = mm;
+        }
+    /* Cholesky M_r = L L^T (lower, in place) */
+    for (j = 0; j < bs; j++) {
+        double dsum = L[bs * j + j];
+        for (k = 0; k < j; k++) dsum -= L[bs * j + k] * L[bs * j + k];
+        if (!(dsum > 0)) return FRM_ERR_NO_CONVERGENCE;
+        L[bs * j + j] = sqrt(dsum);
+        for (i = j + 1; i < bs; i++) {
+            double t = L[bs * i + j];
+            for (k = 0; k < j; k++) t -= L[bs * i + k] * L[bs * j + k];
+            L[bs * i + j] = t / L[bs * j + j];
+        }
+        for (i = 0; i < j; i++) L[bs * i + j] = 0;
+    }
+    /* C = L^-1 K_r L^-T: solve L W = K_r (columns), then L C^T = W^T */
+    for (j = 0; j < bs; j++)
+        for (i = 0; i < bs; i++) {
+            double t = md->Kr[bs * i + j];
+            for (k = 0; k < i; k++) t -= L[bs * i + k] * C[bs * k + j];
+            C[bs * i + j] = t / L[bs * i + i];
+        }
+    for (i = 0; i < bs; i++) /* W = C (rows i); C := L^-1 W^T, symmetric */
+        for (j = 0; j < bs; j++) md->Kr[bs * i + j] = C[bs * j + i];
+    for (j = 0; j < bs; j++)
+        for (i = 0; i < bs; i++) {
+            double t = md->Kr[bs * i + j];
+            for (k = 0; k < i; k++) t -= L[bs * i + k] * C[bs * k + j];
+            C[bs * i + j] = t / L[bs * i + i];
+        }
+    for (i = 0; i < bs; i++)
+        for (j = 0; j < i; j++) C[bs * i + j] = C[bs * j + i] = 0.5 * (C[bs * i + j] + C[bs * j + i]);
+    frm__jacobi(C, bs, md->V, md->ev);
+    /* Q = L^-T V (back substitution per column) into Kr, columns sorted by eigenvalue */
+    for (j = 0; j < bs; j++)
+        for (i = bs - 1; i >= 0; i--) {
+            double t = md->V[bs * i + j];
+            for (k = i + 1; k < bs; k++) t -= L[bs * k + i] * md->Kr[bs * k + j];
+            md->Kr[bs * i + j] = t / L[bs * i + i];
+        }
+    {
+        int order[1024], tmpi; /* block <= 2 count <= 2000: sort indices by insertion */
+        int *ord = bs <= 1024 ? order : NULL;
+        if (!ord) return FRM_ERR_NO_CONVERGENCE;
+        for (i = 0; i < bs; i++) ord[i] = i;
+        for (i = 1; i < bs; i++)
+            for (j = i; j > 0 && md->ev[ord[j]] < md->ev[ord[j - 1]]; j--) tmpi = ord[j], ord[j] = ord[j - 1], ord[j - 1] = tmpi;
+        /* X = Y Q, Z = K Y Q (Z through the X storage as temporary: Z is rebuilt from it) */
+        for (k = 0; k < n6; k++) {
+            double y[1024], z[1024];
+            for (i = 0; i < bs; i++) y[i] = (double)md->Y[(size_t)i * n6 + k], z[i] = (double)md->Z[(size_t)i * n6 + k];
+            for (j = 0; j < bs; j++) {
+                double tx = 0, tz = 0;
+                for (i = 0; i < bs; i++) tx += y[i] * md->Kr[bs * i + ord[j]], tz += z[i] * md->Kr[bs * i + ord[j]];
+                md->X[(size_t)j * n6 + k] = (frm_real)tx;
+                md->Z[(size_t)j * n6 + k] = (frm_real)tz;
+            }
+        }
+        for (j = 0; j < bs; j++) md->lambda[j] = md->ev[ord[j]];
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
+{
+    int n6, i, j, k, it, free_dof = 0, bs, want, err, converged = 0;
+    double shift, cg_tol;
+    unsigned long long seed = 0x9E3779B97F4A7C15ull;
+    if (!md || !m || md->frame_count != m->frame_count) return FRM_ERR_ARG;
+    if (md->block > 1024) return FRM_ERR_ARG;
+    n6 = 6 * m->frame_count;
+    md->found = 0;
+    frm__reset_stats(m);
+    for (i = 0; i < m->frame_count; i++)
+        if (m->state[i] == FRM__FREE)
+            for (k = 0; k < 6; k++) free_dof += !((m->axes[i] >> k) & 1);
+    if (free_dof == 0) return FRM_OK;
+    bs = md->block < free_dof ? md->block : free_dof;
+    want = md->count < bs ? md->count : bs;
+    err = frm__linearize(m, NULL, 0);
+    if (err) return err;
+    frm__mass_update(m);
+    shift = md->shift;
+    if (!(shift > 0)) { /* 1e-4 of the mean translational K_ii / m_i */
+        double sum = 0;
+        int count = 0;
+        for (i = 0; i < m->frame_count; i++)
+            if (m->state[i] == FRM__FREE && m->mass_world[10 * (size_t)i] > 0) {
+                const frm_real *K = m->kdiag + 36 * (size_t)i;
+                sum += ((double)K[0] + (double)K[7] + (double)K[14]) / (3 * (double)m->mass_world[10 * (size_t)i]);
+                count++;
+            }
+        shift = count && sum > 0 ? 1e-4 * sum / count : 1;
+    }
+    frm__build_precond(m, shift, 1.0);
+    cg_tol = 1e-3 * md->tolerance;
+    if (cg_tol < (FRM__IS_FLOAT ? 1e-6 : 1e-13)) cg_tol = FRM__IS_FLOAT ? 1e-6 : 1e-13;
+    /* deterministic start: pseudo-random vectors on the free components */
+    for (j = 0; j < bs; j++) {
+        frm_real *x = md->X + (size_t)j * n6;
+        for (k = 0; k < n6; k++) x[k] = (frm_real)(frm__random(&seed) - 0.5);
+        frm__mask(m, x);
+    }
+    for (it = 0; it < md->max_iterations && !converged; it++) {
+        double worst = 0;
+        for (j = 0; j < bs; j++) { /* Y_j = (K + shift M)^-1 M X_j */
+            const frm_real *x = md->X + (size_t)j * n6;
+            frm_real *y = md->Y + (size_t)j * n6;
+            int cg;
+            for (i = 0; i < m->frame_count; i++) {
+                double mv[6];
+                frm__mass_apply(m, i, x + 6 * i, mv);
+                for (k = 0; k < 6; k++) md->b[6 * i + k] = (frm_real)mv[k];
+            }
+            if (it == 0) memset(y, 0, sizeof(frm_real) * (size_t)n6);
+            else /* the Ritz vector's own answer, x / (lambda + shift): exact once converged */
+                for (k = 0; k < n6; k++) y[k] = (frm_real)((double)x[k] / (md->lambda[j] + shift));
+            cg = frm__linear_solve(m, shift, 1.0, cg_tol, md->b, y);
+            if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
+            if (cg != FRM__CG_OK) return FRM_ERR_NO_CONVERGENCE;
+            frm__stiffness_product(m, y, md->Z + (size_t)j * n6, 0);
+            frm__mask(m, md->Z + (size_t)j * n6);
+        }
+        err = frm__modal_ritz(md, m, bs);
+        if (err) return err;
+        for (j = 0; j < want; j++) { /* residual |K x - lambda M x| / ((|lambda| + shift) |M x|) */
+            const frm_real *x = md->X + (size_t)j * n6, *z = md->Z + (size_t)j * n6;
+            double rr = 0, mm = 0, r;
+            for (i = 0; i < m->frame_count; i++) {
+                double mv[6];
+                if (m->state[i] != FRM__FREE) continue;
+                frm__mass_apply(m, i, x + 6 * i, mv);
+                for (k = 0; k < 6; k++) {
+                    double d;
+                    if ((m->axes[i] >> k) & 1) continue;
+                    d = (double)z[6 * i + k] - md->lambda[j] * mv[k];
+                    rr += d * d;
+                    mm += mv[k] * mv[k];
+                }
+            }
+            r = sqrt(rr) / ((fabs(md->lambda[j]) + shift) * sqrt(mm));
+            if (!frm__finite(r)) return FRM_ERR_NOT_FINITE;
+            if (r > worst) worst = r;
+        }
+        converged = worst <= md->tolerance;
+    }
+    m->lin_valid = 0;
+    if (!converged) return FRM_ERR_NO_CONVERGENCE;
+    md->found = want;
+    return FRM_OK;
+}
+
+FRMDEF int frm_modal_count(const frm_modal *md) { return md ? md->found : 0; }
+
+FRMDEF double frm_modal_frequency(const frm_modal *md, int i)
+{
+    if (!md || i < 0 || i >= md->found) return -1;
+    return md->lambda[i] > 0 ? sqrt(md->lambda[i]) / (2 * 3.14159265358979323846) : 0;
+}
+
+FRMDEF const frm_real *frm_modal_shape(const frm_modal *md, int i)
+{
+    if (!md || i < 0 || i >= md->found) return NULL;
+    return md->X + (size_t)i * 6 * (size_t)md->frame_count;
+}
+
+FRMDEF void frm_modal_destroy(frm_modal *md)
+{
+    frm_allocator a;
+    if (!md) return;
+    a = md->allocator;
+    frm__free(&a, md, md->bytes);
 }
 
 #if defined(FRM_STATIC) && defined(__GNUC__)
