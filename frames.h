@@ -1467,12 +1467,16 @@ FRMDEF void frm_probe_destroy(frm_probe *p);
    mass (see MASS). Matrix-free: block shift-invert subspace iteration, each solve of
    (K + shift M) y = M x by the model's linear solver (frm__linear_solve), Rayleigh-Ritz
    on the block, until every wanted mode's residual |K x - lambda M x| / ((|lambda| +
-   shift) |M x|) <= tolerance. ---- */
+   shift) |M x|) <= tolerance, or their Ritz values change by less than 1e-2 tolerance
+   (|lambda| + shift) in an iteration (the rounding of the K products bounds the residual
+   near eps |K| / (lambda + shift): above 1e-4 for a slender beam in float). ---- */
 
 typedef struct frm_modal_desc {
     int count;          /* modes wanted, >= 1, default 6 */
     int max_iterations; /* subspace iterations, default 100 */
-    frm_real tolerance; /* each wanted mode's relative residual, default 1e-8 (float 1e-4) */
+    frm_real tolerance; /* each wanted mode's relative residual, default 1e-8 (float 1e-2: float's
+                           K products and CG leave a residual of 2e-3 on the R3 beam; the
+                           eigenvalue's error is of the order of its square) */
     frm_real shift;     /* 1/s^2: K + shift M must be positive definite; <= 0 (default): automatic,
                            1e-4 times the mean of the free frames' K_ii / m_i (translational), so
                            free bodies' rigid modes (0 Hz) work */
@@ -7530,6 +7534,7 @@ struct frm_modal {
     frm_real *X, *Y, *Z; /* block vectors of 6 n: the basis, the solves, K Y */
     frm_real *b;         /* one right-hand side */
     double *Kr, *Mr, *V, *ev, *lambda, *work; /* block x block (ev, lambda: block) */
+    double *previous;                         /* block: the last iteration's Ritz values */
     frm_allocator allocator;
     size_t bytes;
 };
@@ -7540,7 +7545,7 @@ FRMDEF frm_modal_desc frm_modal_default_desc(void)
     memset(&d, 0, sizeof d);
     d.count = 6;
     d.max_iterations = 100;
-    d.tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-8);
+    d.tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-2 : 1e-8);
     d.shift = 0;
     d.internal_cookie = FRM__MODAL_COOKIE;
     return d;
@@ -7559,6 +7564,7 @@ static void frm__modal_layout(frm_modal *t, frm__carver *c, int n6)
     FRM__CARVE(c, t->work, double, B * B);
     FRM__CARVE(c, t->ev, double, B);
     FRM__CARVE(c, t->lambda, double, B);
+    FRM__CARVE(c, t->previous, double, B);
 }
 
 FRMDEF int frm_modal_create(const frm_model *m, const frm_modal_desc *d, frm_modal **out)
@@ -7719,7 +7725,8 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
         frm__mask(m, x);
     }
     for (it = 0; it < md->max_iterations && !converged; it++) {
-        double worst = 0;
+        double worst = 0, change = 0;
+        if (it) memcpy(md->previous, md->lambda, sizeof(double) * (size_t)bs);
         for (j = 0; j < bs; j++) { /* Y_j = (K + shift M)^-1 M X_j */
             const frm_real *x = md->X + (size_t)j * n6;
             frm_real *y = md->Y + (size_t)j * n6;
@@ -7758,8 +7765,12 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
             r = sqrt(rr) / ((fabs(md->lambda[j]) + shift) * sqrt(mm));
             if (!frm__finite(r)) return FRM_ERR_NOT_FINITE;
             if (r > worst) worst = r;
+            if (it && fabs(md->lambda[j] - md->previous[j]) / (fabs(md->lambda[j]) + shift) > change)
+                change = fabs(md->lambda[j] - md->previous[j]) / (fabs(md->lambda[j]) + shift);
         }
-        converged = worst <= md->tolerance;
+        /* the residual, or Ritz values that no longer move: the K products' rounding bounds
+           the residual near eps |K| / (lambda + shift) (float: above 1e-4 on slender beams) */
+        converged = worst <= md->tolerance || (it > 1 && change <= 1e-2 * md->tolerance);
     }
     m->lin_valid = 0;
     if (!converged) return FRM_ERR_NO_CONVERGENCE;
