@@ -10,7 +10,8 @@
    compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
    samples, exact forces and stiffness (material and geometric),
    a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
-   gradient, matrix-free or by assembled 6x6 blocks, and point probes (a material point's
+   gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
+   frequencies and modes about the current state) and point probes (a material point's
    position, displacement and velocity through the shape functions). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
@@ -98,7 +99,8 @@
        6. Read frm_model_positions / _orientations / _velocities / _displacements, and
           frm_model_sample_positions / _deformation_gradients, to render or measure; any
           material point through a probe (frm_probe_create once, then frm_probe_positions
-          / _displacements / _velocities; see PROBES).
+          / _displacements / _velocities; see PROBES); natural frequencies and modes about
+          the current state with frm_modal_create / _solve (see MODAL ANALYSIS).
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
    HOW TO EXTEND (each kind of extension has one table or switch; add a row, not a branch)
@@ -448,8 +450,15 @@
            T/100    0.179   +1.31e-3         3.86e-4   +1.31e-3
            T/400    0.0481  +8.23e-5         6.09e-6   +8.22e-5
        (implicit Euler's phase is second order too; its amplitude is first order, BDF2's
-       decay a period falls as dt^3); R3_FIGURES_HERE
-       Same cost per step as implicit Euler (one more vector update).
+       decay a period falls as dt^3). Tests: the model against BDF2's discrete recurrence
+       with Rayleigh damping (3.8e-8), order 2 on a damped beam (changes of u(T) fall 3.84
+       times a halving; implicit Euler 1.85), bit-identical threads, history restarts, the
+       stress sweep. The R3 beam (10 x 2 x 2 hexahedral cells, released from a 0.15 mm
+       sag; period from zero crossings against BDF2 at T/1600, 1.98766 s): implicit Euler
+       +3.19, +0.52, +0.11 % at T/20, T/50, T/100, BDF2 +3.03, +0.47, +0.11, +0.005 % at
+       T/20..T/400 (the crossings' floor is about 0.03 %: the higher modes that BDF2 keeps);
+       bench/bench.c's time part (issue 19) measures both on the bench's beams. Same cost
+       per step as implicit Euler (one more vector update).
        Held axes (frm_model_set_frame_axes): the held components are projected out of every
        linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
        line search and the step update; their velocity is zero; their forces count as
@@ -650,8 +659,38 @@
          FRM_ERR_SHAPE_DEGENERATE); steel-like
          stiffness needs the round-off floor to stop Newton, which it does only once
          Newton no longer halves the residual (R1 float +0.17 %).
+       - Free bodies have more zero-energy modes than the six rigid ones (issue 19, measured
+         by frm_modal on a free 2 x 2 x 2-cell hexahedral cube: 11): every frame turning by
+         the same small angle moves no sample (weights that reproduce linear fields) and
+         leaves F a rotation, which no term of the default model sees (the divergence term
+         sees only non-uniform turns); two more such modes on that grid. frame_coupling =
+         1e-2 leaves exactly the six rigid modes (next 0.25 Hz there). They carry no load
+         and do not move the material, but they are modes of the frames' dynamics.
+       - BDF2 treats orientations in the tangent coordinates at the current one and keeps
+         the mass at the step's start: second order for translations and small rotations
+         per step, first order in the terms of frames spinning fast (see SOLVERS).
        - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
          chain solver, inverse actuation and the CUDA companion are not in this version.
+
+   MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
+   count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
+   (the symmetric part of K, gravity's and the stresses' geometric terms included; the
+   constraints as set) and runs block shift-invert subspace iteration: Y = (K + shift M)^-1
+   M X by the model's linear solver (block-Jacobi CG, warm-started at X / (lambda + shift)
+   once a Ritz value exists), Rayleigh-Ritz on Y (Cholesky of Y^T M Y, Jacobi), X the
+   M-orthonormal Ritz vectors, until every wanted residual is below tolerance (or the Ritz
+   values stop moving). Chosen over LOBPCG for its simplicity with a matrix-free K and an
+   existing CG; measured: the R3 beam one cell across, 8 modes, about 40,000 CG iterations
+   (0.5 s), equal to the dense eigenvalues to 1e-6 (tests/test_frames_elem.c). The
+   automatic shift (1e-4 of the mean K_ii / m_i) keeps K + shift M definite for free
+   bodies; 1e-2 and 1e-3 took 60 % and 20 % more CG iterations on R3. Measured: R3 with
+   tetrahedral frames two cells across 0.4982, 0.4982, 2.9982, 2.9982, 4.8506 Hz (3D:
+   0.5091 twice, 3.0531 twice, torsion 4.5101: -2.1 %, -1.8 %, +7.6 %, the discretisation's
+   error, see ACCURACY and LIMITS), no mode below the bending pair; a clamped-free bar with
+   axial motion only 7.9037 and 23.662 Hz against 7.9057 and 23.717 (c / 4L, 3c / 4L: the
+   linear elements' dispersion). A free body has six rigid modes at 0 Hz and, with the
+   default model, more: every frame turning alike moves no material (frame_coupling > 0
+   removes them; LIMITS).
 
    PROBES (issue 19): frm_probe_create(m, &desc, rest_points, count, &p) finds each point
    once: FRM_PROBE_TETS the tetrahedron of desc.elements (frame indices) containing it
@@ -669,7 +708,7 @@
    HISTORY
        unreleased (issue 19): FRM_BDF2 (see SOLVERS), frm_model_set_integrator,
              frm_model_set_damping, frm_model_displacements, frm_model_rest_positions,
-             point probes (frm_probe_*). Results of existing models bit-identical; the
+             point probes (frm_probe_*), modal analysis (frm_modal_*). Results of existing models bit-identical; the
              model block grows by 25 reals a frame.
        unreleased (issue 20): extension points. Laws through one table (frm__laws) with a
              per-sample parameter block (FRM_LAW_PARAMS) and FRM_LAW_COUNT; new laws
