@@ -683,7 +683,12 @@
    existing CG; measured: the R3 beam one cell across, 8 modes, about 40,000 CG iterations
    (0.5 s), equal to the dense eigenvalues to 1e-6 (tests/test_frames_elem.c). The
    automatic shift (1e-4 of the mean K_ii / m_i) keeps K + shift M definite for free
-   bodies; 1e-2 and 1e-3 took 60 % and 20 % more CG iterations on R3. Measured: R3 with
+   bodies; 1e-2 and 1e-3 took 60 % and 20 % more CG iterations on R3. Where CG meets
+   negative curvature (K + shift M indefinite: gravity's torques at a state off
+   equilibrium, compression) the automatic shift grows a hundredfold and the iteration
+   restarts (three times at most; a given shift is not changed: FRM_ERR_NO_CONVERGENCE);
+   negative eigenvalues then come out as negative frequencies (a clamped beam at rest
+   under gravity, not an equilibrium: -0.60 Hz in tests/test_frames.c). Measured: R3 with
    tetrahedral frames two cells across 0.4982, 0.4982, 2.9982, 2.9982, 4.8506 Hz (3D:
    0.5091 twice, 3.0531 twice, torsion 4.5101: -2.1 %, -1.8 %, +7.6 %, the discretisation's
    error, see ACCURACY and LIMITS), no mode below the bending pair; a clamped-free bar with
@@ -1518,7 +1523,9 @@ typedef struct frm_modal_desc {
                            eigenvalue's error is of the order of its square) */
     frm_real shift;     /* 1/s^2: K + shift M must be positive definite; <= 0 (default): automatic,
                            1e-4 times the mean of the free frames' K_ii / m_i (translational), so
-                           free bodies' rigid modes (0 Hz) work */
+                           free bodies' rigid modes (0 Hz) work, raised a hundredfold (three
+                           times at most) where K + shift M turns out indefinite (gravity's
+                           torques at a state off equilibrium, compression) */
     unsigned int internal_cookie; /* set by frm_modal_default_desc; do not touch */
 } frm_modal_desc;
 
@@ -1539,8 +1546,9 @@ FRMDEF int frm_modal_create(const frm_model *m, const frm_modal_desc *d, frm_mod
 FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m);
 /* Modes computed by the last successful solve (0 before). */
 FRMDEF int frm_modal_count(const frm_modal *md);
-/* Frequency of mode i in Hz, ascending (sqrt(max(lambda, 0)) / 2 pi; rigid modes 0 to
-   round-off); -1 for i out of range. */
+/* Frequency of mode i in Hz, ascending: sqrt(lambda) / 2 pi (rigid modes 0 to round-off);
+   a negative lambda (an unstable direction of a state off equilibrium) gives
+   -sqrt(-lambda) / 2 pi; -1 for i out of range (check frm_modal_count). */
 FRMDEF double frm_modal_frequency(const frm_modal *md, int i);
 /* Mode i's shape, 6 per frame (translation, rotation about world axes), M-orthonormal,
    zero on held components; NULL for i out of range. Valid until the next solve. */
@@ -7723,14 +7731,16 @@ static int frm__modal_ritz(frm_modal *md, frm_model *m, int bs)
     return FRM_OK;
 }
 
+#define FRM__MODAL_INDEFINITE 1
+
+static int frm__modal_iterate(frm_modal *md, frm_model *m, int bs, int want, double shift, double cg_tol);
+
 FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
 {
-    int n6, i, j, k, it, free_dof = 0, bs, want, err, converged = 0;
+    int i, k, free_dof = 0, bs, want, err, attempt;
     double shift, cg_tol;
-    unsigned long long seed = 0x9E3779B97F4A7C15ull;
     if (!md || !m || md->frame_count != m->frame_count) return FRM_ERR_ARG;
     if (md->block > 1024) return FRM_ERR_ARG;
-    n6 = 6 * m->frame_count;
     md->found = 0;
     frm__reset_stats(m);
     for (i = 0; i < m->frame_count; i++)
@@ -7754,8 +7764,26 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
             }
         shift = count && sum > 0 ? 1e-4 * sum / count : 1;
     }
-    frm__build_precond(m, shift, 1.0);
     cg_tol = 1e-3 * md->tolerance;
+    for (attempt = 0;; attempt++) {
+        err = frm__modal_iterate(md, m, bs, want, shift, cg_tol);
+        /* K + shift M indefinite (a state off equilibrium, gravity's torques, compression):
+           an automatic shift grows a hundredfold, up to three times */
+        if (err != FRM__MODAL_INDEFINITE || md->shift > 0 || attempt == 3) break;
+        shift *= 100;
+    }
+    m->lin_valid = 0;
+    if (err == FRM__MODAL_INDEFINITE) err = FRM_ERR_NO_CONVERGENCE;
+    if (!err) md->found = want;
+    return err;
+}
+
+/* The subspace iteration at a given shift (frm_modal_solve). */
+static int frm__modal_iterate(frm_modal *md, frm_model *m, int bs, int want, double shift, double cg_tol)
+{
+    int n6 = 6 * m->frame_count, i, j, k, it, err, converged = 0;
+    unsigned long long seed = 0x9E3779B97F4A7C15ull;
+    frm__build_precond(m, shift, 1.0);
     if (cg_tol < (FRM__IS_FLOAT ? 1e-6 : 1e-13)) cg_tol = FRM__IS_FLOAT ? 1e-6 : 1e-13;
     /* deterministic start: pseudo-random vectors on the free components */
     for (j = 0; j < bs; j++) {
@@ -7780,6 +7808,7 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
                 for (k = 0; k < n6; k++) y[k] = (frm_real)((double)x[k] / (md->lambda[j] + shift));
             cg = frm__linear_solve(m, shift, 1.0, cg_tol, md->b, y);
             if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
+            if (cg == FRM__CG_NEGATIVE) return FRM__MODAL_INDEFINITE;
             if (cg != FRM__CG_OK) return FRM_ERR_NO_CONVERGENCE;
             frm__stiffness_product(m, y, md->Z + (size_t)j * n6, 0);
             frm__mask(m, md->Z + (size_t)j * n6);
@@ -7811,10 +7840,7 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
            the residual near eps |K| / (lambda + shift) (float: above 1e-4 on slender beams) */
         converged = worst <= md->tolerance || (it > 1 && change <= 1e-2 * md->tolerance);
     }
-    m->lin_valid = 0;
-    if (!converged) return FRM_ERR_NO_CONVERGENCE;
-    md->found = want;
-    return FRM_OK;
+    return converged ? FRM_OK : FRM_ERR_NO_CONVERGENCE;
 }
 
 FRMDEF int frm_modal_count(const frm_modal *md) { return md ? md->found : 0; }
@@ -7822,7 +7848,8 @@ FRMDEF int frm_modal_count(const frm_modal *md) { return md ? md->found : 0; }
 FRMDEF double frm_modal_frequency(const frm_modal *md, int i)
 {
     if (!md || i < 0 || i >= md->found) return -1;
-    return md->lambda[i] > 0 ? sqrt(md->lambda[i]) / (2 * 3.14159265358979323846) : 0;
+    return md->lambda[i] >= 0 ? sqrt(md->lambda[i]) / (2 * 3.14159265358979323846)
+                              : -sqrt(-md->lambda[i]) / (2 * 3.14159265358979323846);
 }
 
 FRMDEF const frm_real *frm_modal_shape(const frm_modal *md, int i)

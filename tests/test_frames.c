@@ -3664,6 +3664,54 @@ static void test_i19_bdf2_threads(void)
     }
 }
 
+
+/* Issue 19's parts allocate only at their creation: BDF2 steps, frm_modal_solve and the
+   probes' evaluations allocate nothing; destroying the modal, the probe and the model frees
+   everything (the model's allocator serves all three). */
+static void test_i19_no_allocation(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.5};
+    counting_allocator c = {0, 0, 0, 0};
+    scene sc;
+    frm_probe_desc pd = frm_probe_default_desc();
+    frm_modal_desc md_desc = frm_modal_default_desc();
+    frm_probe *p = NULL;
+    frm_modal *md = NULL;
+    frm_real pt[3] = {(frm_real)0.5, (frm_real)0.25, (frm_real)0.25}, out[3];
+    int allocs, step;
+    REQUIRE(scene_hex(&sc, lo, hi, 2, 1, 1, 2, FRM_LAW_NEO_HOOKEAN, 1e4, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    frm_model_destroy(sc.m);
+    sc.d.integrator = FRM_BDF2;
+    sc.d.allocator.alloc = count_alloc;
+    sc.d.allocator.free = count_free;
+    sc.d.allocator.user = &c;
+    REQUIRE(frm_model_create(&sc.d, &sc.m) == FRM_OK);
+    clamp_beam(sc.m, &sc.s);
+    md_desc.count = 4;
+    REQUIRE(frm_probe_create(sc.m, &pd, pt, 1, &p) == FRM_OK);
+    REQUIRE(frm_modal_create(sc.m, &md_desc, &md) == FRM_OK);
+    allocs = c.allocs;
+    step = frm_modal_solve(md, sc.m); /* at rest */
+    REQUIRE(step == FRM_OK); /* gravity's torques make K indefinite here: the automatic shift grows */
+    printf("    modal at rest under gravity (not an equilibrium): %.4f %.4f Hz\n", frm_modal_frequency(md, 0),
+           frm_modal_frequency(md, 1));
+    for (step = 0; step < 3; step++) REQUIRE(frm_model_step(sc.m) == FRM_OK);
+    REQUIRE(frm_probe_positions(p, sc.m, out) == FRM_OK);
+    REQUIRE(frm_probe_velocities(p, sc.m, out) == FRM_OK);
+    step = frm_modal_solve(md, sc.m); /* about the sagging state: modes, or an error code */
+    printf("    modal about the sagging state: %s\n", frm_error_string(step));
+    CHECK(step == FRM_OK || step == FRM_ERR_NO_CONVERGENCE);
+    CHECK_INT(allocs, c.allocs);
+    CHECK(step != FRM_OK || frm_modal_count(md) == 4);
+    frm_modal_destroy(md);
+    frm_probe_destroy(p);
+    frm_model_destroy(sc.m);
+    sc.m = NULL;
+    CHECK_INT(c.allocs, c.frees);
+    CHECK(c.live == 0);
+    frm_sampling_free(&sc.s);
+}
+
 static const test_case cases[] = {
     TEST(test_shape_tet),
     TEST(test_shape_hex),
@@ -3708,6 +3756,7 @@ static const test_case cases[] = {
     TEST(test_i19_bdf2_sweep),
     TEST(test_i19_set_damping),
     TEST(test_i19_bdf2_threads),
+    TEST(test_i19_no_allocation),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
