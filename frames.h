@@ -1120,7 +1120,8 @@ typedef struct frm_desc {
                                   incremental potential by Newton iterations with a line search;
                                   FRM_IMPLICIT_EULER_LINEARIZED: one linearised iteration per step
                                   (the thesis's eq. 3.64; cheaper, accurate only while the step
-                                  moves little, see SOLVERS) */
+                                  moves little, see SOLVERS); FRM_BDF2: second order, the same
+                                  Newton (see SOLVERS); frm_model_set_integrator changes it */
     int implicit_linearized;   /* the older spelling of integrator = FRM_IMPLICIT_EULER_LINEARIZED:
                                   0 (default) or 1, which selects the linearised integrator */
     frm_linear_solver linear_solver; /* default FRM_LINEAR_SOLVER_CG */
