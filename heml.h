@@ -788,6 +788,9 @@ typedef enum heml_integrator {
                                           potential to newton_tolerance, matrix-free CG, line search */
     HEML_IMPLICIT_EULER_LINEARIZED = 2, /* one linearised Newton iteration, no line search (fast,
                                           accurate only while the step is nearly linear) */
+    HEML_BDF2 = 3,                      /* second-order backward differentiation: the same Newton
+                                          minimisation with (2 dt / 3, (4 u_n - u_n-1) / 3, ...);
+                                          its first step (and after a restart) is implicit Euler */
     HEML_INTEGRATOR_COUNT               /* number of integrators (not one): validation only */
 } heml_integrator;
 
@@ -1313,6 +1316,13 @@ struct heml_model {
     heml_real *static_rhs, *static_pred; /* static solve: the tangent predictor's K pred = rhs */
     heml_real *krylov[HEML__KRYLOV];   /* the linear solvers' workspace (heml__cg, heml__minres) */
     heml_real *dv_prev; /* implicit warm start */
+    /* BDF2's history: the start state (u_n-1, v_n-1) of the last successful step, valid when
+       that step was a BDF2 step of hist_dt seconds and nothing has changed the state or the
+       constraints since (heml__history_reset) */
+    heml_real *hist_u, *hist_v;
+    heml_real *bdf2_ubar, *bdf2_vbar;  /* BDF2 scratch: (4 u_n - u_n-1) / 3, (4 v_n - v_n-1) / 3 */
+    int hist_valid;
+    heml_real hist_dt;
     const heml_real *lin_x; /* linearisation point of the CG operator */
 
     /* coarse space (heml__coarse_build) */
@@ -2605,7 +2615,7 @@ static void *heml__carve(heml__carver *c, size_t bytes)
 
 #define HEML__CARVE(c, ptr, type, count) ((ptr) = (type *)heml__carve((c), sizeof(type) * (size_t)(count)))
 
-/* The scratch vectors, 3n reals each (22: 14 by role and 8 for Krylov), and the roles that share
+/* The scratch vectors, 3n reals each (24: 16 by role and 8 for Krylov), and the roles that share
    memory: a static solve and a step never run at once (static_* = step_*, static_rhs and
    static_pred = implicit_dmass and implicit_warm); the linearised implicit step does not
    run Newton (lin_* = newton_R, newton_delta, newton_ut); the saddle probe runs between
@@ -2630,6 +2640,8 @@ static void heml__layout_scratch(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->implicit_dmass, heml_real, n3);
     HEML__CARVE(c, m->implicit_warm, heml_real, n3);
     HEML__CARVE(c, m->newton_shift_diag, heml_real, n3);
+    HEML__CARVE(c, m->bdf2_ubar, heml_real, n3);
+    HEML__CARVE(c, m->bdf2_vbar, heml_real, n3);
     m->static_u = m->step_u0;
     m->static_saved = m->step_v0;
     m->static_dpin = m->step_u1;
@@ -2686,6 +2698,8 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->prony_q_next, heml_real, m->prony_reals);
     heml__layout_scratch(m, c);
     HEML__CARVE(c, m->dv_prev, heml_real, 3 * n);
+    HEML__CARVE(c, m->hist_u, heml_real, 3 * n);
+    HEML__CARVE(c, m->hist_v, heml_real, 3 * n);
     HEML__CARVE(c, m->div_u, heml_real, 3 * n);
     HEML__CARVE(c, m->div_f, heml_real, 3 * n);
     HEML__CARVE(c, m->node_agg, int, m->agg_count ? n : 0);
@@ -4390,48 +4404,89 @@ static int heml__precision_ok(const heml_model *m, const heml_real *u)
     return eps * umax <= (double)m->precision_limit * m->h_min;
 }
 
-/* Backward Euler (HEML_IMPLICIT_EULER): u1 minimises the incremental potential (see
-   heml__objective) by heml__newton to newton_tolerance in at most newton_iterations
-   iterations, from u1 = u0 with the first Krylov solve warm-started at dt (v0 + the last
-   step's dv). Fails (state kept) with HEML_ERR_NO_CONVERGENCE / HEML_ERR_ROUND_OFF when
-   Newton does not get there, HEML_ERR_INVERTED when the answer has more inverted
-   tetrahedra than u0 and allow_inversion is 0. */
-static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
-                          heml_real *u1, heml_real *v1)
+/* The incremental potential's minimisation shared by implicit Euler and BDF2: u1 minimises
+       W(u) - load . u + sum m |u - ubar - h vbar|^2 / (2 h^2) + alpha sum m |u - ubar|^2 / (2 h)
+   (heml__objective with u0 = ubar, v0 = vbar, dt = h) by heml__newton to newton_tolerance in
+   at most newton_iterations iterations, from u1 = start with the first Krylov solve
+   warm-started at dt (vstart + the last step's dv); then v1 = (u1 - ubar) / h on the free
+   axes (vbar on the pinned ones). Implicit Euler: h = dt, ubar = start = u0, vbar = vstart
+   = v0; BDF2: h = 2 dt / 3, ubar = (4 u0 - u_n-1) / 3, vbar likewise, start = u0. Fails
+   (state kept) with HEML_ERR_NO_CONVERGENCE / HEML_ERR_ROUND_OFF when Newton does not get
+   there, HEML_ERR_INVERTED when the answer has more inverted tetrahedra than its start and
+   allow_inversion is 0. */
+static int heml__incremental(heml_model *m, heml_real h, const heml_real *ubar, const heml_real *vbar,
+                             heml_real dt, const heml_real *start, const heml_real *vstart, heml_real *u1,
+                             heml_real *v1)
 {
     int i, r, err, n = m->node_count, n3 = 3 * n;
     heml_real *dmass = m->implicit_dmass, *load = m->objective_load, *warm = m->implicit_warm;
     heml__objective ob;
-    double cm = (1.0 + (double)dt * (double)m->mass_damping) / ((double)dt * (double)dt);
+    double cm = (1.0 + (double)h * (double)m->mass_damping) / ((double)h * (double)h);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
             dmass[j] = (heml_real)(cm * (double)m->mass[i]);
             load[j] = (m->ext[j] + m->mass[i] * m->gravity[r]) * m->free_mask[j];
-            warm[j] = dt * (v0[j] + m->dv_prev[j]);
+            warm[j] = dt * (vstart[j] + m->dv_prev[j]);
         }
     memset(&ob, 0, sizeof ob);
     ob.load = load;
-    ob.u0 = u0;
-    ob.v0 = v0;
+    ob.u0 = ubar;
+    ob.v0 = vbar;
     ob.dmass = dmass;
     ob.warm = warm;
-    ob.dt = (double)dt;
+    ob.dt = (double)h;
     ob.alpha = (double)m->mass_damping;
     ob.tol = (double)m->newton_tolerance;
     ob.max_iterations = m->newton_iterations;
     ob.energy_search = !m->has_prony; /* a Prony history's force has no potential */
-    memcpy(u1, u0, sizeof(heml_real) * (size_t)n3);
+    memcpy(u1, start, sizeof(heml_real) * (size_t)n3);
     err = heml__newton(m, &ob, u1);
     if (err) return err;
     if (!m->allow_inversion && m->stats.inverted > ob.inverted_start) return HEML_ERR_INVERTED;
     for (i = 0; i < n3; i++) {
         heml_real fm = m->free_mask[i];
-        v1[i] = fm > 0 ? (u1[i] - u0[i]) / dt : v0[i];
-        m->dv_prev[i] = (v1[i] - v0[i]) * fm;
+        v1[i] = fm > 0 ? (u1[i] - ubar[i]) / h : vbar[i];
+        m->dv_prev[i] = (v1[i] - vstart[i]) * fm;
     }
     return HEML_OK;
 }
+
+/* Backward Euler (HEML_IMPLICIT_EULER): heml__incremental with h = dt from (u0, v0). */
+static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                          heml_real *u1, heml_real *v1)
+{
+    return heml__incremental(m, dt, u0, v0, dt, u0, v0, u1, v1);
+}
+
+/* BDF2 (HEML_BDF2): u_n+1 - 4/3 u_n + 1/3 u_n-1 = beta v_n+1 and the same for v with the
+   acceleration, beta = 2 dt / 3, is the stationarity of the incremental potential of
+   heml__incremental with (h, ubar, vbar) = (beta, (4 u_n - u_n-1) / 3, (4 v_n - v_n-1) / 3):
+   one Newton minimisation, the same line search and acceptance test as implicit Euler.
+   Newton starts from u_n (ubar is an extrapolation, which may invert what u_n does not).
+   Without a valid history of the same dt (the first step, or after a restart: see
+   heml__history_reset) the step is one implicit Euler step. Pinned axes: ubar = u0 (their
+   target) and vbar = v0 (their velocity over the step), as implicit Euler. */
+static int heml__bdf2(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0, heml_real *u1,
+                      heml_real *v1)
+{
+    heml_real *ubar = m->bdf2_ubar, *vbar = m->bdf2_vbar;
+    heml_real beta = (heml_real)(2.0 * (double)dt / 3.0);
+    int i, n3 = 3 * m->node_count;
+    if (!m->hist_valid || m->hist_dt != dt) return heml__implicit(m, dt, u0, v0, u1, v1);
+    for (i = 0; i < n3; i++) {
+        int free_axis = m->free_mask[i] > 0;
+        ubar[i] = free_axis ? (heml_real)((4.0 * (double)u0[i] - (double)m->hist_u[i]) / 3.0) : u0[i];
+        vbar[i] = free_axis ? (heml_real)((4.0 * (double)v0[i] - (double)m->hist_v[i]) / 3.0) : v0[i];
+    }
+    return heml__incremental(m, beta, ubar, vbar, dt, u0, v0, u1, v1);
+}
+
+/* Forgets BDF2's history: its next step is an implicit Euler step. Called wherever the state
+   or the constraints change other than by a BDF2 step (heml_set_positions, displacements,
+   velocities, every pin, release or drive of a node, a static solve, a step of another
+   integrator, a failed step). */
+static void heml__history_reset(heml_model *m) { m->hist_valid = 0; }
 
 /* >>integrators-table: one row per heml_integrator, indexed by it (see HOW TO EXTEND).
    `step` advances the working copies: from the start (u0, v0: pinned axes already at their
@@ -4439,19 +4494,23 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, cons
    state alone (heml_step_ex commits the candidate, or keeps the state on an error).
    `is_explicit`: the step needs no force differential (so a user law without second
    derivatives may use it) and keeps the semi-explicit divergence check's reference (an
-   implicit step resets it). */
+   implicit step resets it). `uses_history`: after a successful step heml_step_ex keeps its
+   start (u0, v0) and dt as the history (hist_u, hist_v, hist_dt) that the next step reads;
+   any other step, and any failed one, resets the history. */
 typedef int (*heml__step_fn)(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
                              heml_real *u1, heml_real *v1);
 typedef struct heml__integrator_ops {
     const char *name;
     heml__step_fn step;
     int is_explicit;
+    int uses_history; /* the step reads the last step's start (hist_u, hist_v): heml_step_ex keeps it */
 } heml__integrator_ops;
 
 static const heml__integrator_ops heml__integrators[] = {
-    {"semi-explicit Euler", heml__semi_explicit, 1},
-    {"implicit Euler", heml__implicit, 0},
-    {"linearised implicit Euler", heml__implicit_linearized, 0},
+    {"semi-explicit Euler", heml__semi_explicit, 1, 0},
+    {"implicit Euler", heml__implicit, 0, 0},
+    {"linearised implicit Euler", heml__implicit_linearized, 0, 0},
+    {"BDF2", heml__bdf2, 0, 1},
 };
 /* an integrator added to heml_integrator without its row (or the reverse) fails to compile */
 typedef char heml__integrators_has_a_row_per_integrator
@@ -4476,12 +4535,24 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, (double)dt);
     heml__begin_step(m, dt, u0, v0);
-    if (!heml__precision_ok(m, u0)) return HEML_ERR_PRECISION;
+    if (!heml__precision_ok(m, u0)) {
+        heml__history_reset(m);
+        return HEML_ERR_PRECISION;
+    }
     err = ops->step(m, dt, u0, v0, u1, v1);
     if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
     if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);
+        heml__history_reset(m);
         return err;
+    }
+    if (ops->uses_history) {
+        memcpy(m->hist_u, u0, sizeof(heml_real) * n3);
+        memcpy(m->hist_v, v0, sizeof(heml_real) * n3);
+        m->hist_dt = dt;
+        m->hist_valid = 1;
+    } else {
+        heml__history_reset(m);
     }
     heml__commit(m, u1, v1);
     if (!ops->is_explicit) m->div_valid = 0;
@@ -4601,6 +4672,7 @@ HEMLDEF int heml_solve_static(heml_model *m)
     }
     heml__commit(m, u, NULL);
     m->div_valid = 0;
+    heml__history_reset(m);
     memset(m->dv_prev, 0, sizeof(heml_real) * (size_t)n3);
     return HEML_OK;
 }
@@ -4626,6 +4698,7 @@ HEMLDEF int heml_fix_node(heml_model *m, int i)
     m->axes[i] = 7;
     for (r = 0; r < 3; r++) m->target[3 * i + r] = m->disp[3 * i + r];
     heml__set_masks(m, i);
+    heml__history_reset(m);
     return HEML_OK;
 }
 
@@ -4638,6 +4711,7 @@ HEMLDEF int heml_set_displacement_axes(heml_model *m, int i, unsigned axes, cons
     for (r = 0; r < 3; r++)
         if ((axes >> r) & 1) m->target[3 * i + r] = u[r];
     heml__set_masks(m, i);
+    heml__history_reset(m);
     return HEML_OK;
 }
 
@@ -4741,6 +4815,7 @@ HEMLDEF int heml_set_positions(heml_model *m, const heml_real *positions)
     for (i = 0; i < 3 * m->node_count; i++) m->disp[i] = positions[i] - m->rest[i];
     memcpy(m->pos, positions, sizeof(heml_real) * 3 * (size_t)m->node_count);
     m->div_valid = 0;
+    heml__history_reset(m);
     return HEML_OK;
 }
 
@@ -4751,6 +4826,7 @@ HEMLDEF int heml_set_displacements(heml_model *m, const heml_real *displacements
     memcpy(m->disp, displacements, sizeof(heml_real) * 3 * (size_t)m->node_count);
     heml__update_positions(m);
     m->div_valid = 0;
+    heml__history_reset(m);
     return HEML_OK;
 }
 
@@ -4761,6 +4837,7 @@ HEMLDEF int heml_set_velocities(heml_model *m, const heml_real *velocities)
     if (!heml__all_finite(velocities, 3 * (size_t)m->node_count)) return HEML_ERR_ARG;
     for (i = 0; i < 3 * m->node_count; i++) m->vel[i] = velocities[i] * (m->mass[i / 3] > 0);
     m->div_valid = 0;
+    heml__history_reset(m);
     return HEML_OK;
 }
 

@@ -1,0 +1,379 @@
+/* Tests of heml.h, part 4: accuracy in time and in space (issue 19). BDF2 (HEML_BDF2): its
+   order on a linear oscillator against implicit Euler's, its amplitude decay and period per
+   period against the closed form of its amplification factor, its restart rules (first
+   step, set state, pins, failed steps), no allocation, its steps against their own BDF2
+   equations in a reduced stress sweep. */
+#define HEML_IMPLEMENTATION
+#include "../heml.h"
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "test.h"
+#include "fixtures.h"
+
+#define IS_FLOAT (sizeof(heml_real) == sizeof(float))
+#define PI 3.14159265358979323846
+
+static heml_real *alloc_reals(int count)
+{
+    return (heml_real *)calloc(count > 0 ? (size_t)count : 1, sizeof(heml_real));
+}
+
+static heml_model *make_model_ex(const tetmesh *mesh, heml_material mt, double gz, heml_desc *dd)
+{
+    heml_real *x = alloc_reals(3 * mesh->node_count);
+    heml_desc d = dd ? *dd : heml_default_desc();
+    heml_model *m = NULL;
+    int i;
+    for (i = 0; i < 3 * mesh->node_count; i++) x[i] = (heml_real)mesh->nodes[i];
+    d.rest_positions = x;
+    d.node_count = mesh->node_count;
+    d.tets = mesh->tets;
+    d.tet_count = mesh->tet_count;
+    d.material = mt;
+    d.gravity[2] = (heml_real)gz;
+    if (heml_create(&d, &m)) m = NULL;
+    free(x);
+    return m;
+}
+
+/* ---- a one-degree-of-freedom oscillator --------------------------------------------- */
+
+/* One tetrahedron, nodes 0-2 pinned, node 3 on rollers (x and y pinned): one degree of
+   freedom z, m z'' = -k z at small amplitude, k from heml_apply_stiffness. */
+typedef struct osc1 {
+    heml_model *m;
+    double k, mass, omega, amp;
+} osc1;
+
+static int osc1_make(osc1 *o, double alpha, heml_allocator *allocator)
+{
+    static const int tet[4] = {0, 1, 2, 3};
+    static const double nodes[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.3, 1};
+    heml_real X[12], dx[12], out[12], zero[3] = {0, 0, 0};
+    heml_desc d = heml_default_desc();
+    int i;
+    for (i = 0; i < 12; i++) X[i] = (heml_real)nodes[i];
+    d.rest_positions = X;
+    d.node_count = 4;
+    d.tets = tet;
+    d.tet_count = 1;
+    d.material = heml_material_from_young(HEML_NEO_HOOKEAN, 1e4, 0.3);
+    d.gravity[2] = 0;
+    d.mass_damping = (heml_real)alpha;
+    d.newton_tolerance = (heml_real)(IS_FLOAT ? 1e-5 : 1e-12); /* the integrator's error, not Newton's */
+    d.cg_tolerance = (heml_real)(IS_FLOAT ? 1e-6 : 1e-12);
+    if (allocator) d.allocator = *allocator;
+    if (heml_create(&d, &o->m)) return 0;
+    for (i = 0; i < 3; i++) heml_fix_node(o->m, i);
+    heml_set_displacement_axes(o->m, 3, 3u, zero);
+    memset(dx, 0, sizeof dx);
+    dx[11] = 1;
+    heml_apply_stiffness(o->m, dx, out);
+    o->k = -(double)out[11];
+    o->mass = (double)heml_masses(o->m)[3];
+    o->omega = sqrt(o->k / o->mass);
+    o->amp = IS_FLOAT ? 1e-3 : 1e-6;
+    return 1;
+}
+
+/* Starts at z = amp, v = 0. */
+static void osc1_start(osc1 *o)
+{
+    heml_real z[12], w[12];
+    memset(z, 0, sizeof z);
+    memset(w, 0, sizeof w);
+    z[11] = (heml_real)o->amp;
+    heml_set_displacements(o->m, z);
+    heml_set_velocities(o->m, w);
+}
+
+/* |z(t) - amp cos(omega t)| / amp after `steps` steps over one period. */
+static double osc1_error(osc1 *o, heml_integrator integ, int steps)
+{
+    double T = 2 * PI / o->omega;
+    int s;
+    osc1_start(o);
+    for (s = 0; s < steps; s++)
+        if (heml_step_ex(o->m, (heml_real)(T / steps), integ)) return 1e9;
+    return fabs((double)heml_displacements(o->m)[11] - o->amp) / o->amp;
+}
+
+/* The principal root zeta (re, im) of a scheme's amplification for y' = i w y, wh = w h:
+   implicit Euler zeta = 1 / (1 - i wh); BDF2 (1 - 2 i wh / 3) zeta^2 - 4/3 zeta + 1/3 = 0,
+   the root near 1. */
+static void amplification(int bdf2, double wh, double *re, double *im)
+{
+    if (!bdf2) {
+        *re = 1 / (1 + wh * wh);
+        *im = wh / (1 + wh * wh);
+    } else {
+        /* zeta = (4/3 + sqrt(16/9 - 4/3 a)) / (2 a), a = 1 - 2 i wh / 3 */
+        double ar = 1, ai = -2 * wh / 3, dr = 16.0 / 9 - 4.0 / 3 * ar, di = -4.0 / 3 * ai;
+        double mod = sqrt(sqrt(dr * dr + di * di)), arg = 0.5 * atan2(di, dr);
+        double sr = mod * cos(arg), si = mod * sin(arg), nr = 4.0 / 3 + sr, ni = si;
+        double den = 4 * (ar * ar + ai * ai); /* (n / (2 a)) = n conj(a) / (2 |a|^2) */
+        *re = 2 * (nr * ar + ni * ai) / den;
+        *im = 2 * (ni * ar - nr * ai) / den;
+    }
+}
+
+/* Runs `periods` periods at `per` steps per exact period and fits z_n+2 = a z_n+1 + b z_n
+   by least squares over the last `periods - 1` periods (BDF2's parasitic root, |zeta| of
+   about 1/3 per step, has died out by then): |zeta|^2 = -b, arg zeta = acos(a / (2
+   |zeta|)). Returns the decay of the amplitude per exact period, 1 - |zeta|^per, and the
+   relative period error T_h / T - 1 = 2 pi / (per arg zeta) - 1. */
+static int osc1_fit(osc1 *o, heml_integrator integ, int per, int periods, double *decay, double *period_error)
+{
+    double T = 2 * PI / o->omega, h = T / per, s11 = 0, s12 = 0, s22 = 0, r1 = 0, r2 = 0, zm2 = 0, zm1 = 0;
+    double a, b, det, mod, arg;
+    int s, steps = per * periods;
+    osc1_start(o);
+    for (s = 1; s <= steps; s++) {
+        double z;
+        if (heml_step_ex(o->m, (heml_real)h, integ)) return 0;
+        z = (double)heml_displacements(o->m)[11] / o->amp;
+        if (s > per + 2) {
+            s11 += zm1 * zm1;
+            s12 += zm1 * zm2;
+            s22 += zm2 * zm2;
+            r1 += z * zm1;
+            r2 += z * zm2;
+        }
+        zm2 = zm1;
+        zm1 = z;
+    }
+    det = s11 * s22 - s12 * s12;
+    a = (r1 * s22 - r2 * s12) / det;
+    b = (s11 * r2 - s12 * r1) / det;
+    mod = sqrt(-b);
+    arg = acos(a / (2 * mod));
+    *decay = 1 - pow(mod, per);
+    *period_error = 2 * PI / (per * arg) - 1;
+    return 1;
+}
+
+/* ---- BDF2 ---------------------------------------------------------------------------- */
+
+/* Halving dt divides BDF2's error at t = T by 4 and implicit Euler's by 2 (BDF2's first
+   step is implicit Euler: its local error O(dt^2) keeps the global error second order). */
+static void test_bdf2_order(void)
+{
+    osc1 o;
+    heml_integrator integ[2] = {HEML_IMPLICIT_EULER, HEML_BDF2};
+    int k, l;
+    REQUIRE(osc1_make(&o, 0.0, NULL));
+    for (k = 0; k < 2; k++) {
+        double e[4], lo = k ? 3.5 : 1.8, hi = k ? 4.5 : 2.2;
+        int base = 50, levels = IS_FLOAT && k ? 2 : 3; /* float: BDF2's finest errors reach its rounding */
+        for (l = 0; l < 4; l++) e[l] = osc1_error(&o, integ[k], base << l);
+        printf("    %s: error at T with T/%d..T/%d: %.3g %.3g %.3g %.3g, ratios %.3f %.3f %.3f\n",
+               k ? "BDF2" : "implicit Euler", base, base << 3, e[0], e[1], e[2], e[3], e[0] / e[1], e[1] / e[2],
+               e[2] / e[3]);
+        for (l = 0; l < levels; l++) {
+            CHECK(e[l] / e[l + 1] > lo);
+            CHECK(e[l] / e[l + 1] < hi);
+        }
+    }
+    heml_destroy(o.m);
+}
+
+/* The amplitude decay per period and the period error of both schemes, measured from the
+   simulated sequence (osc1_fit), against the closed form of their amplification factor:
+   decay to 3 digits (relative 1e-3) wherever it is above 1e-6 of the amplitude per
+   period (float: 1e-2 where above 1e-3), the period to 1e-5 of T (float 1e-3). Prints the
+   table of issue 19 (T/20, T/50, T/100, T/400). */
+static void test_bdf2_decay_closed_form(void)
+{
+    static const int pers[4] = {20, 50, 100, 400};
+    osc1 o;
+    int k, l;
+    REQUIRE(osc1_make(&o, 0.0, NULL));
+    printf("    scheme          dt      decay/period (theory)      period error (theory)\n");
+    for (k = 0; k < 2; k++)
+        for (l = 0; l < 4; l++) {
+            double decay, perr, re, im, mod, arg, tdecay, tperr, wh = 2 * PI / pers[l];
+            int periods = pers[l] >= 400 ? 3 : 5;
+            if (TEST_IS_QUICK && pers[l] >= 400) continue;
+            REQUIRE(osc1_fit(&o, k ? HEML_BDF2 : HEML_IMPLICIT_EULER, pers[l], periods, &decay, &perr));
+            amplification(k, wh, &re, &im);
+            mod = sqrt(re * re + im * im);
+            arg = atan2(im, re);
+            tdecay = 1 - pow(mod, pers[l]);
+            tperr = 2 * PI / (pers[l] * arg) - 1;
+            printf("    %-14s T/%-4d %.6f (%.6f)       %+.6f (%+.6f)\n", k ? "BDF2" : "implicit Euler", pers[l], decay,
+                   tdecay, perr, tperr);
+            if (tdecay > (IS_FLOAT ? 1e-3 : 1e-6)) CHECK_REL(tdecay, decay, IS_FLOAT ? 1e-2 : 1e-3);
+            CHECK_NEAR(tperr, perr, IS_FLOAT ? 1e-3 : 1e-5);
+        }
+    heml_destroy(o.m);
+}
+
+/* The first BDF2 step, and the first after heml_set_velocities, a pin, a step of another
+   integrator, a change of dt or a failed step, is exactly an implicit Euler step (the two
+   models stay bit-identical); the second is not. A failed step keeps the state. */
+static void test_bdf2_restarts(void)
+{
+    osc1 a, b;
+    double T, dt;
+    heml_real w[12], zero[3] = {0, 0, 0};
+    int s;
+    REQUIRE(osc1_make(&a, 0.5, NULL));
+    REQUIRE(osc1_make(&b, 0.5, NULL));
+    T = 2 * PI / a.omega;
+    dt = T / 30;
+    osc1_start(&a);
+    osc1_start(&b);
+    CHECK_INT(HEML_OK, heml_step_ex(a.m, (heml_real)dt, HEML_BDF2));
+    CHECK_INT(HEML_OK, heml_step_ex(b.m, (heml_real)dt, HEML_IMPLICIT_EULER));
+    CHECK(heml_displacements(a.m)[11] == heml_displacements(b.m)[11]);
+    CHECK(heml_velocities(a.m)[11] == heml_velocities(b.m)[11]);
+    /* a second BDF2 step differs from implicit Euler (b restarts its own BDF2 from a's state) */
+    CHECK_INT(HEML_OK, heml_step_ex(a.m, (heml_real)dt, HEML_BDF2));
+    CHECK_INT(HEML_OK, heml_step_ex(b.m, (heml_real)dt, HEML_IMPLICIT_EULER));
+    CHECK(heml_displacements(a.m)[11] != heml_displacements(b.m)[11]);
+    for (s = 0; s < (IS_FLOAT ? 4 : 5); s++) { /* each restart (float: its one Newton iteration
+                                                   converges, so no failed step here; the stress
+                                                   sweep checks failed steps); a BDF2 step
+                                                   equals implicit Euler's from the same state */
+        heml_set_displacements(b.m, heml_displacements(a.m));
+        memcpy(w, heml_velocities(a.m), sizeof w);
+        heml_set_velocities(b.m, w);
+        CHECK_INT(HEML_OK, heml_step_ex(a.m, (heml_real)dt, HEML_BDF2)); /* history valid again */
+        heml_set_displacements(b.m, heml_displacements(a.m));
+        memcpy(w, heml_velocities(a.m), sizeof w);
+        heml_set_velocities(b.m, w);
+        if (s == 0) heml_set_velocities(a.m, w);
+        if (s == 1) heml_set_displacement_axes(a.m, 3, 3u, zero);
+        if (s == 2) CHECK_INT(HEML_OK, heml_step_ex(a.m, (heml_real)dt, HEML_SEMI_EXPLICIT_EULER));
+        if (s == 2) CHECK_INT(HEML_OK, heml_step_ex(b.m, (heml_real)dt, HEML_SEMI_EXPLICIT_EULER));
+        if (s == 3) dt *= 0.5;
+        if (s == 4) { /* a failed step (one Newton iteration at a tolerance it cannot reach) keeps the state */
+            heml_real u = heml_displacements(a.m)[11], v = heml_velocities(a.m)[11];
+            heml_set_newton_iterations(a.m, 1);
+            heml_set_solver(a.m, (heml_real)1e-30, 1);
+            CHECK(heml_step_ex(a.m, (heml_real)dt, HEML_BDF2) != HEML_OK);
+            CHECK(heml_displacements(a.m)[11] == u);
+            CHECK(heml_velocities(a.m)[11] == v);
+            heml_set_newton_iterations(a.m, 20);
+            heml_set_solver(a.m, (heml_real)(IS_FLOAT ? 1e-6 : 1e-12), 1000);
+        }
+        CHECK_INT(HEML_OK, heml_step_ex(a.m, (heml_real)dt, HEML_BDF2));
+        CHECK_INT(HEML_OK, heml_step_ex(b.m, (heml_real)dt, HEML_IMPLICIT_EULER));
+        CHECK(heml_displacements(a.m)[11] == heml_displacements(b.m)[11]);
+        CHECK(heml_velocities(a.m)[11] == heml_velocities(b.m)[11]);
+    }
+    heml_destroy(a.m);
+    heml_destroy(b.m);
+}
+
+/* BDF2 steps allocate nothing (the history is part of the model). */
+static void test_bdf2_no_allocation(void)
+{
+    counting_allocator c = {0, 0, 0, 0};
+    heml_allocator al;
+    osc1 o;
+    int s, before;
+    al.alloc = count_alloc;
+    al.free = count_free;
+    al.user = &c;
+    REQUIRE(osc1_make(&o, 0.0, &al));
+    osc1_start(&o);
+    before = c.allocs;
+    for (s = 0; s < 10; s++) CHECK_INT(HEML_OK, heml_step_ex(o.m, (heml_real)(2 * PI / o.omega / 50), HEML_BDF2));
+    CHECK_INT(before, c.allocs);
+    heml_destroy(o.m);
+}
+
+/* The residual of the BDF2 equations at the model's state, f + M g - M (u - ubar - beta
+   vbar) / beta^2 over the free axes, relative to the largest of its terms' norms (the
+   scale of the step's Newton tolerance; the forces' norm includes the reactions). */
+static double bdf2_residual(heml_model *m, const heml_real *ubar, const heml_real *vbar, double beta, double gz)
+{
+    const heml_real *f = heml_compute_forces(m), *x = heml_displacements(m), *mass = heml_masses(m);
+    double s = 0.0, g = 0.0, ff = 0.0, in = 0.0;
+    int i, r, n = heml_node_count(m);
+    for (i = 0; i < 3 * n; i++) ff += (double)f[i] * (double)f[i]; /* reactions too, as Newton's scale */
+    for (i = 0; i < n; i++) {
+        if (heml_node_pinned(m, i)) continue;
+        for (r = 0; r < 3; r++) {
+            int j = 3 * i + r;
+            double mi = (double)mass[i], e = (double)x[j] - (double)ubar[j] - beta * (double)vbar[j];
+            double R = (double)f[j] + mi * (r == 2 ? gz : 0.0) - mi * e / (beta * beta);
+            s += R * R;
+            g += mi * mi * (r == 2 ? gz * gz : 0.0);
+            in += pow(mi * e / (beta * beta), 2);
+        }
+    }
+    if (ff > g) g = ff;
+    if (in > g) g = in;
+    return sqrt(s / g);
+}
+
+/* E from 1 Pa to 200 GPa, nu from 0 to 0.4999, dt from 1e-6 to 1 s: a clamped beam under
+   gravity, one implicit Euler start and a BDF2 step; every BDF2 step that succeeds
+   satisfies its BDF2 equations (residual computed here from the test's own copy of the
+   history) to 10 times the Newton tolerance (1e-5, float 1e-3), or the step returns an
+   error code and keeps the state. */
+static void test_bdf2_stress_sweep(void)
+{
+    static const double Es[4] = {1, 1e4, 1e7, 2e11}, nus[4] = {0, 0.3, 0.45, 0.4999}, dts[3] = {1e-6, 1e-2, 1};
+    tetmesh beam;
+    int ie, in, id, ok = 0, codes = 0, wrong = 0;
+    tetmesh_beam(&beam, 1.0, 0.1, 0.1, 4, 1, 1, TETMESH_SPLIT6);
+    for (ie = 0; ie < 4; ie++)
+        for (in = 0; in < 4; in++)
+            for (id = 0; id < 3; id++) {
+                heml_material mt = heml_material_from_young(HEML_NEO_HOOKEAN, Es[ie], nus[in]);
+                heml_model *m = make_model_ex(&beam, mt, -9.81, NULL);
+                int i, n3 = 3 * beam.node_count, err;
+                heml_real *u0 = alloc_reals(n3), *v0 = alloc_reals(n3), *ub = alloc_reals(n3), *vb = alloc_reals(n3);
+                REQUIRE(m != NULL);
+                for (i = 0; i < beam.node_count; i++)
+                    if (beam.nodes[3 * i] == 0.0) heml_fix_node(m, i);
+                err = heml_step_ex(m, (heml_real)dts[id], HEML_BDF2);
+                if (err == HEML_OK) {
+                    memcpy(u0, heml_displacements(m), sizeof(heml_real) * n3);
+                    memcpy(v0, heml_velocities(m), sizeof(heml_real) * n3);
+                    err = heml_step_ex(m, (heml_real)dts[id], HEML_BDF2);
+                    if (err) { /* a failed step keeps the state */
+                        CHECK(memcmp(u0, heml_displacements(m), sizeof(heml_real) * n3) == 0);
+                        CHECK(memcmp(v0, heml_velocities(m), sizeof(heml_real) * n3) == 0);
+                    }
+                }
+                if (err == HEML_OK) {
+                    double r;
+                    for (i = 0; i < n3; i++) { /* the history: u_n-1 = 0, v_n-1 = 0 */
+                        ub[i] = (heml_real)(4.0 * (double)u0[i] / 3.0);
+                        vb[i] = (heml_real)(4.0 * (double)v0[i] / 3.0);
+                    }
+                    r = bdf2_residual(m, ub, vb, 2.0 * dts[id] / 3.0, -9.81);
+                    ok++;
+                    if (!(r <= (IS_FLOAT ? 1e-3 : 1e-5))) {
+                        wrong++;
+                        printf("    WRONG BDF2 E %g nu %g dt %g: residual %.3g of its terms\n", Es[ie], nus[in],
+                               dts[id], r);
+                    }
+                } else {
+                    codes++;
+                    printf("    BDF2 E %g nu %g dt %g: %s\n", Es[ie], nus[in], dts[id], heml_error_string(err));
+                }
+                free(u0);
+                free(v0);
+                free(ub);
+                free(vb);
+                heml_destroy(m);
+            }
+    printf("    %d BDF2 steps right, %d error codes, %d wrong\n", ok - wrong, codes, wrong);
+    CHECK_INT(0, wrong);
+    tetmesh_free(&beam);
+}
+
+static const test_case cases[] = {
+    TEST(test_bdf2_order),
+    TEST(test_bdf2_decay_closed_form),
+    TEST(test_bdf2_restarts),
+    TEST(test_bdf2_no_allocation),
+    TEST(test_bdf2_stress_sweep),
+};
+
+int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
