@@ -715,6 +715,18 @@ typedef HEML_REAL heml_real;
 #define heml_tet_stress heml_tet_stress_f32
 #define heml_stable_time_step heml_stable_time_step_f32
 #define heml_memory_bytes heml_memory_bytes_f32
+#define heml_probe_create heml_probe_create_f32
+#define heml_probe_positions heml_probe_positions_f32
+#define heml_probe_displacements heml_probe_displacements_f32
+#define heml_probe_velocities heml_probe_velocities_f32
+#define heml_probe_destroy heml_probe_destroy_f32
+#define heml_modal_default_desc heml_modal_default_desc_f32
+#define heml_modal_create heml_modal_create_f32
+#define heml_modal_solve heml_modal_solve_f32
+#define heml_modal_count heml_modal_count_f32
+#define heml_modal_frequency heml_modal_frequency_f32
+#define heml_modal_shape heml_modal_shape_f32
+#define heml_modal_destroy heml_modal_destroy_f32
 #else
 #define HEML__FLOAT 0
 #endif
@@ -1097,6 +1109,65 @@ HEMLDEF int heml_tet_stress(heml_model *m, int tet, heml_stress_kind kind, heml_
 HEMLDEF double heml_stable_time_step(const heml_model *m);
 /* Bytes held by the model. */
 HEMLDEF size_t heml_memory_bytes(const heml_model *m);
+
+/* ---- point probes (see POINT PROBES) ---- */
+
+typedef struct heml_probe heml_probe;
+/* Locates `count` material points given by their rest positions (3 per point, m) in the
+   model's rest mesh, once: each point's containing tetrahedron and its barycentric
+   coordinates (computed in double). A point outside every tetrahedron by no more than 1e-6
+   of its nearest tetrahedron's size (in barycentric coordinates: points on the surface, up
+   to rounding) takes that tetrahedron; farther out: HEML_ERR_ARG. Allocates the probe (the
+   model's allocator); costs O(count x tetrahedra) at most. The probe reads only the model
+   it was made for (the same node count is checked). */
+HEMLDEF int heml_probe_create(const heml_model *m, const heml_real *rest_points, int count, heml_probe **out);
+/* The points' current positions (rest + u), displacements and velocities, 3 per point
+   (caller-owned out), interpolated from the containing tetrahedron's nodes; no allocation. */
+HEMLDEF int heml_probe_positions(const heml_probe *p, const heml_model *m, heml_real *out);
+HEMLDEF int heml_probe_displacements(const heml_probe *p, const heml_model *m, heml_real *out);
+HEMLDEF int heml_probe_velocities(const heml_probe *p, const heml_model *m, heml_real *out);
+/* Frees the probe (NULL allowed). */
+HEMLDEF void heml_probe_destroy(heml_probe *p);
+
+/* ---- modal analysis (see MODAL ANALYSIS) ---- */
+
+typedef struct heml_modal_desc {
+    int count;           /* modes wanted (>= 1), the lowest; default 6 */
+    int max_iterations;  /* subspace iterations before HEML_ERR_NO_CONVERGENCE, default 100 */
+    heml_real tolerance; /* relative change of each wanted eigenvalue between iterations at
+                            convergence, default 1e-8 (float 1e-4) */
+    heml_real shift;     /* 1/s^2: sigma of K + sigma M (the shift-invert operator); < 0
+                            (default -1): automatic, 1e-5 of the largest stiffness diagonal over
+                            mass (free bodies' rigid modes need sigma > 0) */
+} heml_modal_desc;
+typedef struct heml_modal heml_modal;
+/* The defaults above. */
+HEMLDEF heml_modal_desc heml_modal_default_desc(void);
+/* Sizes and allocates the workspace of a modal analysis of model m (the model's allocator):
+   for count modes about 2 count (at least count + 8) vectors of 3n reals, three times.
+   HEML_ERR_ARG for a bad description, HEML_ERR_ALLOC. */
+HEMLDEF int heml_modal_create(const heml_model *m, const heml_modal_desc *d, heml_modal **out);
+/* The lowest `count` natural frequencies and mode shapes of the model about its current
+   state (the tangent stiffness there, K = -df/du, Prony terms as heml_apply_stiffness)
+   with its pinned axes, M the lumped masses. No allocation; the model's state is not
+   changed (its stats are kept). HEML_ERR_NO_CONVERGENCE after max_iterations (the previous
+   results are then invalid: count reads 0), HEML_ERR_UNSTABLE when K + shift M is not
+   positive definite (an unstable state: raise shift), HEML_ERR_ARG when the model has fewer
+   free degrees of freedom than the workspace's vectors, or is not the one the workspace
+   was sized for, HEML_ERR_NO_SECOND_DERIVATIVES, HEML_ERR_NOT_FINITE. */
+HEMLDEF int heml_modal_solve(heml_modal *md, heml_model *m);
+/* Modes available (count after a successful solve, else 0). */
+HEMLDEF int heml_modal_count(const heml_modal *md);
+/* Frequency of mode i, Hz, ascending: sqrt(lambda) / (2 pi) for K x = lambda M x (rigid
+   modes of a free body: 0 within round-off; an unstable direction, lambda < 0, gives
+   -sqrt(-lambda) / (2 pi)). NaN for a bad i. */
+HEMLDEF double heml_modal_frequency(const heml_modal *md, int i);
+/* Shape of mode i: 3n values (m per unit modal amplitude, zero on pinned axes),
+   M-orthonormal (x_i . M x_j = delta_ij, kg m^2), pointing into the workspace (valid until
+   the next solve or heml_modal_destroy). NULL for a bad i. */
+HEMLDEF const heml_real *heml_modal_shape(const heml_modal *md, int i);
+/* Frees the workspace (NULL allowed). */
+HEMLDEF void heml_modal_destroy(heml_modal *md);
 
 #endif /* HEML_H */
 
@@ -4989,6 +5060,443 @@ HEMLDEF double heml_stable_time_step(const heml_model *m)
         }
     }
     return best;
+}
+
+/* >>probes ---------------------------------------------------------------------------- */
+
+struct heml_probe {
+    heml_allocator allocator;
+    size_t bytes;
+    int count, node_count;
+    int *nodes;       /* 4 per point: the containing tetrahedron's nodes */
+    heml_real *weights; /* 4 per point: their barycentric coordinates */
+};
+
+/* Node j of tetrahedron t (description numbering). */
+static int heml__tet_node(const heml_model *m, int t, int j)
+{
+    int slot = m->tet_slot[t];
+    return m->blk_idx[(size_t)(slot / HEML__W) * 4 * HEML__W + (size_t)HEML__W * j + slot % HEML__W];
+}
+
+/* Barycentric coordinates b of point p in the rest tetrahedron t (double, Cramer's rule). */
+static void heml__barycentric(const heml_model *m, int t, const double p[3], double b[4])
+{
+    double x0[3], e[3][3], d[3], det, c[3][3];
+    int j, r, n0 = heml__tet_node(m, t, 0);
+    for (r = 0; r < 3; r++) {
+        x0[r] = (double)m->rest[3 * n0 + r];
+        d[r] = p[r] - x0[r];
+    }
+    for (j = 0; j < 3; j++) {
+        int nj = heml__tet_node(m, t, j + 1);
+        for (r = 0; r < 3; r++) e[j][r] = (double)m->rest[3 * nj + r] - x0[r];
+    }
+    /* rows of the inverse of the matrix whose columns are e[0..2]: cross products / det */
+    c[0][0] = e[1][1] * e[2][2] - e[1][2] * e[2][1];
+    c[0][1] = e[1][2] * e[2][0] - e[1][0] * e[2][2];
+    c[0][2] = e[1][0] * e[2][1] - e[1][1] * e[2][0];
+    c[1][0] = e[2][1] * e[0][2] - e[2][2] * e[0][1];
+    c[1][1] = e[2][2] * e[0][0] - e[2][0] * e[0][2];
+    c[1][2] = e[2][0] * e[0][1] - e[2][1] * e[0][0];
+    c[2][0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+    c[2][1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+    c[2][2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    det = e[0][0] * c[0][0] + e[0][1] * c[0][1] + e[0][2] * c[0][2];
+    for (j = 0; j < 3; j++) b[j + 1] = (c[j][0] * d[0] + c[j][1] * d[1] + c[j][2] * d[2]) / det;
+    b[0] = 1.0 - b[1] - b[2] - b[3];
+}
+
+HEMLDEF int heml_probe_create(const heml_model *m, const heml_real *rest_points, int count, heml_probe **out)
+{
+    heml_probe *p;
+    heml__carver c;
+    int i, t, j;
+    if (!out) return HEML_ERR_ARG;
+    *out = NULL;
+    if (!m || !rest_points || count < 1 || count > HEML__MAX_NODES) return HEML_ERR_ARG;
+    if (!heml__all_finite(rest_points, 3 * (size_t)count)) return HEML_ERR_ARG;
+    c.base = NULL;
+    c.offset = sizeof(heml_probe);
+    heml__carve(&c, sizeof(int) * 4 * (size_t)count);
+    heml__carve(&c, sizeof(heml_real) * 4 * (size_t)count);
+    p = (heml_probe *)heml__alloc(&m->allocator, c.offset);
+    if (!p) return HEML_ERR_ALLOC;
+    memset(p, 0, sizeof *p);
+    p->bytes = c.offset;
+    c.base = (char *)p;
+    c.offset = sizeof(heml_probe);
+    HEML__CARVE(&c, p->nodes, int, 4 * (size_t)count);
+    HEML__CARVE(&c, p->weights, heml_real, 4 * (size_t)count);
+    p->allocator = m->allocator;
+    p->count = count;
+    p->node_count = m->node_count;
+    for (i = 0; i < count; i++) {
+        double x[3], b[4], best_b[4] = {0, 0, 0, 0}, best = -INFINITY;
+        int best_t = -1;
+        for (j = 0; j < 3; j++) x[j] = (double)rest_points[3 * i + j];
+        for (t = 0; t < m->tet_count && best < 0.0; t++) { /* the first containing tetrahedron */
+            double lo;
+            heml__barycentric(m, t, x, b);
+            for (j = 1, lo = b[0]; j < 4; j++) lo = b[j] < lo ? b[j] : lo;
+            if (lo > best) {
+                best = lo;
+                best_t = t;
+                memcpy(best_b, b, sizeof b);
+            }
+        }
+        if (!(best >= -1e-6) || best_t < 0) {
+            heml_probe_destroy(p);
+            return HEML_ERR_ARG;
+        }
+        for (j = 0; j < 4; j++) {
+            p->nodes[4 * i + j] = heml__tet_node(m, best_t, j);
+            p->weights[4 * i + j] = (heml_real)best_b[j];
+        }
+    }
+    *out = p;
+    return HEML_OK;
+}
+
+/* out = the field f (3 per node) interpolated at the probe's points, plus base (or NULL). */
+static int heml__probe_eval(const heml_probe *p, const heml_model *m, const heml_real *f, const heml_real *base,
+                            heml_real *out)
+{
+    int i, j, r;
+    if (!p || !m || !out || p->node_count != m->node_count) return HEML_ERR_ARG;
+    for (i = 0; i < p->count; i++)
+        for (r = 0; r < 3; r++) {
+            double s = 0.0;
+            for (j = 0; j < 4; j++) {
+                int n = p->nodes[4 * i + j];
+                s += (double)p->weights[4 * i + j] * ((double)f[3 * n + r] + (base ? (double)base[3 * n + r] : 0.0));
+            }
+            out[3 * i + r] = (heml_real)s;
+        }
+    return HEML_OK;
+}
+
+HEMLDEF int heml_probe_positions(const heml_probe *p, const heml_model *m, heml_real *out)
+{
+    return m ? heml__probe_eval(p, m, m->disp, m->rest, out) : HEML_ERR_ARG;
+}
+
+HEMLDEF int heml_probe_displacements(const heml_probe *p, const heml_model *m, heml_real *out)
+{
+    return m ? heml__probe_eval(p, m, m->disp, NULL, out) : HEML_ERR_ARG;
+}
+
+HEMLDEF int heml_probe_velocities(const heml_probe *p, const heml_model *m, heml_real *out)
+{
+    return m ? heml__probe_eval(p, m, m->vel, NULL, out) : HEML_ERR_ARG;
+}
+
+HEMLDEF void heml_probe_destroy(heml_probe *p)
+{
+    if (p) {
+        heml_allocator a = p->allocator;
+        heml__free(&a, p, p->bytes);
+    }
+}
+
+/* >>modal ----------------------------------------------------------------------------- */
+
+struct heml_modal {
+    heml_allocator allocator;
+    size_t bytes;
+    int count, vectors, node_count, max_iterations, solved, iterations;
+    double tolerance, shift;
+    double *freq;               /* count, Hz */
+    double *mu, *mu_prev;       /* vectors: Ritz values of K + sigma M */
+    double *Kr, *Mr, *L, *W;    /* vectors^2: the Rayleigh-Ritz matrices, Cholesky factor, eigenvectors */
+    heml_real *X, *Y, *KY;      /* vectors x 3n: the basis, (K + sigma M)^-1 M X, (K + sigma M) Y */
+    heml_real *smass, *rhs;     /* 3n: sigma m per degree of freedom; M X_j */
+};
+
+HEMLDEF heml_modal_desc heml_modal_default_desc(void)
+{
+    heml_modal_desc d;
+    d.count = 6;
+    d.max_iterations = 100;
+    d.tolerance = (heml_real)(HEML__FLOAT ? 1e-4 : 1e-8);
+    d.shift = -1;
+    return d;
+}
+
+static void heml__modal_layout(heml_modal *md, heml__carver *c, size_t n3)
+{
+    size_t p = (size_t)md->vectors;
+    HEML__CARVE(c, md->freq, double, md->count);
+    HEML__CARVE(c, md->mu, double, p);
+    HEML__CARVE(c, md->mu_prev, double, p);
+    HEML__CARVE(c, md->Kr, double, p * p);
+    HEML__CARVE(c, md->Mr, double, p * p);
+    HEML__CARVE(c, md->L, double, p * p);
+    HEML__CARVE(c, md->W, double, p * p);
+    HEML__CARVE(c, md->X, heml_real, p * n3);
+    HEML__CARVE(c, md->Y, heml_real, p * n3);
+    HEML__CARVE(c, md->KY, heml_real, p * n3);
+    HEML__CARVE(c, md->smass, heml_real, n3);
+    HEML__CARVE(c, md->rhs, heml_real, n3);
+}
+
+HEMLDEF int heml_modal_create(const heml_model *m, const heml_modal_desc *d, heml_modal **out)
+{
+    heml_modal tmp, *md;
+    heml__carver c;
+    size_t n3;
+    if (!out) return HEML_ERR_ARG;
+    *out = NULL;
+    if (!m || !d || d->count < 1 || d->max_iterations < 1 || !(heml__finite((double)d->tolerance) && d->tolerance > 0) ||
+        !heml__finite((double)d->shift))
+        return HEML_ERR_ARG;
+    n3 = 3 * (size_t)m->node_count;
+    if ((size_t)d->count > n3) return HEML_ERR_ARG;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.count = d->count;
+    tmp.vectors = 2 * d->count > d->count + 8 ? 2 * d->count : d->count + 8;
+    if ((size_t)tmp.vectors > n3) tmp.vectors = (int)n3;
+    c.base = NULL;
+    c.offset = sizeof(heml_modal);
+    heml__modal_layout(&tmp, &c, n3);
+    md = (heml_modal *)heml__alloc(&m->allocator, c.offset);
+    if (!md) return HEML_ERR_ALLOC;
+    memset(md, 0, c.offset);
+    md->allocator = m->allocator;
+    md->bytes = c.offset;
+    md->count = tmp.count;
+    md->vectors = tmp.vectors;
+    md->node_count = m->node_count;
+    md->max_iterations = d->max_iterations;
+    md->tolerance = (double)d->tolerance;
+    md->shift = (double)d->shift;
+    c.base = (char *)md;
+    c.offset = sizeof(heml_modal);
+    heml__modal_layout(md, &c, n3);
+    *out = md;
+    return HEML_OK;
+}
+
+/* Eigen-decomposition of the symmetric p x p matrix A (destroyed) by cyclic Jacobi
+   rotations: eigenvalues in d, eigenvectors in the columns of V (row-major). */
+static void heml__jacobi_eigen(double *A, int p, double *d, double *V)
+{
+    int i, j, k, sweep;
+    for (i = 0; i < p; i++)
+        for (j = 0; j < p; j++) V[i * p + j] = i == j;
+    for (sweep = 0; sweep < 64; sweep++) {
+        double off = 0.0, diag = 0.0;
+        for (i = 0; i < p; i++) {
+            diag += A[i * p + i] * A[i * p + i];
+            for (j = i + 1; j < p; j++) off += A[i * p + j] * A[i * p + j];
+        }
+        if (off <= 1e-32 * diag || off == 0.0) break;
+        for (i = 0; i < p; i++)
+            for (j = i + 1; j < p; j++) {
+                double apq = A[i * p + j], theta, t, cs, sn;
+                if (apq == 0.0) continue;
+                theta = (A[j * p + j] - A[i * p + i]) / (2.0 * apq);
+                t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                cs = 1.0 / sqrt(t * t + 1.0);
+                sn = t * cs;
+                for (k = 0; k < p; k++) { /* columns i, j */
+                    double aki = A[k * p + i], akj = A[k * p + j];
+                    A[k * p + i] = cs * aki - sn * akj;
+                    A[k * p + j] = sn * aki + cs * akj;
+                }
+                for (k = 0; k < p; k++) { /* rows i, j */
+                    double aik = A[i * p + k], ajk = A[j * p + k];
+                    A[i * p + k] = cs * aik - sn * ajk;
+                    A[j * p + k] = sn * aik + cs * ajk;
+                }
+                for (k = 0; k < p; k++) {
+                    double vki = V[k * p + i], vkj = V[k * p + j];
+                    V[k * p + i] = cs * vki - sn * vkj;
+                    V[k * p + j] = sn * vki + cs * vkj;
+                }
+            }
+    }
+    for (i = 0; i < p; i++) d[i] = A[i * p + i];
+}
+
+/* The Rayleigh-Ritz step: Kr w = mu Mr w (p x p, Mr positive definite) by Cholesky
+   Mr = L L^T and Jacobi on L^-1 Kr L^-T; mu ascending, the M-orthonormal Ritz vectors'
+   coefficients in the columns of W. Returns 0 when Mr is not positive definite. Kr is
+   destroyed. */
+static int heml__ritz(heml_modal *md)
+{
+    int p = md->vectors, i, j, k;
+    double *Kr = md->Kr, *Mr = md->Mr, *L = md->L, *W = md->W, *mu = md->mu;
+    double *C = md->Mr; /* Mr is spent once factored */
+    for (i = 0; i < p; i++)
+        for (j = 0; j <= i; j++) {
+            double s = Mr[i * p + j];
+            for (k = 0; k < j; k++) s -= L[i * p + k] * L[j * p + k];
+            if (i == j) {
+                if (!(s > 0)) return 0;
+                L[i * p + i] = sqrt(s);
+            } else {
+                L[i * p + j] = s / L[j * p + j];
+            }
+        }
+    for (i = 0; i < p; i++) /* Kr := L^-1 Kr (columns), then C = (L^-1 (L^-1 Kr)^T) */
+        for (j = 0; j < p; j++) {
+            double s = Kr[i * p + j];
+            for (k = 0; k < i; k++) s -= L[i * p + k] * Kr[k * p + j];
+            Kr[i * p + j] = s / L[i * p + i];
+        }
+    for (j = 0; j < p; j++)
+        for (i = 0; i < p; i++) {
+            double s = Kr[j * p + i]; /* (L^-1 Kr)^T [i][j] */
+            for (k = 0; k < i; k++) s -= L[i * p + k] * C[k * p + j];
+            C[i * p + j] = s / L[i * p + i];
+        }
+    for (i = 0; i < p; i++) /* symmetrise the round-off */
+        for (j = 0; j < i; j++) C[i * p + j] = C[j * p + i] = 0.5 * (C[i * p + j] + C[j * p + i]);
+    heml__jacobi_eigen(C, p, mu, Kr); /* eigenvectors of C into Kr */
+    for (j = 0; j < p; j++) /* W = L^-T V */
+        for (i = p - 1; i >= 0; i--) {
+            double s = Kr[i * p + j];
+            for (k = i + 1; k < p; k++) s -= L[k * p + i] * W[k * p + j];
+            W[i * p + j] = s / L[i * p + i];
+        }
+    for (i = 1; i < p; i++) /* sort ascending (insertion: p is small), columns of W with mu */
+        for (j = i; j > 0 && mu[j - 1] > mu[j]; j--) {
+            double t = mu[j];
+            mu[j] = mu[j - 1];
+            mu[j - 1] = t;
+            for (k = 0; k < p; k++) {
+                t = W[k * p + j];
+                W[k * p + j] = W[k * p + j - 1];
+                W[k * p + j - 1] = t;
+            }
+        }
+    return 1;
+}
+
+/* Block shift-invert subspace iteration (Bathe) with Rayleigh-Ritz: Y = (K + sigma M)^-1
+   M X by the model's linear solver (heml__linear_solve: preconditioned CG with the static
+   solve's coarse space, warm-started at X / mu), then the Ritz pairs of (K + sigma M, M) in
+   span Y, with the exact products (K + sigma M) Y, give the next M-orthonormal X. Converged
+   when every wanted Ritz value moved by at most tolerance of itself. */
+HEMLDEF int heml_modal_solve(heml_modal *md, heml_model *m)
+{
+    int p, n3, i, j, a, it, err = HEML_ERR_NO_CONVERGENCE, nfree = 0;
+    double sigma, pi2 = 2.0 * 3.14159265358979323846, inner;
+    heml_stats saved;
+    if (!md || !m || md->node_count != m->node_count) return HEML_ERR_ARG;
+    if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
+    p = md->vectors;
+    n3 = 3 * m->node_count;
+    md->solved = 0;
+    for (i = 0; i < n3; i++) nfree += m->free_mask[i] > 0;
+    if (nfree < p) return HEML_ERR_ARG;
+    sigma = md->shift;
+    if (sigma < 0) {
+        double top = 0.0;
+        for (i = 0; i < n3; i++)
+            if (m->free_mask[i] > 0 && (double)m->diag[i] / (double)m->mass[i / 3] > top)
+                top = (double)m->diag[i] / (double)m->mass[i / 3];
+        sigma = 1e-5 * top;
+    }
+    for (i = 0; i < n3; i++) md->smass[i] = (heml_real)(sigma * (double)m->mass[i / 3]) * m->free_mask[i];
+    inner = md->tolerance < 1e-3 ? md->tolerance : 1e-3;
+    saved = m->stats;
+    heml__prony_coefficients(m, (double)m->time_step);
+    for (j = 0; j < p; j++) { /* a fixed pseudo-random start on the free axes */
+        heml_real *x = md->X + (size_t)j * n3;
+        for (i = 0; i < n3; i++) {
+            unsigned h = (unsigned)i * 2654435761u + (unsigned)j * 40503u + 1u;
+            h ^= h >> 15;
+            h *= 2246822519u;
+            h ^= h >> 13;
+            x[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
+        }
+        md->mu[j] = 0.0;
+    }
+    for (it = 0; it < md->max_iterations; it++) {
+        int done = it > 0;
+        for (j = 0; j < p; j++) {
+            heml_real *x = md->X + (size_t)j * n3, *y = md->Y + (size_t)j * n3;
+            int kerr;
+            for (i = 0; i < n3; i++) {
+                md->rhs[i] = m->mass[i / 3] * x[i] * m->free_mask[i];
+                y[i] = md->mu[j] > 0 ? (heml_real)((double)x[i] / md->mu[j]) : 0;
+            }
+            kerr = heml__linear_solve(m, HEML__SPD, m->disp, md->smass, 1.0, md->rhs, y, inner, 1);
+            if (kerr == HEML__NEGATIVE_CURVATURE) kerr = HEML_ERR_UNSTABLE;
+            if (kerr == HEML_ERR_NO_CONVERGENCE) kerr = HEML_OK; /* the iterate still improves the basis */
+            if (kerr) {
+                m->stats = saved;
+                return kerr;
+            }
+        }
+        m->lin_x = m->disp;
+        for (j = 0; j < p; j++) heml__cg_apply(m, md->smass, 1.0, md->Y + (size_t)j * n3, md->KY + (size_t)j * n3);
+        for (a = 0; a < p; a++)
+            for (j = 0; j <= a; j++) {
+                const heml_real *ya = md->Y + (size_t)a * n3, *yj = md->Y + (size_t)j * n3;
+                double k1 = heml__dot(ya, md->KY + (size_t)j * n3, n3), k2 = heml__dot(yj, md->KY + (size_t)a * n3, n3);
+                double s = 0.0;
+                for (i = 0; i < n3; i++) s += (double)m->mass[i / 3] * (double)m->free_mask[i] * (double)ya[i] * (double)yj[i];
+                md->Kr[a * p + j] = md->Kr[j * p + a] = 0.5 * (k1 + k2);
+                md->Mr[a * p + j] = md->Mr[j * p + a] = s;
+            }
+        if (!heml__all_finite(md->Y, (size_t)p * (size_t)n3)) {
+            m->stats = saved;
+            return HEML_ERR_NOT_FINITE;
+        }
+        memcpy(md->mu_prev, md->mu, sizeof(double) * (size_t)p);
+        if (!heml__ritz(md)) {
+            m->stats = saved;
+            return HEML_ERR_NOT_FINITE;
+        }
+        for (j = 0; j < p; j++) { /* X = Y W */
+            heml_real *x = md->X + (size_t)j * n3;
+            for (i = 0; i < n3; i++) {
+                double s = 0.0;
+                for (a = 0; a < p; a++) s += (double)md->Y[(size_t)a * n3 + i] * md->W[a * p + j];
+                x[i] = (heml_real)s;
+            }
+        }
+        for (j = 0; j < md->count; j++)
+            if (!(fabs(md->mu[j] - md->mu_prev[j]) <= md->tolerance * fabs(md->mu[j]))) done = 0;
+        if (done) {
+            err = HEML_OK;
+            break;
+        }
+    }
+    md->iterations = it;
+    m->stats = saved;
+    if (err) return err;
+    for (j = 0; j < md->count; j++) {
+        double lambda = md->mu[j] - sigma;
+        md->freq[j] = (lambda >= 0 ? sqrt(lambda) : -sqrt(-lambda)) / pi2;
+    }
+    md->solved = 1;
+    return HEML_OK;
+}
+
+HEMLDEF int heml_modal_count(const heml_modal *md) { return md && md->solved ? md->count : 0; }
+
+HEMLDEF double heml_modal_frequency(const heml_modal *md, int i)
+{
+    if (!md || !md->solved || i < 0 || i >= md->count) return NAN;
+    return md->freq[i];
+}
+
+HEMLDEF const heml_real *heml_modal_shape(const heml_modal *md, int i)
+{
+    if (!md || !md->solved || i < 0 || i >= md->count) return NULL;
+    return md->X + (size_t)i * 3 * (size_t)md->node_count;
+}
+
+HEMLDEF void heml_modal_destroy(heml_modal *md)
+{
+    if (md) {
+        heml_allocator a = md->allocator;
+        heml__free(&a, md, md->bytes);
+    }
 }
 
 #if defined(HEML_STATIC) && defined(__GNUC__)

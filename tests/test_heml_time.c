@@ -368,12 +368,135 @@ static void test_bdf2_stress_sweep(void)
     tetmesh_free(&beam);
 }
 
+
+/* ---- point probes -------------------------------------------------------------------- */
+
+static heml_model *box_model(int nx, int ny, int nz, double sx, double sy, double sz, heml_allocator *al, tetmesh *mesh)
+{
+    heml_desc d = heml_default_desc();
+    box_mesh(mesh, nx, ny, nz, sx, sy, sz, TETMESH_SPLIT5);
+    if (al) d.allocator = *al;
+    return make_model_ex(mesh, heml_material_from_young(HEML_NEO_HOOKEAN, 1e4, 0.3), 0.0, &d);
+}
+
+/* An affine displacement and velocity field is interpolated exactly (P1): probes at random
+   interior points, at nodes and on faces give rest + A X + b, A X + b and B X + c to
+   round-off; evaluation allocates nothing, creation once. */
+static void test_probe_affine_exact(void)
+{
+    static const double A[3][3] = {{0.01, -0.02, 0.005}, {0.003, 0.02, -0.01}, {-0.004, 0.006, 0.015}};
+    static const double bv[3] = {0.1, -0.2, 0.05}, B[3][3] = {{1, 2, 3}, {-1, 0.5, 0}, {0.2, -0.3, 0.7}};
+    counting_allocator c = {0, 0, 0, 0};
+    heml_allocator al;
+    tetmesh mesh;
+    heml_model *m;
+    heml_probe *p = NULL;
+    enum { NP = 40 };
+    heml_real pts[3 * NP], out[3 * NP], *u, *v;
+    unsigned seed = 7;
+    int i, r, k, n3, allocs;
+    double worst[3] = {0, 0, 0};
+    al.alloc = count_alloc;
+    al.free = count_free;
+    al.user = &c;
+    m = box_model(3, 2, 2, 1.5, 1.0, 0.8, &al, &mesh);
+    REQUIRE(m != NULL);
+    n3 = 3 * mesh.node_count;
+    u = alloc_reals(n3);
+    v = alloc_reals(n3);
+    for (i = 0; i < mesh.node_count; i++)
+        for (r = 0; r < 3; r++) {
+            const double *X = mesh.nodes + 3 * i;
+            u[3 * i + r] = (heml_real)(A[r][0] * X[0] + A[r][1] * X[1] + A[r][2] * X[2] + bv[r]);
+            v[3 * i + r] = (heml_real)(B[r][0] * X[0] + B[r][1] * X[1] + B[r][2] * X[2] - bv[r]);
+        }
+    heml_set_displacements(m, u);
+    heml_set_velocities(m, v);
+    for (i = 0; i < NP; i++) { /* interior, then nodes, then points on the faces x = 0 and z = 0.8 */
+        double x = 0.75 + 0.74 * rnd(&seed), y = 0.5 + 0.49 * rnd(&seed), z = 0.4 + 0.39 * rnd(&seed);
+        if (i >= 20 && i < 30) {
+            const double *X = mesh.nodes + 3 * ((i * 7) % mesh.node_count);
+            x = X[0], y = X[1], z = X[2];
+        }
+        if (i >= 30) {
+            if (i & 1) x = 0.0;
+            else z = 0.8;
+        }
+        pts[3 * i] = (heml_real)x, pts[3 * i + 1] = (heml_real)y, pts[3 * i + 2] = (heml_real)z;
+    }
+    CHECK_INT(HEML_OK, heml_probe_create(m, pts, NP, &p));
+    REQUIRE(p != NULL);
+    allocs = c.allocs;
+    for (k = 0; k < 3; k++) {
+        CHECK_INT(HEML_OK, k == 0 ? heml_probe_positions(p, m, out)
+                                  : k == 1 ? heml_probe_displacements(p, m, out) : heml_probe_velocities(p, m, out));
+        for (i = 0; i < NP; i++)
+            for (r = 0; r < 3; r++) {
+                double X[3], e;
+                X[0] = (double)pts[3 * i], X[1] = (double)pts[3 * i + 1], X[2] = (double)pts[3 * i + 2];
+                e = k == 2 ? B[r][0] * X[0] + B[r][1] * X[1] + B[r][2] * X[2] - bv[r]
+                           : A[r][0] * X[0] + A[r][1] * X[1] + A[r][2] * X[2] + bv[r] + (k == 0 ? X[r] : 0.0);
+                e = fabs((double)out[3 * i + r] - e);
+                worst[k] = e > worst[k] ? e : worst[k];
+            }
+    }
+    printf("    worst errors: positions %.2g m, displacements %.2g m, velocities %.2g m/s\n", worst[0], worst[1],
+           worst[2]);
+    CHECK(worst[0] <= (IS_FLOAT ? 1e-6 : 1e-14));
+    CHECK(worst[1] <= (IS_FLOAT ? 1e-7 : 1e-15));
+    CHECK(worst[2] <= (IS_FLOAT ? 1e-5 : 1e-13));
+    CHECK_INT(allocs, c.allocs);
+    heml_probe_destroy(p);
+    CHECK_INT(1, c.allocs - c.frees); /* the model only */
+    free(u);
+    free(v);
+    heml_destroy(m);
+    CHECK_INT(c.allocs, c.frees);
+    tetmesh_free(&mesh);
+}
+
+/* Points outside the body fail with HEML_ERR_ARG (and leave *out NULL), points on the
+   surface within rounding do not; bad arguments; a probe read with another model. */
+static void test_probe_errors(void)
+{
+    tetmesh mesh, mesh2;
+    heml_model *m = box_model(2, 2, 2, 1.0, 1.0, 1.0, NULL, &mesh), *m2 = box_model(1, 1, 2, 1.0, 1.0, 1.0, NULL, &mesh2);
+    heml_probe *p = (heml_probe *)&mesh; /* must be set to NULL on failure */
+    heml_real out[6], far[6] = {0.5, 0.5, 0.5, 1.01, 0.5, 0.5}, edge[6] = {0.5, 0.5, 0.5, 1.0, 1.0, 0.3};
+    heml_real nan_pt[3] = {0.5, 0.5, 0.5};
+    REQUIRE(m && m2);
+    nan_pt[1] = (heml_real)NAN;
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(m, far, 2, &p));
+    CHECK(p == NULL);
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(NULL, edge, 2, &p));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(m, NULL, 2, &p));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(m, edge, 0, &p));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(m, edge, 2, NULL));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_create(m, nan_pt, 1, &p));
+    CHECK_INT(HEML_OK, heml_probe_create(m, edge, 2, &p));
+    REQUIRE(p != NULL);
+    CHECK_INT(HEML_OK, heml_probe_positions(p, m, out));
+    CHECK_NEAR(1.0, (double)out[3], 1e-6);
+    CHECK_NEAR(0.3, (double)out[5], 1e-6);
+    CHECK_INT(HEML_ERR_ARG, heml_probe_positions(p, m2, out));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_velocities(p, m, NULL));
+    CHECK_INT(HEML_ERR_ARG, heml_probe_displacements(NULL, m, out));
+    heml_probe_destroy(p);
+    heml_probe_destroy(NULL);
+    heml_destroy(m);
+    heml_destroy(m2);
+    tetmesh_free(&mesh);
+    tetmesh_free(&mesh2);
+}
+
 static const test_case cases[] = {
     TEST(test_bdf2_order),
     TEST(test_bdf2_decay_closed_form),
     TEST(test_bdf2_restarts),
     TEST(test_bdf2_no_allocation),
     TEST(test_bdf2_stress_sweep),
+    TEST(test_probe_affine_exact),
+    TEST(test_probe_errors),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
