@@ -688,6 +688,12 @@
          the moduli: in float, the forces of strains below about 1e-5 drown) and their
          energies lose relative accuracy at small strains; the built-in laws form both
          without cancellation.
+       - HEML_BDF2 needs a constant dt and an undisturbed history: every pin call (also
+         heml_set_displacement to drive a node each step), state setter, other integrator
+         or failed step restarts it with one implicit Euler step, so a node driven every
+         step makes every step implicit Euler (first order). Modal analysis: the cost is
+         p = max(2 count, count + 8) Krylov solves per iteration; heml_probe_create scans
+         every tetrahedron per point (no spatial index).
        - Do not compile the implementation with -ffast-math: reassociation would undo the
          cancellation-free sums (and the rounding correction of ln J).
 
