@@ -56,7 +56,7 @@ TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 COMPILE_ONLY := test_compile_all test_compile_static
 # the programs each configuration builds and runs (all of them unless listed here)
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
-TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_tensormass test_tensormass_qs
+TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
