@@ -480,8 +480,9 @@
        tetrahedron and barycentric coordinates once (double, from the rest positions: the
        first tetrahedron that contains it, else the one it is least outside of, accepted
        within 1e-6 in barycentric coordinates, i.e. on the surface up to rounding; farther
-       out HEML_ERR_ARG), by a scan of all tetrahedra per point (O(points x tetrahedra),
-       at create only). Then position, displacement and velocity are the P1 interpolation
+       out HEML_ERR_ARG), through a temporary uniform grid of about one cell per
+       tetrahedron listing the tetrahedra whose bounding box overlaps it (a point outside
+       or on the surface scans all tetrahedra; the answer is the same as a full scan's). Then position, displacement and velocity are the P1 interpolation
        of the four nodes' values (exact for affine fields), 3 per point, no allocation.
 
    MODAL ANALYSIS (heml_modal_*): the lowest `count` natural frequencies and M-orthonormal
@@ -693,7 +694,7 @@
          or failed step restarts it with one implicit Euler step, so a node driven every
          step makes every step implicit Euler (first order). Modal analysis: the cost is
          p = max(2 count, count + 8) Krylov solves per iteration; heml_probe_create scans
-         every tetrahedron per point (no spatial index).
+         every tetrahedron for each point outside or on the surface of the body.
        - Do not compile the implementation with -ffast-math: reassociation would undo the
          cancellation-free sums (and the rounding correction of ln J).
 
@@ -1213,8 +1214,10 @@ typedef struct heml_probe heml_probe;
    coordinates (computed in double). A point outside every tetrahedron by no more than 1e-6
    of its nearest tetrahedron's size (in barycentric coordinates: points on the surface, up
    to rounding) takes that tetrahedron; farther out: HEML_ERR_ARG. Allocates the probe (the
-   model's allocator); costs O(count x tetrahedra) at most. The probe reads only the model
-   it was made for (the same node count is checked). */
+   model's allocator; a temporary grid of about one cell per tetrahedron finds the
+   candidates, O(count + tetrahedra) for points inside, a scan of all tetrahedra for a point
+   outside or on the surface). The probe reads only the model it was made for (the same
+   node count is checked). */
 HEMLDEF int heml_probe_create(const heml_model *m, const heml_real *rest_points, int count, heml_probe **out);
 /* The points' current positions (rest + u), displacements and velocities, 3 per point
    (caller-owned out), interpolated from the containing tetrahedron's nodes; no allocation. */
@@ -1257,9 +1260,10 @@ HEMLDEF int heml_modal_count(const heml_modal *md);
    modes of a free body: 0 within round-off; an unstable direction, lambda < 0, gives
    -sqrt(-lambda) / (2 pi)). NaN for a bad i. */
 HEMLDEF double heml_modal_frequency(const heml_modal *md, int i);
-/* Shape of mode i: 3n values (m per unit modal amplitude, zero on pinned axes),
-   M-orthonormal (x_i . M x_j = delta_ij, kg m^2), pointing into the workspace (valid until
-   the next solve or heml_modal_destroy). NULL for a bad i. */
+/* Shape of mode i: 3n values, zero on pinned axes, M-orthonormal: x_i . M x_j = delta_ij
+   with M in kg (so the shape is in 1/sqrt(kg) per unit of a modal coordinate in sqrt(kg)
+   m; scale it as needed), pointing into the workspace (valid until the next solve or
+   heml_modal_destroy). NULL for a bad i. */
 HEMLDEF const heml_real *heml_modal_shape(const heml_modal *md, int i);
 /* Frees the workspace (NULL allowed). */
 HEMLDEF void heml_modal_destroy(heml_modal *md);
@@ -5202,11 +5206,130 @@ static void heml__barycentric(const heml_model *m, int t, const double p[3], dou
     b[0] = 1.0 - b[1] - b[2] - b[3];
 }
 
+/* A uniform grid over the rest nodes' bounding box, about one cell per tetrahedron or
+   fewer; cell c lists (ascending) the tetrahedra whose bounding box overlaps it, in
+   items[start[c] .. start[c + 1] - 1]. Temporary (heml_probe_create). */
+typedef struct heml__grid {
+    double lo[3], inv[3];
+    int n[3];
+    int *start, *cursor, *items;
+    size_t start_bytes, item_bytes;
+} heml__grid;
+
+static int heml__grid_axis(const heml__grid *g, int r, double x)
+{
+    double f = (x - g->lo[r]) * g->inv[r];
+    return f < 0 ? 0 : f >= (double)g->n[r] ? g->n[r] - 1 : (int)f;
+}
+
+/* The cell ranges a[r] .. b[r] of tetrahedron t's rest bounding box. */
+static void heml__grid_range(const heml_model *m, const heml__grid *g, int t, int a[3], int b[3])
+{
+    int j, r;
+    for (r = 0; r < 3; r++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (j = 0; j < 4; j++) {
+            double x = (double)m->rest[3 * heml__tet_node(m, t, j) + r];
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+        }
+        a[r] = heml__grid_axis(g, r, lo);
+        b[r] = heml__grid_axis(g, r, hi);
+    }
+}
+
+static int heml__grid_build(const heml_model *m, heml__grid *g)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, big = 0.0, vol = 1.0, s;
+    int i, r, t, T = m->tet_count, a[3], b[3], x, y, z;
+    size_t cells, total = 0;
+    for (i = 0; i < m->node_count; i++)
+        for (r = 0; r < 3; r++) {
+            double v = (double)m->rest[3 * i + r];
+            lo[r] = v < lo[r] ? v : lo[r];
+            hi[r] = v > hi[r] ? v : hi[r];
+        }
+    for (r = 0; r < 3; r++) big = hi[r] - lo[r] > big ? hi[r] - lo[r] : big;
+    for (r = 0; r < 3; r++) vol *= heml__max_d(hi[r] - lo[r], 1e-3 * big);
+    s = cbrt(vol / (double)T);
+    for (;;) {
+        for (r = 0, cells = 1; r < 3; r++) {
+            double k = (hi[r] - lo[r]) / s;
+            g->n[r] = k < 1.0 ? 1 : k > 1e6 ? 1000000 : (int)k;
+            cells *= (size_t)g->n[r];
+        }
+        if (cells <= (size_t)T + 1) break;
+        s *= 1.25;
+    }
+    for (r = 0; r < 3; r++) {
+        g->lo[r] = lo[r];
+        g->inv[r] = hi[r] > lo[r] ? (double)g->n[r] / (hi[r] - lo[r]) : 0.0;
+    }
+    g->start_bytes = sizeof(int) * (2 * cells + 1);
+    g->start = (int *)heml__alloc(&m->allocator, g->start_bytes);
+    if (!g->start) return HEML_ERR_ALLOC;
+    g->cursor = g->start + cells + 1;
+    memset(g->start, 0, g->start_bytes);
+    for (t = 0; t < T; t++) {
+        heml__grid_range(m, g, t, a, b);
+        for (z = a[2]; z <= b[2]; z++)
+            for (y = a[1]; y <= b[1]; y++)
+                for (x = a[0]; x <= b[0]; x++) g->start[((size_t)z * g->n[1] + y) * g->n[0] + x + 1]++;
+    }
+    for (i = 0; i < (int)cells; i++) {
+        total += (size_t)g->start[i + 1];
+        g->start[i + 1] = (int)total;
+        g->cursor[i] = g->start[i];
+    }
+    g->item_bytes = sizeof(int) * (total ? total : 1);
+    g->items = (int *)heml__alloc(&m->allocator, g->item_bytes);
+    if (!g->items) return HEML_ERR_ALLOC;
+    for (t = 0; t < T; t++) {
+        heml__grid_range(m, g, t, a, b);
+        for (z = a[2]; z <= b[2]; z++)
+            for (y = a[1]; y <= b[1]; y++)
+                for (x = a[0]; x <= b[0]; x++) g->items[g->cursor[((size_t)z * g->n[1] + y) * g->n[0] + x]++] = t;
+    }
+    return HEML_OK;
+}
+
+/* The tetrahedron for point x and its barycentric coordinates: the first (lowest index)
+   tetrahedron containing it, from the grid cell's list (every tetrahedron containing x
+   overlaps x's cell); else, by a scan of all, the one x is least outside of, accepted
+   within 1e-6 in barycentric coordinates. Returns the tetrahedron or -1. */
+static int heml__locate(const heml_model *m, const heml__grid *g, const double x[3], double best_b[4])
+{
+    double b[4], best = -INFINITY, lo;
+    int k, j, t, best_t = -1;
+    size_t c = ((size_t)heml__grid_axis(g, 2, x[2]) * g->n[1] + heml__grid_axis(g, 1, x[1])) * g->n[0] +
+               heml__grid_axis(g, 0, x[0]);
+    for (k = g->start[c]; k < g->start[c + 1]; k++) {
+        t = g->items[k];
+        heml__barycentric(m, t, x, b);
+        for (j = 1, lo = b[0]; j < 4; j++) lo = b[j] < lo ? b[j] : lo;
+        if (lo >= 0.0) {
+            memcpy(best_b, b, sizeof b);
+            return t;
+        }
+    }
+    for (t = 0; t < m->tet_count && best < 0.0; t++) {
+        heml__barycentric(m, t, x, b);
+        for (j = 1, lo = b[0]; j < 4; j++) lo = b[j] < lo ? b[j] : lo;
+        if (lo > best) {
+            best = lo;
+            best_t = t;
+            memcpy(best_b, b, sizeof b);
+        }
+    }
+    return best >= -1e-6 ? best_t : -1;
+}
+
 HEMLDEF int heml_probe_create(const heml_model *m, const heml_real *rest_points, int count, heml_probe **out)
 {
     heml_probe *p;
     heml__carver c;
-    int i, t, j;
+    heml__grid g;
+    int i, j, err;
     if (!out) return HEML_ERR_ARG;
     *out = NULL;
     if (!m || !rest_points || count < 1 || count > HEML__MAX_NODES) return HEML_ERR_ARG;
@@ -5226,28 +5349,27 @@ HEMLDEF int heml_probe_create(const heml_model *m, const heml_real *rest_points,
     p->allocator = m->allocator;
     p->count = count;
     p->node_count = m->node_count;
-    for (i = 0; i < count; i++) {
-        double x[3], b[4], best_b[4] = {0, 0, 0, 0}, best = -INFINITY;
-        int best_t = -1;
+    memset(&g, 0, sizeof g);
+    err = heml__grid_build(m, &g);
+    for (i = 0; i < count && !err; i++) {
+        double x[3], b[4];
+        int t;
         for (j = 0; j < 3; j++) x[j] = (double)rest_points[3 * i + j];
-        for (t = 0; t < m->tet_count && best < 0.0; t++) { /* the first containing tetrahedron */
-            double lo;
-            heml__barycentric(m, t, x, b);
-            for (j = 1, lo = b[0]; j < 4; j++) lo = b[j] < lo ? b[j] : lo;
-            if (lo > best) {
-                best = lo;
-                best_t = t;
-                memcpy(best_b, b, sizeof b);
-            }
-        }
-        if (!(best >= -1e-6) || best_t < 0) {
-            heml_probe_destroy(p);
-            return HEML_ERR_ARG;
+        t = heml__locate(m, &g, x, b);
+        if (t < 0) {
+            err = HEML_ERR_ARG;
+            break;
         }
         for (j = 0; j < 4; j++) {
-            p->nodes[4 * i + j] = heml__tet_node(m, best_t, j);
-            p->weights[4 * i + j] = (heml_real)best_b[j];
+            p->nodes[4 * i + j] = heml__tet_node(m, t, j);
+            p->weights[4 * i + j] = (heml_real)b[j];
         }
+    }
+    heml__free(&m->allocator, g.items, g.item_bytes);
+    heml__free(&m->allocator, g.start, g.start_bytes);
+    if (err) {
+        heml_probe_destroy(p);
+        return err;
     }
     *out = p;
     return HEML_OK;
