@@ -70,8 +70,11 @@ TESTS_clang-float := $(filter-out test_compile_static,$(TESTS))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a
 # test program of a configuration named "examples"
+# tests/test_packaging.sh (CMake and pkg-config consumers) and tests/test_viewer.sh (the
+# viewer headless under Xvfb) count the same way; each skips with one line and RESULT 0 0
+# when its tools are absent.
 RESULTS := $(foreach c,$(CONFIGS),$(foreach t,$(TESTS_$(c)),build/$(c)/$(t).result)) \
-           build/examples/test_examples.result
+           build/examples/test_examples.result build/packaging/test_packaging.result
 
 .PHONY: all test test-run examples bench bench-quick clean
 # keep the test binaries between runs (they are intermediate files of the .result rules)
@@ -111,6 +114,13 @@ build/examples/test_examples.result: tests/test_examples.sh $(foreach e,$(EXAMPL
 	@sh tests/test_examples.sh build/examples build/tmp/examples > build/examples/test_examples.log 2>&1; \
 	  echo "$$?" > build/examples/test_examples.status; \
 	  grep '^RESULT ' build/examples/test_examples.log > $@ || echo "RESULT 0 1 crashed" > $@
+
+build/packaging/test_packaging.result: tests/test_packaging.sh tests/consumer/CMakeLists.txt \
+    tests/consumer/main.c CMakeLists.txt cmake/softbodyConfig.cmake.in cmake/softbody.pc.in $(HEADERS)
+	@mkdir -p build/packaging
+	@sh tests/test_packaging.sh build/tmp/packaging > build/packaging/test_packaging.log 2>&1; \
+	  echo "$$?" > build/packaging/test_packaging.status; \
+	  grep '^RESULT ' build/packaging/test_packaging.log > $@ || echo "RESULT 0 1 crashed" > $@
 
 # The bench: bench.c plus every adapter bench/model_*.c compiled twice (double, float).
 # Built for this machine; the flags and git revision go into every CSV row.
