@@ -7,7 +7,8 @@
 # the free end lower when the beam is cut through. Also a user's TetGen mesh and a closed
 # OBJ surface (frames' meshless sampling), and a bad argument. Prints PASS/FAIL per case
 # and `RESULT <passed> <failed>` (tests/summarize.sh). Without the viewer binary (no
-# GLFW) or without xvfb-run, prints one line and `RESULT 0 0`.
+# GLFW), without xvfb-run or without Mesa's software renderer, prints one line and
+# `RESULT 0 0`.
 #
 #   sh tests/test_viewer.sh VIEWER_BINARY TMP_DIR [name-filter]
 #
@@ -23,6 +24,15 @@ fi
 if [ -z "$VW_UNDER_XVFB" ]; then
     if ! command -v xvfb-run >/dev/null 2>&1; then
         echo "(xvfb-run not found: the viewer tests are skipped; on Debian: apt-get install xvfb libgl1-mesa-dri)"
+        echo "RESULT 0 0"
+        exit 0
+    fi
+    swrast=""
+    for f in /usr/lib/*/dri/swrast_dri.so /usr/lib/dri/swrast_dri.so /usr/lib64/dri/swrast_dri.so; do
+        [ -e "$f" ] && swrast=$f
+    done
+    if [ -z "$swrast" ]; then
+        echo "(Mesa's software renderer not found: the viewer tests are skipped; on Debian: apt-get install libgl1-mesa-dri)"
         echo "RESULT 0 0"
         exit 0
     fi
