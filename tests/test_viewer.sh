@@ -3,8 +3,9 @@
 # built-in scene and model renders a few frames at 320x240 into a PNG, and
 # tests/png_check.c checks the file (structure, CRC-32, Adler-32, size, not blank) and
 # where the body is: the cantilever's tip lower after its sag than at rest for every model
-# and precision, the lobe's bottom lower after it hangs, the tip higher when dragged up,
-# the free end lower when the beam is cut through. Also a user's TetGen mesh and a closed
+# and precision, the lobe's bottom lower after it hangs, the tip higher when the mouse drags
+# it up (with a hand force in the readout), the free half gone when a scalpel stroke cuts
+# the beam through. Also a user's TetGen mesh and a closed
 # OBJ surface (frames' meshless sampling), and a bad argument. Prints PASS/FAIL per case
 # and `RESULT <passed> <failed>` (tests/summarize.sh). Without the viewer binary (no
 # GLFW), without xvfb-run or without Mesa's software renderer, prints one line and
@@ -94,18 +95,23 @@ sag cantilever_heml_sag --model heml --field stress
 sag cantilever_heml_float_sag --model heml --precision float --integrator linearized
 sag cantilever_frames_sag --model frames
 
-if want cantilever_pull_up; then
-    if shot pull --frames 20 --pull 0,0,0.08 && [ "$top" -le $((rest_top - 8)) ] &&
-       grep -q 'hand force [1-9]' "$tmp/pull.out"; then report cantilever_pull_up 0 ""
-    else report cantilever_pull_up 1 "${why:-tip top row $top, at rest $rest_top; $(grep -o 'hand force [^|]*' "$tmp/pull.out")}"; fi
+# a hand: press on the tip (its middle row, 2 pixels in from its end) and move the mouse
+# 40 pixels up: the tip rises, and the readout shows the force it pulls back with
+if want cantilever_drag_up; then
+    gx=$((rest_x1 - 2)) gy=$(((rest_top + rest_bottom) / 2))
+    if shot drag --frames 20 --drag "$gx,$gy,0,-40" && [ "$top" -le $((rest_top - 15)) ] &&
+       grep -q 'hand force [1-9]' "$tmp/drag.out"; then report cantilever_drag_up 0 ""
+    else report cantilever_drag_up 1 "${why:-tip top row $top, at rest $rest_top; $(grep -o 'hand force [^|]*' "$tmp/drag.out")}"; fi
 fi
 
-# cut through at mid-length, the free half falls out of the picture (0.5 m in 20 frames)
-if want cantilever_cut_falls; then
-    half=$((rest_x0 + (rest_x1 - rest_x0) * 6 / 10))
-    if shot cut --frames 20 --cut-x 0.2 && grep -q '^cut: [1-9]' "$tmp/cut.out" &&
-       [ "$x1" -le "$half" ] && grep -q '^tip: [^ ]* [^ ]* -0*\.[2-9]' "$tmp/cut.out"; then report cantilever_cut_falls 0 ""
-    else report cantilever_cut_falls 1 "${why:-rightmost body column $x1, at rest $rest_x1; $(grep -h '^cut\|^tip' "$tmp/cut.out" | tr '\n' ' ')}"; fi
+# a scalpel stroke down across the middle of the beam: the free half falls out of the
+# picture (0.5 m in 20 frames) and the tip's z drops below -0.2 m
+if want cantilever_scalpel; then
+    sx=$(((rest_x0 + rest_x1) / 2)) half=$((rest_x0 + (rest_x1 - rest_x0) * 6 / 10))
+    if shot cut --frames 20 --stroke "$sx,$((rest_top - 20)),$sx,$((rest_bottom + 20))" &&
+       grep -q '^cut: [1-9]' "$tmp/cut.out" && [ "$x1" -le "$half" ] &&
+       grep -q '^tip: [^ ]* [^ ]* -0*\.[2-9]' "$tmp/cut.out"; then report cantilever_scalpel 0 ""
+    else report cantilever_scalpel 1 "${why:-rightmost body column $x1, at rest $rest_x1; $(grep -h '^cut\|^tip' "$tmp/cut.out" | tr '\n' ' ')}"; fi
 fi
 
 if want lobe_hangs; then

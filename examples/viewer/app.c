@@ -188,58 +188,54 @@ void vw_app_release(vw_app *a)
     a->force[0] = a->force[1] = a->force[2] = 0;
 }
 
-static double vw__segment_distance(const double p[2], const double q[2], const double s[2])
+/* Twice the signed area of the triangle (a, b, c) in the screen plane. */
+static double vw__cross(const double a[2], const double b[2], const double c[2])
 {
-    double d[2] = {q[0] - p[0], q[1] - p[1]}, len2 = d[0] * d[0] + d[1] * d[1], t = 0, e[2];
-    if (len2 > 0) t = ((s[0] - p[0]) * d[0] + (s[1] - p[1]) * d[1]) / len2;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    e[0] = p[0] + t * d[0] - s[0];
-    e[1] = p[1] + t * d[1] - s[1];
-    return sqrt(e[0] * e[0] + e[1] * e[1]);
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
-/* Current centroid of tetrahedron t (from the drawn points: tensormass's are its nodes). */
-static void vw__centroid(const vw_app *a, int t, double c[3])
+/* 1 if segments p-q and a-b intersect (touching counts). */
+static int vw__segments_cross(const double p[2], const double q[2], const double a[2], const double b[2])
 {
-    int k, j;
-    for (k = 0; k < 3; k++) {
-        c[k] = 0;
-        for (j = 0; j < 4; j++) c[k] += 0.25 * a->points[3 * a->mesh.tets[4 * t + j] + k];
+    double d1 = vw__cross(p, q, a), d2 = vw__cross(p, q, b), d3 = vw__cross(a, b, p), d4 = vw__cross(a, b, q);
+    return d1 * d2 <= 0 && d3 * d4 <= 0 && (d1 != 0 || d2 != 0);
+}
+
+/* 1 if point s lies in the triangle (a, b, c). */
+static int vw__inside(const double s[2], const double a[2], const double b[2], const double c[2])
+{
+    double u = vw__cross(a, b, s), v = vw__cross(b, c, s), w = vw__cross(c, a, s);
+    return (u >= 0 && v >= 0 && w >= 0) || (u <= 0 && v <= 0 && w <= 0);
+}
+
+/* 1 if the stroke p-q crosses the screen footprint of tetrahedron t (the convex hull of
+   its four projected corners): it crosses one of its six edges or starts inside it. */
+static int vw__stroke_crosses(const vw_app *a, int t, const double p[2], const double q[2])
+{
+    double s[4][2], depth, x[3];
+    int i, j, k;
+    for (i = 0; i < 4; i++) {
+        for (k = 0; k < 3; k++) x[k] = a->points[3 * a->mesh.tets[4 * t + i] + k];
+        vw_camera_project(a, x, s[i], &depth);
+        if (depth <= 0) return 0;
     }
+    for (i = 0; i < 4; i++)
+        for (j = i + 1; j < 4; j++)
+            if (vw__segments_cross(p, q, s[i], s[j])) return 1;
+    for (i = 0; i < 4; i++) /* p inside the triangle of the three other corners */
+        if (vw__inside(p, s[(i + 1) % 4], s[(i + 2) % 4], s[(i + 3) % 4])) return 1;
+    return 0;
 }
 
-/* The scalpel: removes the live tetrahedra whose centroid projects within 6 screen units
-   of the stroke segment p-q (through the whole depth of the body). */
+/* The scalpel: removes the live tetrahedra the stroke segment p-q crosses on the screen,
+   through the whole depth of the body. */
 int vw_app_cut_segment(vw_app *a, const double p[2], const double q[2])
 {
     int t, n = 0, removed = 0;
     int *list = (int *)malloc(sizeof(int) * (size_t)(a->mesh.tet_count + 1));
     if (!list || a->model != VW_TENSORMASS) return free(list), 0;
-    for (t = 0; t < a->mesh.tet_count; t++) {
-        double c[3], s[2], depth;
-        if (!a->api->tet_alive(a->sim, t)) continue;
-        vw__centroid(a, t, c);
-        vw_camera_project(a, c, s, &depth);
-        if (depth > 0 && vw__segment_distance(p, q, s) < 6.0) list[n++] = t;
-    }
-    if (n) a->api->cut(a->sim, list, n, &removed);
-    free(list);
-    a->removed_total += removed;
-    return removed;
-}
-
-int vw_app_cut_plane(vw_app *a, double x)
-{
-    int t, n = 0, removed = 0;
-    double cell = (a->scene.hi[0] - a->scene.lo[0]) / 16;
-    int *list = (int *)malloc(sizeof(int) * (size_t)(a->mesh.tet_count + 1));
-    if (!list || a->model != VW_TENSORMASS) return free(list), 0;
-    for (t = 0; t < a->mesh.tet_count; t++) {
-        double c = 0;
-        int j;
-        for (j = 0; j < 4; j++) c += 0.25 * a->mesh.nodes[3 * a->mesh.tets[4 * t + j]];
-        if (fabs(c - x) < cell) list[n++] = t;
-    }
+    for (t = 0; t < a->mesh.tet_count; t++)
+        if (a->api->tet_alive(a->sim, t) && vw__stroke_crosses(a, t, p, q)) list[n++] = t;
     if (n) a->api->cut(a->sim, list, n, &removed);
     free(list);
     a->removed_total += removed;
@@ -268,7 +264,7 @@ void vw_app_readout(const vw_app *a, char *out, size_t size)
     double stable = a->api->stable_time_step(a->sim);
     char stable_text[32];
     if (stable > 0) snprintf(stable_text, sizeof stable_text, "%.3g ms", 1e3 * stable);
-    else snprintf(stable_text, sizeof stable_text, "none (implicit only)");
+    else snprintf(stable_text, sizeof stable_text, "n/a, implicit only");
     snprintf(out, size,
              "%s | %s %s, %s | dt %.3g ms (stable %s) | %.3g ms/step, %.0f steps/s | %s %.3g..%.3g | "
              "hand force %.3g N | %d tets cut%s%s%s",

@@ -52,8 +52,6 @@ void vw_app_move_grab(vw_app *a, double x, double y);
 void vw_app_pull(vw_app *a, const double offset[3]); /* the grabbed handle to its start + offset */
 void vw_app_release(vw_app *a);
 int vw_app_cut_segment(vw_app *a, const double p[2], const double q[2]); /* tets removed */
-int vw_app_cut_plane(vw_app *a, double x);  /* removes tets whose rest centroid is within
-                                               1/16 of the length of the plane x = const */
 int vw_app_tip(const vw_app *a);            /* free handle of largest x (ties: largest z) */
 void vw_app_readout(const vw_app *a, char *out, size_t size);
 extern const char *const vw_model_names[VW_MODEL_COUNT];

@@ -253,10 +253,13 @@ static int vw__text(float *v, const char *text, float x, float y, float h)
     int count = 0, s;
     for (; *text; text++, x += 1.5f * w) {
         int bits = vw__segments(*text);
-        if (*text == '.') { /* a short stroke at the baseline */
-            p[0] = x - 0.6f * w, p[1] = y, q[0] = x - 0.4f * w, q[1] = y;
-            vw__line(v + VW_VERTEX_FLOATS * count, p, q, ink);
-            count += 2;
+        if (*text == '.') { /* a small square on the baseline */
+            float sq[5][2] = {{-.65f, 0}, {-.35f, 0}, {-.35f, .15f}, {-.65f, .15f}, {-.65f, 0}};
+            for (s = 0; s < 4; s++) {
+                p[0] = x + sq[s][0] * w, p[1] = y + sq[s][1] * h, q[0] = x + sq[s + 1][0] * w, q[1] = y + sq[s + 1][1] * h;
+                vw__line(v + VW_VERTEX_FLOATS * count, p, q, ink);
+                count += 2;
+            }
             x -= 0.9f * w;
             continue;
         }
@@ -291,6 +294,7 @@ static void vw__legend(vw_app *a, const float *identity, const float *light)
     char text[32];
     int i, k, count = 0;
     if (!v) return;
+    vw_render_wireframe(0);
     for (i = 0; i < 16; i++) {
         float q[6][3] = {{x0, y0 + i * h, 0}, {x1, y0 + i * h, 0}, {x1, y0 + (i + 1) * h, 0},
                          {x0, y0 + i * h, 0}, {x1, y0 + (i + 1) * h, 0}, {x0, y0 + (i + 1) * h, 0}};

@@ -192,9 +192,11 @@ void vw_render_begin(int width, int height, int wireframe)
     gl.Viewport(0, 0, width, height);
     gl.ClearColor(0.93f, 0.94f, 0.96f, 1);
     gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    gl.PolygonMode(GL_FRONT_AND_BACK, wireframe ? GL_LINE : GL_FILL);
+    vw_render_wireframe(wireframe);
     gl.UseProgram(vw__program);
 }
+
+void vw_render_wireframe(int on) { gl.PolygonMode(GL_FRONT_AND_BACK, on ? GL_LINE : GL_FILL); }
 
 void vw_render_batch(int primitive, const float *vertices, int count, const float mvp[16], const float light[3],
                      int lit, float point_size)

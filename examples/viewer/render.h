@@ -15,6 +15,8 @@ typedef vw_gl_proc (*vw_gl_loader)(const char *name);
 int vw_render_init(vw_gl_loader load, char *err);
 /* Clears the framebuffer (width x height pixels) and sets the fill mode. */
 void vw_render_begin(int width, int height, int wireframe);
+/* Triangles filled (0) or as their edges (1). */
+void vw_render_wireframe(int on);
 /* Draws `count` vertices; mvp column-major; light: direction towards the light (lit). */
 void vw_render_batch(int primitive, const float *vertices, int count, const float mvp[16], const float light[3],
                      int lit, float point_size);

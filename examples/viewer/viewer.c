@@ -17,9 +17,11 @@
    Headless (tests, pictures): render N frames of 1/60 s without input, write a PNG, print
    the readout and the tip position, and exit:
        --frames N --screenshot FILE.png
-       --pull DX,DY,DZ           drag the tip (the free handle of largest x) by this
-                                 offset (m), ramped over the first half of the frames
-       --cut-x X                 first cut the tetrahedra within a thin slab at x = X (m)
+       --drag X,Y,DX,DY          press the left button at window point (X, Y) (picking the
+                                 handle there) and move the mouse by (DX, DY), ramped over
+                                 the first half of the frames: what a hand does
+       --stroke X0,Y0,X1,Y1      first a scalpel stroke (right button) from (X0, Y0) to
+                                 (X1, Y1), window coordinates, y down
 
    Keys: mouse left on the body drags it (left elsewhere orbits), right drags the scalpel,
    wheel zooms; M model, P precision, I integrator, C colour field, W wireframe, T tearing,
@@ -37,8 +39,8 @@
 
 typedef struct vw_options {
     const char *scene, *mesh, *screenshot;
-    int frames, headless, width, height, cut;
-    double pull[3], cut_x;
+    int frames, headless, width, height, drag, stroke;
+    double drag_at[4], stroke_at[4];
 } vw_options;
 
 static void vw__usage(const char *why)
@@ -46,7 +48,7 @@ static void vw__usage(const char *why)
     fprintf(stderr, "usage: viewer [--scene cantilever|lobe | --mesh FILE] [--model tensormass|heml|frames]\n"
                     "       [--precision double|float] [--integrator explicit|implicit|linearized]\n"
                     "       [--field displacement|stress|J] [--size WxH] [--wireframe]\n"
-                    "       [--frames N --screenshot FILE.png [--pull DX,DY,DZ] [--cut-x X]]\n"
+                    "       [--frames N --screenshot FILE.png [--drag X,Y,DX,DY] [--stroke X0,Y0,X1,Y1]]\n"
                     "(%s)\n",
             why);
     exit(2);
@@ -86,9 +88,10 @@ static void vw__parse(int argc, char **argv, vw_options *o, vw_app *a)
         else if (strcmp(k, "--screenshot") == 0) o->screenshot = v;
         else if (strcmp(k, "--size") == 0 && sscanf(v, "%dx%d", &o->width, &o->height) == 2 && o->width > 0 &&
                  o->height > 0 && o->width <= 4096 && o->height <= 4096) continue;
-        else if (strcmp(k, "--pull") == 0 && sscanf(v, "%lf,%lf,%lf", &o->pull[0], &o->pull[1], &o->pull[2]) == 3)
-            continue;
-        else if (strcmp(k, "--cut-x") == 0 && sscanf(v, "%lf", &o->cut_x) == 1) o->cut = 1;
+        else if (strcmp(k, "--drag") == 0 && sscanf(v, "%lf,%lf,%lf,%lf", &o->drag_at[0], &o->drag_at[1],
+                                                      &o->drag_at[2], &o->drag_at[3]) == 4) o->drag = 1;
+        else if (strcmp(k, "--stroke") == 0 && sscanf(v, "%lf,%lf,%lf,%lf", &o->stroke_at[0], &o->stroke_at[1],
+                                                        &o->stroke_at[2], &o->stroke_at[3]) == 4) o->stroke = 1;
         else vw__usage("unknown option or bad value");
     }
     if (o->headless != (o->screenshot != NULL)) vw__usage("--frames and --screenshot go together");
@@ -252,20 +255,36 @@ static void vw__interactive(GLFWwindow *w, vw_app *a)
     }
 }
 
+/* The scripted input of the headless mode before the first frame: a cut, a grab. */
+static int vw__script_start(vw_app *a, const vw_options *o)
+{
+    if (o->stroke)
+        printf("cut: %d tetrahedra removed by the stroke\n", vw_app_cut_segment(a, o->stroke_at, o->stroke_at + 2));
+    if (o->drag) {
+        int h = vw_app_pick(a, o->drag_at[0], o->drag_at[1]);
+        if (h < 0) return fprintf(stderr, "viewer: nothing to grab at %g, %g\n", o->drag_at[0], o->drag_at[1]), -1;
+        vw_app_grab(a, h, o->drag_at[0], o->drag_at[1]);
+    }
+    return 0;
+}
+
+/* The mouse of frame i, ramped over the first half of the frames. */
+static void vw__script_frame(vw_app *a, const vw_options *o, int i)
+{
+    double ramp = o->frames > 1 ? 2.0 * (i + 1) / o->frames : 1;
+    if (ramp > 1) ramp = 1;
+    if (a->grabbed >= 0)
+        vw_app_move_grab(a, o->drag_at[0] + ramp * o->drag_at[2], o->drag_at[1] + ramp * o->drag_at[3]);
+}
+
 static int vw__headless(vw_app *a, const vw_options *o)
 {
     char readout[512];
     double tip[3];
-    int i, k, tip_handle = vw_app_tip(a);
-    if (o->cut) printf("cut: %d tetrahedra removed at x = %g m\n", vw_app_cut_plane(a, o->cut_x), o->cut_x);
-    if (o->pull[0] != 0 || o->pull[1] != 0 || o->pull[2] != 0) {
-        a->grabbed = tip_handle;
-        a->api->handle_position(a->sim, tip_handle, a->grab_start);
-    }
+    int i, tip_handle = vw_app_tip(a);
+    if (vw__script_start(a, o)) return 1;
     for (i = 0; i < o->frames; i++) {
-        double ramp = o->frames > 1 ? 2.0 * (i + 1) / o->frames : 1, d[3];
-        for (k = 0; k < 3; k++) d[k] = (ramp < 1 ? ramp : 1) * o->pull[k];
-        if (a->grabbed >= 0) vw_app_pull(a, d);
+        vw__script_frame(a, o, i);
         vw_app_advance(a);
     }
     vw_draw(a);
