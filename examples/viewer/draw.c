@@ -253,14 +253,14 @@ static int vw__text(float *v, const char *text, float x, float y, float h)
     int count = 0, s;
     for (; *text; text++, x += 1.5f * w) {
         int bits = vw__segments(*text);
-        if (*text == '.') { /* a small square on the baseline */
-            float sq[5][2] = {{-.65f, 0}, {-.35f, 0}, {-.35f, .15f}, {-.65f, .15f}, {-.65f, 0}};
+        if (*text == '.') { /* a small square on the baseline, in a narrow slot */
+            float sq[5][2] = {{.1f, 0}, {.4f, 0}, {.4f, .15f}, {.1f, .15f}, {.1f, 0}};
             for (s = 0; s < 4; s++) {
                 p[0] = x + sq[s][0] * w, p[1] = y + sq[s][1] * h, q[0] = x + sq[s + 1][0] * w, q[1] = y + sq[s + 1][1] * h;
                 vw__line(v + VW_VERTEX_FLOATS * count, p, q, ink);
                 count += 2;
             }
-            x -= 0.9f * w;
+            x -= 0.8f * w;
             continue;
         }
         for (s = 0; s < 7; s++) {
