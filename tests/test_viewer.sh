@@ -13,7 +13,7 @@
 #
 #   sh tests/test_viewer.sh VIEWER_BINARY TMP_DIR [name-filter]
 #
-# Run by the Makefile as build/viewer/test_viewer.result; about 6 s.
+# Run by the Makefile as build/viewer/test_viewer.result; about 3 s.
 viewer=$1
 tmp=$2
 filter=$3
@@ -94,6 +94,13 @@ sag cantilever_tensormass_float_explicit_sag --model tensormass --precision floa
 sag cantilever_heml_sag --model heml --field stress
 sag cantilever_heml_float_sag --model heml --precision float --integrator linearized
 sag cantilever_frames_sag --model frames
+
+# live switches through the keys: M twice (heml, then frames), P (float); frames still sags
+sag cantilever_keys_frames_float_sag --keys mmp
+if want keys_readout; then
+    if grep -q 'frames SVK float' "$tmp/cantilever_keys_frames_float_sag.out"; then report keys_readout 0 ""
+    else report keys_readout 1 "$(grep '^readout' "$tmp/cantilever_keys_frames_float_sag.out")"; fi
+fi
 
 # a hand: press on the tip (its middle row, 2 pixels in from its end) and move the mouse
 # 40 pixels up: the tip rises, and the readout shows the force it pulls back with

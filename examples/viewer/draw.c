@@ -110,16 +110,17 @@ static void vw__vertex(float *v, const float p[3], const float n[3], const float
     memcpy(v + 6, c, 3 * sizeof(float));
 }
 
-/* Blue (low) - white - red (high). */
+/* Blue (low) - yellow - red (high): no colour close to the light background. */
 static void vw__colour(float t, float c[3])
 {
+    float u;
     t = t < 0 ? 0 : t > 1 ? 1 : t;
     if (t < 0.5f) {
-        c[0] = c[1] = 0.25f + 1.5f * t;
-        c[2] = 1;
+        u = 2 * t;
+        c[0] = 0.2f + 0.75f * u, c[1] = 0.3f + 0.55f * u, c[2] = 1 - 0.8f * u;
     } else {
-        c[0] = 1;
-        c[1] = c[2] = 1 - 1.5f * (t - 0.5f);
+        u = 2 * t - 1;
+        c[0] = 0.95f - 0.05f * u, c[1] = 0.85f - 0.75f * u, c[2] = 0.2f - 0.1f * u;
     }
 }
 

@@ -43,7 +43,7 @@ static int vw_png__chunk(FILE *f, const char *type, const unsigned char *data, s
     vw_png__be32(head, (unsigned long)n);
     memcpy(head + 4, type, 4);
     vw_png__be32(tail, crc);
-    return fwrite(head, 1, 8, f) == 8 && fwrite(data, 1, n, f) == n && fwrite(tail, 1, 4, f) == 4;
+    return fwrite(head, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) && fwrite(tail, 1, 4, f) == 4;
 }
 
 /* The zlib stream of raw (filter byte 0 + row) scanlines in stored blocks of <= 65535 bytes. */

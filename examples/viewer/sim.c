@@ -457,23 +457,26 @@ static double vw__stress_from_gradient(const vw_sim *s, const double F[9], int g
 }
 
 /* Per tetrahedron (into scratch): J = det F or the von Mises stress; heml's stress from
-   heml_tet_stress (Cauchy, its own law). */
+   heml_tet_stresses (Cauchy, its own law; 0 where a tetrahedron is inverted). */
 static void vw__tet_values(vw_sim *s, int kind, const double *x)
 {
-    int t;
+    heml_real *sig = NULL;
+    int t, k;
+    if (s->hm && kind == VW_FIELD_STRESS) {
+        sig = (heml_real *)malloc(sizeof(heml_real) * 9 * (size_t)s->tet_count);
+        if (sig) heml_tet_stresses(s->hm, HEML_STRESS_CAUCHY, sig);
+    }
     for (t = 0; t < s->tet_count; t++) {
-        double d[9], F[9];
+        double d[9], F[9], a[9];
         vw__edges(x, s->tets + 4 * t, d);
         vw__mul3(d, s->rest_inverse + 9 * t, F);
         if (kind == VW_FIELD_VOLUME_RATIO) s->scratch[t] = (float)vw__det3(F);
         else if (s->hm) {
-            heml_real sig[9];
-            double a[9];
-            int k, rc = heml_tet_stress(s->hm, t, HEML_STRESS_CAUCHY, sig);
-            for (k = 0; k < 9; k++) a[k] = (double)sig[k];
-            s->scratch[t] = rc ? 0.0f : (float)vw__von_mises(a);
+            for (k = 0; k < 9; k++) a[k] = sig ? (double)sig[9 * t + k] : 0.0;
+            s->scratch[t] = a[0] == a[0] ? (float)vw__von_mises(a) : 0.0f;
         } else s->scratch[t] = (float)vw__stress_from_gradient(s, F, 0);
     }
+    free(sig);
 }
 
 /* Averages the live tetrahedra's values onto their nodes. */

@@ -22,6 +22,7 @@
                                  the first half of the frames: what a hand does
        --stroke X0,Y0,X1,Y1      first a scalpel stroke (right button) from (X0, Y0) to
                                  (X1, Y1), window coordinates, y down
+       --keys KEYS               first press these keys (e.g. MP: next model, then float)
 
    Keys: mouse left on the body drags it (left elsewhere orbits), right drags the scalpel,
    wheel zooms; M model, P precision, I integrator, C colour field, W wireframe, T tearing,
@@ -38,7 +39,7 @@
 #include <string.h>
 
 typedef struct vw_options {
-    const char *scene, *mesh, *screenshot;
+    const char *scene, *mesh, *screenshot, *keys;
     int frames, headless, width, height, drag, stroke;
     double drag_at[4], stroke_at[4];
 } vw_options;
@@ -48,7 +49,7 @@ static void vw__usage(const char *why)
     fprintf(stderr, "usage: viewer [--scene cantilever|lobe | --mesh FILE] [--model tensormass|heml|frames]\n"
                     "       [--precision double|float] [--integrator explicit|implicit|linearized]\n"
                     "       [--field displacement|stress|J] [--size WxH] [--wireframe]\n"
-                    "       [--frames N --screenshot FILE.png [--drag X,Y,DX,DY] [--stroke X0,Y0,X1,Y1]]\n"
+                    "       [--frames N --screenshot FILE.png [--keys KEYS] [--drag X,Y,DX,DY] [--stroke X0,Y0,X1,Y1]]\n"
                     "(%s)\n",
             why);
     exit(2);
@@ -86,6 +87,7 @@ static void vw__parse(int argc, char **argv, vw_options *o, vw_app *a)
         else if (strcmp(k, "--field") == 0) a->field = vw__choice(v, fields, 3, k);
         else if (strcmp(k, "--frames") == 0 && sscanf(v, "%d", &o->frames) == 1 && o->frames >= 0) o->headless = 1;
         else if (strcmp(k, "--screenshot") == 0) o->screenshot = v;
+        else if (strcmp(k, "--keys") == 0) o->keys = v;
         else if (strcmp(k, "--size") == 0 && sscanf(v, "%dx%d", &o->width, &o->height) == 2 && o->width > 0 &&
                  o->height > 0 && o->width <= 4096 && o->height <= 4096) continue;
         else if (strcmp(k, "--drag") == 0 && sscanf(v, "%lf,%lf,%lf,%lf", &o->drag_at[0], &o->drag_at[1],
@@ -277,11 +279,14 @@ static void vw__script_frame(vw_app *a, const vw_options *o, int i)
         vw_app_move_grab(a, o->drag_at[0] + ramp * o->drag_at[2], o->drag_at[1] + ramp * o->drag_at[3]);
 }
 
-static int vw__headless(vw_app *a, const vw_options *o)
+static int vw__headless(GLFWwindow *w, vw_app *a, const vw_options *o)
 {
     char readout[512];
     double tip[3];
-    int i, tip_handle = vw_app_tip(a);
+    int i, tip_handle;
+    for (i = 0; o->keys && o->keys[i]; i++) /* GLFW's codes of letters, digits, space: ASCII */
+        vw__on_key(w, o->keys[i] >= 'a' && o->keys[i] <= 'z' ? o->keys[i] - 'a' + 'A' : o->keys[i], 0, GLFW_PRESS, 0);
+    tip_handle = vw_app_tip(a);
     if (vw__script_start(a, o)) return 1;
     for (i = 0; i < o->frames; i++) {
         vw__script_frame(a, o, i);
@@ -317,7 +322,7 @@ int main(int argc, char **argv)
     if (!glfwInit()) return fprintf(stderr, "viewer: GLFW cannot start (no display?)\n"), 1;
     w = vw__window(&o, &a);
     if (!w) rc = 1;
-    else if (o.headless) rc = vw__headless(&a, &o);
+    else if (o.headless) rc = vw__headless(w, &a, &o);
     else vw__interactive(w, &a);
     if (w) {
         vw_render_shutdown();
