@@ -80,6 +80,53 @@
           diagnostics.
        6. heml_destroy(m).
 
+   HOW TO EXTEND (where a new law, integrator or linear solver goes; each kind is one enum
+   value, one row of one private table, and the functions that row names)
+       A constitutive law: a heml_law value before HEML_LAW_COUNT (validation uses the
+           count) and its row of heml__laws (>>laws-table; a static assert refuses a table
+           that does not have one row per law): `name`; `kind` (HEML__K_INVARIANTS for a
+           law w(I1, I2, J)); `stress`, `energy`, `differential`: functions of the form of
+           heml__law_svk that fill, for a block of tetrahedra (heml__blk), w_1, w_2, w_J and
+           s0 = 2 w_1 + 4 w_2 + w_J formed without cancellation at rest, plus w (energy) and
+           the six second derivatives h (differential), continued below J0 (FLAT AND
+           INVERTED TETRAHEDRA); `make` (its constants into heml__mat) and `check` (their
+           ranges, HEML_ERR_MATERIAL); heml_material_from_young's case. Leave `fast_path`
+           at 0: the vectorised kernels (heml__forces_nh, heml__diff_nh) compute
+           Neo-Hookean and nothing else; set it only for a law that is exactly heml__law_raw
+           without an I2 term, or write a kernel for the law and a flag for it. Everything
+           else (the general path's kinematics, stress coefficients, P1 forces and their
+           differential, Prony, energies, stresses, the small-strain moduli for the
+           preconditioner and heml_stable_time_step) comes from those functions.
+       An integrator: a heml_integrator value before HEML_INTEGRATOR_COUNT and its row of
+           heml__integrators (>>integrators-table): `name`, `step` (start state -> candidate,
+           no change of the model's state: heml_step_ex commits it or keeps the state),
+           `is_explicit` (needs no force differential). Its scratch vectors are named
+           fields of heml_model, carved in heml__layout_scratch (where any sharing with
+           another role is written down).
+       A linear solver (or a preconditioner: heml__precond is the one place): a
+           heml_linear_solver value before HEML_LINEAR_SOLVER_COUNT and its row of
+           heml__linear_solvers (>>linear-solvers): `solve` and `solve_indefinite`, with the
+           return codes listed there (HEML_OK, HEML_ERR_NO_CONVERGENCE, HEML_ERR_NOT_FINITE,
+           the private negative-curvature signal). Every solve goes through
+           heml__linear_solve; no solver calls heml__cg directly.
+       The tests it must add (tests/test_heml*.c): a law: forces = -gradient of its energy
+           and differential = derivative of the force by finite differences, at moderate
+           strain and below J0, through the model (the all-law loops of test_heml.c:
+           all_laws, test_law_table_forces_and_differentials), against an energy written
+           independently from F (fem_energy_forces), zero force at rest and under rigid
+           motions, and its closed form where there is one (uniaxial stretch: R4 for St
+           Venant-Kirchhoff, R5 for Neo-Hookean, of /work/shared/REFERENCES.md, in
+           test_uniaxial_closed_forms; Mooney-Rivlin has none there yet); an integrator: its order of accuracy on the linear oscillator
+           (test_integrator_order), a failed step keeping the state, no allocation, and
+           bit-identical results across thread counts (test_threads_bit_identical); a
+           linear solver: the static and implicit tests unchanged, the same return codes
+           (NO_CONVERGENCE at the cap, NOT_FINITE), determinism across threads.
+       What the bench must show (make bench, bench/model_heml.c): a law: its force and
+           differential ns per tetrahedron in kernels.csv next to Neo-Hookean's, and its
+           R1/R2/R4/R5 rows; an integrator or solver: the R2/R3 rows (error and time) and
+           the stability sweep; a change to an existing path: no row slower (callgrind
+           instruction counts where the machine is noisy) and every result bit-identical.
+
    UNITS: SI throughout. Positions m, moduli Pa, density kg/m^3, time s, forces N,
    mass_damping 1/s, gravity m/s^2 (default 9.81 along -z), Prony tau s.
 
@@ -560,6 +607,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 20) extension points: laws, integrators and linear solvers through
+             one private table each (heml__laws, heml__integrators, heml__linear_solvers;
+             see HOW TO EXTEND); HEML_LAW_COUNT, HEML_INTEGRATOR_COUNT, heml_linear_solver
+             and desc.linear_solver; the Neo-Hookean kernels run only for laws whose
+             fast_path flag is set; results bit-identical to 0.3.0.
        0.3.0 (2026-12-02) no silent wrong answers (issue 18): the static solve is a
              continuation with a tangent predictor, an energy line search, a
              Levenberg-Marquardt shift at negative curvature and an inversion acceptance
@@ -726,16 +778,25 @@ typedef enum heml_law {
     HEML_NEO_HOOKEAN_INCOMPRESSIBLE = 3,    /* table 3 + penalty: c1, kappa */
     HEML_MOONEY_RIVLIN_INCOMPRESSIBLE = 4,  /* table 3 + penalty: c1, c2, kappa */
     HEML_MASS_SPRING = 5,                   /* sec. 5.3: young_modulus */
-    HEML_USER = 6                           /* callbacks (heml_user_law) */
+    HEML_USER = 6,                          /* callbacks (heml_user_law) */
+    HEML_LAW_COUNT                          /* number of laws (not a law): validation only */
 } heml_law;
 
 typedef enum heml_integrator {
     HEML_SEMI_EXPLICIT_EULER = 0,      /* eq. 32 (default) */
     HEML_IMPLICIT_EULER = 1,           /* backward Euler: Newton minimisation of the incremental
                                           potential to newton_tolerance, matrix-free CG, line search */
-    HEML_IMPLICIT_EULER_LINEARIZED = 2 /* one linearised Newton iteration, no line search (fast,
+    HEML_IMPLICIT_EULER_LINEARIZED = 2, /* one linearised Newton iteration, no line search (fast,
                                           accurate only while the step is nearly linear) */
+    HEML_INTEGRATOR_COUNT               /* number of integrators (not one): validation only */
 } heml_integrator;
+
+/* Linear solvers of the implicit steps and the static solve (desc.linear_solver). */
+typedef enum heml_linear_solver {
+    HEML_LINEAR_SOLVER_CG = 0, /* Jacobi-preconditioned conjugate gradient (plus the coarse space
+                                  in static solves), MINRES where an indefinite system needs it */
+    HEML_LINEAR_SOLVER_COUNT   /* number of linear solvers (not one): validation only */
+} heml_linear_solver;
 
 typedef enum heml_stress_kind {
     HEML_STRESS_PK1 = 0,   /* first Piola-Kirchhoff P, force per rest area, Pa */
@@ -833,6 +894,8 @@ typedef struct heml_desc {
     heml_real cg_tolerance;          /* relative residual of the implicit step's CG, default 1e-6
                                         (1e-5 float) */
     int cg_max_iterations;           /* Krylov iterations per linear solve, default 1000 */
+    heml_linear_solver linear_solver; /* every linear solve (implicit steps, static solve and its
+                                        saddle probe), default HEML_LINEAR_SOLVER_CG */
     int static_max_iterations;       /* Newton iterations of heml_solve_static per load step,
                                         default 50 */
     heml_real static_tolerance;      /* its residual relative to the larger of the loads and the
@@ -1110,18 +1173,17 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
-#define HEML__SCRATCH 22    /* 3n scratch vectors */
+#define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
 #define HEML__MAX_NODES 200000000
 
-/* kernel kinds: how a law is evaluated */
-#define HEML__K_RAW 0    /* c1 (I1-3) + c2 (I2-3) - p0 ln J + kappa/2 ln^2 J (NH, table 3) */
-#define HEML__K_SPLIT 1  /* split Mooney-Rivlin */
-#define HEML__K_SVK 2
-#define HEML__K_USER 3
-#define HEML__K_SPRING 4
+/* kernel kinds: which kernels evaluate a law (the law's row in heml__laws says) */
+#define HEML__K_INVARIANTS 0 /* a function w(I1, I2, J): the general path (and the fast one
+                                where the law's fast_path flag allows it) */
+#define HEML__K_USER 1       /* the same through user callbacks (checked at rest at create) */
+#define HEML__K_SPRING 2     /* mass-spring: link tensions, its own kernels (heml__spring_*) */
 
 /* what a law evaluation must produce besides the first derivatives */
 #define HEML__WANT_ENERGY 1
@@ -1138,15 +1200,46 @@ HEMLDEF size_t heml_memory_bytes(const heml_model *m);
 /* A material in kernel form. */
 typedef struct heml__mat {
     int kind, uses_i2;
+    int fast;                    /* its law's fast_path flag, and no I2 term, and no Prony: the
+                                    vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
     heml_law law;
-    heml_real c1, c2, p0, kappa; /* K_RAW, K_SPLIT (c1, c2, kappa) */
-    heml_real mu, lambda, guard; /* K_SVK */
-    heml_real young;             /* K_SPRING */
+    const struct heml__law_ops *ops; /* its law's row of heml__laws */
+    heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
+    heml_real mu, lambda, guard; /* heml__law_svk */
+    heml_real young;             /* mass-spring */
     double density;
     double small_mu, small_lambda; /* small-strain moduli: preconditioner, time step */
     heml_user_law user;
     int prony_count, prony_first; /* its terms in the model's Prony arrays */
 } heml__mat;
+
+struct heml__blk;
+/* A law's evaluation on a block of HEML__W tetrahedra (see heml__law). */
+typedef void (*heml__law_fn)(const heml__mat *mt, struct heml__blk *b, int valid, int want);
+
+/* One row of heml__laws (>>laws-table), indexed by heml_law: everything the library knows
+   about a law. `energy`, `stress` and `differential` evaluate the law in invariants on a
+   block (heml__blk): each fills the stress terms (w_1, w_2, w_J, s0); `energy` also w
+   (called with HEML__WANT_ENERGY), `differential` also the second derivatives h (with
+   HEML__WANT_SECOND). The built-in laws share J, ln J and J^-2/3 between the three, so
+   each gives one function for all of them; NULL for mass-spring, whose kernels are the
+   heml__spring_* functions (kind HEML__K_SPRING). `make` fills the kernel constants from a
+   heml_material, `check` validates them (0, or an error code with a message).
+   `fast_path`: the vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) may
+   evaluate this law's forces and differentials; they compute w = c1 (I1 - 3) - p0 ln J +
+   kappa/2 ln^2 J from heml__mat's c1, p0, kappa and nothing else, so set it only for a law
+   that is exactly that (they also run only without an I2 term and without Prony). Default
+   0: a new law goes through the general path; tests/test_heml.c's
+   test_law_table_forces_and_differentials fails if a law is routed to the fast path
+   wrongly. */
+typedef struct heml__law_ops {
+    const char *name;
+    int kind; /* HEML__K_* */
+    heml__law_fn energy, stress, differential;
+    void (*make)(const heml_material *src, heml__mat *mt);
+    int (*check)(const heml_material *src, int index, char *msg, size_t msg_size);
+    int fast_path;
+} heml__law_ops;
 
 struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
@@ -1154,6 +1247,7 @@ struct heml_model {
     int agg_count;                         /* aggregates of the coarse space (0: none) */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
+    heml_linear_solver linear_solver;
     heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
     heml_real newton_tolerance, min_increment, precision_limit;
     int cg_max_iterations, newton_iterations, static_max_iterations, max_increments, allow_inversion, leave_saddles;
@@ -1202,8 +1296,22 @@ struct heml_model {
     heml_real *prony_q, *prony_q_next;      /* committed state and the one being built */
     size_t prony_reals;
 
-    /* scratch */
-    heml_real *scratch[HEML__SCRATCH];
+    /* scratch vectors (3n reals each), named by role; heml__layout_scratch carves them and is
+       the one place where two roles share memory (the pairs named there never live at once) */
+    heml_real *step_u0, *step_v0, *step_u1, *step_v1; /* heml_step_ex: start and candidate */
+    heml_real *static_u, *static_saved, *static_dpin, *static_dfdpin; /* heml_solve_static: current,
+                                          last converged, the pins' move, df/du times it */
+    heml_real *work_f;                 /* forces at the current point (every integrator, Newton) */
+    heml_real *newton_R, *newton_delta; /* Newton: residual, direction */
+    heml_real *newton_ut, *newton_ft, *newton_Rt; /* Newton: the line search's trial point, its
+                                          forces and residual (also the saddle escape's) */
+    heml_real *newton_shift_diag;      /* Newton: D + shift diag K0 after negative curvature */
+    heml_real *probe_b, *probe_x;      /* saddle probe: K x = b */
+    heml_real *lin_dmass, *lin_du, *lin_rhs; /* linearised implicit step: D, du, dt^2 R */
+    heml_real *objective_load;         /* Newton's objective: f_ext + M g (static and implicit) */
+    heml_real *implicit_dmass, *implicit_warm; /* implicit Euler: D, the first solve's guess */
+    heml_real *static_rhs, *static_pred; /* static solve: the tangent predictor's K pred = rhs */
+    heml_real *krylov[HEML__KRYLOV];   /* the linear solvers' workspace (heml__cg, heml__minres) */
     heml_real *dv_prev; /* implicit warm start */
     const heml_real *lin_x; /* linearisation point of the CG operator */
 
@@ -1346,7 +1454,7 @@ static const int heml__link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3,
 /* The workspace of one block of HEML__W tetrahedra: every stage of a kernel is a loop
    over the lanes of these arrays. Everything that vanishes at rest is formed from the
    displacements without cancellation (see THE MODEL). */
-typedef struct heml__blk {
+struct heml__blk {
     heml_real e[9][HEML__W];  /* link displacements du_j = u_j - u_0: component r of j at [3 (j-1) + r] */
     heml_real H[9][HEML__W];  /* displacement gradient H = F - I = du V^-1, row-major */
     heml_real K[9][HEML__W];  /* cof F - I = tr H I - H^T + cof H, row-major */
@@ -1365,7 +1473,8 @@ typedef struct heml__blk {
     heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
     heml_real de[9][HEML__W]; /* differential: the links of dx */
     heml_real len[6][HEML__W]; /* springs: clamped link lengths */
-} heml__blk;
+};
+typedef struct heml__blk heml__blk;
 
 /* Kinematics of the block from its link displacements (e) and rest gradients (R): H, cof F - I,
    J - 1, C - I and the invariants, each a polynomial in H without a constant term (a
@@ -1451,15 +1560,16 @@ HEML__INLINE heml_real heml__log_jc(heml_real Jc, heml_real jc1, heml_real iJ)
     return heml__log(Jc) + (jc1 - (Jc - 1)) * iJ;
 }
 
-/* K_RAW: w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J (p0 = 2 c1 +
+/* heml__law_raw (Neo-Hookean eq. 26 and table 3 + penalty): w = c1 (I1 - 3) + c2 (I2 - 3) + U(J), U = -p0 ln J + kappa/2 ln^2 J (p0 = 2 c1 +
    4 c2), U' = (kappa ln J - p0) / J, U'' = (kappa (1 - ln J) + p0) / J^2, continued below
    J0 by U(J0) + U'(J0) d + U''(J0) d^2 / 2 (d = J - J0): the tangent of the volumetric
    stress, sec. 4.4. Neo-Hookean eq. 26: c1 = mu/2, c2 = 0, p0 = mu, kappa = lambda.
    s0 = p0 + w_J = (kappa ln Jc + p0 (Jc - 1)) / Jc + U'' d. The energy uses
    c1 (I1 - 3) - 2 c1 ln J = c1 (q1 + 2 d + 2 (x - log1p x)), x = Jc - 1, and
    I2 - 3 - 4 ln J = 2 (I1 - 3 - 2 ln J) + ((I1 - 3)^2 - tr2) / 2. */
-static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_raw(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1486,13 +1596,14 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int want)
         }
 }
 
-/* K_SPLIT (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
+/* heml__law_split, the compressible Mooney-Rivlin (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
    (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
    2 a + I1 a' = 2/3 a (3 (Jc - 1) - (I1 - 3)) / Jc and 4 b + I2 b' = 4/3 b (3 (Jc - 1) -
    (I2 - 3)) / Jc, plus the continuation terms in d. */
-static void heml__law_split(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1524,12 +1635,13 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int want)
     }
 }
 
-/* K_SVK (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
+/* heml__law_svk (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
    = lambda/8 (I1 - 3)^2 + mu/4 tr (C - I)^2, w_1 = lambda/4 (I1 - 3) + mu/2 (I1 - 1),
    w_2 = -mu/2, s0 = (lambda/2 + mu) (I1 - 3) + w_J, plus the guard (lambda + 2 mu)/2 d^2
    below J0. */
-static void heml__law_svk(const heml__mat *mt, heml__blk *b, int want)
+static void heml__law_svk(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
+    (void)valid;
     const heml_real mu = mt->mu, lambda = mt->lambda, guard = mt->guard;
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -1545,7 +1657,7 @@ static void heml__law_svk(const heml__mat *mt, heml__blk *b, int want)
     }
 }
 
-/* K_USER: the callbacks at (I1, I2, Jc) for the `valid` lanes (padding lanes get zeros),
+/* heml__law_user: the callbacks at (I1, I2, Jc) for the `valid` lanes (padding lanes get zeros),
    continued below J0 to first order in J: w += w_J d + w_JJ d^2 / 2, w_1 += w_1J d,
    w_2 += w_2J d, w_J += w_JJ d (second derivatives held at J0); without `second`, w_J is
    held at its J0 value. s0 = 2 w_1 + 4 w_2 + w_J is formed from the callbacks' values, so
@@ -1599,14 +1711,15 @@ static void heml__law_user(const heml__mat *mt, heml__blk *b, int valid, int wan
     for (k = 0; k < HEML__W; k++) b->s0[k] = 2 * b->w1[k] + 4 * b->w2[k] + b->wJ[k];
 }
 
+/* The law of a material on a block, through its row of heml__laws (the one dispatch of
+   the general path): energy when asked for it, else the differential when asked for
+   second derivatives, else the stress. */
 static void heml__law(const heml__mat *mt, heml__blk *b, int valid, int want)
 {
-    switch (mt->kind) {
-    case HEML__K_RAW: heml__law_raw(mt, b, want); break;
-    case HEML__K_SPLIT: heml__law_split(mt, b, want); break;
-    case HEML__K_SVK: heml__law_svk(mt, b, want); break;
-    default: heml__law_user(mt, b, valid, want); break;
-    }
+    const heml__law_ops *ops = mt->ops;
+    if (want & HEML__WANT_ENERGY) ops->energy(mt, b, valid, want);
+    else if (want & HEML__WANT_SECOND) ops->differential(mt, b, valid, want);
+    else ops->stress(mt, b, valid, want);
 }
 
 /* Evaluates a law at rest (I1 = I2 = 3, J = 1) for creation checks: fills w_1, w_2, w_J,
@@ -1907,7 +2020,7 @@ static void heml__p_times_grad(const heml_real *HEML__RESTRICT R, heml__blk *HEM
     }
 }
 
-/* The Neo-Hookean kernel (K_RAW without I2 and without Prony), in stages that are each a
+/* The Neo-Hookean kernel (heml__law_raw without I2 and without Prony: heml__mat.fast), in stages that are each a
    short loop over the lanes: H and J - 1; the volumetric scalars (w_J = U'(J), continued
    below J0, s0 = p0 + w_J); the stress
        P = s0 I + 2 c1 H + w_J (tr H I - H^T + cof H)   (times Vol, into b->K)
@@ -2090,7 +2203,7 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         heml__spring_forces(b, b->co, NULL);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count && !want_energy) {
+    if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
         heml__forces_nh(mt, m->jm1_0, R, b);
         return 0.0;
     }
@@ -2202,14 +2315,15 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    const heml_real sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
+    heml_real sp;
     int k;
     heml__gather(idx, u, b->e);
     heml__gather(idx, dx, b->de);
-    if (mt->kind == HEML__K_RAW && !mt->uses_i2 && !mt->prony_count) {
+    if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
     }
+    sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml_real dsig[6][HEML__W];
@@ -2237,7 +2351,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         heml__spring_forces(b, b->co, dsig);
         return;
     }
-    /* (raw laws without I2 reach here only with Prony: the general path covers them, with
+    /* (fast-path laws reach here only with Prony: the general path covers them, with
        zero I-derivatives) */
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
@@ -2491,12 +2605,49 @@ static void *heml__carve(heml__carver *c, size_t bytes)
 
 #define HEML__CARVE(c, ptr, type, count) ((ptr) = (type *)heml__carve((c), sizeof(type) * (size_t)(count)))
 
+/* The scratch vectors, 3n reals each (22: 14 by role and 8 for Krylov), and the roles that share
+   memory: a static solve and a step never run at once (static_* = step_*, static_rhs and
+   static_pred = implicit_dmass and implicit_warm); the linearised implicit step does not
+   run Newton (lin_* = newton_R, newton_delta, newton_ut); the saddle probe runs between
+   Newton iterations, whose direction and shifted diagonal are then spent (probe_b =
+   newton_delta, probe_x = newton_shift_diag). */
+static void heml__layout_scratch(heml_model *m, heml__carver *c)
+{
+    size_t n3 = 3 * (size_t)m->node_count;
+    int i;
+    HEML__CARVE(c, m->step_u0, heml_real, n3);
+    HEML__CARVE(c, m->step_v0, heml_real, n3);
+    HEML__CARVE(c, m->step_u1, heml_real, n3);
+    HEML__CARVE(c, m->step_v1, heml_real, n3);
+    HEML__CARVE(c, m->work_f, heml_real, n3);
+    HEML__CARVE(c, m->newton_R, heml_real, n3);
+    HEML__CARVE(c, m->newton_delta, heml_real, n3);
+    HEML__CARVE(c, m->newton_ut, heml_real, n3);
+    HEML__CARVE(c, m->newton_ft, heml_real, n3);
+    HEML__CARVE(c, m->newton_Rt, heml_real, n3);
+    for (i = 0; i < HEML__KRYLOV; i++) HEML__CARVE(c, m->krylov[i], heml_real, n3);
+    HEML__CARVE(c, m->objective_load, heml_real, n3);
+    HEML__CARVE(c, m->implicit_dmass, heml_real, n3);
+    HEML__CARVE(c, m->implicit_warm, heml_real, n3);
+    HEML__CARVE(c, m->newton_shift_diag, heml_real, n3);
+    m->static_u = m->step_u0;
+    m->static_saved = m->step_v0;
+    m->static_dpin = m->step_u1;
+    m->static_dfdpin = m->step_v1;
+    m->static_rhs = m->implicit_dmass;
+    m->static_pred = m->implicit_warm;
+    m->lin_dmass = m->newton_R;
+    m->lin_du = m->newton_delta;
+    m->lin_rhs = m->newton_ut;
+    m->probe_b = m->newton_delta;
+    m->probe_x = m->newton_shift_diag;
+}
+
 /* Lays out every array of the model in the block at c->base (or measures it). */
 static void heml__layout(heml_model *m, heml__carver *c)
 {
     size_t n = (size_t)m->node_count, s = (size_t)m->slot_count, B = (size_t)m->block_count;
     size_t C = (size_t)m->chunk_count, P = (size_t)m->prony_total, M = (size_t)m->material_count;
-    int i;
     HEML__CARVE(c, m->rest, heml_real, 3 * n);
     HEML__CARVE(c, m->pos, heml_real, 3 * n);
     HEML__CARVE(c, m->disp, heml_real, 3 * n);
@@ -2533,7 +2684,7 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->prony_s, heml_real, M);
     HEML__CARVE(c, m->prony_q, heml_real, m->prony_reals);
     HEML__CARVE(c, m->prony_q_next, heml_real, m->prony_reals);
-    for (i = 0; i < HEML__SCRATCH; i++) HEML__CARVE(c, m->scratch[i], heml_real, 3 * n);
+    heml__layout_scratch(m, c);
     HEML__CARVE(c, m->dv_prev, heml_real, 3 * n);
     HEML__CARVE(c, m->div_u, heml_real, 3 * n);
     HEML__CARVE(c, m->div_f, heml_real, 3 * n);
@@ -2552,58 +2703,142 @@ static int heml__fail(const heml_desc *d, int code, const char *detail)
     return code;
 }
 
-/* A material in kernel form (no checks). */
+/* >>laws-table: each law's kernel constants (make), parameter checks (check) and its row
+   of heml__laws. */
+
+static void heml__make_svk(const heml_material *src, heml__mat *mt)
+{
+    mt->mu = src->mu;
+    mt->lambda = src->lambda;
+    mt->guard = src->lambda + 2 * src->mu;
+    mt->uses_i2 = 1;
+}
+
+static void heml__make_nh(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->mu / 2;
+    mt->p0 = src->mu;
+    mt->kappa = src->lambda;
+}
+
+static void heml__make_nh_incompressible(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->p0 = 2 * src->c1;
+    mt->kappa = src->bulk_modulus;
+}
+
+static void heml__make_mr_incompressible(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->c2 = src->c2;
+    mt->p0 = 2 * src->c1 + 4 * src->c2;
+    mt->kappa = src->bulk_modulus;
+    mt->uses_i2 = src->c2 != 0;
+}
+
+static void heml__make_mr(const heml_material *src, heml__mat *mt)
+{
+    mt->c1 = src->c1;
+    mt->c2 = src->c2;
+    mt->kappa = src->bulk_modulus;
+    mt->uses_i2 = src->c2 != 0;
+}
+
+static void heml__make_spring(const heml_material *src, heml__mat *mt) { mt->young = src->young_modulus; }
+
+static void heml__make_user(const heml_material *src, heml__mat *mt)
+{
+    (void)src;
+    mt->uses_i2 = 1;
+}
+
+static int heml__check_lame(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite((double)src->mu) && heml__finite((double)src->lambda) && src->mu > 0 &&
+          3 * src->lambda + 2 * src->mu > 0)) {
+        snprintf(msg, msg_size, "material %d: mu %g, lambda %g (need mu > 0, 3 lambda + 2 mu > 0)", index,
+                 (double)src->mu, (double)src->lambda);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+static int heml__check_c1_c2_kappa(double c1, double c2, double kappa, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite(c1) && heml__finite(c2) && heml__finite(kappa) && c1 >= 0.0 && c2 >= 0.0 && c1 + c2 > 0.0 &&
+          kappa > 0.0)) {
+        snprintf(msg, msg_size, "material %d: c1 %g, c2 %g, kappa %g (need c1, c2 >= 0, c1 + c2 > 0, "
+                 "kappa > 0)", index, c1, c2, kappa);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+static int heml__check_nh_incompressible(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    return heml__check_c1_c2_kappa((double)src->c1, 0.0, (double)src->bulk_modulus, index, msg, msg_size);
+}
+
+static int heml__check_mr(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    return heml__check_c1_c2_kappa((double)src->c1, (double)src->c2, (double)src->bulk_modulus, index, msg, msg_size);
+}
+
+static int heml__check_spring(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!(heml__finite((double)src->young_modulus) && src->young_modulus > 0)) {
+        snprintf(msg, msg_size, "material %d: Young's modulus %g", index, (double)src->young_modulus);
+        return HEML_ERR_MATERIAL;
+    }
+    return HEML_OK;
+}
+
+/* (the user law's rest-state checks need the law evaluated: heml__validate_material) */
+static int heml__check_user(const heml_material *src, int index, char *msg, size_t msg_size)
+{
+    if (!src->user.first) {
+        snprintf(msg, msg_size, "material %d: user law without a first-derivative callback", index);
+        return HEML_ERR_USER_LAW;
+    }
+    return HEML_OK;
+}
+
+/* The laws, indexed by heml_law (see heml__law_ops and HOW TO EXTEND). fast_path is set
+   where heml__law_raw without an I2 term is the law: Neo-Hookean (eq. 26: c1 = mu/2,
+   p0 = mu, kappa = lambda), its table 3 + penalty form, and the incompressible
+   Mooney-Rivlin, which has an I2 term unless c2 = 0 (heml__mat.fast also needs no I2
+   term). */
+static const heml__law_ops heml__laws[] = {
+    {"St Venant-Kirchhoff", HEML__K_INVARIANTS, heml__law_svk, heml__law_svk, heml__law_svk, heml__make_svk,
+     heml__check_lame, 0},
+    {"Neo-Hookean", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw, heml__make_nh, heml__check_lame,
+     1},
+    {"Mooney-Rivlin", HEML__K_INVARIANTS, heml__law_split, heml__law_split, heml__law_split, heml__make_mr,
+     heml__check_mr, 0},
+    {"Neo-Hookean (incompressible)", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw,
+     heml__make_nh_incompressible, heml__check_nh_incompressible, 1},
+    {"Mooney-Rivlin (incompressible)", HEML__K_INVARIANTS, heml__law_raw, heml__law_raw, heml__law_raw,
+     heml__make_mr_incompressible, heml__check_mr, 1},
+    {"mass-spring", HEML__K_SPRING, NULL, NULL, NULL, heml__make_spring, heml__check_spring, 0},
+    {"user", HEML__K_USER, heml__law_user, heml__law_user, heml__law_user, heml__make_user, heml__check_user, 0},
+};
+/* a law added to heml_law without its row (or the reverse) fails to compile here */
+typedef char heml__laws_has_a_row_per_law[sizeof heml__laws / sizeof heml__laws[0] == HEML_LAW_COUNT ? 1 : -1];
+
+/* A material in kernel form (no checks; src->law valid). */
 static void heml__make_mat(const heml_material *src, heml__mat *mt)
 {
+    const heml__law_ops *ops = heml__laws + src->law;
     memset(mt, 0, sizeof *mt);
     mt->law = src->law;
+    mt->ops = ops;
+    mt->kind = ops->kind;
     mt->density = (double)src->density;
     mt->user = src->user;
     mt->prony_count = src->prony_count;
-    switch (src->law) {
-    case HEML_STVK:
-        mt->kind = HEML__K_SVK;
-        mt->mu = src->mu;
-        mt->lambda = src->lambda;
-        mt->guard = src->lambda + 2 * src->mu;
-        mt->uses_i2 = 1;
-        break;
-    case HEML_NEO_HOOKEAN:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->mu / 2;
-        mt->p0 = src->mu;
-        mt->kappa = src->lambda;
-        break;
-    case HEML_NEO_HOOKEAN_INCOMPRESSIBLE:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->c1;
-        mt->p0 = 2 * src->c1;
-        mt->kappa = src->bulk_modulus;
-        break;
-    case HEML_MOONEY_RIVLIN_INCOMPRESSIBLE:
-        mt->kind = HEML__K_RAW;
-        mt->c1 = src->c1;
-        mt->c2 = src->c2;
-        mt->p0 = 2 * src->c1 + 4 * src->c2;
-        mt->kappa = src->bulk_modulus;
-        mt->uses_i2 = src->c2 != 0;
-        break;
-    case HEML_MOONEY_RIVLIN:
-        mt->kind = HEML__K_SPLIT;
-        mt->c1 = src->c1;
-        mt->c2 = src->c2;
-        mt->kappa = src->bulk_modulus;
-        mt->uses_i2 = src->c2 != 0;
-        break;
-    case HEML_MASS_SPRING:
-        mt->kind = HEML__K_SPRING;
-        mt->young = src->young_modulus;
-        break;
-    default:
-        mt->kind = HEML__K_USER;
-        mt->uses_i2 = 1;
-        break;
-    }
+    ops->make(src, mt);
+    mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
 }
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
@@ -2637,8 +2872,8 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
 {
     heml__mat mt;
     double mu, lambda, sum = 0.0;
-    int i;
-    if ((int)src->law < 0 || (int)src->law > HEML_USER) {
+    int i, err;
+    if ((unsigned)src->law >= HEML_LAW_COUNT) {
         snprintf(msg, msg_size, "material %d: unknown law %d", index, (int)src->law);
         return HEML_ERR_LAW;
     }
@@ -2662,42 +2897,11 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
         snprintf(msg, msg_size, "material %d: Prony weights sum to %g (must be < 1)", index, sum);
         return HEML_ERR_PRONY;
     }
-    switch (src->law) {
-    case HEML_STVK:
-    case HEML_NEO_HOOKEAN:
-        if (!(heml__finite((double)src->mu) && heml__finite((double)src->lambda) && src->mu > 0 &&
-              3 * src->lambda + 2 * src->mu > 0)) {
-            snprintf(msg, msg_size, "material %d: mu %g, lambda %g (need mu > 0, 3 lambda + 2 mu > 0)",
-                     index, (double)src->mu, (double)src->lambda);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    case HEML_NEO_HOOKEAN_INCOMPRESSIBLE:
-    case HEML_MOONEY_RIVLIN_INCOMPRESSIBLE:
-    case HEML_MOONEY_RIVLIN: {
-        double c1 = (double)src->c1, c2 = src->law == HEML_NEO_HOOKEAN_INCOMPRESSIBLE ? 0.0 : (double)src->c2;
-        double kappa = (double)src->bulk_modulus;
-        if (!(heml__finite(c1) && heml__finite(c2) && heml__finite(kappa) && c1 >= 0.0 && c2 >= 0.0 &&
-              c1 + c2 > 0.0 && kappa > 0.0)) {
-            snprintf(msg, msg_size, "material %d: c1 %g, c2 %g, kappa %g (need c1, c2 >= 0, c1 + c2 > 0, "
-                     "kappa > 0)", index, c1, c2, kappa);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    }
-    case HEML_MASS_SPRING:
-        if (!(heml__finite((double)src->young_modulus) && src->young_modulus > 0)) {
-            snprintf(msg, msg_size, "material %d: Young's modulus %g", index, (double)src->young_modulus);
-            return HEML_ERR_MATERIAL;
-        }
-        break;
-    default: {
+    err = heml__laws[src->law].check(src, index, msg, msg_size);
+    if (err) return err;
+    if (heml__laws[src->law].kind == HEML__K_USER) { /* stress-free and stable at rest */
         heml__blk b;
         double w1, w2, wJ, tol = HEML__FLOAT ? 1e-4 : 1e-9;
-        if (!src->user.first) {
-            snprintf(msg, msg_size, "material %d: user law without a first-derivative callback", index);
-            return HEML_ERR_USER_LAW;
-        }
         heml__make_mat(src, &mt);
         heml__law_at_rest(&mt, jm1_0, &b);
         w1 = (double)b.w1[0];
@@ -2710,13 +2914,13 @@ static int heml__validate_material(const heml_material *src, heml_real jm1_0, in
                      "small-strain mu %g, lambda %g", index, 2 * w1 + 4 * w2 + wJ, mu, lambda);
             return HEML_ERR_USER_LAW;
         }
-        break;
-    }
     }
     return HEML_OK;
 }
 
-static int heml__validate(const heml_desc *d)
+/* Creation stage 1 (see heml_create): every check of the description, before anything is
+   allocated. */
+static int heml__create_validate(const heml_desc *d)
 {
     char msg[200];
     int i, t, err, M;
@@ -2733,8 +2937,10 @@ static int heml__validate(const heml_desc *d)
         return heml__fail(d, HEML_ERR_TIME_STEP, "time_step");
     if (!(heml__finite((double)d->mass_damping) && d->mass_damping >= 0))
         return heml__fail(d, HEML_ERR_DAMPING, "mass_damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 2)
+    if ((unsigned)d->integrator >= HEML_INTEGRATOR_COUNT)
         return heml__fail(d, HEML_ERR_INTEGRATOR, "integrator");
+    if ((unsigned)d->linear_solver >= HEML_LINEAR_SOLVER_COUNT)
+        return heml__fail(d, HEML_ERR_SOLVER, "linear_solver");
     if (!(heml__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1 ||
         d->newton_iterations < 1 || d->static_max_iterations < 1 ||
         !(heml__finite((double)d->static_tolerance) && d->static_tolerance > 0) ||
@@ -3260,81 +3466,91 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.precision_limit = (heml_real)1e-4;
     d.cg_tolerance = (heml_real)(HEML__FLOAT ? 1e-5 : 1e-6);
     d.cg_max_iterations = 1000;
+    d.linear_solver = HEML_LINEAR_SOLVER_CG;
     d.static_max_iterations = 50;
     d.static_tolerance = (heml_real)(HEML__FLOAT ? 1e-4 : 1e-9);
     d.internal_cookie = HEML__COOKIE;
     return d;
 }
 
-HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
-{
-    heml_model tmp, *m;
-    heml__carver carver;
-    const heml_material *src;
-    int err, i, t, M, T, n, C_max, *counts, *fill, *bstart, *stamp, *colour_of, *order;
-    heml__order *order_of;
-    size_t tmp_bytes;
-    void *tmp_block;
-    double *mass_acc, *diag_acc;
-    heml_allocator alloc;
-    if (!out) return HEML_ERR_ARG;
-    *out = NULL;
-    if (!d) return HEML_ERR_ARG;
-    err = heml__validate(d);
-    if (err) return err;
-    M = d->materials ? d->material_count : 1;
-    src = d->materials ? d->materials : &d->material;
-    T = d->tet_count;
-    n = d->node_count;
-    alloc = d->allocator;
-    C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
-    /* temporary: mass and diagonal accumulators, the tetrahedra's order, per-material
-       counters, node stamps, chunk colours and reorder space */
-    tmp_bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
-                sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
-    tmp_block = heml__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
-    mass_acc = (double *)tmp_block;
-    diag_acc = mass_acc + n;
-    order_of = (heml__order *)(diag_acc + 3 * (size_t)n);
-    counts = (int *)(order_of + T);
-    fill = counts + M;
-    bstart = fill + M;
-    stamp = bstart + M;
-    colour_of = stamp + n;
-    order = colour_of + C_max;
+/* Creation in four stages that read top to bottom: heml__create_validate (the description,
+   every check before anything is allocated), heml__create_size (counts: blocks, chunks,
+   Prony state, aggregates; the temporary workspace), heml__create_layout (the model's one
+   block carved, the settings copied), heml__create_precompute (materials, the tetrahedra's
+   order and rest constants, masses, chunks, colours, masks). */
 
-    memset(&tmp, 0, sizeof tmp);
-    tmp.node_count = n;
-    tmp.tet_count = T;
-    tmp.material_count = M;
-    for (i = 0; i < M; i++) counts[i] = fill[i] = 0;
-    for (t = 0; t < T; t++) counts[d->tet_material ? d->tet_material[t] : 0]++;
+/* Temporary workspace of heml_create (one allocation, freed before it returns): mass and
+   stiffness-diagonal accumulators, the tetrahedra's order, per-material counts, fills and
+   first blocks, node stamps (then the aggregate of each node), chunk colours and reorder
+   space. */
+typedef struct heml__create_tmp {
+    void *block;
+    size_t bytes;
+    double *mass_acc, *diag_acc;
+    heml__order *order_of;
+    int *counts, *fill, *bstart, *stamp, *colour_of, *order;
+} heml__create_tmp;
+
+/* Creation stage 2: sizes the model (in *tmp, a model not yet allocated) and allocates the
+   temporary workspace w. */
+static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_tmp *w)
+{
+    const heml_material *src = d->materials ? d->materials : &d->material;
+    int i, t, M = d->materials ? d->material_count : 1, T = d->tet_count, n = d->node_count;
+    int C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
+    w->bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
+               sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+    w->block = heml__alloc(&d->allocator, w->bytes);
+    if (!w->block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
+    w->mass_acc = (double *)w->block;
+    w->diag_acc = w->mass_acc + n;
+    w->order_of = (heml__order *)(w->diag_acc + 3 * (size_t)n);
+    w->counts = (int *)(w->order_of + T);
+    w->fill = w->counts + M;
+    w->bstart = w->fill + M;
+    w->stamp = w->bstart + M;
+    w->colour_of = w->stamp + n;
+    w->order = w->colour_of + C_max;
+
+    memset(tmp, 0, sizeof *tmp);
+    tmp->node_count = n;
+    tmp->tet_count = T;
+    tmp->material_count = M;
+    for (i = 0; i < M; i++) w->counts[i] = w->fill[i] = 0;
+    for (t = 0; t < T; t++) w->counts[d->tet_material ? d->tet_material[t] : 0]++;
     for (i = 0; i < M; i++) {
-        int blocks = (counts[i] + HEML__W - 1) / HEML__W;
-        bstart[i] = tmp.block_count;
-        tmp.block_count += blocks;
-        tmp.chunk_count += (blocks + HEML__CHUNK - 1) / HEML__CHUNK;
-        tmp.prony_total += src[i].prony_count;
-        tmp.prony_reals += (size_t)blocks * HEML__W * HEML__NQ * (size_t)src[i].prony_count;
-        if (src[i].law == HEML_MASS_SPRING && counts[i]) tmp.has_springs = 1;
-        if (src[i].prony_count && counts[i]) tmp.has_prony = 1;
-        if (src[i].law == HEML_USER && !src[i].user.second && counts[i]) tmp.has_user_without_second = 1;
+        int blocks = (w->counts[i] + HEML__W - 1) / HEML__W, used = w->counts[i] > 0;
+        w->bstart[i] = tmp->block_count;
+        tmp->block_count += blocks;
+        tmp->chunk_count += (blocks + HEML__CHUNK - 1) / HEML__CHUNK;
+        tmp->prony_total += src[i].prony_count;
+        tmp->prony_reals += (size_t)blocks * HEML__W * HEML__NQ * (size_t)src[i].prony_count;
+        if (heml__laws[src[i].law].kind == HEML__K_SPRING && used) tmp->has_springs = 1;
+        if (src[i].prony_count && used) tmp->has_prony = 1;
+        if (heml__laws[src[i].law].kind == HEML__K_USER && !src[i].user.second && used)
+            tmp->has_user_without_second = 1;
     }
-    tmp.slot_count = tmp.block_count * HEML__W;
+    tmp->slot_count = tmp->block_count * HEML__W;
     {
         int cells[HEML__MAX_AGG];
-        tmp.agg_count = heml__aggregate(d->rest_positions, n, stamp, cells);
+        tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
     }
+    return HEML_OK;
+}
+
+/* Creation stage 3: allocates the model's block, carves every array in it (heml__layout)
+   and copies the description's settings and rest positions. */
+static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml_model **out)
+{
+    heml_model tmp = *sized, *m;
+    heml__carver carver;
+    int i;
     carver.base = NULL;
     carver.offset = sizeof(heml_model);
     heml__layout(&tmp, &carver);
     tmp.block_bytes = carver.offset;
-    tmp.block = heml__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        heml__free(&alloc, tmp_block, tmp_bytes);
-        return heml__fail(d, HEML_ERR_ALLOC, "model block");
-    }
+    tmp.block = heml__alloc(&d->allocator, tmp.block_bytes);
+    if (!tmp.block) return heml__fail(d, HEML_ERR_ALLOC, "model block");
     memset(tmp.block, 0, tmp.block_bytes);
     carver.base = (char *)tmp.block;
     carver.offset = sizeof(heml_model);
@@ -3343,6 +3559,7 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     *m = tmp;
 
     m->integrator = d->integrator;
+    m->linear_solver = d->linear_solver;
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
     for (i = 0; i < 3; i++) m->gravity[i] = d->gravity[i];
@@ -3359,17 +3576,22 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
     m->precision_limit = d->precision_limit;
     m->J0 = d->inversion_threshold;
     m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
-    m->allocator = alloc;
+    m->allocator = d->allocator;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = T >= HEML_PARALLEL_MIN_TETS;
+    m->parallel = d->tet_count >= HEML_PARALLEL_MIN_TETS;
+    memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
+    memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
+    *out = m;
+    return HEML_OK;
+}
 
-    memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
-    memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)n);
-    /* materials and their Prony terms */
-    for (i = 0, t = 0; i < M; i++) {
+/* Materials in kernel form with their Prony terms and small-strain moduli. */
+static void heml__create_materials(heml_model *m, const heml_material *src)
+{
+    int i, k, t;
+    for (i = 0, t = 0; i < m->material_count; i++) {
         heml__mat *mt = m->mats + i;
-        int k;
         heml__make_mat(src + i, mt);
         mt->prony_first = t;
         for (k = 0; k < src[i].prony_count; k++, t++) {
@@ -3380,44 +3602,76 @@ HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
     }
-    /* slots: tetrahedra grouped by material, in node order (heml__node_order), each
-       material padded to whole blocks */
-    heml__node_order(d, order_of);
+}
+
+/* Chunks of consecutive blocks of one material, and each block's Prony state offset. */
+static void heml__create_chunks(heml_model *m, const heml_material *src, const heml__create_tmp *w)
+{
+    int i, c = 0;
+    size_t off = 0;
+    for (i = 0; i < m->material_count; i++) {
+        int blocks = (w->counts[i] + HEML__W - 1) / HEML__W, b;
+        for (b = 0; b < blocks; b++) {
+            m->blk_prony[w->bstart[i] + b] = off;
+            off += (size_t)HEML__W * HEML__NQ * (size_t)src[i].prony_count;
+        }
+        for (b = 0; b < blocks; b += HEML__CHUNK, c++) {
+            m->chunk_begin[c] = w->bstart[i] + b;
+            m->chunk_end[c] = w->bstart[i] + (b + HEML__CHUNK < blocks ? b + HEML__CHUNK : blocks);
+            m->chunk_material[c] = i;
+        }
+    }
+    HEML_ASSERT(c == m->chunk_count && off == m->prony_reals);
+}
+
+/* Creation stage 4: everything the rest state determines: materials, the tetrahedra's
+   slots (grouped by material, in node order: heml__node_order, each material padded to
+   whole blocks), rest constants, masses and the stiffness diagonal (heml__fill_tets),
+   chunks, aggregates, colours, masks, Prony coefficients, the shortest edge. */
+static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__create_tmp *w)
+{
+    const heml_material *src = d->materials ? d->materials : &d->material;
+    int i, t;
+    heml__create_materials(m, src);
+    heml__node_order(d, w->order_of);
     for (i = 0; i < m->slot_count; i++) m->slot_tet[i] = -1;
-    for (i = 0; i < T; i++) {
-        int mi = order_of[i].material, slot = bstart[mi] * HEML__W + fill[mi]++;
-        t = order_of[i].tet;
+    for (i = 0; i < m->tet_count; i++) {
+        int mi = w->order_of[i].material, slot = w->bstart[mi] * HEML__W + w->fill[mi]++;
+        t = w->order_of[i].tet;
         m->slot_tet[slot] = t;
         m->tet_slot[t] = slot;
     }
-    heml__fill_tets(m, d, mass_acc, diag_acc);
-    /* chunks, Prony offsets */
-    {
-        int c = 0;
-        size_t off = 0;
-        for (i = 0; i < M; i++) {
-            int blocks = (counts[i] + HEML__W - 1) / HEML__W, b;
-            for (b = 0; b < blocks; b++) {
-                m->blk_prony[bstart[i] + b] = off;
-                off += (size_t)HEML__W * HEML__NQ * (size_t)src[i].prony_count;
-            }
-            for (b = 0; b < blocks; b += HEML__CHUNK, c++) {
-                m->chunk_begin[c] = bstart[i] + b;
-                m->chunk_end[c] = bstart[i] + (b + HEML__CHUNK < blocks ? b + HEML__CHUNK : blocks);
-                m->chunk_material[c] = i;
-            }
-        }
-        HEML_ASSERT(c == m->chunk_count && off == m->prony_reals);
-    }
-    if (m->agg_count) memcpy(m->node_agg, stamp, sizeof(int) * (size_t)n);
+    heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
+    heml__create_chunks(m, src, w);
+    if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);
-    heml__colour_groups(m, stamp, colour_of, order);
-    for (i = 0; i < n; i++) heml__set_masks(m, i);
+    heml__colour_groups(m, w->stamp, w->colour_of, w->order);
+    for (i = 0; i < m->node_count; i++) heml__set_masks(m, i);
     m->coarse_version = m->pin_version - 1;
     heml__prony_coefficients(m, (double)m->time_step);
-    heml__free(&alloc, tmp_block, tmp_bytes);
     m->h_min = heml__shortest_edge(d);
     m->stats.newton_iterations = 0;
+}
+
+HEMLDEF int heml_create(const heml_desc *d, heml_model **out)
+{
+    heml_model sized, *m = NULL;
+    heml__create_tmp w;
+    heml_allocator alloc;
+    int err;
+    if (!out) return HEML_ERR_ARG;
+    *out = NULL;
+    if (!d) return HEML_ERR_ARG;
+    memset(&w, 0, sizeof w);
+    err = heml__create_validate(d);
+    if (err) return err;
+    alloc = d->allocator;
+    err = heml__create_size(d, &sized, &w);
+    if (err) return err;
+    err = heml__create_layout(d, &sized, &m);
+    if (!err) heml__create_precompute(d, m, &w);
+    heml__free(&alloc, w.block, w.bytes);
+    if (err) return err;
     *out = m;
     return HEML_OK;
 }
@@ -3475,6 +3729,12 @@ static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real 
 }
 
 #define HEML__NEGATIVE_CURVATURE 1 /* private result of heml__cg */
+/* heml__cg's workspace vectors that callers read after a solve: the last direction p, its
+   product q = A p, the Jacobi preconditioner; HEML__CG_FREE and the next are unused by CG */
+#define HEML__CG_P 2
+#define HEML__CG_Q 3
+#define HEML__CG_PINV 4
+#define HEML__CG_FREE 5
 
 /* Solves (D - c df/dx(x_lin)) x = b on the free degrees of freedom by Jacobi-
    preconditioned CG. x holds the initial guess; pinned entries are held at 0. Returns
@@ -3482,7 +3742,7 @@ static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real 
    the last iterate), HEML__NEGATIVE_CURVATURE at a direction of non-positive curvature
    (the system is not positive definite; x is the iterate before it). With `coarse` (the
    static problem, diag NULL and c = 1) the preconditioner adds the coarse correction.
-   Scratch s[0..4]. */
+   Workspace s[0..4]: r, z, p, q, pinv (HEML__CG_*; p, q and pinv are read after a solve). */
 static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
                     const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s)
 {
@@ -3545,7 +3805,8 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
    by the static solve (Newton iterates far from equilibrium, or beyond a buckling load,
    have an indefinite tangent, where CG would stop) and by the implicit step after CG met
    negative curvature. `coarse` as for heml__cg. Returns HEML_OK or
-   HEML_ERR_NO_CONVERGENCE. Scratch s[0..7]. */
+   HEML_ERR_NO_CONVERGENCE (or HEML_ERR_NOT_FINITE for a right-hand side whose norm
+   overflows). Workspace s[0..7]. */
 static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
                         const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s)
 {
@@ -3608,6 +3869,46 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (heml_real)(phibar / beta1);
     return phibar <= tol ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
+}
+
+/* >>linear-solvers: one row per heml_linear_solver, indexed by it (see HOW TO EXTEND).
+   `solve` is for systems expected to be positive definite, `solve_indefinite` for
+   symmetric indefinite ones. Both solve (D - c df/dx(x_lin)) x = b on the free degrees of
+   freedom (D a diagonal or NULL; with `coarse` the static solve's coarse correction) from
+   the guess in x, to |r| <= rtol |b|, in the model's Krylov workspace (m->krylov), and
+   return the same codes:
+       HEML_OK                   converged;
+       HEML_ERR_NO_CONVERGENCE   cg_max_iterations reached (x is the last iterate);
+       HEML_ERR_NOT_FINITE       |b|^2 or the residual is not finite;
+       HEML__NEGATIVE_CURVATURE  (private, positive; `solve` only) a direction of
+                                 non-positive curvature: the system is not positive
+                                 definite, x is the iterate before it. Callers decide: the
+                                 linearised step switches to solve_indefinite, Newton adds a
+                                 Levenberg-Marquardt shift, the saddle probe has found its
+                                 saddle, the static predictor drops the prediction. */
+typedef int (*heml__solve_fn)(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
+                              const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s);
+typedef struct heml__linear_solver_ops {
+    const char *name;
+    heml__solve_fn solve, solve_indefinite;
+} heml__linear_solver_ops;
+
+static const heml__linear_solver_ops heml__linear_solvers[] = {
+    {"conjugate gradient (MINRES if indefinite)", heml__cg, heml__minres},
+};
+typedef char heml__linear_solvers_has_a_row_per_solver
+    [sizeof heml__linear_solvers / sizeof heml__linear_solvers[0] == HEML_LINEAR_SOLVER_COUNT ? 1 : -1];
+
+#define HEML__SPD 0
+#define HEML__INDEFINITE 1
+
+/* Every linear solve of the library goes through here, to the model's linear solver. */
+static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, const heml_real *diag, double c,
+                              const heml_real *b, heml_real *x, double rtol, int coarse)
+{
+    const heml__linear_solver_ops *ops = heml__linear_solvers + m->linear_solver;
+    return (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
+                                                                            m->krylov);
 }
 
 /* >>integrators ----------------------------------------------------------------------- */
@@ -3712,7 +4013,7 @@ static int heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0,
                                heml_real *u1, heml_real *v1)
 {
     int i, r, n = m->node_count;
-    heml_real *f = m->scratch[4], alpha = m->mass_damping;
+    heml_real *f = m->work_f, alpha = m->mass_damping;
     double K1 = 0.0, work = 0.0;
     heml__forces(m, u0, f, 1);
     if (heml__all_finite(f, 3 * (size_t)n) && heml__diverged(m, u0, v0, f)) return HEML_ERR_DIVERGED;
@@ -3745,10 +4046,9 @@ static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_rea
                                      heml_real *u1, heml_real *v1)
 {
     int i, r, err, n = m->node_count, n3 = 3 * n;
-    heml_real *f = m->scratch[4], *dmass = m->scratch[5], *du = m->scratch[6], *rhs = m->scratch[7];
-    heml_real *krylov[8], alpha = m->mass_damping;
+    heml_real *f = m->work_f, *dmass = m->lin_dmass, *du = m->lin_du, *rhs = m->lin_rhs;
+    heml_real alpha = m->mass_damping;
     double dt2 = (double)dt * dt;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[9 + i];
     for (i = 0; i < n3; i++) dmass[i] = (heml_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
     heml__forces(m, u0, f, 1);
     for (i = 0; i < n; i++)
@@ -3760,9 +4060,9 @@ static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_rea
             du[j] = dt * (v0[j] + m->dv_prev[j]);
         }
     if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-    err = heml__cg(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+    err = heml__linear_solve(m, HEML__SPD, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
     if (err == HEML__NEGATIVE_CURVATURE)
-        err = heml__minres(m, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0, krylov);
+        err = heml__linear_solve(m, HEML__INDEFINITE, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
     if (err) return err;
     m->stats.newton_iterations = 1;
     for (i = 0; i < n3; i++) {
@@ -3888,18 +4188,17 @@ static int heml__stalled(heml_model *m, const heml__objective *ob, const heml_re
    round-off, and Newton goes on from there. Returns HEML_OK (a minimum, as far as the
    probe sees), 1 (escaped: u, R, pt updated), HEML_ERR_ROUND_OFF (a saddle that no step
    lowers measurably: heml_real cannot tell it from a minimum) or HEML_ERR_NO_CONVERGENCE
-   (HEML__ESCAPES escapes already). Scratch 6, 7, 8, 9, 10-17, 21. */
+   (HEML__ESCAPES escapes already). Scratch: probe_b, probe_x, newton_ut/ft/Rt, krylov. */
 #define HEML__RAYLEIGH 40
 static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_real *u, heml_real *R, heml__point *pt,
                                int *escapes)
 {
-    heml_real *b = m->scratch[6], *ut = m->scratch[7], *ft = m->scratch[8], *Rt = m->scratch[9];
-    heml_real *x = m->scratch[21], *krylov[8], *v, *kv, *w, *kw, *pinv;
+    heml_real *b = m->probe_b, *ut = m->newton_ut, *ft = m->newton_ft, *Rt = m->newton_Rt;
+    heml_real *x = m->probe_x, *v, *kv, *w, *kw, *pinv;
     int i, n3 = 3 * m->node_count, kerr, ls, sgn, it;
     double eps = HEML__FLOAT ? FLT_EPSILON : DBL_EPSILON, rho = 0.0, vmax = 0.0, step, first, norm;
     heml__point tp;
     if (!ob->check_minimum) return HEML_OK;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
     for (i = 0; i < n3; i++) {
         unsigned h = (unsigned)i * 2654435761u;
         h ^= h >> 15;
@@ -3908,10 +4207,12 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
         b[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
         x[i] = 0;
     }
-    kerr = heml__cg(m, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse, krylov);
+    kerr = heml__linear_solve(m, HEML__SPD, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
     if (kerr == HEML_ERR_NOT_FINITE) return kerr;
     if (kerr != HEML__NEGATIVE_CURVATURE) return HEML_OK;
-    v = krylov[2], kv = krylov[3], pinv = krylov[4], w = krylov[5], kw = krylov[6];
+    /* the solve's last direction p and K p, its preconditioner, and two free vectors */
+    v = m->krylov[HEML__CG_P], kv = m->krylov[HEML__CG_Q], pinv = m->krylov[HEML__CG_PINV];
+    w = m->krylov[HEML__CG_FREE], kw = m->krylov[HEML__CG_FREE + 1];
     for (it = 0; it <= HEML__RAYLEIGH; it++) { /* v . K v / v . K0 v down, in span{v, P (K v - rho K0 v)} */
         double a11 = 0, a12 = 0, a22 = 0, b11 = 0, b12 = 0, b22 = 0, det, mid, mu, cx, cy;
         for (i = 0; i < n3; i++) {
@@ -3992,15 +4293,14 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
    Converged when |R| <= tol max(|load|, |f|, |inertia|) and, for the static solve
    (check_minimum), heml__saddle_escape finds no negative curvature. When neither |R| nor Phi made
    progress in HEML__STALL iterations, or the line search found no acceptable step, or
-   after max_iterations: heml__stalled decides. Scratch 4..17. */
+   after max_iterations: heml__stalled decides. Scratch: work_f, newton_*, krylov. */
 static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
 {
-    heml_real *f = m->scratch[4], *R = m->scratch[5], *delta = m->scratch[6], *ut = m->scratch[7];
-    heml_real *ft = m->scratch[8], *Rt = m->scratch[9], *reg = m->scratch[21], *krylov[8];
+    heml_real *f = m->work_f, *R = m->newton_R, *delta = m->newton_delta, *ut = m->newton_ut;
+    heml_real *ft = m->newton_ft, *Rt = m->newton_Rt, *reg = m->newton_shift_diag;
     int i, it, n3 = 3 * m->node_count, quiet = 0, escapes = 0, done;
     double best, prev = 0.0, eta = 1e-3, tol = ob->tol, shift = 0.0;
     heml__point pt, tp;
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
     heml__eval(m, ob, u, f, R, &pt);
     ob->inverted_start = m->stats.inverted;
     best = pt.res;
@@ -4028,7 +4328,7 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
                 D = reg;
             }
             for (i = 0; i < n3; i++) delta[i] = it == 0 && ob->warm ? ob->warm[i] * m->free_mask[i] : 0;
-            kerr = heml__cg(m, u, D, 1.0, R, delta, eta, ob->coarse, krylov);
+            kerr = heml__linear_solve(m, HEML__SPD, u, D, 1.0, R, delta, eta, ob->coarse);
             if (kerr != HEML__NEGATIVE_CURVATURE || shift >= HEML__SHIFT_MAX) break;
             shift = shift > 0 ? 10.0 * shift : HEML__SHIFT_MIN;
         }
@@ -4036,7 +4336,7 @@ static int heml__newton(heml_model *m, heml__objective *ob, heml_real *u)
         krylov_ok = kerr == HEML_OK && shift == 0.0;
         slope = heml__dot(R, delta, n3);
         if (!(slope > 0.0)) { /* still negative curvature, or a warm start that ascends */
-            const heml_real *pinv = krylov[4];
+            const heml_real *pinv = m->krylov[HEML__CG_PINV];
             for (i = 0; i < n3; i++) delta[i] = pinv[i] * R[i];
             slope = heml__dot(R, delta, n3);
             krylov_ok = 0;
@@ -4100,7 +4400,7 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, cons
                           heml_real *u1, heml_real *v1)
 {
     int i, r, err, n = m->node_count, n3 = 3 * n;
-    heml_real *dmass = m->scratch[19], *load = m->scratch[18], *warm = m->scratch[20];
+    heml_real *dmass = m->implicit_dmass, *load = m->objective_load, *warm = m->implicit_warm;
     heml__objective ob;
     double cm = (1.0 + (double)dt * (double)m->mass_damping) / ((double)dt * (double)dt);
     for (i = 0; i < n; i++)
@@ -4133,34 +4433,58 @@ static int heml__implicit(heml_model *m, heml_real dt, const heml_real *u0, cons
     return HEML_OK;
 }
 
+/* >>integrators-table: one row per heml_integrator, indexed by it (see HOW TO EXTEND).
+   `step` advances the working copies: from the start (u0, v0: pinned axes already at their
+   targets, see heml__begin_step) to a candidate (u1, v1) in dt seconds, leaving the model's
+   state alone (heml_step_ex commits the candidate, or keeps the state on an error).
+   `is_explicit`: the step needs no force differential (so a user law without second
+   derivatives may use it) and keeps the semi-explicit divergence check's reference (an
+   implicit step resets it). */
+typedef int (*heml__step_fn)(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
+                             heml_real *u1, heml_real *v1);
+typedef struct heml__integrator_ops {
+    const char *name;
+    heml__step_fn step;
+    int is_explicit;
+} heml__integrator_ops;
+
+static const heml__integrator_ops heml__integrators[] = {
+    {"semi-explicit Euler", heml__semi_explicit, 1},
+    {"implicit Euler", heml__implicit, 0},
+    {"linearised implicit Euler", heml__implicit_linearized, 0},
+};
+/* an integrator added to heml_integrator without its row (or the reverse) fails to compile */
+typedef char heml__integrators_has_a_row_per_integrator
+    [sizeof heml__integrators / sizeof heml__integrators[0] == HEML_INTEGRATOR_COUNT ? 1 : -1];
+
 HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator)
 {
+    const heml__integrator_ops *ops;
     heml_real *u0, *v0, *u1, *v1;
     size_t n3;
     int err = HEML_OK;
     if (!m) return HEML_ERR_ARG;
     if (!(heml__finite((double)dt) && dt > 0)) return HEML_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 2) return HEML_ERR_INTEGRATOR;
-    if (integrator != HEML_SEMI_EXPLICIT_EULER && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
+    if ((unsigned)integrator >= HEML_INTEGRATOR_COUNT) return HEML_ERR_INTEGRATOR;
+    ops = heml__integrators + integrator;
+    if (!ops->is_explicit && m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * (size_t)m->node_count;
-    u0 = m->scratch[0];
-    v0 = m->scratch[1];
-    u1 = m->scratch[2];
-    v1 = m->scratch[3];
+    u0 = m->step_u0;
+    v0 = m->step_v0;
+    u1 = m->step_u1;
+    v1 = m->step_v1;
     memset(&m->stats, 0, sizeof m->stats);
     heml__prony_coefficients(m, (double)dt);
     heml__begin_step(m, dt, u0, v0);
     if (!heml__precision_ok(m, u0)) return HEML_ERR_PRECISION;
-    if (integrator == HEML_SEMI_EXPLICIT_EULER) err = heml__semi_explicit(m, dt, u0, v0, u1, v1);
-    else if (integrator == HEML_IMPLICIT_EULER) err = heml__implicit(m, dt, u0, v0, u1, v1);
-    else err = heml__implicit_linearized(m, dt, u0, v0, u1, v1);
+    err = ops->step(m, dt, u0, v0, u1, v1);
     if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
     if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);
         return err;
     }
     heml__commit(m, u1, v1);
-    if (integrator != HEML_SEMI_EXPLICIT_EULER) m->div_valid = 0;
+    if (!ops->is_explicit) m->div_valid = 0;
     return HEML_OK;
 }
 
@@ -4183,26 +4507,25 @@ HEMLDEF int heml_step(heml_model *m)
    (allow_inversion = 0) no more tetrahedra are inverted than at the start; where the
    predictor inverts more, Newton starts from the pinned axes' move alone. Stops: max_increments attempts, an
    increment below min_increment, a round-off stall (HEML_ERR_ROUND_OFF: a smaller load
-   would not help), or a load whose norm is not finite (HEML_ERR_NOT_FINITE). Scratch: 0-4,
-   18-20 here, 4-17 Newton's. */
+   would not help), or a load whose norm is not finite (HEML_ERR_NOT_FINITE). Scratch:
+   static_*, objective_load and work_f here, Newton's (work_f, newton_*, krylov). */
 HEMLDEF int heml_solve_static(heml_model *m)
 {
-    heml_real *u, *saved, *dpin, *q, *load, *rhs, *pred, *f, *krylov[8];
+    heml_real *u, *saved, *dpin, *q, *load, *rhs, *pred, *f;
     int i, r, n3, err = HEML_OK, attempts = 0, inverted_start;
     double lambda = 0.0, increment = 1.0;
     heml__objective ob;
     if (!m) return HEML_ERR_ARG;
     if (m->has_user_without_second) return HEML_ERR_NO_SECOND_DERIVATIVES;
     n3 = 3 * m->node_count;
-    u = m->scratch[0];
-    saved = m->scratch[1];
-    dpin = m->scratch[2];
-    q = m->scratch[3];
-    f = m->scratch[4];
-    load = m->scratch[18];
-    rhs = m->scratch[19];
-    pred = m->scratch[20];
-    for (i = 0; i < 8; i++) krylov[i] = m->scratch[10 + i];
+    u = m->static_u;
+    saved = m->static_saved;
+    dpin = m->static_dpin;
+    q = m->static_dfdpin;
+    f = m->work_f;
+    load = m->objective_load;
+    rhs = m->static_rhs;
+    pred = m->static_pred;
     memset(&m->stats, 0, sizeof m->stats);
     if (!heml__precision_ok(m, m->disp) || !heml__precision_ok(m, m->target)) return HEML_ERR_PRECISION;
     heml__prony_coefficients(m, -1.0);
@@ -4243,7 +4566,7 @@ HEMLDEF int heml_solve_static(heml_model *m)
             rhs[i] = (f[i] + load[i] + q[i]) * m->free_mask[i];
             pred[i] = 0;
         }
-        kerr = heml__cg(m, u, NULL, 1.0, rhs, pred, 1e-3, 1, krylov);
+        kerr = heml__linear_solve(m, HEML__SPD, u, NULL, 1.0, rhs, pred, 1e-3, 1);
         if (kerr == HEML_ERR_NOT_FINITE) {
             err = kerr;
             break;
@@ -4274,7 +4597,7 @@ HEMLDEF int heml_solve_static(heml_model *m)
     if (!heml__all_finite(u, (size_t)n3)) return HEML_ERR_NOT_FINITE;
     if (!heml__precision_ok(m, u)) return HEML_ERR_PRECISION;
     if (m->has_prony) { /* the Prony state of the last pass at u: make sure it is at u */
-        heml__forces(m, u, m->scratch[4], 1);
+        heml__forces(m, u, m->work_f, 1);
     }
     heml__commit(m, u, NULL);
     m->div_valid = 0;

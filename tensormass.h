@@ -81,6 +81,65 @@
        hd.tet_dynamic = which tets are dynamic, hd.fixed_nodes; tmass_hybrid_create, then
        tmass_hybrid_step / tmass_hybrid_set_displacement / tmass_hybrid_remove_tets.
 
+   HOW TO EXTEND (a new model kind, integrator or linear solver is a local change: one
+   enum value before its _COUNT sentinel, one row in one private table, the functions the
+   row names; nothing else dispatches on these enums)
+       Model kind (a "law": another force model on the same mesh). tmass_model_kind gets a
+         value before TMASS_MODEL_KIND_COUNT; tmass__kinds[] (section >>laws) gets a row:
+         name; assemble_tet (add or remove one tetrahedron's stiffness and lumped mass, at
+         creation and when cutting); force (internal force, elastic plus stiffness
+         damping, at u and v); differential (the linearised implicit Euler step: the force
+         term and the tangent left in the edge tensors, returning its factor c); energy;
+         implicit_newton (the full nonlinear implicit step, or NULL when the model is
+         linear); static_solve; flags (TMASS__KIND_LINEAR: constant tensors, so the
+         quasi-static and hybrid models and tmass_vertex_tensor accept it;
+         TMASS__KIND_POISSON: poisson_ratio is validated and lambda, mu stored). The
+         table's length is checked at compile time against the sentinel.
+       Integrator. tmass_integrator gets a value before TMASS_INTEGRATOR_COUNT;
+         tmass__integrators[] (section >>integrators) gets a row {name, step, is_explicit}.
+         step(m, dt) reads m->step_u0, m->step_v0 (pinned nodes already at their targets)
+         and writes m->step_u1, m->step_v1; tmass_step_ex does the rest (finiteness,
+         divergence check when is_explicit, precision check, inverted count when not,
+         commit, state kept on failure). Work vectors are named by role in tmass_model and
+         carved in tmass__layout: reuse one whose role cannot overlap yours (say so at the
+         aliasing in tmass__layout) or add one there (3n reals per node count).
+       Linear solver. tmass_linear_solver gets a value before TMASS_LINEAR_SOLVER_COUNT
+         (selected by desc.linear_solver); tmass__linear_solvers[] (section >>solver) gets
+         a row {name, solve, solve_block}. solve(m, diag, c, b, x) solves
+         (diag + c K) x = b on the free degrees of freedom (K applied by tmass__matvec,
+         including a hybrid's coupling block), x holding the initial guess; solve_block
+         solves K X = B for TMASS__RHS interleaved columns (the quasi-static
+         precomputation). Both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (cap reached or a
+         direction of non-positive curvature) or TMASS_ERR_NOT_FINITE, add to stats
+         (cg_iterations, cg_residual, stiffness_products, negative_curvature) and set
+         m->cg_indefinite when the matrix was not positive definite along a direction,
+         leaving that direction in m->cg_p and mask A p in m->cg_q (the springs' static
+         minimum check, tmass__spring_check_minimum, reads them).
+         Every solve of the header calls tmass__linear_solve / tmass__linear_solve_block:
+         never call a solver directly.
+       Tests each must add (tests/test_tensormass.c, test_tensormass_qs.c for the
+         precomputed paths): a model kind, force = -gradient of its energy by finite
+         differences (as test_force_is_minus_energy_gradient and
+         test_spring_force_is_minus_energy_gradient), differential = derivative of the
+         force (test_stiffness_is_minus_force_gradient,
+         test_spring_incremental_potential_gradient), a closed form where one exists
+         (test_stiffness_equals_p1_fem, test_cantilever_r1, test_masses), the static and
+         implicit solves agreeing (test_springs_implicit_matches_static); an integrator,
+         its order of accuracy on the oscillator (test_integrator_order: halving dt
+         divides the error by 2^order) and its energy behaviour
+         (test_semi_implicit_energy_bounded, test_explicit_euler_grows_rk4_decays); a
+         linear solver, the same answers as CG within the tolerance on the static,
+         implicit and quasi-static tests, its failure codes (test_cg_cap_fails,
+         test_huge_load_not_finite); all three, determinism (test_threads_bit_identical:
+         bit-identical for 1 and 2 threads) and no allocation after creation
+         (test_no_allocation_after_create); test_extension_enums_validated covers the
+         sentinels.
+       Bench (bench/model_tensormass.c: a kind is a row of tm_models with its create
+         function; an integrator a BENCH_ id of bench/bench.h mapped in tm_step): the new
+         entry's speed/accuracy rows (R1-R5) and stability table next to the existing
+         ones, and the existing rows no slower (callgrind instruction counts of a step
+         loop per integrator, or make bench-quick, before and after, in the note).
+
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, time s, forces
    N, mass_damping 1/s, stiffness_damping s, gravity m/s^2 (default 9.81 along -z).
 
@@ -134,7 +193,8 @@
    static solve, the same fields in the same order as heml_stats and frm_stats:
    newton_iterations, cg_iterations, cg_residual, residual, increments, increment_cuts,
    line_search_cuts, negative_curvature, inverted, force_evaluations, stiffness_products.
-       Linear solves: Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
+       Linear solves (desc.linear_solver; TMASS_LINEAR_SOLVER_CG, the only one today):
+       Jacobi-preconditioned CG to |r| <= cg_tolerance |b| (default 1e-6,
        1e-5 float) within cg_max_iterations (2000); at the cap it fails (see ERRORS). Its
        dot products accumulate in double. A relative residual does not bound the error
        (error <= cond |r| / |b|): in float, nearly incompressible materials are refused at
@@ -351,6 +411,12 @@
          with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       unreleased (issue 20) explicit extension points, results bit-identical: the
+             private tables tmass__kinds, tmass__integrators, tmass__linear_solvers (see
+             HOW TO EXTEND); TMASS_MODEL_KIND_COUNT, TMASS_INTEGRATOR_COUNT,
+             tmass_linear_solver and desc.linear_solver; work vectors named by role, CG
+             with its own (the model block grows by 5 vectors of 3n reals, 120 bytes per
+             node in double); tmass_create and tmass_hybrid_create in named stages.
        unreleased (issue 18) no silent wrong answers: an implicit step after driving a node
              counted the node's move twice (free nodes 2x the static answer at long dt);
              the quasi-static preload ignored pinned nodes away from rest; CG at its cap,
@@ -541,16 +607,25 @@ enum {
 
 typedef enum tmass_model_kind {
     TMASS_TENSOR_MASS = 0, /* linear elasticity, Cotin et al. eqs. 5-6 (default) */
-    TMASS_MASS_SPRING = 1  /* springs on the mesh edges, eq. 7 (baseline) */
+    TMASS_MASS_SPRING = 1, /* springs on the mesh edges, eq. 7 (baseline) */
+    TMASS_MODEL_KIND_COUNT /* number of kinds (validation), not a kind */
 } tmass_model_kind;
 
 typedef enum tmass_integrator {
     TMASS_EXPLICIT_EULER = 0,
     TMASS_SEMI_IMPLICIT_EULER = 1,
     TMASS_RK4 = 2,
-    TMASS_IMPLICIT_EULER = 3,           /* springs: Newton on the incremental potential */
-    TMASS_IMPLICIT_EULER_LINEARIZED = 4 /* one linearised Newton iteration (see INTEGRATORS) */
+    TMASS_IMPLICIT_EULER = 3,            /* springs: Newton on the incremental potential */
+    TMASS_IMPLICIT_EULER_LINEARIZED = 4, /* one linearised Newton iteration (see INTEGRATORS) */
+    TMASS_INTEGRATOR_COUNT               /* number of integrators (validation), not one */
 } tmass_integrator;
+
+/* The solver of every linear system (static solve, implicit steps, Newton iterations,
+   quasi-static precomputation). */
+typedef enum tmass_linear_solver {
+    TMASS_LINEAR_SOLVER_CG = 0, /* Jacobi-preconditioned conjugate gradient (SOLVERS) */
+    TMASS_LINEAR_SOLVER_COUNT   /* number of solvers (validation), not one */
+} tmass_linear_solver;
 
 /* Custom allocator: alloc(size, align, user) returns memory aligned to `align` (a power
    of two <= 64) or NULL; free(ptr, size, user) releases it. */
@@ -589,6 +664,7 @@ typedef struct tmass_desc {
     tmass_real gravity[3];       /* m/s^2, default (0, 0, -9.81) */
     tmass_real time_step;        /* s, default 1e-3, used by tmass_step */
     tmass_integrator integrator; /* default TMASS_IMPLICIT_EULER */
+    tmass_linear_solver linear_solver; /* default TMASS_LINEAR_SOLVER_CG */
     tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-6 (1e-5 float) */
     int cg_max_iterations;       /* default 2000 */
 
@@ -802,7 +878,7 @@ typedef struct tmass_qs_desc {
 TMASSDEF tmass_qs_desc tmass_qs_default_desc(void);
 /* Precomputes the quasi-static model of the tensor-mass model m (its mesh, material, pinned
    nodes, gravity and external forces at this moment). Costs 3 * |nodes| + 1 CG solves,
-   run 8 at a time so that each K product serves eight; uses m's scratch memory and a
+   run 8 at a time so that each K product serves eight; uses m's work vectors and a
    temporary block of 6 x 8 vectors (freed before returning) and leaves m's state
    unchanged. */
 TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **out);
@@ -941,7 +1017,6 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #define TMASS__EPS (sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON)
 /* largest eps(tmass_real) lambda / mu the tensor model accepts (LIMITS; float: nu <= 0.4994) */
 #define TMASS__LAMBDA_MU_LIMIT 1e-4
-#define TMASS__SCRATCH 10      /* 3n scratch vectors */
 
 /* node states */
 #define TMASS__FREE 0
@@ -952,6 +1027,7 @@ struct tmass_model {
     int node_count, tet_count, edge_total, edge_count, live_tets;
     tmass_model_kind kind;
     tmass_integrator integrator;
+    tmass_linear_solver linear_solver;
     tmass_real time_step, mass_damping, stiffness_damping, gravity[3], cg_tolerance;
     int cg_max_iterations;
     double divergence_strain, precision_limit, newton_tolerance;
@@ -999,8 +1075,29 @@ struct tmass_model {
     int *tri, *tri_owner, *face_pos;
     int tri_count;
 
-    /* scratch */
-    tmass_real *scratch[TMASS__SCRATCH];
+    /* working vectors (3n reals each), named by role; tmass__layout carves them and says
+       which roles share memory (roles of different entry points or integrators that never
+       run at the same time) */
+    tmass_real *step_u0, *step_v0;   /* a step's start: displacements and velocities, pinned
+                                        nodes at their targets (tmass__begin_step) */
+    tmass_real *step_u1, *step_v1;   /* a step's result, committed when it is accepted */
+    tmass_real *step_accel;          /* accelerations (explicit integrators, RK4 stages) */
+    tmass_real *force_work;          /* u + beta v for the stiffness-damped elastic force */
+    tmass_real *rk4_u, *rk4_v;       /* RK4 stage state */
+    tmass_real *implicit_rhs;        /* linearised implicit Euler: right-hand side */
+    tmass_real *implicit_diag;       /* M (1 + dt alpha) per degree of freedom (also Newton's) */
+    tmass_real *implicit_dv;         /* velocity increment solved for */
+    tmass_real *implicit_vfree;      /* springs: v0 on the free nodes */
+    tmass_real *implicit_kv;         /* springs: K v0_free */
+    tmass_real *newton_residual;     /* springs' Newton (implicit step, static solve) */
+    tmass_real *newton_dx, *newton_trial; /* Newton step and line-search trial point */
+    tmass_real *static_u;            /* static solve: the displacement solved for */
+    tmass_real *static_accepted;     /* springs' continuation: last accepted state */
+    tmass_real *static_probe_rhs, *static_probe_x; /* springs' minimum check: probe solve */
+    tmass_real *qs_rhs, *qs_x;       /* quasi-static preload solve */
+    tmass_real *qs_mark;             /* quasi-static creation: precomputed-node marks (n) */
+    tmass_real *cg_r, *cg_z, *cg_p, *cg_q, *cg_pinv; /* CG: residual, preconditioned
+                                        residual, direction, A p, Jacobi inverse diagonal */
     tmass_real *dv_prev; /* implicit warm start */
     double *partials; /* 2 * partial_count block sums */
     int cg_indefinite; /* the last CG stopped on p . A p <= 0 */
@@ -1171,7 +1268,6 @@ static void *tmass__carve(tmass__carver *c, size_t bytes)
 static void tmass__layout(tmass_model *m, tmass__carver *c)
 {
     size_t n = (size_t)m->node_count, t = (size_t)m->tet_count, e = (size_t)m->edge_total;
-    int s;
     TMASS__CARVE(c, m->rest, tmass_real, 3 * n);
     TMASS__CARVE(c, m->disp, tmass_real, 3 * n);
     TMASS__CARVE(c, m->pos, tmass_real, 3 * n);
@@ -1208,118 +1304,44 @@ static void tmass__layout(tmass_model *m, tmass__carver *c)
     TMASS__CARVE(c, m->tri, int, 12 * t);
     TMASS__CARVE(c, m->tri_owner, int, 4 * t);
     TMASS__CARVE(c, m->face_pos, int, 4 * t);
-    for (s = 0; s < TMASS__SCRATCH; s++) TMASS__CARVE(c, m->scratch[s], tmass_real, 3 * n);
+    /* working vectors: 16 distinct 3n arrays (the 11 of 0.2.0 plus CG's own five, so no
+       output or state buffer is lent to CG any more). Roles that never run at the same
+       time share memory, set up here and only here:
+         - RK4's stage state, the linearised implicit Euler's vectors and the springs'
+           Newton vectors belong to different integrators of one step;
+         - the static solve and the quasi-static preload solve are entry points of their
+           own, never inside a step: they reuse the step's state vectors. */
+    TMASS__CARVE(c, m->step_u0, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_v0, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_u1, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_v1, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->step_accel, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->force_work, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_rhs, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_diag, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->implicit_dv, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->newton_trial, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_r, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_z, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_p, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_q, tmass_real, 3 * n);
+    TMASS__CARVE(c, m->cg_pinv, tmass_real, 3 * n);
     TMASS__CARVE(c, m->dv_prev, tmass_real, 3 * n);
+    m->rk4_u = m->implicit_rhs;
+    m->rk4_v = m->implicit_diag;
+    m->implicit_vfree = m->step_u1; /* read before the step's result is written */
+    m->implicit_kv = m->force_work; /* the springs' force needs no work vector */
+    m->newton_residual = m->implicit_rhs;
+    m->newton_dx = m->implicit_dv;
+    m->static_u = m->step_u1;
+    m->static_accepted = m->step_u0;
+    m->static_probe_rhs = m->implicit_rhs; /* after the continuation, its Newton is over */
+    m->static_probe_x = m->implicit_dv;
+    m->qs_rhs = m->step_u0;
+    m->qs_x = m->step_u1;
+    m->qs_mark = m->step_v0;
     TMASS__CARVE(c, m->partials, double, 2 * (size_t)m->partial_count);
     TMASS__CARVE(c, m->tear_list, int, t);
-}
-
-/* >>validation ------------------------------------------------------------------------ */
-
-static int tmass__fail(const tmass_desc *d, int code, const char *detail)
-{
-    if (d && d->log) d->log(code, detail, d->log_user);
-    return code;
-}
-
-static int tmass__validate_material(const tmass_desc *d, double E, double nu, int t, char *msg,
-                                    size_t msg_size)
-{
-    if (!(tmass__finite(E) && E > 0.0)) {
-        snprintf(msg, msg_size, "Young's modulus %g of tetrahedron %d", E, t);
-        return TMASS_ERR_YOUNG_MODULUS;
-    }
-    if (d->kind == TMASS_TENSOR_MASS && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
-        snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
-        return TMASS_ERR_POISSON_RATIO;
-    }
-    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
-       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
-    if (d->kind == TMASS_TENSOR_MASS && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
-        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
-                 nu, t);
-        return TMASS_ERR_POISSON_RATIO;
-    }
-    return TMASS_OK;
-}
-
-static int tmass__validate(const tmass_desc *d)
-{
-    char msg[160];
-    int i, t, err;
-    /* a desc without the cookie was not made by tmass_default_desc: nothing in it can be
-       trusted, its log callback least of all (issue 18) */
-    if (d->internal_cookie != TMASS__COOKIE) return TMASS_ERR_DESC;
-    if (d->kind != TMASS_TENSOR_MASS && d->kind != TMASS_MASS_SPRING)
-        return tmass__fail(d, TMASS_ERR_MODEL_KIND, "kind");
-    if (d->node_count < 4 || d->node_count > 200000000 || !d->rest_positions)
-        return tmass__fail(d, TMASS_ERR_NODE_COUNT, "node_count must be >= 4 with positions");
-    if (d->tet_count < 1 || d->tet_count > 200000000 || !d->tets)
-        return tmass__fail(d, TMASS_ERR_TET_COUNT, "tet_count must be >= 1 with indices");
-    if (!(tmass__finite(d->density) && d->density > 0))
-        return tmass__fail(d, TMASS_ERR_DENSITY, "density");
-    if (!(tmass__finite(d->time_step) && d->time_step > 0))
-        return tmass__fail(d, TMASS_ERR_TIME_STEP, "time_step");
-    if (!(tmass__finite(d->mass_damping) && d->mass_damping >= 0) ||
-        !(tmass__finite(d->stiffness_damping) && d->stiffness_damping >= 0))
-        return tmass__fail(d, TMASS_ERR_DAMPING, "damping");
-    if ((int)d->integrator < 0 || (int)d->integrator > 4)
-        return tmass__fail(d, TMASS_ERR_INTEGRATOR, "integrator");
-    if (!(tmass__finite(d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
-        return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
-    if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
-        return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
-    if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
-        !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
-        return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
-    for (i = 0; i < 3; i++)
-        if (!tmass__finite(d->gravity[i])) return tmass__fail(d, TMASS_ERR_ARG, "gravity");
-    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        return tmass__fail(d, TMASS_ERR_ARG, "allocator needs both alloc and free");
-    for (i = 0; i < 3 * d->node_count; i++)
-        if (!tmass__finite(d->rest_positions[i])) {
-            snprintf(msg, sizeof msg, "rest position of node %d is not finite", i / 3);
-            return tmass__fail(d, TMASS_ERR_NODE_NOT_FINITE, msg);
-        }
-    for (t = 0; t < d->tet_count; t++) {
-        const int *q = d->tets + 4 * t;
-        double E = d->tet_young_modulus ? (double)d->tet_young_modulus[t] : (double)d->young_modulus;
-        double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
-        double g[4][3], six_v, longest = 0.0;
-        int a, b;
-        for (a = 0; a < 4; a++) {
-            if (q[a] < 0 || q[a] >= d->node_count) {
-                snprintf(msg, sizeof msg, "tetrahedron %d: node index %d out of range", t, q[a]);
-                return tmass__fail(d, TMASS_ERR_INDEX_RANGE, msg);
-            }
-            for (b = 0; b < a; b++)
-                if (q[a] == q[b]) {
-                    snprintf(msg, sizeof msg, "tetrahedron %d uses node %d twice", t, q[a]);
-                    return tmass__fail(d, TMASS_ERR_INDEX_REPEATED, msg);
-                }
-        }
-        err = tmass__validate_material(d, E, nu, t, msg, sizeof msg);
-        if (err) return tmass__fail(d, err, msg);
-        for (a = 0; a < 4; a++)
-            for (b = a + 1; b < 4; b++) {
-                const tmass_real *pa = d->rest_positions + 3 * q[a], *pb = d->rest_positions + 3 * q[b];
-                double dx = (double)pa[0] - pb[0], dy = (double)pa[1] - pb[1], dz = (double)pa[2] - pb[2];
-                double l2 = dx * dx + dy * dy + dz * dz;
-                if (l2 > longest) longest = l2;
-            }
-        six_v = tmass__shape_gradients(d->rest_positions + 3 * q[0], d->rest_positions + 3 * q[1],
-                                       d->rest_positions + 3 * q[2], d->rest_positions + 3 * q[3], g);
-        /* a regular tetrahedron has 6V = l^3 / sqrt(2); flag slivers 1e8 times flatter */
-        if (!(fabs(six_v) > 1e-8 * longest * sqrt(longest))) {
-            snprintf(msg, sizeof msg, "tetrahedron %d is flat (6V = %g)", t, six_v);
-            return tmass__fail(d, TMASS_ERR_TET_DEGENERATE, msg);
-        }
-        if (six_v < 0.0) {
-            snprintf(msg, sizeof msg, "tetrahedron %d is negatively oriented", t);
-            return tmass__fail(d, TMASS_ERR_TET_INVERTED, msg);
-        }
-    }
-    return TMASS_OK;
 }
 
 /* >>precomputation -------------------------------------------------------------------- */
@@ -1506,33 +1528,215 @@ static void tmass__add_tensor(tmass_real *dst, const double *src, double sign)
     for (k = 0; k < 9; k++) dst[k] = (tmass_real)((double)dst[k] + sign * src[k]);
 }
 
-/* Adds (sign +1) or subtracts (-1) the contribution of tetrahedron t: tensors, spring
-   stiffnesses and lumped masses. The ten tensor updates of sec. 5.5. */
-static void tmass__apply_tet(tmass_model *m, int t, double sign)
+/* Adds (sign +1) or subtracts (-1) the contribution of tetrahedron t: tensors and
+   lumped masses. The ten tensor updates of sec. 5.5. */
+static void tmass__tensor_assemble_tet(tmass_model *m, int t, double sign)
 {
     double K[4][4][9], v;
     const int *q = m->tet_nodes + 4 * t;
     int j, l;
-    v = m->kind == TMASS_TENSOR_MASS ? tmass__tet_tensors(m, t, K) : tmass__rest_volume(m, t);
+    v = tmass__tet_tensors(m, t, K);
     for (j = 0; j < 4; j++) {
         m->mass[q[j]] = (tmass_real)((double)m->mass[q[j]] + sign * m->density * v / 4.0);
-        if (m->kind == TMASS_TENSOR_MASS) tmass__add_tensor(m->vertex_tensor + 9 * q[j], K[j][j], sign);
+        tmass__add_tensor(m->vertex_tensor + 9 * q[j], K[j][j], sign);
     }
     for (l = 0; l < 6; l++) {
         int j0 = tmass__edge_local[l][0], j1 = tmass__edge_local[l][1];
         int slot = m->edge_slot[m->tet_edges[6 * t + l]];
-        if (m->kind == TMASS_TENSOR_MASS) {
-            /* the slot stores K_ab with a < b */
-            if (q[j0] < q[j1])
-                tmass__add_tensor(m->edge_tensor + 9 * slot, K[j0][j1], sign);
-            else
-                tmass__add_tensor(m->edge_tensor + 9 * slot, K[j1][j0], sign);
-        } else {
-            double l0 = m->edge_rest_length[slot];
-            m->edge_stiffness[slot] =
-                (tmass_real)((double)m->edge_stiffness[slot] + sign * m->tet_young[t] * v / (l0 * l0));
+        /* the slot stores K_ab with a < b */
+        if (q[j0] < q[j1])
+            tmass__add_tensor(m->edge_tensor + 9 * slot, K[j0][j1], sign);
+        else
+            tmass__add_tensor(m->edge_tensor + 9 * slot, K[j1][j0], sign);
+    }
+}
+
+/* The same for springs: lumped masses and the six spring stiffnesses k = E V / l0^2. */
+static void tmass__spring_assemble_tet(tmass_model *m, int t, double sign)
+{
+    double v;
+    const int *q = m->tet_nodes + 4 * t;
+    int j, l;
+    v = tmass__rest_volume(m, t);
+    for (j = 0; j < 4; j++) m->mass[q[j]] = (tmass_real)((double)m->mass[q[j]] + sign * m->density * v / 4.0);
+    for (l = 0; l < 6; l++) {
+        int slot = m->edge_slot[m->tet_edges[6 * t + l]];
+        double l0 = m->edge_rest_length[slot];
+        m->edge_stiffness[slot] =
+            (tmass_real)((double)m->edge_stiffness[slot] + sign * m->tet_young[t] * v / (l0 * l0));
+    }
+}
+
+/* >>laws ------------------------------------------------------------------------------ */
+
+/* The model kinds (the "laws" of this header), one row per tmass_model_kind: every place
+   where the kind selects physics goes through this table (HOW TO EXTEND). */
+typedef struct tmass__kind_ops {
+    const char *name;
+    /* per-tetrahedron precomputation: add (sign +1) or remove (-1) tetrahedron t's
+       stiffness and lumped mass (creation, cutting) */
+    void (*assemble_tet)(tmass_model *m, int t, double sign);
+    /* internal force (elastic plus stiffness damping) at displacement u and velocity v
+       (v may be NULL) into out; w: a 3n work vector */
+    void (*force)(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out, tmass_real *w);
+    /* the force's differential for the linearised implicit Euler step from (x0, v0):
+       writes f(x0, v0) - dt K v0_free into f, leaves the system's stiffness part in the
+       edge tensors (what tmass__matvec applies) and returns its factor c, so that the
+       step solves (M (1 + dt alpha) + c K) dv = dt (f + loads) */
+    double (*differential)(tmass_model *m, tmass_real dt, const tmass_real *x0, const tmass_real *v0,
+                           tmass_real *f);
+    /* elastic energy at displacement u, J (may use m->force as work) */
+    double (*energy)(tmass_model *m, const tmass_real *u);
+    /* TMASS_IMPLICIT_EULER: a Newton solve of the nonlinear step, or NULL when the kind is
+       linear (the linearised step is then exact) */
+    int (*implicit_newton)(tmass_model *m, tmass_real dt);
+    /* static equilibrium from u (pinned entries at their targets), in place */
+    int (*static_solve)(tmass_model *m, tmass_real *u);
+    int flags; /* TMASS__KIND_* */
+} tmass__kind_ops;
+
+/* linear with constant tensors in the model: K is what the edge tensors hold, so the
+   quasi-static precomputation, the hybrid model and tmass_vertex_tensor apply */
+#define TMASS__KIND_LINEAR 1
+/* uses poisson_ratio (validated; lambda and mu stored per tetrahedron) */
+#define TMASS__KIND_POISSON 2
+
+static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w);
+static void tmass__spring_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w);
+static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f);
+static double tmass__spring_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f);
+static double tmass__tensor_energy(tmass_model *m, const tmass_real *u);
+static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u);
+static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt);
+static int tmass__tensor_static(tmass_model *m, tmass_real *u);
+static int tmass__spring_static_solve(tmass_model *m, tmass_real *u);
+
+static const tmass__kind_ops tmass__kinds[] = {
+    /* TMASS_TENSOR_MASS */
+    {"tensor-mass", tmass__tensor_assemble_tet, tmass__tensor_force, tmass__tensor_differential,
+     tmass__tensor_energy, NULL, tmass__tensor_static, TMASS__KIND_LINEAR | TMASS__KIND_POISSON},
+    /* TMASS_MASS_SPRING */
+    {"mass-spring", tmass__spring_assemble_tet, tmass__spring_force, tmass__spring_differential,
+     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static_solve, 0}};
+/* one row per kind (a negative array size stops the build otherwise) */
+typedef char tmass__kinds_size_check[sizeof tmass__kinds / sizeof tmass__kinds[0] == TMASS_MODEL_KIND_COUNT ? 1 : -1];
+
+static void tmass__apply_tet(tmass_model *m, int t, double sign) { tmass__kinds[m->kind].assemble_tet(m, t, sign); }
+
+/* >>validation ------------------------------------------------------------------------ */
+
+static int tmass__fail(const tmass_desc *d, int code, const char *detail)
+{
+    if (d && d->log) d->log(code, detail, d->log_user);
+    return code;
+}
+
+static int tmass__validate_material(const tmass_desc *d, double E, double nu, int t, char *msg,
+                                    size_t msg_size)
+{
+    if (!(tmass__finite(E) && E > 0.0)) {
+        snprintf(msg, msg_size, "Young's modulus %g of tetrahedron %d", E, t);
+        return TMASS_ERR_YOUNG_MODULUS;
+    }
+    int poisson = (tmass__kinds[d->kind].flags & TMASS__KIND_POISSON) != 0;
+    if (poisson && !(tmass__finite(nu) && nu > -1.0 && nu < 0.5)) {
+        snprintf(msg, msg_size, "Poisson ratio %g of tetrahedron %d", nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    /* the tensors are stored in tmass_real: rounding them perturbs the shear (bending)
+       stiffness by about eps lambda / mu, which near-incompressibility amplifies (LIMITS) */
+    if (poisson && TMASS__EPS * 2.0 * nu / (1.0 - 2.0 * nu) > TMASS__LAMBDA_MU_LIMIT) {
+        snprintf(msg, msg_size, "Poisson ratio %.6g of tetrahedron %d: too close to 0.5 for float (<= 0.4994)",
+                 nu, t);
+        return TMASS_ERR_POISSON_RATIO;
+    }
+    return TMASS_OK;
+}
+
+/* Stage 1 of tmass_create (and of tmass_hybrid_create): every check on the description,
+   before anything is allocated. */
+static int tmass__create_validate(const tmass_desc *d)
+{
+    char msg[160];
+    int i, t, err;
+    /* a desc without the cookie was not made by tmass_default_desc: nothing in it can be
+       trusted, its log callback least of all (issue 18) */
+    if (d->internal_cookie != TMASS__COOKIE) return TMASS_ERR_DESC;
+    if ((unsigned)d->kind >= TMASS_MODEL_KIND_COUNT) return tmass__fail(d, TMASS_ERR_MODEL_KIND, "kind");
+    if (d->node_count < 4 || d->node_count > 200000000 || !d->rest_positions)
+        return tmass__fail(d, TMASS_ERR_NODE_COUNT, "node_count must be >= 4 with positions");
+    if (d->tet_count < 1 || d->tet_count > 200000000 || !d->tets)
+        return tmass__fail(d, TMASS_ERR_TET_COUNT, "tet_count must be >= 1 with indices");
+    if (!(tmass__finite(d->density) && d->density > 0))
+        return tmass__fail(d, TMASS_ERR_DENSITY, "density");
+    if (!(tmass__finite(d->time_step) && d->time_step > 0))
+        return tmass__fail(d, TMASS_ERR_TIME_STEP, "time_step");
+    if (!(tmass__finite(d->mass_damping) && d->mass_damping >= 0) ||
+        !(tmass__finite(d->stiffness_damping) && d->stiffness_damping >= 0))
+        return tmass__fail(d, TMASS_ERR_DAMPING, "damping");
+    if ((unsigned)d->integrator >= TMASS_INTEGRATOR_COUNT)
+        return tmass__fail(d, TMASS_ERR_INTEGRATOR, "integrator");
+    if ((unsigned)d->linear_solver >= TMASS_LINEAR_SOLVER_COUNT)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "linear_solver");
+    if (!(tmass__finite(d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
+    if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
+    if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
+        !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
+        return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
+    for (i = 0; i < 3; i++)
+        if (!tmass__finite(d->gravity[i])) return tmass__fail(d, TMASS_ERR_ARG, "gravity");
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return tmass__fail(d, TMASS_ERR_ARG, "allocator needs both alloc and free");
+    for (i = 0; i < 3 * d->node_count; i++)
+        if (!tmass__finite(d->rest_positions[i])) {
+            snprintf(msg, sizeof msg, "rest position of node %d is not finite", i / 3);
+            return tmass__fail(d, TMASS_ERR_NODE_NOT_FINITE, msg);
+        }
+    for (t = 0; t < d->tet_count; t++) {
+        const int *q = d->tets + 4 * t;
+        double E = d->tet_young_modulus ? (double)d->tet_young_modulus[t] : (double)d->young_modulus;
+        double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
+        double g[4][3], six_v, longest = 0.0;
+        int a, b;
+        for (a = 0; a < 4; a++) {
+            if (q[a] < 0 || q[a] >= d->node_count) {
+                snprintf(msg, sizeof msg, "tetrahedron %d: node index %d out of range", t, q[a]);
+                return tmass__fail(d, TMASS_ERR_INDEX_RANGE, msg);
+            }
+            for (b = 0; b < a; b++)
+                if (q[a] == q[b]) {
+                    snprintf(msg, sizeof msg, "tetrahedron %d uses node %d twice", t, q[a]);
+                    return tmass__fail(d, TMASS_ERR_INDEX_REPEATED, msg);
+                }
+        }
+        err = tmass__validate_material(d, E, nu, t, msg, sizeof msg);
+        if (err) return tmass__fail(d, err, msg);
+        for (a = 0; a < 4; a++)
+            for (b = a + 1; b < 4; b++) {
+                const tmass_real *pa = d->rest_positions + 3 * q[a], *pb = d->rest_positions + 3 * q[b];
+                double dx = (double)pa[0] - pb[0], dy = (double)pa[1] - pb[1], dz = (double)pa[2] - pb[2];
+                double l2 = dx * dx + dy * dy + dz * dz;
+                if (l2 > longest) longest = l2;
+            }
+        six_v = tmass__shape_gradients(d->rest_positions + 3 * q[0], d->rest_positions + 3 * q[1],
+                                       d->rest_positions + 3 * q[2], d->rest_positions + 3 * q[3], g);
+        /* a regular tetrahedron has 6V = l^3 / sqrt(2); flag slivers 1e8 times flatter */
+        if (!(fabs(six_v) > 1e-8 * longest * sqrt(longest))) {
+            snprintf(msg, sizeof msg, "tetrahedron %d is flat (6V = %g)", t, six_v);
+            return tmass__fail(d, TMASS_ERR_TET_DEGENERATE, msg);
+        }
+        if (six_v < 0.0) {
+            snprintf(msg, sizeof msg, "tetrahedron %d is negatively oriented", t);
+            return tmass__fail(d, TMASS_ERR_TET_INVERTED, msg);
         }
     }
+    return TMASS_OK;
 }
 
 /* >>creation -------------------------------------------------------------------------- */
@@ -1561,6 +1765,7 @@ TMASSDEF tmass_desc tmass_default_desc(void)
     d.gravity[2] = (tmass_real)-9.81;
     d.time_step = (tmass_real)1e-3;
     d.integrator = TMASS_IMPLICIT_EULER;
+    d.linear_solver = TMASS_LINEAR_SOLVER_CG;
     d.cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-6);
     d.cg_max_iterations = 2000;
     d.newton_iterations = 20;
@@ -1589,64 +1794,72 @@ static void tmass__init_boundary(tmass_model *m)
         }
 }
 
-TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
+/* tmass_create in four stages that read top to bottom: validate the description, size
+   the model (the temporary edge and face tables, the edge count, every array's length),
+   lay out the one block (allocate and carve), precompute (copy the mesh and settings,
+   edges, tensors or springs, masses, chunks and colours, neighbours, boundary). */
+
+/* Temporary tables of creation: start[n+1], key[6T], payload[6T], tet_edge[6T]. */
+typedef struct tmass__create_tables {
+    char *block;
+    size_t bytes;
+    int *start, *key, *payload, *tet_edge;
+} tmass__create_tables;
+
+/* Allocates the temporary tables and counts the edges; sizes holds every array length
+   tmass__layout needs. */
+static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__create_tables *w)
 {
-    tmass_model tmp, *m;
+    int n = d->node_count, T = d->tet_count, E;
+    w->bytes = sizeof(int) * ((size_t)n + 1 + 18 * (size_t)T);
+    w->block = (char *)tmass__alloc(&d->allocator, w->bytes);
+    if (!w->block) return tmass__fail(d, TMASS_ERR_ALLOC, "temporary tables");
+    w->start = (int *)w->block;
+    w->key = w->start + n + 1;
+    w->payload = w->key + 6 * (size_t)T;
+    w->tet_edge = w->payload + 6 * (size_t)T;
+    E = tmass__build_edges(d->tets, T, n, w->start, w->key, w->payload, w->tet_edge, NULL, NULL);
+    memset(sizes, 0, sizeof *sizes);
+    sizes->node_count = n;
+    sizes->tet_count = T;
+    sizes->edge_total = E;
+    sizes->chunk_size = E / 32;
+    if (sizes->chunk_size < 256) sizes->chunk_size = 256;
+    if (sizes->chunk_size > 4096) sizes->chunk_size = 4096;
+    sizes->chunk_total = (E + sizes->chunk_size - 1) / sizes->chunk_size;
+    sizes->partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
+    return TMASS_OK;
+}
+
+/* Allocates the model's block (the struct first, then every array, 64-byte aligned) and
+   carves it; *out points at the zeroed model with its arrays in place. */
+static int tmass__create_layout(const tmass_desc *d, const tmass_model *sizes, tmass_model **out)
+{
+    tmass_model tmp = *sizes;
     tmass__carver carver;
-    int err, i, t, n, T, E;
-    int *start = NULL, *key = NULL, *payload = NULL, *tet_edge_tmp = NULL;
-    size_t tmp_bytes;
-    char *tmp_block = NULL;
-    tmass_allocator alloc;
-
-    if (!out) return TMASS_ERR_ARG;
-    *out = NULL;
-    if (!d) return TMASS_ERR_ARG;
-    err = tmass__validate(d);
-    if (err) return err;
-
-    n = d->node_count;
-    T = d->tet_count;
-    alloc = d->allocator;
-
-    /* temporary arrays for edge and face tables: start[n+1], key[6T], payload[6T],
-       tet_edge_tmp[6T] */
-    tmp_bytes = sizeof(int) * ((size_t)n + 1 + 18 * (size_t)T);
-    tmp_block = (char *)tmass__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return tmass__fail(d, TMASS_ERR_ALLOC, "temporary tables");
-    start = (int *)tmp_block;
-    key = start + n + 1;
-    payload = key + 6 * (size_t)T;
-    tet_edge_tmp = payload + 6 * (size_t)T;
-    E = tmass__build_edges(d->tets, T, n, start, key, payload, tet_edge_tmp, NULL, NULL);
-
-    memset(&tmp, 0, sizeof tmp);
-    tmp.node_count = n;
-    tmp.tet_count = T;
-    tmp.edge_total = E;
-    tmp.chunk_size = E / 32;
-    if (tmp.chunk_size < 256) tmp.chunk_size = 256;
-    if (tmp.chunk_size > 4096) tmp.chunk_size = 4096;
-    tmp.chunk_total = (E + tmp.chunk_size - 1) / tmp.chunk_size;
-    tmp.partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
     carver.base = NULL;
     carver.offset = sizeof(tmass_model);
     tmass__layout(&tmp, &carver);
     tmp.block_bytes = carver.offset;
-    tmp.block = tmass__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        tmass__free(&alloc, tmp_block, tmp_bytes);
-        return tmass__fail(d, TMASS_ERR_ALLOC, "model block");
-    }
+    tmp.block = tmass__alloc(&d->allocator, tmp.block_bytes);
+    if (!tmp.block) return TMASS_ERR_ALLOC;
     memset(tmp.block, 0, tmp.block_bytes);
     carver.base = (char *)tmp.block;
     carver.offset = sizeof(tmass_model);
     tmass__layout(&tmp, &carver);
-    m = (tmass_model *)tmp.block;
-    *m = tmp;
+    *out = (tmass_model *)tmp.block;
+    **out = tmp;
+    (*out)->allocator = d->allocator;
+    return TMASS_OK;
+}
 
+/* The description's settings into the model. */
+static void tmass__create_settings(const tmass_desc *d, tmass_model *m)
+{
+    int i;
     m->kind = d->kind;
     m->integrator = d->integrator;
+    m->linear_solver = d->linear_solver;
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
     m->stiffness_damping = d->stiffness_damping;
@@ -1659,15 +1872,20 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
     m->load_scale = 1.0;
     m->precision_limit = (double)d->precision_limit;
     m->density = (double)d->density;
-    m->allocator = alloc;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = E >= TMASS_PARALLEL_MIN_EDGES;
+    m->parallel = m->edge_total >= TMASS_PARALLEL_MIN_EDGES;
+}
 
+/* The mesh, its edges and per-tetrahedron materials; rest lengths (springs, the
+   precision check). */
+static void tmass__create_mesh(const tmass_desc *d, tmass_model *m, tmass__create_tables *w)
+{
+    int i, t, n = m->node_count, T = m->tet_count, E;
     memcpy(m->rest, d->rest_positions, sizeof(tmass_real) * 3 * (size_t)n);
     memcpy(m->pos, d->rest_positions, sizeof(tmass_real) * 3 * (size_t)n);
     memcpy(m->tet_nodes, d->tets, sizeof(int) * 4 * (size_t)T);
-    E = tmass__build_edges(d->tets, T, n, start, key, payload, m->tet_edges, m->edge_a, m->edge_b);
+    E = tmass__build_edges(d->tets, T, n, w->start, w->key, w->payload, m->tet_edges, m->edge_a, m->edge_b);
     m->edge_count = E;
     for (i = 0; i < E; i++) {
         m->edge_id[i] = i;
@@ -1678,7 +1896,7 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         double nu = d->tet_poisson_ratio ? (double)d->tet_poisson_ratio[t] : (double)d->poisson_ratio;
         int l;
         m->tet_young[t] = E_t;
-        if (d->kind == TMASS_TENSOR_MASS) {
+        if (tmass__kinds[d->kind].flags & TMASS__KIND_POISSON) {
             m->tet_lambda[t] = E_t * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
             m->tet_mu[t] = E_t / (2.0 * (1.0 + nu));
         }
@@ -1694,8 +1912,20 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         if (i == 0 || (double)m->edge_rest_length[i] < m->shortest_edge)
             m->shortest_edge = (double)m->edge_rest_length[i];
     }
-    for (t = 0; t < T; t++) tmass__apply_tet(m, t, 1.0);
-    for (i = 0; i < n; i++) {
+}
+
+/* Everything the rest state determines: the kind's per-tetrahedron assembly (tensors or
+   spring stiffnesses, lumped masses), node states, edge chunks and their colours, face
+   neighbours, boundary triangles. Returns TMASS_ERR_TET_DUPLICATE or _NONMANIFOLD from
+   the neighbour search. */
+static int tmass__create_precompute(const tmass_desc *d, tmass_model *m, tmass__create_tables *w)
+{
+    int i, t, err, E;
+    tmass__create_settings(d, m);
+    tmass__create_mesh(d, m, w);
+    E = m->edge_count;
+    for (t = 0; t < m->tet_count; t++) tmass__apply_tet(m, t, 1.0);
+    for (i = 0; i < m->node_count; i++) {
         m->node_state[i] = m->node_tets[i] > 0 ? TMASS__FREE : TMASS__INACTIVE;
         m->inv_mass[i] = m->mass[i] > 0 ? (tmass_real)(1.0 / (double)m->mass[i]) : (tmass_real)0;
         tmass__set_masks(m, i, m->node_state[i] == TMASS__FREE, 0);
@@ -1704,16 +1934,41 @@ TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
         int b = i * m->chunk_size, e = b + m->chunk_size;
         m->chunk_live[i] = (e > E ? E : e) - b;
     }
-    tmass__colour_chunks(m, start, key);
-    err = tmass__build_neighbors(m, start, key, payload);
-    tmass__free(&alloc, tmp_block, tmp_bytes);
+    tmass__colour_chunks(m, w->start, w->key);
+    err = tmass__build_neighbors(m, w->start, w->key, w->payload);
+    if (err) return err;
+    tmass__init_boundary(m);
+    m->stats.newton_iterations = 1;
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_create(const tmass_desc *d, tmass_model **out)
+{
+    tmass_model sizes, *m = NULL;
+    tmass__create_tables w;
+    tmass_allocator alloc;
+    int err;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!d) return TMASS_ERR_ARG;
+    err = tmass__create_validate(d);
+    if (err) return err;
+    alloc = d->allocator;
+    memset(&w, 0, sizeof w);
+    err = tmass__create_size(d, &sizes, &w);
+    if (err) return err;
+    err = tmass__create_layout(d, &sizes, &m);
+    if (err) {
+        tmass__free(&alloc, w.block, w.bytes);
+        return tmass__fail(d, err, "model block");
+    }
+    err = tmass__create_precompute(d, m, &w);
+    tmass__free(&alloc, w.block, w.bytes);
     if (err) {
         tmass__free(&alloc, m->block, m->block_bytes);
         return tmass__fail(d, err, err == TMASS_ERR_TET_DUPLICATE ? "a tetrahedron is listed twice"
                                    : "a triangle is shared by three or more tetrahedra");
     }
-    tmass__init_boundary(m);
-    m->stats.newton_iterations = 1;
     *out = m;
     return TMASS_OK;
 }
@@ -1985,14 +2240,17 @@ static void tmass__spring_forces(tmass_model *m, const tmass_real *u, const tmas
    be NULL):
    tensor:  out = -K (u + beta v)   (w is scratch)
    springs: out = eq. 7 plus axial damping. */
-static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tmass_real *v,
-                                  tmass_real *out, tmass_real *w)
+static void tmass__spring_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w)
+{
+    (void)w;
+    tmass__spring_forces(m, u, v, out, 0.0, 0.0, NULL, NULL, 0);
+}
+
+static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass_real *v, tmass_real *out,
+                                tmass_real *w)
 {
     int i, n3 = 3 * m->node_count;
-    if (m->kind == TMASS_MASS_SPRING) {
-        tmass__spring_forces(m, u, v, out, 0.0, 0.0, NULL, NULL, 0);
-        return;
-    }
     if (v && m->stiffness_damping != 0) {
         tmass_real beta = m->stiffness_damping;
         for (i = 0; i < n3; i++) w[i] = u[i] + beta * v[i];
@@ -2002,6 +2260,22 @@ static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tma
     }
     for (i = 0; i < n3; i++) out[i] = -out[i];
     m->stats.force_evaluations++;
+}
+
+static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tmass_real *v,
+                                  tmass_real *out, tmass_real *w)
+{
+    tmass__kinds[m->kind].force(m, u, v, out, w);
+}
+
+/* 1/2 u^T K u = -1/2 u . f (f into m->force) */
+static double tmass__tensor_energy(tmass_model *m, const tmass_real *u)
+{
+    int i, n3 = 3 * m->node_count;
+    double elastic = 0.0;
+    tmass__tensor_force(m, u, NULL, m->force, m->force_work);
+    for (i = 0; i < n3; i++) elastic -= 0.5 * (double)u[i] * (double)m->force[i];
+    return elastic;
 }
 
 /* Acceleration of the free nodes (zero elsewhere):
@@ -2114,22 +2388,23 @@ static double tmass__sum_partials(const tmass_model *m, int offset)
 /* Solves (D + c K) x = b on the free degrees of freedom by Jacobi-preconditioned CG
    (diag: D per degree of freedom, or NULL). x holds the initial guess; pinned and
    inactive entries are held at 0. Stops when |r| <= cg_tolerance |b| or after
-   cg_max_iterations. Scratch s[0..4]. Returns TMASS_OK, TMASS_ERR_NOT_FINITE (|b|^2 or the
+   cg_max_iterations. Works in the model's CG vectors (m->cg_r, cg_z, cg_p, cg_q, cg_pinv),
+   which nothing else uses; b and x must not be any of them. Returns TMASS_OK, TMASS_ERR_NOT_FINITE (|b|^2 or the
    residual not finite) or TMASS_ERR_NO_CONVERGENCE (the cap reached above the tolerance,
    or a direction of non-positive curvature: the caller fails, issue 18's policy). Adds
    its iterations to the stats and sets stats.cg_residual. */
 static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b,
-                     tmass_real *x, tmass_real **s)
+                     tmass_real *x)
 {
     tmass__cg_ctx k;
     int n3 = 3 * m->node_count, i, it, blocks = m->partial_count;
-    tmass_real *pinv = s[4];
+    tmass_real *pinv = m->cg_pinv;
     double bb = 0.0, rr, rz, tol2, pdp, rho_min = HUGE_VAL, rho_max = 0.0;
     k.m = m;
-    k.r = s[0];
-    k.z = s[1];
-    k.p = s[2];
-    k.q = s[3];
+    k.r = m->cg_r;
+    k.z = m->cg_z;
+    k.p = m->cg_p;
+    k.q = m->cg_q;
     k.x = x;
     k.pinv = pinv;
     k.diag = diag;
@@ -2218,6 +2493,43 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     return tmass__finite(rr) ? TMASS_ERR_NO_CONVERGENCE : TMASS_ERR_NOT_FINITE;
 }
 
+/* The linear solvers, one row per tmass_linear_solver (HOW TO EXTEND). Every linear
+   solve of this header goes through tmass__linear_solve (one system) or
+   tmass__linear_solve_block (TMASS__RHS systems with the same matrix, the quasi-static
+   precomputation); both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (iteration cap, or
+   non-positive curvature) or TMASS_ERR_NOT_FINITE. */
+typedef struct tmass__linear_solver_ops {
+    const char *name;
+    /* (D + c K) x = b on the free degrees of freedom, x the initial guess (see tmass__cg).
+       Stopping on a direction p with p . A p <= 0, it sets m->cg_indefinite and leaves p
+       in m->cg_p and mask A p in m->cg_q (the springs' minimum check reads them). */
+    int (*solve)(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b, tmass_real *x);
+    /* K X = B for TMASS__RHS interleaved columns; w four work arrays like X, pinv the
+       Jacobi inverse diagonal (see tmass__cg_block) */
+    int (*solve_block)(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                       const tmass_real *pinv, double tol, int max_iterations);
+} tmass__linear_solver_ops;
+
+static int tmass__cg_block(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                           const tmass_real *pinv, double tol, int max_iterations);
+
+static const tmass__linear_solver_ops tmass__linear_solvers[] = {
+    {"Jacobi-preconditioned CG", tmass__cg, tmass__cg_block}};
+typedef char tmass__linear_solvers_size_check[sizeof tmass__linear_solvers / sizeof tmass__linear_solvers[0] ==
+                                                      TMASS_LINEAR_SOLVER_COUNT ? 1 : -1];
+
+static int tmass__linear_solve(tmass_model *m, const tmass_real *diag, double c, const tmass_real *b,
+                               tmass_real *x)
+{
+    return tmass__linear_solvers[m->linear_solver].solve(m, diag, c, b, x);
+}
+
+static int tmass__linear_solve_block(tmass_model *m, const tmass_real *B, tmass_real *X, tmass_real **w,
+                                     const tmass_real *pinv, double tol, int max_iterations)
+{
+    return tmass__linear_solvers[m->linear_solver].solve_block(m, B, X, w, pinv, tol, max_iterations);
+}
+
 /* >>integrators ----------------------------------------------------------------------- */
 
 static int tmass__all_finite(const tmass_real *a, size_t count)
@@ -2252,38 +2564,45 @@ static void tmass__commit(tmass_model *m, const tmass_real *u, const tmass_real 
     for (i = 0; i < n3; i++) m->pos[i] = m->rest[i] + u[i];
 }
 
-static void tmass__explicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                  const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+/* The integrators. Each step function reads the step's start (m->step_u0, m->step_v0:
+   displacements and velocities, pinned nodes at their targets) and writes its result to
+   m->step_u1, m->step_v1; tmass_step_ex checks and commits it. They are listed in
+   tmass__integrators (below), indexed by tmass_integrator. */
+static int tmass__explicit_euler(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count;
-    tmass_real *a = m->scratch[4];
-    tmass__acceleration(m, x0, v0, a, m->scratch[5]);
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1, *a = m->step_accel;
+    tmass__acceleration(m, x0, v0, a, m->force_work);
     for (i = 0; i < n3; i++) {
         x1[i] = x0[i] + dt * v0[i] * m->free_mask[i];
         v1[i] = v0[i] + dt * a[i];
     }
+    return TMASS_OK;
 }
 
-static void tmass__semi_implicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                       const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+static int tmass__semi_implicit_euler(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count;
-    tmass_real *a = m->scratch[4];
-    tmass__acceleration(m, x0, v0, a, m->scratch[5]);
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1, *a = m->step_accel;
+    tmass__acceleration(m, x0, v0, a, m->force_work);
     for (i = 0; i < n3; i++) {
         v1[i] = v0[i] + dt * a[i];
         x1[i] = x0[i] + dt * v1[i] * m->free_mask[i];
     }
+    return TMASS_OK;
 }
 
-static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, const tmass_real *v0,
-                       tmass_real *x1, tmass_real *v1)
+static int tmass__rk4(tmass_model *m, tmass_real dt)
 {
     /* k1 = f(y0), k2 = f(y0 + dt/2 k1), k3 = f(y0 + dt/2 k2), k4 = f(y0 + dt k3),
        y1 = y0 + dt/6 (k1 + 2 k2 + 2 k3 + k4); y = (x, v), f(y) = (v, a(x, v)).
        x1, v1 accumulate; (xs, vs) is the stage state, a its acceleration. */
     int i, stage, n3 = 3 * m->node_count;
-    tmass_real *xs = m->scratch[4], *vs = m->scratch[5], *a = m->scratch[6], *w = m->scratch[7];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1;
+    tmass_real *xs = m->rk4_u, *vs = m->rk4_v, *a = m->step_accel, *w = m->force_work;
     static const double weight[4] = {1.0, 2.0, 2.0, 1.0};
     static const double next[4] = {0.5, 0.5, 1.0, 0.0};
     memcpy(xs, x0, sizeof(tmass_real) * (size_t)n3);
@@ -2301,6 +2620,7 @@ static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, cons
             vs[i] = v0[i] + hn * a[i];
         }
     }
+    return TMASS_OK;
 }
 
 /* Backward Euler, linearised once (exact for the linear tensor model):
@@ -2311,44 +2631,49 @@ static void tmass__rk4(tmass_model *m, tmass_real dt, const tmass_real *x0, cons
    their velocity (target - u) / dt: that velocity enters the damping forces only, never
    the elastic prediction x0 + dt v0 (which would count the pinned move twice, issue 18
    item 6). A CG that does not reach its tolerance fails the step (issue 18 item 9). */
-static int tmass__implicit_euler(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                 const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+/* tensor: f(x0, v0) - dt K v0_free = -K (u0 + beta v0 + dt v0_free); c = dt^2 + dt beta */
+static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f)
+{
+    int i, n3 = 3 * m->node_count;
+    tmass_real *w = m->force_work, beta = m->stiffness_damping;
+    for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
+    tmass__matvec(m, w, f);
+    for (i = 0; i < n3; i++) f[i] = -f[i];
+    m->stats.force_evaluations++;
+    return (double)dt * dt + (double)dt * m->stiffness_damping;
+}
+
+/* springs: the force (damping with the full v0), the tangent S = dt^2 K + dt D into the
+   tensors (c = 1), and K v0_free */
+static double tmass__spring_differential(tmass_model *m, tmass_real dt, const tmass_real *x0,
+                                         const tmass_real *v0, tmass_real *f)
+{
+    int i, n3 = 3 * m->node_count;
+    tmass_real *vfree = m->implicit_vfree, *kv = m->implicit_kv;
+    for (i = 0; i < n3; i++) vfree[i] = v0[i] * m->free_mask[i];
+    tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, vfree, kv, 0);
+    for (i = 0; i < n3; i++) f[i] -= dt * kv[i];
+    return 1.0;
+}
+
+static int tmass__implicit_euler_linear(tmass_model *m, tmass_real dt)
 {
     int i, r, n = m->node_count, n3 = 3 * n, err;
-    tmass_real *f = m->scratch[4], *dmass = m->scratch[5], *dv = m->scratch[6], *w = m->scratch[7];
-    tmass_real *cg_scratch[5];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1;
+    tmass_real *f = m->implicit_rhs, *dmass = m->implicit_diag, *dv = m->implicit_dv;
     tmass_real alpha = m->mass_damping;
     double c;
-    /* x1, v1 and w are free while CG runs: lend them to it */
-    cg_scratch[0] = m->scratch[8];
-    cg_scratch[1] = m->scratch[9];
-    cg_scratch[2] = x1;
-    cg_scratch[3] = v1;
-    cg_scratch[4] = w;
     for (i = 0; i < n3; i++) dmass[i] = (tmass_real)((1.0 + (double)dt * alpha) * (double)m->mass[i / 3]);
-    if (m->kind == TMASS_TENSOR_MASS) {
-        /* f(x0, v0) - dt K v0_free = -K (u0 + beta v0 + dt v0_free) */
-        tmass_real beta = m->stiffness_damping;
-        for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
-        tmass__matvec(m, w, f);
-        for (i = 0; i < n3; i++) f[i] = -f[i];
-        m->stats.force_evaluations++;
-        c = (double)dt * dt + (double)dt * m->stiffness_damping;
-    } else {
-        /* spring force (damping with the full v0), tangent S = dt^2 K + dt D into the
-           tensors (c = 1), and K v0_free (x1 lends its memory to v0_free) */
-        for (i = 0; i < n3; i++) x1[i] = v0[i] * m->free_mask[i];
-        tmass__spring_forces(m, x0, v0, f, (double)dt * dt, (double)dt, x1, w, 0);
-        for (i = 0; i < n3; i++) f[i] -= dt * w[i];
-        c = 1.0;
-    }
+    c = tmass__kinds[m->kind].differential(m, dt, x0, v0, f);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             int j = 3 * i + r;
             f[j] = dt * (f[j] + m->ext[j] + m->mass[i] * (m->gravity[r] - alpha * v0[j]));
         }
     memcpy(dv, m->dv_prev, sizeof(tmass_real) * (size_t)n3);
-    err = tmass__cg(m, dmass, c, f, dv, cg_scratch);
+    err = tmass__linear_solve(m, dmass, c, f, dv);
     if (err) return err;
     for (i = 0; i < n3; i++) {
         tmass_real fm = m->free_mask[i];
@@ -2422,21 +2747,13 @@ static double tmass__spring_incremental_potential(const tmass_model *m, tmass_re
     return h2 * (tmass__spring_energy(m, x) - work) + inertia;
 }
 
-static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt, const tmass_real *x0,
-                                         const tmass_real *v0, tmass_real *x1, tmass_real *v1)
+static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt)
 {
     int i, n3 = 3 * m->node_count, it, err, halvings;
-    tmass_real *R = m->scratch[4], *dmass = m->scratch[5], *dx = m->scratch[6], *xt = m->scratch[7];
-    tmass_real *cg_scratch[5];
+    const tmass_real *x0 = m->step_u0, *v0 = m->step_v0;
+    tmass_real *x1 = m->step_u1, *v1 = m->step_v1; /* v1 holds v(x) */
+    tmass_real *R = m->newton_residual, *dmass = m->implicit_diag, *dx = m->newton_dx, *xt = m->newton_trial;
     double rr, ref2, load2 = 0.0, tol2, h2 = (double)dt * dt;
-    /* CG scratch: scratch[8] and [9], the warm-start vector (unused by this integrator),
-       the force output array (recomputed by tmass_forces) and xt (free until the line
-       search); v1 holds v(x) */
-    cg_scratch[0] = m->scratch[8];
-    cg_scratch[1] = m->scratch[9];
-    cg_scratch[2] = m->dv_prev;
-    cg_scratch[3] = m->force;
-    cg_scratch[4] = xt;
     for (i = 0; i < n3; i++) {
         dmass[i] = (tmass_real)((1.0 + (double)dt * m->mass_damping) * (double)m->mass[i / 3]);
         x1[i] = x0[i] + dt * v0[i] * m->free_mask[i]; /* the predictor */
@@ -2455,7 +2772,7 @@ static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt, const tm
         if (it >= m->newton_iterations) return TMASS_ERR_NO_CONVERGENCE;
         m->stats.newton_iterations++;
         memset(dx, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, dmass, 1.0, R, dx, cg_scratch);
+        err = tmass__linear_solve(m, dmass, 1.0, R, dx);
         if (err) return err;
         for (i = 0; i < n3; i++) slope += (double)R[i] * dx[i];
         phi = tmass__spring_incremental_potential(m, dt, x0, v0, x1);
@@ -2536,44 +2853,63 @@ static int tmass__count_inverted(const tmass_model *m, const tmass_real *u)
     return count;
 }
 
+/* TMASS_IMPLICIT_EULER: the kind's Newton solve where it has one, else the linearised
+   step (exact for a linear kind). */
+static int tmass__implicit_euler(tmass_model *m, tmass_real dt)
+{
+    m->stats.increments = 1;
+    if (tmass__kinds[m->kind].implicit_newton) return tmass__kinds[m->kind].implicit_newton(m, dt);
+    m->stats.newton_iterations = 1;
+    return tmass__implicit_euler_linear(m, dt);
+}
+
+static int tmass__implicit_euler_linearized(tmass_model *m, tmass_real dt)
+{
+    m->stats.increments = 1;
+    m->stats.newton_iterations = 1;
+    return tmass__implicit_euler_linear(m, dt);
+}
+
+/* The integrators, one row per tmass_integrator (HOW TO EXTEND). is_explicit: the step
+   is checked for divergence (TMASS_ERR_DIVERGED) and does not count inverted tetrahedra. */
+typedef struct tmass__integrator_ops {
+    const char *name;
+    int (*step)(tmass_model *m, tmass_real dt); /* step_u0/v0 -> step_u1/v1 */
+    int is_explicit;
+} tmass__integrator_ops;
+
+static const tmass__integrator_ops tmass__integrators[] = {
+    {"explicit Euler", tmass__explicit_euler, 1},
+    {"semi-implicit Euler", tmass__semi_implicit_euler, 1},
+    {"RK4", tmass__rk4, 1},
+    {"implicit Euler", tmass__implicit_euler, 0},
+    {"implicit Euler, linearised", tmass__implicit_euler_linearized, 0}};
+typedef char tmass__integrators_size_check[sizeof tmass__integrators / sizeof tmass__integrators[0] ==
+                                                   TMASS_INTEGRATOR_COUNT ? 1 : -1];
+
 TMASSDEF int tmass_step_ex(tmass_model *m, tmass_real dt, tmass_integrator integrator)
 {
-    tmass_real *x0, *v0, *x1, *v1;
-    int n3, err = TMASS_OK, implicit;
+    const tmass__integrator_ops *ops;
+    tmass_real *x1, *v1;
+    int n3, err;
     if (!m) return TMASS_ERR_ARG;
     if (!(tmass__finite((double)dt) && dt > 0)) return TMASS_ERR_TIME_STEP;
-    if ((int)integrator < 0 || (int)integrator > 4) return TMASS_ERR_INTEGRATOR;
+    if ((unsigned)integrator >= TMASS_INTEGRATOR_COUNT) return TMASS_ERR_INTEGRATOR;
+    ops = &tmass__integrators[integrator];
     n3 = 3 * m->node_count;
-    x0 = m->scratch[0];
-    v0 = m->scratch[1];
-    x1 = m->scratch[2];
-    v1 = m->scratch[3];
+    x1 = m->step_u1;
+    v1 = m->step_v1;
     memset(&m->stats, 0, sizeof m->stats);
-    tmass__begin_step(m, dt, x0, v0);
-    switch (integrator) {
-    case TMASS_EXPLICIT_EULER: tmass__explicit_euler(m, dt, x0, v0, x1, v1); break;
-    case TMASS_SEMI_IMPLICIT_EULER: tmass__semi_implicit_euler(m, dt, x0, v0, x1, v1); break;
-    case TMASS_RK4: tmass__rk4(m, dt, x0, v0, x1, v1); break;
-    case TMASS_IMPLICIT_EULER:
-    case TMASS_IMPLICIT_EULER_LINEARIZED:
-        m->stats.increments = 1;
-        if (m->kind == TMASS_MASS_SPRING && integrator == TMASS_IMPLICIT_EULER) {
-            err = tmass__spring_implicit_newton(m, dt, x0, v0, x1, v1);
-        } else {
-            m->stats.newton_iterations = 1;
-            err = tmass__implicit_euler(m, dt, x0, v0, x1, v1);
-        }
-        break;
-    }
+    tmass__begin_step(m, dt, m->step_u0, m->step_v0);
+    err = ops->step(m, dt);
     if (!err && (!tmass__all_finite(x1, (size_t)n3) || !tmass__all_finite(v1, (size_t)n3))) err = TMASS_ERR_NOT_FINITE;
-    implicit = integrator == TMASS_IMPLICIT_EULER || integrator == TMASS_IMPLICIT_EULER_LINEARIZED;
-    if (!err && !implicit && tmass__stretched_past(m, x1)) err = TMASS_ERR_DIVERGED;
+    if (!err && ops->is_explicit && tmass__stretched_past(m, x1)) err = TMASS_ERR_DIVERGED;
     if (!err && tmass__imprecise(m, x1)) err = TMASS_ERR_PRECISION;
     if (err) {
         memset(m->dv_prev, 0, sizeof(tmass_real) * (size_t)n3);
         return err;
     }
-    if (implicit) m->stats.inverted = tmass__count_inverted(m, x1);
+    if (!ops->is_explicit) m->stats.inverted = tmass__count_inverted(m, x1);
     tmass__commit(m, x1, v1);
     return TMASS_OK;
 }
@@ -2650,10 +2986,9 @@ static double tmass__spring_potential(const tmass_model *m, const tmass_real *x)
 static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int cap)
 {
     int i, n3 = 3 * m->node_count, it, err = TMASS_OK;
-    tmass_real *f = m->scratch[1], *du = m->scratch[2], *xt = m->scratch[8], *cg_scratch[5];
+    tmass_real *f = m->newton_residual, *du = m->newton_dx, *xt = m->newton_trial;
     double ff, tol = m->newton_tolerance, tol2 = tol * tol * ref2;
     double eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
     ff = tmass__spring_residual(m, x, f, 1);
     for (it = 0; it < cap; it++) {
         double dn = 0.0, xn = 0.0, alpha = 1.0, fft = 0.0, slope, potential;
@@ -2663,13 +2998,13 @@ static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int 
         if (ff <= tol2 || ff <= tmass__roundoff_floor2(m, x, NULL)) return TMASS_OK;
         m->stats.newton_iterations++;
         memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
+        err = tmass__linear_solve(m, NULL, 1.0, f, du);
         slope = 0.0; /* f . du = minus the potential's slope along du */
         for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         if ((err && m->cg_indefinite) || (!err && !(slope > 0))) { /* on the PD part */
             tmass__spring_residual(m, x, f, 0);
             memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-            err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
+            err = tmass__linear_solve(m, NULL, 1.0, f, du);
             slope = 0.0;
             for (i = 0; i < n3; i++) slope += (double)f[i] * du[i];
         }
@@ -2715,7 +3050,7 @@ static int tmass__spring_newton(tmass_model *m, tmass_real *x, double ref2, int 
 static int tmass__spring_static(tmass_model *m, tmass_real *x)
 {
     int i, n3 = 3 * m->node_count, err = TMASS_OK, attempts = 0;
-    tmass_real *accepted = m->scratch[9], *f = m->scratch[1];
+    tmass_real *accepted = m->static_accepted, *f = m->newton_residual;
     double s = 0.0, ds = 1.0, ref2;
     for (i = 0; i < n3; i++) accepted[i] = m->pin_mask[i] * m->target[i];
     m->load_scale = 1.0;
@@ -2750,6 +3085,25 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
     return TMASS_OK;
 }
 
+/* Static equilibrium of the tensor model: one linear solve K du = f (it is linear: a
+   converged, finite solve is exact for the model). */
+static int tmass__tensor_static(tmass_model *m, tmass_real *x)
+{
+    int i, n3 = 3 * m->node_count, err;
+    tmass_real *f = m->newton_residual, *du = m->newton_dx;
+    m->stats.newton_iterations = 1;
+    m->stats.increments = 1;
+    tmass__internal_force(m, x, NULL, f, m->force_work);
+    for (i = 0; i < n3; i++)
+        f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
+    memset(du, 0, sizeof(tmass_real) * (size_t)n3);
+    err = tmass__linear_solve(m, NULL, 1.0, f, du);
+    for (i = 0; i < n3; i++) x[i] += du[i];
+    return err;
+}
+
+static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u) { return tmass__spring_energy(m, u); }
+
 /* Is the spring model's converged static state x a minimum? A zero residual holds at
    saddles too (a tetrahedron flattened through its base: its compressed springs balance,
    and either mirror image of the rest shape lies lower). A probe solve K_t y = b with the
@@ -2757,16 +3111,17 @@ static int tmass__spring_static(tmass_model *m, tmass_real *x)
    1e-5) meets a direction p of negative curvature where K_t is indefinite; p . K_t p below
    -1e3 eps sum_k |p_k (K_t p)_k| (its round-off) is a saddle: TMASS_ERR_UNSTABLE. So is a
    diagonal entry below -1e3 eps max |diagonal| (the Jacobi preconditioner hides those
-   axes from CG). A probe at its cap counts as a minimum. Scratch 1-7 (x may be scratch
-   0). */
+   axes from CG). A probe at its cap counts as a minimum. It reads the direction the
+   linear solver stopped on (m->cg_p, and m->cg_q = mask K_t p: the contract of a solver
+   that reports m->cg_indefinite, see tmass__linear_solver_ops). Works in the static
+   probe vectors (x is m->static_u). */
 static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
 {
     int i, n3 = 3 * m->node_count, err;
-    tmass_real *b = m->scratch[1], *y = m->scratch[2], *p = m->scratch[5], *q = m->scratch[6], *cg_scratch[5];
+    tmass_real *b = m->static_probe_rhs, *y = m->static_probe_x, *p = m->cg_p, *q = m->cg_q;
     tmass_real tolerance = m->cg_tolerance;
     double pq = 0.0, scale = 0.0, eps = sizeof(tmass_real) == sizeof(float) ? (double)FLT_EPSILON : DBL_EPSILON;
     double dmax = 0.0, dmin = 0.0;
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
     tmass__spring_residual(m, x, b, 1); /* the full tangent at x */
     /* a negative diagonal entry is negative curvature along that axis (and the Jacobi
        preconditioner zeroes such axes, so CG would not see them) */
@@ -2785,7 +3140,7 @@ static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
         y[i] = 0;
     }
     m->cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-7);
-    err = tmass__cg(m, NULL, 1.0, b, y, cg_scratch);
+    err = tmass__linear_solve(m, NULL, 1.0, b, y);
     m->cg_tolerance = tolerance;
     if (err == TMASS_ERR_NOT_FINITE) return err;
     if (!m->cg_indefinite) return TMASS_OK;
@@ -2796,6 +3151,15 @@ static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
     return pq < -1e3 * eps * scale ? TMASS_ERR_UNSTABLE : TMASS_OK;
 }
 
+/* The springs' static solve (their row of tmass__kinds): the load continuation, then the
+   minimum check. */
+static int tmass__spring_static_solve(tmass_model *m, tmass_real *x)
+{
+    int err = tmass__spring_static(m, x);
+    if (!err) err = tmass__spring_check_minimum(m, x);
+    return err;
+}
+
 /* Static equilibrium: one CG solve K u = f_ext + M g for the tensor model (it is
    linear: a converged, finite solve is exact for the model), the continuation of
    tmass__spring_static for the spring model. Accepted only with finite values inside
@@ -2803,31 +3167,16 @@ static int tmass__spring_check_minimum(tmass_model *m, const tmass_real *x)
 TMASSDEF int tmass_solve_static(tmass_model *m)
 {
     int i, n3, err = TMASS_OK;
-    tmass_real *x, *f, *cg_scratch[5];
+    tmass_real *x;
     if (!m) return TMASS_ERR_ARG;
     n3 = 3 * m->node_count;
-    x = m->scratch[0];
-    f = m->scratch[1];
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[3 + i];
+    x = m->static_u;
     memset(&m->stats, 0, sizeof m->stats);
     for (i = 0; i < n3; i++) {
         tmass_real pin = m->pin_mask[i];
         x[i] = m->disp[i] + pin * (m->target[i] - m->disp[i]);
     }
-    if (m->kind == TMASS_TENSOR_MASS) {
-        tmass_real *du = m->scratch[2];
-        m->stats.newton_iterations = 1;
-        m->stats.increments = 1;
-        tmass__internal_force(m, x, NULL, f, m->scratch[8]);
-        for (i = 0; i < n3; i++)
-            f[i] = (f[i] + m->ext[i] + m->mass[i / 3] * m->gravity[i % 3]) * m->free_mask[i];
-        memset(du, 0, sizeof(tmass_real) * (size_t)n3);
-        err = tmass__cg(m, NULL, 1.0, f, du, cg_scratch);
-        for (i = 0; i < n3; i++) x[i] += du[i];
-    } else {
-        err = tmass__spring_static(m, x);
-        if (!err) err = tmass__spring_check_minimum(m, x);
-    }
+    err = tmass__kinds[m->kind].static_solve(m, x);
     if (err) return err;
     if (!tmass__all_finite(x, n3)) return TMASS_ERR_NOT_FINITE;
     if (tmass__imprecise(m, x)) return TMASS_ERR_PRECISION;
@@ -3128,7 +3477,7 @@ TMASSDEF size_t tmass_memory_bytes(const tmass_model *m) { return m ? m->block_b
 TMASSDEF const tmass_real *tmass_forces(tmass_model *m)
 {
     if (!m) return NULL;
-    tmass__internal_force(m, m->disp, NULL, m->force, m->scratch[0]);
+    tmass__internal_force(m, m->disp, NULL, m->force, m->force_work);
     return m->force;
 }
 
@@ -3162,13 +3511,7 @@ TMASSDEF int tmass_energy(tmass_model *m, tmass_energies *out)
     double kinetic = 0.0, elastic = 0.0, grav = 0.0, ext = 0.0;
     if (!m || !out) return TMASS_ERR_ARG;
     n = m->node_count;
-    if (m->kind == TMASS_TENSOR_MASS) {
-        /* 1/2 u^T K u = -1/2 u . f */
-        tmass__internal_force(m, m->disp, NULL, m->force, m->scratch[0]);
-        for (i = 0; i < 3 * n; i++) elastic -= 0.5 * (double)m->disp[i] * (double)m->force[i];
-    } else {
-        elastic = tmass__spring_energy(m, m->disp);
-    }
+    elastic = tmass__kinds[m->kind].energy(m, m->disp);
     for (i = 0; i < n; i++)
         for (r = 0; r < 3; r++) {
             double v = m->vel[3 * i + r], u = m->disp[3 * i + r];
@@ -3187,7 +3530,7 @@ TMASSDEF int tmass_energy(tmass_model *m, tmass_energies *out)
 
 TMASSDEF int tmass_vertex_tensor(const tmass_model *m, int i, tmass_real out[9])
 {
-    if (!m || !out || m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_ARG;
+    if (!m || !out || !(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_ARG;
     if (i < 0 || i >= m->node_count) return TMASS_ERR_NODE_RANGE;
     memcpy(out, m->vertex_tensor + 9 * i, 9 * sizeof(tmass_real));
     return TMASS_OK;
@@ -3196,7 +3539,7 @@ TMASSDEF int tmass_vertex_tensor(const tmass_model *m, int i, tmass_real out[9])
 TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real out[9])
 {
     int k, s, r, c;
-    if (!m || !out || m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_ARG;
+    if (!m || !out || !(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_ARG;
     if (a < 0 || a >= m->node_count || b < 0 || b >= m->node_count) return TMASS_ERR_NODE_RANGE;
     for (k = 0; k < m->chunk_total; k++)
         for (s = m->chunk_start[k]; s < m->chunk_start[k] + m->chunk_live[k]; s++) {
@@ -3357,14 +3700,14 @@ static int tmass__qs_prepare(const tmass_model *m, const tmass_qs_desc *d, tmass
     *out = NULL;
     if (!m || !d) return TMASS_ERR_ARG;
     if (d->internal_cookie != TMASS__QS_COOKIE) return TMASS_ERR_DESC;
-    if (m->kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (!(tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (d->max_contacts < 1 || d->max_contacts > 4096 || (d->nodes && d->node_count < 1) ||
         (d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return TMASS_ERR_ARG;
     if (!(tmass__finite((double)d->cg_tolerance) && d->cg_tolerance > 0) || d->cg_max_iterations < 1)
         return TMASS_ERR_SOLVER;
-    /* mark the precomputed nodes in a scratch vector of the model (3n reals) */
-    mark = m->scratch[9];
+    /* mark the precomputed nodes in the model's qs_mark work vector */
+    mark = m->qs_mark;
     memset(mark, 0, sizeof(tmass_real) * (size_t)m->node_count);
     if (d->nodes) {
         for (i = 0; i < d->node_count; i++) {
@@ -3558,7 +3901,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
 {
     enum { R = TMASS__RHS };
     tmass_qs *q;
-    tmass_real *b, *x, *cg_scratch[5], *block, *w[4], *B, *X, *pinv, saved_tol;
+    tmass_real *b, *x, *block, *w[4], *B, *X, *pinv, saved_tol;
     size_t vec, block_bytes;
     int err, i, j0, r, saved_iter, total, n3, o3, p3;
     if (!out) return TMASS_ERR_ARG;
@@ -3573,9 +3916,8 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     /* the preload: K g = f_ext + M g_vec - K u_pinned on the free nodes (one CG), the
        pinned nodes at their targets (pinned nodes away from rest are boundary conditions
        too, issue 18 item 7) */
-    b = m->scratch[0];
-    x = m->scratch[1];
-    for (i = 0; i < 5; i++) cg_scratch[i] = m->scratch[2 + i];
+    b = m->qs_rhs;
+    x = m->qs_x;
     saved_tol = m->cg_tolerance;
     saved_iter = m->cg_max_iterations;
     m->cg_tolerance = d->cg_tolerance;
@@ -3587,7 +3929,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
         b[i] = m->ext[i] + m->mass[i / 3] * m->gravity[i % 3] - b[i];
         x[i] = 0;
     }
-    err = tmass__cg(m, NULL, 1.0, b, x, cg_scratch);
+    err = tmass__linear_solve(m, NULL, 1.0, b, x);
     m->cg_tolerance = saved_tol;
     m->cg_max_iterations = saved_iter;
     for (i = 0; i < n3; i++) x[i] += m->pin_mask[i] * m->target[i];
@@ -3613,7 +3955,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
             memset(B, 0, sizeof(tmass_real) * vec);
             for (r = 0; r < R && j0 + r < p3; r++)
                 B[(size_t)(3 * q->pre_nodes[(j0 + r) / 3] + (j0 + r) % 3) * R + r] = 1;
-            err = tmass__cg_block(m, B, X, w, pinv, (double)d->cg_tolerance, d->cg_max_iterations);
+            err = tmass__linear_solve_block(m, B, X, w, pinv, (double)d->cg_tolerance, d->cg_max_iterations);
             for (r = 0; r < R && j0 + r < p3 && !err; r++) {
                 tmass_real *col = q->compliance + (size_t)(j0 + r) * o3;
                 for (i = 0; i < q->out_count; i++) {
@@ -4277,254 +4619,308 @@ static void tmass__hybrid_subdesc(const tmass_hybrid_desc *d, const unsigned cha
     sub->tet_poisson_ratio = d->model.tet_poisson_ratio ? poisson : NULL;
 }
 
-TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
-{
-    tmass_hybrid tmp, *h;
-    tmass__hy_sizes z;
-    tmass__carver carver;
-    tmass_desc sub;
-    tmass_qs_desc qd;
-    tmass_model *dyn = NULL, *src = NULL;
-    tmass_qs *qs = NULL;
+/* tmass_hybrid_create in stages that read top to bottom: validate the description, size
+   the parts (which tetrahedra are dynamic, the node maps), create the two parts (the
+   dynamic model, the precomputed model and its compliance), find the interface faces and
+   size the hybrid block, lay it out, precompute the coupling (S = C_cc^-1) and the
+   rendering lists. tmass__hy_build carries the creation-time state between them. */
+typedef struct tmass__hy_build {
     tmass_allocator a;
-    int err, i, t, N, T, n_dyn = 0, n_qs = 0, t_dyn = 0, c0 = 0, faces = 0, k;
-    int *dyn_of = NULL, *qs_of = NULL, *itmp = NULL;
-    unsigned char *fixed = NULL, *dynamic = NULL;
-    tmass_real *rtmp = NULL;
-    tmass__face_key *keys = NULL;
+    char *tmp_block; /* temporary: face keys, a rest copy and per-tet materials of a part,
+                        node maps, tets of a part, fixed and dynamic flags */
     size_t tmp_bytes;
-    char *tmp_block;
+    tmass__face_key *keys;
+    tmass_real *rtmp;
+    int *dyn_of, *qs_of, *itmp;
+    unsigned char *fixed, *dynamic;
+    int n_dyn, n_qs, t_dyn, c0, faces;
+    tmass_model *dyn, *src; /* the dynamic part; the precomputed part's model (temporary) */
+    tmass_qs *qs;
+    tmass__hy_sizes z;
+} tmass__hy_build;
 
-    if (!out) return TMASS_ERR_ARG;
-    *out = NULL;
-    if (!d) return TMASS_ERR_ARG;
+static int tmass__hybrid_create_validate(const tmass_hybrid_desc *d)
+{
+    int i, err;
     if (d->internal_cookie != TMASS__HY_COOKIE) return TMASS_ERR_DESC;
-    err = tmass__validate(&d->model);
+    err = tmass__create_validate(&d->model);
     if (err) return err;
-    if (d->model.kind != TMASS_TENSOR_MASS) return TMASS_ERR_MODEL_KIND;
+    if (!(tmass__kinds[d->model.kind].flags & TMASS__KIND_LINEAR)) return TMASS_ERR_MODEL_KIND;
     if (!d->tet_dynamic || d->fixed_count < 0 || (d->fixed_count > 0 && !d->fixed_nodes))
         return TMASS_ERR_ARG;
-    N = d->model.node_count;
-    T = d->model.tet_count;
-    a = d->model.allocator;
     for (i = 0; i < d->fixed_count; i++)
-        if (d->fixed_nodes[i] < 0 || d->fixed_nodes[i] >= N) return TMASS_ERR_NODE_RANGE;
+        if (d->fixed_nodes[i] < 0 || d->fixed_nodes[i] >= d->model.node_count) return TMASS_ERR_NODE_RANGE;
+    return TMASS_OK;
+}
 
-    /* temporary: two node maps, fixed flags, a rest copy, tets and per-tet materials of a
-       part, face keys of both boundaries */
-    tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N + (size_t)T +
-                sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
-                4 * TMASS__ALIGN;
-    tmp_block = (char *)tmass__alloc(&a, tmp_bytes);
-    if (!tmp_block) return TMASS_ERR_ALLOC;
-    carver.base = tmp_block;
+/* The temporary tables; which tetrahedra are dynamic (unsupported precomputed pieces
+   moved over, reported through the log); each part's node numbering. */
+static int tmass__hybrid_create_size(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, t, k, N = d->model.node_count, T = d->model.tet_count;
+    tmass__carver carver;
+    b->tmp_bytes = sizeof(int) * (2 * (size_t)N + 4 * (size_t)T) + (size_t)N + (size_t)T +
+                   sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T) + sizeof(tmass__face_key) * 8 * (size_t)T +
+                   4 * TMASS__ALIGN;
+    b->tmp_block = (char *)tmass__alloc(&b->a, b->tmp_bytes);
+    if (!b->tmp_block) return TMASS_ERR_ALLOC;
+    carver.base = b->tmp_block;
     carver.offset = 0;
-    keys = (tmass__face_key *)tmass__carve(&carver, sizeof(tmass__face_key) * 8 * (size_t)T);
-    rtmp = (tmass_real *)tmass__carve(&carver, sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T));
-    dyn_of = (int *)tmass__carve(&carver, sizeof(int) * (2 * (size_t)N + 4 * (size_t)T));
-    qs_of = dyn_of + N;
-    itmp = qs_of + N;
-    fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
-    dynamic = (unsigned char *)tmass__carve(&carver, (size_t)T);
-    memset(fixed, 0, (size_t)N);
-    for (i = 0; i < d->fixed_count; i++) fixed[d->fixed_nodes[i]] = 1;
-    for (t = 0; t < T; t++) dynamic[t] = d->tet_dynamic[t] != 0;
-    i = tmass__hybrid_support(&d->model, dynamic, fixed, keys, itmp);
+    b->keys = (tmass__face_key *)tmass__carve(&carver, sizeof(tmass__face_key) * 8 * (size_t)T);
+    b->rtmp = (tmass_real *)tmass__carve(&carver, sizeof(tmass_real) * (3 * (size_t)N + 2 * (size_t)T));
+    b->dyn_of = (int *)tmass__carve(&carver, sizeof(int) * (2 * (size_t)N + 4 * (size_t)T));
+    b->qs_of = b->dyn_of + N;
+    b->itmp = b->qs_of + N;
+    b->fixed = (unsigned char *)tmass__carve(&carver, (size_t)N);
+    b->dynamic = (unsigned char *)tmass__carve(&carver, (size_t)T);
+    memset(b->fixed, 0, (size_t)N);
+    for (i = 0; i < d->fixed_count; i++) b->fixed[d->fixed_nodes[i]] = 1;
+    for (t = 0; t < T; t++) b->dynamic[t] = d->tet_dynamic[t] != 0;
+    i = tmass__hybrid_support(&d->model, b->dynamic, b->fixed, b->keys, b->itmp);
     if (i && d->model.log) {
         char msg[160];
         snprintf(msg, sizeof msg, "%d tetrahedra of the precomputed part were not held by fixed nodes "
                  "and were moved to the dynamic part", i);
         d->model.log(TMASS_OK, msg, d->model.log_user);
     }
-    for (i = 0; i < N; i++) dyn_of[i] = qs_of[i] = -1;
+    for (i = 0; i < N; i++) b->dyn_of[i] = b->qs_of[i] = -1;
     for (t = 0; t < T; t++) {
-        int *map = dynamic[t] ? dyn_of : qs_of;
-        t_dyn += dynamic[t] != 0;
+        int *map = b->dynamic[t] ? b->dyn_of : b->qs_of;
+        b->t_dyn += b->dynamic[t] != 0;
         for (k = 0; k < 4; k++) map[d->model.tets[4 * t + k]] = 1;
     }
     for (i = 0; i < N; i++) {
-        if (dyn_of[i] >= 0) dyn_of[i] = n_dyn++;
-        if (qs_of[i] >= 0) qs_of[i] = n_qs++;
+        if (b->dyn_of[i] >= 0) b->dyn_of[i] = b->n_dyn++;
+        if (b->qs_of[i] >= 0) b->qs_of[i] = b->n_qs++;
     }
-    err = t_dyn == 0 || t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
-    /* the dynamic part */
+    return b->t_dyn == 0 || b->t_dyn == T ? TMASS_ERR_ARG : TMASS_OK;
+}
+
+/* The two parts: the dynamic model, the precomputed part's model and its compliance
+   (every node output), each with its fixed nodes pinned. */
+static int tmass__hybrid_create_parts(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, err, N = d->model.node_count, T = d->model.tet_count;
+    tmass_desc sub;
+    tmass_qs_desc qd;
+    tmass__hybrid_subdesc(d, b->dynamic, 1, b->dyn_of, b->n_dyn, b->rtmp, b->itmp, b->rtmp + 3 * N,
+                          b->rtmp + 3 * N + T, &sub);
+    err = tmass_create(&sub, &b->dyn);
+    for (i = 0; i < N && !err; i++)
+        if (b->fixed[i] && b->dyn_of[i] >= 0) err = tmass_fix_node(b->dyn, b->dyn_of[i]);
     if (!err) {
-        tmass__hybrid_subdesc(d, dynamic, 1, dyn_of, n_dyn, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
-        err = tmass_create(&sub, &dyn);
+        tmass__hybrid_subdesc(d, b->dynamic, 0, b->qs_of, b->n_qs, b->rtmp, b->itmp, b->rtmp + 3 * N,
+                              b->rtmp + 3 * N + T, &sub);
+        err = tmass_create(&sub, &b->src);
     }
     for (i = 0; i < N && !err; i++)
-        if (fixed[i] && dyn_of[i] >= 0) err = tmass_fix_node(dyn, dyn_of[i]);
-    /* the precomputed part */
-    if (!err) {
-        tmass__hybrid_subdesc(d, dynamic, 0, qs_of, n_qs, rtmp, itmp, rtmp + 3 * N, rtmp + 3 * N + T, &sub);
-        err = tmass_create(&sub, &src);
-    }
-    for (i = 0; i < N && !err; i++)
-        if (fixed[i] && qs_of[i] >= 0) err = tmass_fix_node(src, qs_of[i]);
+        if (b->fixed[i] && b->qs_of[i] >= 0) err = tmass_fix_node(b->src, b->qs_of[i]);
     if (!err) {
         qd = d->precompute;
         qd.nodes = NULL;
         qd.node_count = 0;
-        qd.allocator = a;
-        err = tmass_qs_create(src, &qd, &qs);
+        qd.allocator = b->a;
+        err = tmass_qs_create(b->src, &qd, &b->qs);
     }
-    if (!err) {
-        /* interface faces: triangles on both parts' boundaries (global numbering; itmp
-           holds each part's local -> global map in turn) */
-        int nk = 0, f;
-        for (i = 0; i < N; i++)
-            if (qs_of[i] >= 0) itmp[qs_of[i]] = i;
-        for (f = 0; f < src->tri_count; f++, nk++) {
-            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[src->tri[3 * f + k]];
-            keys[nk].source = 0;
-            keys[nk].owner = f;
-        }
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0) itmp[dyn_of[i]] = i;
-        for (f = 0; f < dyn->tri_count; f++, nk++) {
-            for (k = 0; k < 3; k++) keys[nk].tri[k] = itmp[dyn->tri[3 * f + k]];
-            keys[nk].source = 1;
-            keys[nk].owner = dyn->tri_owner[f];
-        }
-        for (f = 0; f < nk; f++) tmass__sort3(keys[f].tri, keys[f].key);
-        qsort(keys, (size_t)nk, sizeof *keys, tmass__face_key_cmp);
-        faces = nk;
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) c0++;
+    return err;
+}
+
+/* Interface faces: the triangles of both parts' boundaries, sorted by their sorted nodes
+   (global numbering; itmp holds each part's local -> global map in turn), so a face on
+   both boundaries appears twice in a row. Counts the connection nodes and sizes the
+   hybrid block (b->z). */
+static void tmass__hybrid_create_faces(const tmass_hybrid_desc *d, tmass__hy_build *b)
+{
+    int i, k, f, nk = 0, ifaces = 0, qs_tris = 0, N = d->model.node_count;
+    tmass__face_key *keys = b->keys;
+    for (i = 0; i < N; i++)
+        if (b->qs_of[i] >= 0) b->itmp[b->qs_of[i]] = i;
+    for (f = 0; f < b->src->tri_count; f++, nk++) {
+        for (k = 0; k < 3; k++) keys[nk].tri[k] = b->itmp[b->src->tri[3 * f + k]];
+        keys[nk].source = 0;
+        keys[nk].owner = f;
     }
-    if (!err) {
-        /* the hybrid block */
-        int ifaces = 0, qs_tris = 0;
-        for (i = 0; i < faces; i++) {
-            int shared = (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) ||
-                         (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0);
-            if (keys[i].source == 0) {
-                if (shared)
-                    ifaces++;
-                else
-                    qs_tris++;
-            }
-        }
-        memset(&tmp, 0, sizeof tmp);
-        z.N = N;
-        z.T = T;
-        z.c = c0;
-        z.K = d->precompute.max_contacts;
-        z.qs_tris = qs_tris;
-        z.ifaces = ifaces;
-        z.dyn_tets = t_dyn;
-        z.dyn_nodes = n_dyn;
-        z.tri_capacity = qs_tris + ifaces + 4 * t_dyn;
-        carver.base = NULL;
-        carver.offset = sizeof(tmass_hybrid);
-        tmass__hybrid_layout(&tmp, &z, &carver);
-        tmp.block_bytes = carver.offset;
-        tmp.block = tmass__alloc(&a, tmp.block_bytes);
-        if (!tmp.block) err = TMASS_ERR_ALLOC;
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0) b->itmp[b->dyn_of[i]] = i;
+    for (f = 0; f < b->dyn->tri_count; f++, nk++) {
+        for (k = 0; k < 3; k++) keys[nk].tri[k] = b->itmp[b->dyn->tri[3 * f + k]];
+        keys[nk].source = 1;
+        keys[nk].owner = b->dyn->tri_owner[f];
     }
+    for (f = 0; f < nk; f++) tmass__sort3(keys[f].tri, keys[f].key);
+    qsort(keys, (size_t)nk, sizeof *keys, tmass__face_key_cmp);
+    b->faces = nk;
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0 && b->qs_of[i] >= 0 && !b->fixed[i]) b->c0++;
+    for (i = 0; i < b->faces; i++) {
+        int shared = (i + 1 < b->faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) ||
+                     (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0);
+        if (keys[i].source == 0) {
+            if (shared)
+                ifaces++;
+            else
+                qs_tris++;
+        }
+    }
+    b->z.N = N;
+    b->z.T = d->model.tet_count;
+    b->z.c = b->c0;
+    b->z.K = d->precompute.max_contacts;
+    b->z.qs_tris = qs_tris;
+    b->z.ifaces = ifaces;
+    b->z.dyn_tets = b->t_dyn;
+    b->z.dyn_nodes = b->n_dyn;
+    b->z.tri_capacity = qs_tris + ifaces + 4 * b->t_dyn;
+}
+
+/* Allocates and carves the hybrid block; fills the maps between the whole mesh and the
+   parts. */
+static int tmass__hybrid_create_layout(const tmass__hy_build *b, tmass_hybrid **out)
+{
+    tmass_hybrid tmp, *h;
+    tmass__carver carver;
+    int i, t, N = b->z.N, T = b->z.T, nd = 0, nq = 0;
+    memset(&tmp, 0, sizeof tmp);
+    carver.base = NULL;
+    carver.offset = sizeof(tmass_hybrid);
+    tmass__hybrid_layout(&tmp, &b->z, &carver);
+    tmp.block_bytes = carver.offset;
+    tmp.block = tmass__alloc(&b->a, tmp.block_bytes);
+    if (!tmp.block) return TMASS_ERR_ALLOC;
+    memset(tmp.block, 0, tmp.block_bytes);
+    carver.base = (char *)tmp.block;
+    carver.offset = sizeof(tmass_hybrid);
+    tmass__hybrid_layout(&tmp, &b->z, &carver);
+    h = (tmass_hybrid *)tmp.block;
+    *h = tmp;
+    h->allocator = b->a;
+    h->node_count = N;
+    h->tet_count = T;
+    h->dyn_tets = b->t_dyn;
+    h->dyn = b->dyn;
+    h->qs = b->qs;
+    h->max_contacts = b->z.K;
+    h->tri_capacity = b->z.tri_capacity;
+    memcpy(h->dyn_of, b->dyn_of, sizeof(int) * (size_t)N);
+    memcpy(h->qs_of, b->qs_of, sizeof(int) * (size_t)N);
+    memcpy(h->fixed, b->fixed, (size_t)N);
+    for (i = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0) h->dyn_global[b->dyn_of[i]] = i;
+    for (t = 0; t < T; t++) {
+        h->tet_dynamic[t] = b->dynamic[t];
+        h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
+    }
+    *out = h;
+    return TMASS_OK;
+}
+
+/* The coupling block of the dynamic model (connection nodes, S = (C_cc)^-1 by Cholesky
+   column by column, exactly symmetric; freed with the model) and the connections'
+   preload. */
+static int tmass__hybrid_create_coupling(const tmass__hy_build *b, tmass_hybrid *h)
+{
+    tmass_model *dyn = b->dyn;
+    int i, k, err = TMASS_OK, c0 = b->c0, N = b->z.N;
+    tmass__carver cc;
+    size_t cb = sizeof(int) * (size_t)c0 + sizeof(double) * (9 * (size_t)c0 * c0 + 6 * (size_t)c0) + 2 * TMASS__ALIGN;
+    dyn->coupling_block = tmass__alloc(&b->a, cb);
+    if (!dyn->coupling_block) return TMASS_ERR_ALLOC;
+    dyn->coupling_bytes = cb;
+    cc.base = (char *)dyn->coupling_block;
+    cc.offset = 0;
+    dyn->coupling = (double *)tmass__carve(&cc, sizeof(double) * 9 * (size_t)c0 * c0);
+    dyn->coupling_x = (double *)tmass__carve(&cc, sizeof(double) * 6 * (size_t)c0);
+    dyn->coupling_nodes = (int *)tmass__carve(&cc, sizeof(int) * (size_t)c0);
+    for (i = 0, k = 0; i < N; i++)
+        if (b->dyn_of[i] >= 0 && b->qs_of[i] >= 0 && !b->fixed[i]) {
+            h->conn_qs[k] = b->qs_of[i];
+            dyn->coupling_nodes[k] = b->dyn_of[i];
+            if (b->qs->col_of_node[b->qs_of[i]] < 0) err = TMASS_ERR_NOT_PRECOMPUTED;
+            k++;
+        }
+    h->conn_count = c0;
+    if (!err && c0 > 0) {
+        int c3 = 3 * c0, r, s;
+        double *L = dyn->coupling; /* scratch for the factor */
+        for (r = 0; r < c3; r++)
+            for (s = 0; s < c3; s++) L[(size_t)r * c3 + s] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->conn_qs[s / 3], s % 3);
+        if (tmass__cholesky(L, c3)) err = TMASS_ERR_SINGULAR;
+        for (s = 0; s < c3 && !err; s++) {
+            for (r = 0; r < c3; r++) h->work[r] = r == s;
+            tmass__cholesky_solve(L, c3, h->work);
+            for (r = 0; r < c3; r++) h->S[(size_t)r * c3 + s] = h->work[r];
+        }
+        for (r = 0; r < c3 && !err; r++) /* exact symmetry */
+            for (s = 0; s < r; s++) {
+                double v = 0.5 * (h->S[(size_t)r * c3 + s] + h->S[(size_t)s * c3 + r]);
+                h->S[(size_t)r * c3 + s] = h->S[(size_t)s * c3 + r] = v;
+            }
+        for (r = 0; r < c3; r++) h->g_conn[r] = (double)b->qs->preload[3 * h->conn_qs[r / 3] + r % 3];
+    }
+    return err;
+}
+
+/* The coupling, then the rendering lists (static faces of the precomputed part,
+   interface faces with the dynamic tet across, flags on the dynamic part's faces) and
+   the coupling stiffness in the dynamic model. */
+static int tmass__hybrid_create_precompute(const tmass__hy_build *b, tmass_hybrid *h)
+{
+    const tmass__face_key *keys = b->keys;
+    int i, nq = 0, ni = 0, faces = b->faces;
+    int err = tmass__hybrid_create_coupling(b, h);
+    if (err) return err;
+    for (i = 0; i < faces; i++) {
+        int partner = -1;
+        if (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) partner = i + 1;
+        if (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0) partner = i - 1;
+        if (keys[i].source == 0 && partner < 0) {
+            memcpy(h->qs_tri + 3 * nq++, keys[i].tri, 3 * sizeof(int));
+        } else if (keys[i].source == 0) {
+            memcpy(h->iface_tri + 3 * ni, keys[i].tri, 3 * sizeof(int));
+            h->iface_dyn_tet[ni++] = keys[partner].owner / 4;
+        } else if (partner >= 0) {
+            h->dyn_face_iface[keys[i].owner] = 1;
+        }
+    }
+    h->qs_tri_count = nq;
+    h->iface_count = ni;
+    h->contacts_dirty = 1;
+    return tmass__hybrid_coupling(h);
+}
+
+TMASSDEF int tmass_hybrid_create(const tmass_hybrid_desc *d, tmass_hybrid **out)
+{
+    tmass__hy_build b;
+    tmass_hybrid *h = NULL;
+    int err;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!d) return TMASS_ERR_ARG;
+    err = tmass__hybrid_create_validate(d);
+    if (err) return err;
+    memset(&b, 0, sizeof b);
+    b.a = d->model.allocator;
+    err = tmass__hybrid_create_size(d, &b);
+    if (!b.tmp_block) return err;
+    if (!err) err = tmass__hybrid_create_parts(d, &b);
+    if (!err) tmass__hybrid_create_faces(d, &b);
+    if (!err) err = tmass__hybrid_create_layout(&b, &h);
     if (!err) {
-        size_t cb;
-        memset(tmp.block, 0, tmp.block_bytes);
-        carver.base = (char *)tmp.block;
-        carver.offset = sizeof(tmass_hybrid);
-        tmass__hybrid_layout(&tmp, &z, &carver);
-        h = (tmass_hybrid *)tmp.block;
-        *h = tmp;
-        h->allocator = a;
-        h->node_count = N;
-        h->tet_count = T;
-        h->dyn_tets = t_dyn;
-        h->dyn = dyn;
-        h->qs = qs;
-        h->max_contacts = z.K;
-        h->tri_capacity = z.tri_capacity;
-        memcpy(h->dyn_of, dyn_of, sizeof(int) * (size_t)N);
-        memcpy(h->qs_of, qs_of, sizeof(int) * (size_t)N);
-        memcpy(h->fixed, fixed, (size_t)N);
-        for (i = 0; i < N; i++)
-            if (dyn_of[i] >= 0) h->dyn_global[dyn_of[i]] = i;
-        {
-            int nd = 0, nq = 0;
-            for (t = 0; t < T; t++) {
-                h->tet_dynamic[t] = dynamic[t];
-                h->tet_local[t] = h->tet_dynamic[t] ? nd++ : nq++;
-            }
-        }
-        /* the coupling block lives in the dynamic model (freed with it) */
-        cb = sizeof(int) * (size_t)c0 + sizeof(double) * (9 * (size_t)c0 * c0 + 6 * (size_t)c0) + 2 * TMASS__ALIGN;
-        dyn->coupling_block = tmass__alloc(&a, cb);
-        if (!dyn->coupling_block) err = TMASS_ERR_ALLOC;
-        if (!err) {
-            tmass__carver cc;
-            dyn->coupling_bytes = cb;
-            cc.base = (char *)dyn->coupling_block;
-            cc.offset = 0;
-            dyn->coupling = (double *)tmass__carve(&cc, sizeof(double) * 9 * (size_t)c0 * c0);
-            dyn->coupling_x = (double *)tmass__carve(&cc, sizeof(double) * 6 * (size_t)c0);
-            dyn->coupling_nodes = (int *)tmass__carve(&cc, sizeof(int) * (size_t)c0);
-            for (i = 0, k = 0; i < N; i++)
-                if (dyn_of[i] >= 0 && qs_of[i] >= 0 && !fixed[i]) {
-                    h->conn_qs[k] = qs_of[i];
-                    dyn->coupling_nodes[k] = dyn_of[i];
-                    if (qs->col_of_node[qs_of[i]] < 0) err = TMASS_ERR_NOT_PRECOMPUTED;
-                    k++;
-                }
-            h->conn_count = c0;
-        }
-        if (!err && c0 > 0) {
-            /* S = (C_cc)^-1 by Cholesky, column by column */
-            int c3 = 3 * c0, r, s;
-            double *L = dyn->coupling; /* scratch for the factor */
-            for (r = 0; r < c3; r++)
-                for (s = 0; s < c3; s++) L[(size_t)r * c3 + s] = tmass__hy_C(h, h->conn_qs[r / 3], r % 3, h->conn_qs[s / 3], s % 3);
-            if (tmass__cholesky(L, c3)) err = TMASS_ERR_SINGULAR;
-            for (s = 0; s < c3 && !err; s++) {
-                for (r = 0; r < c3; r++) h->work[r] = r == s;
-                tmass__cholesky_solve(L, c3, h->work);
-                for (r = 0; r < c3; r++) h->S[(size_t)r * c3 + s] = h->work[r];
-            }
-            for (r = 0; r < c3 && !err; r++) /* exact symmetry */
-                for (s = 0; s < r; s++) {
-                    double v = 0.5 * (h->S[(size_t)r * c3 + s] + h->S[(size_t)s * c3 + r]);
-                    h->S[(size_t)r * c3 + s] = h->S[(size_t)s * c3 + r] = v;
-                }
-            for (r = 0; r < c3; r++) h->g_conn[r] = (double)qs->preload[3 * h->conn_qs[r / 3] + r % 3];
-        }
-        if (!err) {
-            /* rendering lists */
-            int nq = 0, ni = 0;
-            for (i = 0; i < faces; i++) {
-                int partner = -1;
-                if (i + 1 < faces && memcmp(keys[i].key, keys[i + 1].key, sizeof keys[i].key) == 0) partner = i + 1;
-                if (i > 0 && memcmp(keys[i].key, keys[i - 1].key, sizeof keys[i].key) == 0) partner = i - 1;
-                if (keys[i].source == 0 && partner < 0) {
-                    memcpy(h->qs_tri + 3 * nq++, keys[i].tri, 3 * sizeof(int));
-                } else if (keys[i].source == 0) {
-                    memcpy(h->iface_tri + 3 * ni, keys[i].tri, 3 * sizeof(int));
-                    h->iface_dyn_tet[ni++] = keys[partner].owner / 4;
-                } else if (partner >= 0) {
-                    h->dyn_face_iface[keys[i].owner] = 1;
-                }
-            }
-            h->qs_tri_count = nq;
-            h->iface_count = ni;
-            h->contacts_dirty = 1;
-            err = tmass__hybrid_coupling(h);
-        }
+        err = tmass__hybrid_create_precompute(&b, h);
         if (err) {
-            tmass__free(&a, tmp.block, tmp.block_bytes);
+            tmass__free(&b.a, h->block, h->block_bytes);
         } else {
             tmass__hybrid_loads(h);
             tmass__hybrid_finish(h);
             *out = h;
         }
     }
-    tmass_destroy(src);
+    tmass_destroy(b.src);
     if (err) {
-        tmass_destroy(dyn);
-        tmass_qs_destroy(qs);
+        tmass_destroy(b.dyn);
+        tmass_qs_destroy(b.qs);
     }
-    tmass__free(&a, tmp_block, tmp_bytes);
+    tmass__free(&b.a, b.tmp_block, b.tmp_bytes);
     return err;
 }
 

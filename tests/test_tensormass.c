@@ -2454,6 +2454,54 @@ static void test_float_ill_conditioned_beam(void)
     tetmesh_free(&mesh);
 }
 
+/* Issue 20: the extension points' enums end in a _COUNT sentinel that validation uses
+   (every value below it accepted, it and negative values refused with their own code),
+   and every integrator of the table steps both model kinds through the one dispatch. */
+static void test_extension_enums_validated(void)
+{
+    tmass_real nodes[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+    int tets[6 * 4] = {0, 1, 3, 7, 0, 5, 1, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 6, 4, 7};
+    tmass_desc base = tmass_default_desc(), d;
+    int kind, integ, i;
+    base.rest_positions = nodes;
+    base.node_count = 8;
+    base.tets = tets;
+    base.tet_count = 6;
+    CHECK_INT(TMASS_LINEAR_SOLVER_CG, base.linear_solver);
+    CHECK_INT(2, TMASS_MODEL_KIND_COUNT);
+    CHECK_INT(5, TMASS_INTEGRATOR_COUNT);
+    CHECK_INT(1, TMASS_LINEAR_SOLVER_COUNT);
+    d = base; d.kind = TMASS_MODEL_KIND_COUNT;                 CHECK_INT(TMASS_ERR_MODEL_KIND, try_create(&d));
+    d = base; d.kind = (tmass_model_kind)-1;                   CHECK_INT(TMASS_ERR_MODEL_KIND, try_create(&d));
+    d = base; d.integrator = TMASS_INTEGRATOR_COUNT;           CHECK_INT(TMASS_ERR_INTEGRATOR, try_create(&d));
+    d = base; d.integrator = (tmass_integrator)-1;             CHECK_INT(TMASS_ERR_INTEGRATOR, try_create(&d));
+    d = base; d.linear_solver = TMASS_LINEAR_SOLVER_COUNT;     CHECK_INT(TMASS_ERR_SOLVER, try_create(&d));
+    d = base; d.linear_solver = (tmass_linear_solver)-1;       CHECK_INT(TMASS_ERR_SOLVER, try_create(&d));
+    for (kind = 0; kind < TMASS_MODEL_KIND_COUNT; kind++) {
+        tmass_model *m = NULL;
+        d = base;
+        d.kind = (tmass_model_kind)kind;
+        d.linear_solver = TMASS_LINEAR_SOLVER_CG;
+        CHECK_INT(TMASS_OK, tmass_create(&d, &m));
+        if (!m) continue;
+        for (i = 4; i < 8; i++) tmass_fix_node(m, i);
+        CHECK_INT(TMASS_ERR_INTEGRATOR, tmass_step_ex(m, (tmass_real)1e-3, TMASS_INTEGRATOR_COUNT));
+        CHECK_INT(TMASS_ERR_INTEGRATOR, tmass_step_ex(m, (tmass_real)1e-3, (tmass_integrator)-1));
+        for (integ = 0; integ < TMASS_INTEGRATOR_COUNT; integ++) {
+            const tmass_stats *st;
+            CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)1e-4, (tmass_integrator)integ));
+            st = tmass_last_stats(m);
+            /* explicit schemes solve nothing; implicit ones count their one increment (the
+               springs' Newton may converge at the predictor, in float, with no solve) */
+            if (integ <= TMASS_RK4) CHECK_INT(0, st->cg_iterations + st->increments);
+            else CHECK_INT(1, st->increments);
+        }
+        CHECK(tmass_positions(m)[2] < 0); /* node 0 sags under gravity */
+        CHECK_INT(TMASS_OK, tmass_solve_static(m));
+        tmass_destroy(m);
+    }
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_float_ill_conditioned_beam),
@@ -2493,6 +2541,7 @@ static const test_case cases[] = {
     TEST(test_implicit_damped_recurrence),
     TEST(test_spring_incremental_potential_gradient),
     TEST(test_stress_sweep),
+    TEST(test_extension_enums_validated),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
