@@ -5,9 +5,9 @@
 # where the body is: the cantilever's tip lower after its sag than at rest for every model
 # and precision, the lobe's bottom lower after it hangs, the tip higher when the mouse drags
 # it up (with a hand force in the readout), the free half gone when a scalpel stroke cuts
-# the beam through. Also a user's TetGen mesh and a closed
-# OBJ surface (frames' meshless sampling), and a bad argument. Prints PASS/FAIL per case
-# and `RESULT <passed> <failed>` (tests/summarize.sh). Without the viewer binary (no
+# the beam through, live key switches. Also a user's TetGen mesh, the same as a Gmsh file,
+# a closed OBJ surface (frames' meshless sampling), and a bad argument. Prints PASS/FAIL
+# per case and `RESULT <passed> <failed>` (tests/summarize.sh). Without the viewer binary (no
 # GLFW), without xvfb-run or without Mesa's software renderer, prints one line and
 # `RESULT 0 0`.
 #
@@ -133,6 +133,16 @@ if want tetgen_mesh; then
     printf '5 4 0\n0 0 1 3 5\n1 0 3 2 6\n2 0 5 4 6\n3 3 6 5 7\n4 0 3 6 5\n' > "$tmp/cube.ele"
     if shot tetgen --mesh "$tmp/cube.node" --frames 5; then report tetgen_mesh 0 ""
     else report tetgen_mesh 1 "$why"; fi
+fi
+
+# the same cube as a Gmsh 2.2 file
+if want gmsh_mesh; then
+    { printf '$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n'
+      printf '1 0 0 0\n2 .1 0 0\n3 0 .1 0\n4 .1 .1 0\n5 0 0 .1\n6 .1 0 .1\n7 0 .1 .1\n8 .1 .1 .1\n$EndNodes\n'
+      printf '$Elements\n5\n1 4 2 0 1 1 2 4 6\n2 4 2 0 1 1 4 3 7\n3 4 2 0 1 1 6 5 7\n'
+      printf '4 4 2 0 1 4 7 6 8\n5 4 2 0 1 1 4 7 6\n$EndElements\n'; } > "$tmp/cube.msh"
+    if shot gmsh --mesh "$tmp/cube.msh" --model heml --frames 5; then report gmsh_mesh 0 ""
+    else report gmsh_mesh 1 "$why"; fi
 fi
 
 # a closed OBJ surface: a box, simulated by frames sampled inside it
