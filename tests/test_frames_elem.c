@@ -1610,14 +1610,15 @@ static void test_modal_r3(void)
         double tol = IS_FLOAT ? 2e-3 : 1e-6, orth;
         int i, n;
         REQUIRE(tet_beam(&s, &m, k, (double)frm_model_default_desc().rotation_divergence) == FRM_OK);
-        d.count = 8;
+        d.count = k == 1 ? 8 : 5; /* two cells across: the five modes R3 gives, to 1e-6 (test time) */
+        if (k == 2 && !IS_FLOAT) d.tolerance = (frm_real)1e-6;
         REQUIRE(frm_modal_create(m, &d, &md) == FRM_OK);
         REQUIRE(frm_modal_solve(md, m) == FRM_OK);
-        CHECK_INT(8, frm_modal_count(md));
+        CHECK_INT(d.count, frm_modal_count(md));
         printf("    R3 tet frames %d cell(s) across, modal (%d CG iterations):", k, frm_model_last_stats(m)->cg_iterations);
-        for (i = 0; i < 8; i++) printf(" %.4f", frm_modal_frequency(md, i));
+        for (i = 0; i < d.count; i++) printf(" %.4f", frm_modal_frequency(md, i));
         printf(" Hz\n");
-        orth = modal_orthonormality(md, m, 8);
+        orth = modal_orthonormality(md, m, d.count);
         CHECK(orth < (IS_FLOAT ? 1e-4 : 1e-9));
         if (k == 1) {
             double *freq = (double *)calloc((size_t)6 * s.frame_count, sizeof(double)), rot[8];
