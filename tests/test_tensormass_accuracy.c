@@ -1,0 +1,508 @@
+/* Tests of tensormass.h's accuracy features (issue 19): the BDF2 integrator against the
+   closed-form amplification factor of the scheme and its order of accuracy, its history
+   rules; point probes and tmass_displacements; modal analysis against closed forms. */
+#define TENSORMASS_IMPLEMENTATION
+#include "../tensormass.h"
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
+#include "test.h"
+#include "fixtures.h"
+
+#define IS_FLOAT (sizeof(tmass_real) == sizeof(float))
+#define PI 3.14159265358979323846
+
+/* ---- small complex arithmetic (C and C++ alike) ---------------------------------------- */
+
+typedef struct cplx {
+    double re, im;
+} cplx;
+
+static cplx c_make(double re, double im)
+{
+    cplx z;
+    z.re = re;
+    z.im = im;
+    return z;
+}
+static cplx c_div(cplx a, cplx b)
+{
+    double d = b.re * b.re + b.im * b.im;
+    return c_make((a.re * b.re + a.im * b.im) / d, (a.im * b.re - a.re * b.im) / d);
+}
+static cplx c_sqrt(cplx a) /* principal root */
+{
+    double r = sqrt(a.re * a.re + a.im * a.im), re = sqrt(0.5 * (r + a.re)), im = sqrt(0.5 * (r - a.re));
+    return c_make(re, a.im < 0 ? -im : im);
+}
+static double c_abs(cplx a) { return sqrt(a.re * a.re + a.im * a.im); }
+static double c_arg(cplx a) { return atan2(a.im, a.re); }
+
+/* The principal root z of each scheme on u'' = -omega^2 u (x_n ~ Re(A z^n)), w = omega h:
+   backward Euler z = 1 / (1 - i w); BDF2, from (3/2 - i w) z^2 - 2 z + 1/2 = 0,
+   z = (2 + sqrt(1 + 2 i w)) / (3 - 2 i w). */
+static cplx amplification(tmass_integrator integ, double w)
+{
+    if (integ == TMASS_BDF2) {
+        cplx r = c_sqrt(c_make(1.0, 2.0 * w));
+        return c_div(c_make(2.0 + r.re, r.im), c_make(3.0, -2.0 * w));
+    }
+    return c_div(c_make(1.0, 0.0), c_make(1.0, -w));
+}
+
+/* Period error (T_h - T) / T and amplitude decay per period 1 - |z|^(T_h / h) of the root z
+   of a step h = T / steps_per_period: T_h = 2 pi h / arg z. */
+static void root_figures(cplx z, double w, double *period_error, double *decay)
+{
+    double theta = c_arg(z);
+    *period_error = w / theta - 1.0;
+    *decay = 1.0 - pow(c_abs(z), 2.0 * PI / theta);
+}
+
+/* ---- a one-mode oscillator --------------------------------------------------------------- */
+
+/* A regular tetrahedron of edge 1 m with its base pinned: by the threefold symmetry about
+   the apex's axis, the apex moving along z is one mode, u'' = -omega^2 u, omega^2 =
+   K_zz / m_apex (the apex's vertex tensor over its lumped mass). */
+static tmass_model *one_mode(tmass_model_kind kind, double mass_damping, double *omega)
+{
+    static const double s3 = 1.7320508075688772;
+    tmass_real nodes[12];
+    int tet[4] = {0, 1, 2, 3}, i;
+    tmass_real g[3] = {0, 0, 0};
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    double base[9] = {1.0 / s3, 0, 0, -0.5 / s3, 0.5, 0, -0.5 / s3, -0.5, 0}, h = sqrt(2.0 / 3.0);
+    for (i = 0; i < 9; i++) nodes[i] = (tmass_real)base[i];
+    nodes[9] = nodes[10] = 0;
+    nodes[11] = (tmass_real)h;
+    d.rest_positions = nodes;
+    d.node_count = 4;
+    d.tets = tet;
+    d.tet_count = 1;
+    d.kind = kind;
+    d.young_modulus = (tmass_real)2e3;
+    d.poisson_ratio = (tmass_real)0.25;
+    d.density = (tmass_real)1000;
+    d.mass_damping = (tmass_real)mass_damping;
+    d.cg_tolerance = (tmass_real)(IS_FLOAT ? 1e-7 : kind == TMASS_TENSOR_MASS ? 1e-15 : 1e-12);
+    d.newton_tolerance = (tmass_real)(IS_FLOAT ? 1e-6 : 1e-10);
+    if (tmass_create(&d, &m)) return NULL;
+    for (i = 0; i < 3; i++) tmass_fix_node(m, i);
+    tmass_set_gravity(m, g);
+    if (kind == TMASS_TENSOR_MASS) {
+        tmass_real K[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        tmass_vertex_tensor(m, 3, K);
+        *omega = sqrt((double)K[8] / (double)tmass_masses(m)[3]);
+    } else { /* three springs k = E l0 ... : read the stiffness back from a small move */
+        tmass_real x[12];
+        memcpy(x, tmass_rest_positions(m), sizeof x);
+        x[11] = (tmass_real)((double)x[11] + 1e-6);
+        tmass_set_positions(m, x);
+        *omega = sqrt(-(double)tmass_forces(m)[11] / 1e-6 / (double)tmass_masses(m)[3]);
+        memcpy(x, tmass_rest_positions(m), sizeof x);
+        tmass_set_positions(m, x);
+    }
+    return m;
+}
+
+/* Starts the apex at u_z = amplitude, at rest. */
+static void pluck(tmass_model *m, double amplitude)
+{
+    tmass_real x[12];
+    memcpy(x, tmass_rest_positions(m), sizeof x);
+    x[11] = (tmass_real)((double)x[11] + amplitude);
+    tmass_set_positions(m, x);
+}
+
+/* The principal root of a run: x_{n+1} = p x_n - q x_{n-1} holds exactly for a sequence
+   Re(A z^n) with p = 2 Re z, q = |z|^2; least squares over samples [first, count) once
+   BDF2's parasitic root (|z_2| about 1/3 per step) has died out. */
+static cplx fitted_root(const double *x, int first, int count)
+{
+    double s00 = 0, s01 = 0, s11 = 0, b0 = 0, b1 = 0, det, p, q;
+    int n;
+    for (n = first; n + 1 < count; n++) {
+        s00 += x[n] * x[n];
+        s01 += x[n] * x[n - 1];
+        s11 += x[n - 1] * x[n - 1];
+        b0 += x[n + 1] * x[n];
+        b1 += x[n + 1] * x[n - 1];
+    }
+    /* p s00 - q s01 = b0, p s01 - q s11 = b1 */
+    det = s01 * s01 - s00 * s11;
+    p = (s01 * b1 - s11 * b0) / det;
+    q = (s00 * b1 - s01 * b0) / det;
+    return c_make(0.5 * p, sqrt(q > 0.25 * p * p ? q - 0.25 * p * p : 0.0));
+}
+
+/* Runs `steps` steps of T / steps_per_period from the plucked state and fits the root. */
+static int measure_root(tmass_model_kind kind, tmass_integrator integ, int steps_per_period, int periods,
+                        cplx *z, double *w)
+{
+    double omega = 0, T, *x;
+    int count = steps_per_period * periods + 60, s, err = TMASS_OK;
+    tmass_model *m = one_mode(kind, 0.0, &omega);
+    if (!m) return -1;
+    T = 2 * PI / omega;
+    *w = omega * T / steps_per_period;
+    x = (double *)malloc(sizeof(double) * (size_t)count);
+    pluck(m, 1e-3);
+    for (s = 0; s < count && !err; s++) {
+        err = tmass_step_ex(m, (tmass_real)(T / steps_per_period), integ);
+        x[s] = (double)m->disp[11];
+    }
+    if (!err) *z = fitted_root(x, 40, count);
+    free(x);
+    tmass_destroy(m);
+    return err;
+}
+
+/* ---- BDF2 ----------------------------------------------------------------------------- */
+
+/* Period error and amplitude decay per period of implicit Euler and BDF2 at T/20 .. T/400
+   equal the schemes' closed forms (from their amplification factors) to 3 digits. Float:
+   the decay of BDF2 (3e-6 per period at T/400) is below the float state's resolution, so
+   float checks T/20 and T/50 only. */
+static void test_bdf2_amplification_closed_form(void)
+{
+    static const int N[4] = {20, 50, 100, 400};
+    static const tmass_integrator integ[2] = {TMASS_IMPLICIT_EULER, TMASS_BDF2};
+    int k, i;
+    for (k = 0; k < 2; k++)
+        for (i = 0; i < (IS_FLOAT ? 2 : 4); i++) {
+            cplx z, zt;
+            double w = 0, pe, de, pt, dt_;
+            int periods = N[i] >= 100 ? 2 : 5;
+            REQUIRE(measure_root(TMASS_TENSOR_MASS, integ[k], N[i], periods, &z, &w) == TMASS_OK);
+            zt = amplification(integ[k], w);
+            root_figures(z, w, &pe, &de);
+            root_figures(zt, w, &pt, &dt_);
+            printf("    %-14s T/%-3d period error %+.4e (theory %+.4e), decay per period %.4e (theory %.4e)\n",
+                   k ? "BDF2" : "implicit Euler", N[i], pe, pt, de, dt_);
+            CHECK_REL(pt, pe, IS_FLOAT ? 1e-2 : 1e-3);
+            CHECK_REL(dt_, de, IS_FLOAT ? 1e-2 : 1e-3);
+        }
+}
+
+/* Exact u(T) of the plucked oscillator: u0 cos(omega T). */
+static double one_mode_error(tmass_model_kind kind, tmass_integrator integ, int steps, double periods)
+{
+    double omega = 0, T, e, amp = IS_FLOAT ? 1e-2 : 1e-3;
+    int s;
+    tmass_model *m = one_mode(kind, 0.0, &omega);
+    if (!m) return -1;
+    T = periods * 2 * PI / omega;
+    pluck(m, amp);
+    amp = (double)m->disp[11]; /* the rounded start */
+    for (s = 0; s < steps; s++)
+        if (tmass_step_ex(m, (tmass_real)(T / steps), integ)) {
+            tmass_destroy(m);
+            return -1;
+        }
+    e = fabs((double)m->disp[11] - amp * cos(omega * T));
+    tmass_destroy(m);
+    return e;
+}
+
+/* Order of accuracy: halving dt divides the error at t = 1.125 periods (phase and
+   amplitude errors both show there) by 4 for BDF2 (its
+   backward Euler start step included: a local error O(h^2), once) and by 2 for implicit
+   Euler; the period error from the fitted root too. The spring model's BDF2 (its Newton
+   minimisation with beta, xbar, vbar) as well, at a small amplitude (|u| / l = 1e-3) where
+   its frequency is the linearised one; its reference is the same model's RK4 at a tiny
+   step (the exact solution of the nonlinear oscillator is not in closed form). */
+static void test_bdf2_order(void)
+{
+    int N = 100, k;
+    double e[3], ie[2], pe[2];
+    for (k = 0; k < 3; k++) e[k] = one_mode_error(TMASS_TENSOR_MASS, TMASS_BDF2, N << k, 1.125);
+    for (k = 0; k < 2; k++) ie[k] = one_mode_error(TMASS_TENSOR_MASS, TMASS_IMPLICIT_EULER, (N << k) * 4, 1.125);
+    printf("    BDF2 N = %d, %d, %d: error %.3e %.3e %.3e, ratios %.3f %.3f (4)\n", N, 2 * N, 4 * N, e[0], e[1],
+           e[2], e[0] / e[1], e[1] / e[2]);
+    printf("    implicit Euler N = %d, %d: error %.3e %.3e, ratio %.3f (2)\n", 4 * N, 8 * N, ie[0], ie[1],
+           ie[0] / ie[1]);
+    REQUIRE(e[0] > 0 && e[1] > 0 && e[2] > 0 && ie[0] > 0 && ie[1] > 0);
+    CHECK_NEAR(4.0, e[0] / e[1], 0.3);
+    CHECK_NEAR(4.0, e[1] / e[2], 0.2);
+    CHECK_NEAR(2.0, ie[0] / ie[1], 0.1);
+    for (k = 0; k < 2; k++) {
+        cplx z;
+        double w = 0, d;
+        REQUIRE(measure_root(TMASS_TENSOR_MASS, TMASS_BDF2, 50 << k, 3, &z, &w) == TMASS_OK);
+        root_figures(z, w, &pe[k], &d);
+    }
+    printf("    BDF2 period error T/50 %.4e, T/100 %.4e: ratio %.3f (4)\n", pe[0], pe[1], pe[0] / pe[1]);
+    CHECK_NEAR(4.0, pe[0] / pe[1], 0.1);
+    if (!IS_FLOAT) { /* springs */
+        double r[3], ref;
+        tmass_model *m;
+        double omega = 0, T;
+        int s, err;
+        m = one_mode(TMASS_MASS_SPRING, 0.0, &omega);
+        REQUIRE(m != NULL);
+        T = 1.125 * 2 * PI / omega;
+        pluck(m, 1e-3);
+        for (s = 0; s < 4000; s++) tmass_step_ex(m, (tmass_real)(T / 4000), TMASS_RK4);
+        ref = (double)m->disp[11];
+        tmass_destroy(m);
+        for (k = 0; k < 3; k++) {
+            m = one_mode(TMASS_MASS_SPRING, 0.0, &omega);
+            REQUIRE(m != NULL);
+            pluck(m, 1e-3);
+            for (s = 0, err = 0; s < (N << k) && !err; s++) err = tmass_step_ex(m, (tmass_real)(T / (N << k)), TMASS_BDF2);
+            CHECK_INT(TMASS_OK, err);
+            r[k] = fabs((double)m->disp[11] - ref);
+            tmass_destroy(m);
+        }
+        printf("    springs BDF2 N = %d, %d, %d: error %.3e %.3e %.3e, ratios %.3f %.3f (4)\n", N, 2 * N, 4 * N,
+               r[0], r[1], r[2], r[0] / r[1], r[1] / r[2]);
+        CHECK_NEAR(4.0, r[0] / r[1], 0.3);
+        CHECK_NEAR(4.0, r[1] / r[2], 0.3);
+    }
+}
+
+/* A general oscillator (the tetrahedron of test_tensormass.c's integrator tests): three
+   nodes pinned, the fourth u'' = -A u - alpha u' - beta A u', A = K_33 / m_3 (3x3). */
+static tmass_model *oscillator3(double mass_damping, double stiffness_damping, double A[9])
+{
+    tmass_real nodes[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2f, 0.3f, 1};
+    int tet[4] = {0, 1, 2, 3}, i;
+    tmass_real K[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, g[3] = {0, 0, 0};
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    d.rest_positions = nodes;
+    d.node_count = 4;
+    d.tets = tet;
+    d.tet_count = 1;
+    d.young_modulus = (tmass_real)2e3;
+    d.poisson_ratio = (tmass_real)0.25;
+    d.density = (tmass_real)1000;
+    d.mass_damping = (tmass_real)mass_damping;
+    d.stiffness_damping = (tmass_real)stiffness_damping;
+    d.cg_tolerance = (tmass_real)(IS_FLOAT ? 1e-7 : 1e-15);
+    if (tmass_create(&d, &m)) return NULL;
+    for (i = 0; i < 3; i++) tmass_fix_node(m, i);
+    tmass_set_gravity(m, g);
+    tmass_vertex_tensor(m, 3, K);
+    for (i = 0; i < 9; i++) A[i] = (double)K[i] / (double)tmass_masses(m)[3];
+    return m;
+}
+
+static void mat3_vec(const double A[9], const double *x, double *y)
+{
+    int r;
+    for (r = 0; r < 3; r++) y[r] = A[3 * r] * x[0] + A[3 * r + 1] * x[1] + A[3 * r + 2] * x[2];
+}
+
+static void solve3(const double M[9], const double b[3], double x[3])
+{
+    double det = M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
+                 M[2] * (M[3] * M[7] - M[4] * M[6]);
+    double inv[9];
+    inv[0] = (M[4] * M[8] - M[5] * M[7]) / det;
+    inv[1] = (M[2] * M[7] - M[1] * M[8]) / det;
+    inv[2] = (M[1] * M[5] - M[2] * M[4]) / det;
+    inv[3] = (M[5] * M[6] - M[3] * M[8]) / det;
+    inv[4] = (M[0] * M[8] - M[2] * M[6]) / det;
+    inv[5] = (M[2] * M[3] - M[0] * M[5]) / det;
+    inv[6] = (M[3] * M[7] - M[4] * M[6]) / det;
+    inv[7] = (M[1] * M[6] - M[0] * M[7]) / det;
+    inv[8] = (M[0] * M[4] - M[1] * M[3]) / det;
+    mat3_vec(inv, b, x);
+}
+
+/* BDF2 with mass and stiffness damping from a moving start equals the scheme's own
+   recurrence, written here in its two-step form (not through the library's substitution):
+       3 u1 - 4 u0 + u_-1 = 2 h v1,   3 v1 - 4 v0 + v_-1 = 2 h (-A u1 - alpha v1 - beta A v1)
+   i.e. ((3 + 2 h alpha) I + (4 h^2 / 3 + 2 h beta) A) v1 = 4 v0 - v_-1 - 2 h / 3 A (4 u0 - u_-1),
+   after one backward Euler step
+       (I (1 + h alpha) + (h^2 + h beta) A) v1 = v0 - h A u0,   u1 = u0 + h v1. */
+static void test_bdf2_damped_recurrence(void)
+{
+    double A[9], u[3] = {0.01, -0.004, 0.006}, v[3] = {-0.02, 0.01, 0.015}, up[3], vp[3];
+    double alpha = 0.7, beta = 0.01, h = 0.05, worst = 0.0, scale = 0.0;
+    tmass_real x[12], w[12];
+    tmass_model *m = oscillator3(alpha, beta, A);
+    int i, s, r;
+    REQUIRE(m != NULL);
+    memcpy(x, tmass_rest_positions(m), sizeof x);
+    memset(w, 0, sizeof w);
+    for (i = 0; i < 3; i++) {
+        x[9 + i] = (tmass_real)((double)x[9 + i] + u[i]);
+        w[9 + i] = (tmass_real)v[i];
+    }
+    tmass_set_positions(m, x);
+    tmass_set_velocities(m, w);
+    for (i = 0; i < 3; i++) { /* the model's rounded start */
+        u[i] = (double)m->disp[9 + i];
+        v[i] = (double)tmass_velocities(m)[9 + i];
+    }
+    for (s = 0; s < 60; s++) {
+        double Mx[9], b[3], Au[3], v1[3], ub[3];
+        CHECK_INT(TMASS_OK, tmass_step_ex(m, (tmass_real)h, TMASS_BDF2));
+        if (s == 0) {
+            mat3_vec(A, u, Au);
+            for (r = 0; r < 9; r++) Mx[r] = (h * h + h * beta) * A[r] + (r % 4 == 0 ? 1.0 + h * alpha : 0.0);
+            for (r = 0; r < 3; r++) b[r] = v[r] - h * Au[r];
+            solve3(Mx, b, v1);
+            for (r = 0; r < 3; r++) ub[r] = u[r] + h * v1[r];
+        } else {
+            for (r = 0; r < 3; r++) ub[r] = 4.0 * u[r] - up[r];
+            mat3_vec(A, ub, Au);
+            for (r = 0; r < 9; r++)
+                Mx[r] = (4.0 * h * h / 3.0 + 2.0 * h * beta) * A[r] + (r % 4 == 0 ? 3.0 + 2.0 * h * alpha : 0.0);
+            for (r = 0; r < 3; r++) b[r] = 4.0 * v[r] - vp[r] - 2.0 * h / 3.0 * Au[r];
+            solve3(Mx, b, v1);
+            for (r = 0; r < 3; r++) ub[r] = (4.0 * u[r] - up[r] + 2.0 * h * v1[r]) / 3.0;
+        }
+        for (r = 0; r < 3; r++) {
+            double d;
+            up[r] = u[r];
+            vp[r] = v[r];
+            u[r] = ub[r];
+            v[r] = v1[r];
+            d = fabs((double)m->disp[9 + r] - u[r]);
+            if (d > worst) worst = d;
+            if (fabs(u[r]) > scale) scale = fabs(u[r]);
+            d = fabs((double)tmass_velocities(m)[9 + r] - v[r]);
+            if (d * h > worst) worst = d * h;
+        }
+    }
+    printf("    60 damped BDF2 steps: max |u - u_recurrence| / max |u| = %.2e\n", worst / scale);
+    CHECK(worst < (IS_FLOAT ? 1e-5 : 1e-12) * scale);
+    tmass_destroy(m);
+}
+
+/* A cube of 2 x 2 x 2 cells, bottom pinned, under gravity, of either kind. */
+static tmass_model *cube_model(tmass_model_kind kind, tetmesh *mesh)
+{
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = (tmass_real *)malloc(sizeof(tmass_real) * 3 * (size_t)mesh->node_count);
+    int i;
+    for (i = 0; i < 3 * mesh->node_count; i++) x[i] = (tmass_real)mesh->nodes[i];
+    d.rest_positions = x;
+    d.node_count = mesh->node_count;
+    d.tets = mesh->tets;
+    d.tet_count = mesh->tet_count;
+    d.kind = kind;
+    d.young_modulus = (tmass_real)1e4;
+    i = tmass_create(&d, &m);
+    free(x);
+    if (i) return NULL;
+    for (i = 0; i < mesh->node_count; i++)
+        if (mesh->nodes[3 * i + 2] == 0.0) tmass_fix_node(m, i);
+    return m;
+}
+
+static int same_state(const tmass_model *a, const tmass_model *b)
+{
+    size_t bytes = sizeof(tmass_real) * 3 * (size_t)a->node_count;
+    return memcmp(a->disp, b->disp, bytes) == 0 && memcmp(a->vel, b->vel, bytes) == 0;
+}
+
+/* Applies reset number i (test_bdf2_history_rules) to one model. */
+static int history_reset(tmass_model *m, int i, tmass_real dt)
+{
+    size_t bytes = sizeof(tmass_real) * 3 * (size_t)m->node_count;
+    int cut = 0, err;
+    tmass_real *copy = (tmass_real *)malloc(bytes);
+    memcpy(copy, m->vel, bytes);
+    switch (i) {
+    case 0: err = tmass_set_velocities(m, copy); break;
+    case 1: err = tmass_set_positions(m, tmass_positions(m)); break;
+    case 2: err = tmass_fix_node(m, 0); break; /* already pinned: the values do not change */
+    case 3: err = tmass_release_node(m, m->node_count - 1); break; /* a free node */
+    case 4: err = tmass_remove_tets(m, &cut, 1, NULL); break;
+    case 5: err = tmass_step_ex(m, dt, TMASS_IMPLICIT_EULER); break;
+    case 6: err = tmass_step_ex(m, dt / 2, TMASS_BDF2); break; /* then a step of dt */
+    default: err = tmass_solve_static(m); break;
+    }
+    free(copy);
+    return err;
+}
+
+/* The history rules (INTEGRATORS): the first BDF2 step, and the first after
+   tmass_set_positions / _velocities, a pin, a release, a cut, another integrator's step,
+   a different dt, a static solve or a failed step, is exactly an implicit Euler step
+   (two models in lockstep, one taking BDF2 and the other implicit Euler there, must stay
+   bit-identical); a failed step leaves the state and the stored history untouched.
+   Both kinds. */
+static void test_bdf2_history_rules(void)
+{
+    tetmesh mesh;
+    int kind, i, s;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        tmass_model *a = cube_model((tmass_model_kind)kind, &mesh), *b = cube_model((tmass_model_kind)kind, &mesh);
+        tmass_real dt = (tmass_real)0.01, *saved;
+        size_t bytes;
+        REQUIRE(a && b);
+        bytes = sizeof(tmass_real) * 3 * (size_t)a->node_count;
+        saved = (tmass_real *)malloc(4 * bytes);
+        /* the first step */
+        CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+        CHECK_INT(TMASS_OK, tmass_step_ex(b, dt, TMASS_IMPLICIT_EULER));
+        CHECK(same_state(a, b));
+        /* a failed step (CG capped at one iteration): state and history kept */
+        CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+        CHECK_INT(1, a->history_ready);
+        memcpy(saved, a->disp, bytes);
+        memcpy(saved + 3 * a->node_count, a->vel, bytes);
+        memcpy(saved + 6 * a->node_count, a->history_u, bytes);
+        memcpy(saved + 9 * a->node_count, a->history_v, bytes);
+        tmass_set_solver(a, (tmass_real)1e-12, 1);
+        CHECK_INT(TMASS_ERR_NO_CONVERGENCE, tmass_step_ex(a, dt, TMASS_BDF2));
+        CHECK(memcmp(saved, a->disp, bytes) == 0 && memcmp(saved + 3 * a->node_count, a->vel, bytes) == 0);
+        CHECK(memcmp(saved + 6 * a->node_count, a->history_u, bytes) == 0 &&
+              memcmp(saved + 9 * a->node_count, a->history_v, bytes) == 0);
+        CHECK_INT(0, a->history_ready);
+        tmass_set_solver(a, b->cg_tolerance, b->cg_max_iterations);
+        tmass_destroy(a);
+        a = cube_model((tmass_model_kind)kind, &mesh);
+        tmass_destroy(b);
+        b = cube_model((tmass_model_kind)kind, &mesh);
+        REQUIRE(a && b);
+        for (i = 0; i < 8; i++) {
+            for (s = 0; s < 3; s++) { /* lockstep, BDF2 proper (the first of them may restart) */
+                CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+                CHECK_INT(TMASS_OK, tmass_step_ex(b, dt, TMASS_BDF2));
+            }
+            CHECK_INT(1, a->history_ready);
+            CHECK_INT(TMASS_OK, history_reset(a, i, dt));
+            CHECK_INT(TMASS_OK, history_reset(b, i, dt));
+            CHECK(same_state(a, b));
+            CHECK_INT(i == 6, a->history_ready); /* the dt / 2 step keeps history, of dt / 2 */
+            CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+            CHECK_INT(TMASS_OK, tmass_step_ex(b, dt, TMASS_IMPLICIT_EULER));
+            if (!same_state(a, b)) printf("    reset %d (kind %d): the next BDF2 step is not implicit Euler\n", i, kind);
+            CHECK(same_state(a, b));
+            /* and a BDF2 step with history differs from implicit Euler */
+            CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+            CHECK_INT(TMASS_OK, tmass_step_ex(a, dt, TMASS_BDF2));
+            CHECK_INT(TMASS_OK, tmass_step_ex(b, dt, TMASS_IMPLICIT_EULER));
+            CHECK_INT(TMASS_OK, tmass_step_ex(b, dt, TMASS_IMPLICIT_EULER));
+            CHECK(!same_state(a, b));
+            tmass_destroy(a);
+            tmass_destroy(b);
+            a = cube_model((tmass_model_kind)kind, &mesh);
+            b = cube_model((tmass_model_kind)kind, &mesh);
+            REQUIRE(a && b);
+        }
+        free(saved);
+        tmass_destroy(a);
+        tmass_destroy(b);
+    }
+    tetmesh_free(&mesh);
+}
+
+int main(int argc, char **argv)
+{
+    static const test_case cases[] = {
+        TEST(test_bdf2_amplification_closed_form),
+        TEST(test_bdf2_order),
+        TEST(test_bdf2_damped_recurrence),
+        TEST(test_bdf2_history_rules),
+    };
+    return TEST_MAIN(argc, argv, cases);
+}
