@@ -538,6 +538,12 @@ typedef TMASS_REAL tmass_real;
 #define tmass_live_tet_count tmass_live_tet_count_f32
 #define tmass_edge_count tmass_edge_count_f32
 #define tmass_positions tmass_positions_f32
+#define tmass_displacements tmass_displacements_f32
+#define tmass_probe_create tmass_probe_create_f32
+#define tmass_probe_positions tmass_probe_positions_f32
+#define tmass_probe_displacements tmass_probe_displacements_f32
+#define tmass_probe_velocities tmass_probe_velocities_f32
+#define tmass_probe_destroy tmass_probe_destroy_f32
 #define tmass_velocities tmass_velocities_f32
 #define tmass_rest_positions tmass_rest_positions_f32
 #define tmass_masses tmass_masses_f32
@@ -644,13 +650,14 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_TET_DUPLICATE, -37, "the same tetrahedron (same four nodes, any order) is listed twice") \
     X(TMASS_ERR_DIVERGED, -38, "explicit step diverged (an edge stretched past divergence_strain); the last valid state was kept") \
     X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept") \
-    X(TMASS_ERR_UNSTABLE, -40, "static solve (spring model) converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept")
+    X(TMASS_ERR_UNSTABLE, -40, "static solve (spring model) converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
+    X(TMASS_ERR_PROBE_OUTSIDE, -41, "probe point outside every tetrahedron of the mesh (or its tetrahedron was cut away)")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -41
+    TMASS_ERR_LAST_ = -42
 };
 
 typedef enum tmass_model_kind {
@@ -841,6 +848,9 @@ TMASSDEF int tmass_tet_count(const tmass_model *m);           /* as in the descr
 TMASSDEF int tmass_live_tet_count(const tmass_model *m);      /* not removed */
 TMASSDEF int tmass_edge_count(const tmass_model *m);          /* live edges */
 TMASSDEF const tmass_real *tmass_positions(const tmass_model *m);      /* 3n, m */
+TMASSDEF const tmass_real *tmass_displacements(const tmass_model *m);  /* 3n, m: u = x - X, the
+                                                                          state itself (exact far
+                                                                          from the origin) */
 TMASSDEF const tmass_real *tmass_velocities(const tmass_model *m);     /* 3n, m/s */
 TMASSDEF const tmass_real *tmass_rest_positions(const tmass_model *m); /* 3n, m */
 TMASSDEF const tmass_real *tmass_masses(const tmass_model *m);         /* n lumped masses, kg */
@@ -888,6 +898,38 @@ TMASSDEF int tmass_vertex_tensor(const tmass_model *m, int i, tmass_real out[9])
 TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real out[9]);
 /* Bytes held by the model. */
 TMASSDEF size_t tmass_memory_bytes(const tmass_model *m);
+
+/* ---- point probes (issue 19) ----
+
+   Displacement, position and velocity at material points that need not be nodes (a
+   beam's tip centre, sensors, markers), given by their rest positions: each point's
+   containing tetrahedron and barycentric weights w are found once, at creation, and
+   every read is the P1 interpolation u(p) = sum_j w_j u_j over its four nodes (the
+   model's own displacement field, exact for it). A point on a face or edge shared by
+   several tetrahedra takes the one it is most inside (the largest smallest weight,
+   lowest index on ties: deterministic); a point outside every tetrahedron by more than
+   1e-6 of a weight (about 1e-6 of the tetrahedron's size) is refused with
+   TMASS_ERR_PROBE_OUTSIDE, one just outside within that tolerance (round-off on the
+   boundary) takes its nearest tetrahedron. */
+typedef struct tmass_probe tmass_probe;
+
+/* Locates `count` points (3 * count rest coordinates, m) in the live tetrahedra of m.
+   Allocates one block through m's allocator; cost O(count x tetrahedra) (a bounding-box
+   test per pair). Fails with TMASS_ERR_PROBE_OUTSIDE (nothing allocated) when a point
+   lies outside the mesh. The probe is read-only afterwards and may be used from several
+   threads. */
+TMASSDEF int tmass_probe_create(const tmass_model *m, const tmass_real *rest_points, int count,
+                                tmass_probe **out);
+/* 3 * count values each, written to out (m, m, m/s), for the model the probe was made
+   for (TMASS_ERR_ARG for a model with another node count). Positions are the rest point
+   plus the interpolated displacement. A tetrahedron cut away since creation: its point
+   still follows the four nodes (which may be inactive, frozen) and the call returns
+   TMASS_ERR_PROBE_OUTSIDE after writing every point. No allocation. */
+TMASSDEF int tmass_probe_positions(const tmass_probe *p, const tmass_model *m, tmass_real *out);
+TMASSDEF int tmass_probe_displacements(const tmass_probe *p, const tmass_model *m, tmass_real *out);
+TMASSDEF int tmass_probe_velocities(const tmass_probe *p, const tmass_model *m, tmass_real *out);
+/* Frees the probe. NULL is allowed. */
+TMASSDEF void tmass_probe_destroy(tmass_probe *p);
 
 /* ---- precomputed quasi-static model (Cotin et al. sec. 4) ----
 
@@ -3564,6 +3606,7 @@ TMASSDEF int tmass_tet_count(const tmass_model *m) { return m ? m->tet_count : 0
 TMASSDEF int tmass_live_tet_count(const tmass_model *m) { return m ? m->live_tets : 0; }
 TMASSDEF int tmass_edge_count(const tmass_model *m) { return m ? m->edge_count : 0; }
 TMASSDEF const tmass_real *tmass_positions(const tmass_model *m) { return m ? m->pos : NULL; }
+TMASSDEF const tmass_real *tmass_displacements(const tmass_model *m) { return m ? m->disp : NULL; }
 TMASSDEF const tmass_real *tmass_velocities(const tmass_model *m) { return m ? m->vel : NULL; }
 TMASSDEF const tmass_real *tmass_rest_positions(const tmass_model *m) { return m ? m->rest : NULL; }
 TMASSDEF const tmass_real *tmass_masses(const tmass_model *m) { return m ? m->mass : NULL; }
@@ -3653,6 +3696,174 @@ TMASSDEF int tmass_edge_tensor(const tmass_model *m, int a, int b, tmass_real ou
             }
         }
     return TMASS_ERR_NO_EDGE;
+}
+
+/* >>probes ---------------------------------------------------------------------------- */
+
+struct tmass_probe {
+    tmass_allocator allocator;
+    size_t bytes;
+    int count, node_count;
+    int *tet;          /* count: containing tetrahedron */
+    int *nodes;        /* 4 * count */
+    tmass_real *weight; /* 4 * count barycentric weights */
+    tmass_real *rest;  /* 3 * count rest points */
+};
+
+/* Barycentric weights of point x in tetrahedron t (rest state), from differences formed in
+   double; returns the smallest weight. */
+static double tmass__barycentric(const tmass_model *m, int t, const tmass_real *x, double w[4])
+{
+    const int *q = m->tet_nodes + 4 * t;
+    double e[3][3], d[3], det, inv[3][3], lo;
+    int j, r;
+    for (j = 0; j < 3; j++)
+        for (r = 0; r < 3; r++) e[r][j] = (double)m->rest[3 * q[j + 1] + r] - (double)m->rest[3 * q[0] + r];
+    for (r = 0; r < 3; r++) d[r] = (double)x[r] - (double)m->rest[3 * q[0] + r];
+    det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+          e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    inv[0][0] = (e[1][1] * e[2][2] - e[1][2] * e[2][1]) / det;
+    inv[0][1] = (e[0][2] * e[2][1] - e[0][1] * e[2][2]) / det;
+    inv[0][2] = (e[0][1] * e[1][2] - e[0][2] * e[1][1]) / det;
+    inv[1][0] = (e[1][2] * e[2][0] - e[1][0] * e[2][2]) / det;
+    inv[1][1] = (e[0][0] * e[2][2] - e[0][2] * e[2][0]) / det;
+    inv[1][2] = (e[0][2] * e[1][0] - e[0][0] * e[1][2]) / det;
+    inv[2][0] = (e[1][0] * e[2][1] - e[1][1] * e[2][0]) / det;
+    inv[2][1] = (e[0][1] * e[2][0] - e[0][0] * e[2][1]) / det;
+    inv[2][2] = (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / det;
+    w[0] = 1.0;
+    for (j = 0; j < 3; j++) {
+        w[j + 1] = inv[j][0] * d[0] + inv[j][1] * d[1] + inv[j][2] * d[2];
+        w[0] -= w[j + 1];
+    }
+    lo = w[0];
+    for (j = 1; j < 4; j++)
+        if (w[j] < lo) lo = w[j];
+    return lo;
+}
+
+/* The live tetrahedron point x is most inside (largest smallest weight), or -1 when
+   every one leaves it outside by more than the tolerance. */
+static int tmass__locate(const tmass_model *m, const tmass_real *x, double w_best[4])
+{
+    const double tolerance = 1e-6;
+    double best = -tolerance;
+    int t, found = -1, j, r;
+    for (t = 0; t < m->tet_count; t++) {
+        const int *q = m->tet_nodes + 4 * t;
+        double w[4], lo;
+        int outside = 0;
+        if (!m->tet_alive[t]) continue;
+        for (r = 0; r < 3 && !outside; r++) { /* bounding box, widened by the tolerance */
+            double a = (double)m->rest[3 * q[0] + r], b = a, pad;
+            for (j = 1; j < 4; j++) {
+                double c = (double)m->rest[3 * q[j] + r];
+                if (c < a) a = c;
+                if (c > b) b = c;
+            }
+            pad = tolerance * (b - a) + 1e-300;
+            outside = (double)x[r] < a - pad || (double)x[r] > b + pad;
+        }
+        if (outside) continue;
+        lo = tmass__barycentric(m, t, x, w);
+        if (lo > best) {
+            best = lo;
+            found = t;
+            for (j = 0; j < 4; j++) w_best[j] = w[j];
+        }
+    }
+    return found;
+}
+
+TMASSDEF int tmass_probe_create(const tmass_model *m, const tmass_real *rest_points, int count,
+                                tmass_probe **out)
+{
+    tmass__carver c;
+    tmass_probe tmp, *p;
+    int i, j;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!m || count < 1 || !rest_points || !tmass__all_finite(rest_points, 3 * (size_t)count)) return TMASS_ERR_ARG;
+    for (i = 0; i < count; i++) { /* locate every point first: nothing allocated on failure */
+        double w[4];
+        if (tmass__locate(m, rest_points + 3 * i, w) < 0) return TMASS_ERR_PROBE_OUTSIDE;
+    }
+    memset(&tmp, 0, sizeof tmp);
+    c.base = NULL;
+    c.offset = sizeof(tmass_probe);
+    TMASS__CARVE(&c, tmp.tet, int, count);
+    TMASS__CARVE(&c, tmp.nodes, int, 4 * (size_t)count);
+    TMASS__CARVE(&c, tmp.weight, tmass_real, 4 * (size_t)count);
+    TMASS__CARVE(&c, tmp.rest, tmass_real, 3 * (size_t)count);
+    tmp.bytes = c.offset;
+    p = (tmass_probe *)tmass__alloc(&m->allocator, tmp.bytes);
+    if (!p) return TMASS_ERR_ALLOC;
+    c.base = (char *)p;
+    c.offset = sizeof(tmass_probe);
+    TMASS__CARVE(&c, tmp.tet, int, count);
+    TMASS__CARVE(&c, tmp.nodes, int, 4 * (size_t)count);
+    TMASS__CARVE(&c, tmp.weight, tmass_real, 4 * (size_t)count);
+    TMASS__CARVE(&c, tmp.rest, tmass_real, 3 * (size_t)count);
+    tmp.allocator = m->allocator;
+    tmp.count = count;
+    tmp.node_count = m->node_count;
+    for (i = 0; i < count; i++) {
+        double w[4];
+        int t = tmass__locate(m, rest_points + 3 * i, w);
+        tmp.tet[i] = t;
+        for (j = 0; j < 4; j++) {
+            tmp.nodes[4 * i + j] = m->tet_nodes[4 * t + j];
+            tmp.weight[4 * i + j] = (tmass_real)w[j];
+        }
+        for (j = 0; j < 3; j++) tmp.rest[3 * i + j] = rest_points[3 * i + j];
+    }
+    *p = tmp;
+    *out = p;
+    return TMASS_OK;
+}
+
+/* out = the interpolation of field f (3 per node) at every point, plus the rest point
+   when add_rest; TMASS_ERR_PROBE_OUTSIDE when a point's tetrahedron was cut away. */
+static int tmass__probe_eval(const tmass_probe *p, const tmass_model *m, const tmass_real *f, int add_rest,
+                             tmass_real *out)
+{
+    int i, j, r, cut = 0;
+    if (!p || !m || !out) return TMASS_ERR_ARG;
+    if (m->node_count != p->node_count) return TMASS_ERR_ARG;
+    for (i = 0; i < p->count; i++) {
+        const int *q = p->nodes + 4 * i;
+        const tmass_real *w = p->weight + 4 * i;
+        for (r = 0; r < 3; r++) {
+            double s = add_rest ? (double)p->rest[3 * i + r] : 0.0;
+            for (j = 0; j < 4; j++) s += (double)w[j] * (double)f[3 * q[j] + r];
+            out[3 * i + r] = (tmass_real)s;
+        }
+        cut |= !m->tet_alive[p->tet[i]];
+    }
+    return cut ? TMASS_ERR_PROBE_OUTSIDE : TMASS_OK;
+}
+
+TMASSDEF int tmass_probe_positions(const tmass_probe *p, const tmass_model *m, tmass_real *out)
+{
+    return tmass__probe_eval(p, m, m ? m->disp : NULL, 1, out);
+}
+
+TMASSDEF int tmass_probe_displacements(const tmass_probe *p, const tmass_model *m, tmass_real *out)
+{
+    return tmass__probe_eval(p, m, m ? m->disp : NULL, 0, out);
+}
+
+TMASSDEF int tmass_probe_velocities(const tmass_probe *p, const tmass_model *m, tmass_real *out)
+{
+    return tmass__probe_eval(p, m, m ? m->vel : NULL, 0, out);
+}
+
+TMASSDEF void tmass_probe_destroy(tmass_probe *p)
+{
+    tmass_allocator a;
+    if (!p) return;
+    a = p->allocator;
+    tmass__free(&a, p, p->bytes);
 }
 
 /* >>dense ----------------------------------------------------------------------------- */
