@@ -91,7 +91,8 @@
          damping, at u and v); differential (the linearised implicit Euler step: the force
          term and the tangent left in the edge tensors, returning its factor c); energy;
          implicit_newton (the full nonlinear implicit step, or NULL when the model is
-         linear); static_solve; flags (TMASS__KIND_LINEAR: constant tensors, so the
+         linear); static_solve; tangent (the full tangent at a state into the tensors, for
+         the modal analysis, or NULL when the tensors always hold K); flags (TMASS__KIND_LINEAR: constant tensors, so the
          quasi-static and hybrid models and tmass_vertex_tensor accept it;
          TMASS__KIND_POISSON: poisson_ratio is validated and lambda, mu stored). The
          table's length is checked at compile time against the sentinel.
@@ -544,6 +545,13 @@ typedef TMASS_REAL tmass_real;
 #define tmass_probe_displacements tmass_probe_displacements_f32
 #define tmass_probe_velocities tmass_probe_velocities_f32
 #define tmass_probe_destroy tmass_probe_destroy_f32
+#define tmass_modal_default_desc tmass_modal_default_desc_f32
+#define tmass_modal_create tmass_modal_create_f32
+#define tmass_modal_solve tmass_modal_solve_f32
+#define tmass_modal_count tmass_modal_count_f32
+#define tmass_modal_frequency tmass_modal_frequency_f32
+#define tmass_modal_shape tmass_modal_shape_f32
+#define tmass_modal_destroy tmass_modal_destroy_f32
 #define tmass_velocities tmass_velocities_f32
 #define tmass_rest_positions tmass_rest_positions_f32
 #define tmass_masses tmass_masses_f32
@@ -930,6 +938,57 @@ TMASSDEF int tmass_probe_displacements(const tmass_probe *p, const tmass_model *
 TMASSDEF int tmass_probe_velocities(const tmass_probe *p, const tmass_model *m, tmass_real *out);
 /* Frees the probe. NULL is allowed. */
 TMASSDEF void tmass_probe_destroy(tmass_probe *p);
+
+/* ---- modal analysis (issue 19) ----
+
+   The lowest `count` natural frequencies and mode shapes of a model about its current
+   state, with its pinned nodes held: K phi = lambda M phi on the free degrees of freedom,
+   f = sqrt(lambda) / (2 pi). K is the tensor model's stiffness (constant), or the
+   springs' full tangent at the current displacement (which may be indefinite under
+   compression: the solve then fails); M the lumped masses. Stiffness damping and gravity
+   play no part. Matrix-free: block shift-invert subspace iteration with Rayleigh-Ritz
+   (Bathe's subspace iteration), a block of q = min(free dofs, max(2 count, count + 8))
+   vectors, each iteration q solves (K + shift M) y = M x through the model's linear
+   solver (Jacobi CG) and q stiffness products, then the q x q projected problem
+   (Cholesky and Jacobi rotations, in double). The shift makes K + shift M definite, so
+   free bodies work: their rigid modes come out at 0 Hz (within round-off, reported as
+   sqrt(max(lambda, 0))). Converged when every wanted pair has
+   |K phi - lambda M phi|_{M^-1} <= tolerance (lambda + shift) + 30 eps(tmass_real) k_max,
+   k_max the largest K_ii / m_i (the second term is the round-off of K phi: it matters in
+   float only). The inner solves run to 1e-10 (float 1e-5) with at least 10,000
+   iterations; stats.newton_iterations reports the subspace iterations. Deterministic
+   (fixed pseudo-random start). */
+typedef struct tmass_modal tmass_modal;
+
+typedef struct tmass_modal_desc {
+    int count;            /* modes wanted, default 6 */
+    int max_iterations;   /* subspace iterations, default 200 */
+    tmass_real tolerance; /* relative eigen-residual, default 1e-8 (float 1e-4) */
+    tmass_real shift;     /* 1/s^2; 0 (default): automatic, 1e-6 (float 1e-4) times the
+                             largest K_ii / m_i of the free degrees of freedom (about the
+                             top of the spectrum); > 0: that value */
+    unsigned int internal_cookie;
+} tmass_modal_desc;
+
+TMASSDEF tmass_modal_desc tmass_modal_default_desc(void);
+/* Sizes and allocates the workspace (through m's allocator, one block: about 3 q vectors
+   of 3n reals plus the q x q matrices) for models with m's node count. */
+TMASSDEF int tmass_modal_create(const tmass_model *m, const tmass_modal_desc *d, tmass_modal **out);
+/* Solves about m's current state and pins. No allocation; m's state (positions,
+   velocities, pins) is not changed; its statistics are those of the last inner solve
+   (stats.cg_iterations summed). TMASS_ERR_ARG (another node count, or fewer free degrees
+   of freedom than count), TMASS_ERR_NO_CONVERGENCE (max_iterations reached, or an inner
+   solve failed: an indefinite tangent), TMASS_ERR_NOT_FINITE; on failure
+   tmass_modal_count is 0. */
+TMASSDEF int tmass_modal_solve(tmass_modal *md, tmass_model *m);
+/* Modes of the last successful solve (0 before). */
+TMASSDEF int tmass_modal_count(const tmass_modal *md);
+/* Frequency of mode i, Hz, ascending; -1 out of range. */
+TMASSDEF double tmass_modal_frequency(const tmass_modal *md, int i);
+/* Shape of mode i: 3n values per degree of freedom (zero on pinned nodes), M-orthonormal
+   (phi_i^T M phi_j = delta_ij); NULL out of range. Valid until the next solve. */
+TMASSDEF const tmass_real *tmass_modal_shape(const tmass_modal *md, int i);
+TMASSDEF void tmass_modal_destroy(tmass_modal *md);
 
 /* ---- precomputed quasi-static model (Cotin et al. sec. 4) ----
 
@@ -1689,6 +1748,10 @@ typedef struct tmass__kind_ops {
     int (*implicit_newton)(tmass_model *m, tmass_real dt);
     /* static equilibrium from u (pinned entries at their targets), in place */
     int (*static_solve)(tmass_model *m, tmass_real *u);
+    /* the full tangent stiffness at displacement u into the vertex and edge tensors (what
+       tmass__matvec applies), or NULL when the tensors always hold K (a linear kind);
+       used by the modal analysis */
+    void (*tangent)(tmass_model *m, const tmass_real *u);
     int flags; /* TMASS__KIND_* */
 } tmass__kind_ops;
 
@@ -1711,14 +1774,15 @@ static double tmass__spring_energy_of(tmass_model *m, const tmass_real *u);
 static int tmass__spring_implicit_newton(tmass_model *m, tmass_real dt);
 static int tmass__tensor_static(tmass_model *m, tmass_real *u);
 static int tmass__spring_static_solve(tmass_model *m, tmass_real *u);
+static void tmass__spring_tangent(tmass_model *m, const tmass_real *u);
 
 static const tmass__kind_ops tmass__kinds[] = {
     /* TMASS_TENSOR_MASS */
     {"tensor-mass", tmass__tensor_assemble_tet, tmass__tensor_force, tmass__tensor_differential,
-     tmass__tensor_energy, NULL, tmass__tensor_static, TMASS__KIND_LINEAR | TMASS__KIND_POISSON},
+     tmass__tensor_energy, NULL, tmass__tensor_static, NULL, TMASS__KIND_LINEAR | TMASS__KIND_POISSON},
     /* TMASS_MASS_SPRING */
     {"mass-spring", tmass__spring_assemble_tet, tmass__spring_force, tmass__spring_differential,
-     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static_solve, 0}};
+     tmass__spring_energy_of, tmass__spring_implicit_newton, tmass__spring_static_solve, tmass__spring_tangent, 0}};
 /* one row per kind (a negative array size stops the build otherwise) */
 typedef char tmass__kinds_size_check[sizeof tmass__kinds / sizeof tmass__kinds[0] == TMASS_MODEL_KIND_COUNT ? 1 : -1];
 
@@ -3105,6 +3169,13 @@ static double tmass__spring_potential(const tmass_model *m, const tmass_real *x)
     return tmass__spring_energy(m, x) - work;
 }
 
+/* The springs' full tangent (compressed springs' negative geometric term included) at u
+   into the tensors; m->step_accel receives the force, as scratch (never inside a step). */
+static void tmass__spring_tangent(tmass_model *m, const tmass_real *u)
+{
+    tmass__spring_forces(m, u, NULL, m->step_accel, 1.0, 0.0, NULL, NULL, 1);
+}
+
 /* Newton for the static equilibrium of the spring model at the current load_scale, from
    x (pinned entries already placed). Each iteration solves K_t du = f by CG with the full
    tangent (quadratic convergence); where compressed springs make K_t indefinite (CG meets
@@ -3864,6 +3935,312 @@ TMASSDEF void tmass_probe_destroy(tmass_probe *p)
     if (!p) return;
     a = p->allocator;
     tmass__free(&a, p, p->bytes);
+}
+
+/* >>modal ----------------------------------------------------------------------------- */
+
+#define TMASS__MODAL_COOKIE 0x4D4F4441u /* "MODA" */
+
+struct tmass_modal {
+    tmass_allocator allocator;
+    size_t bytes;
+    int count, block, node_count, max_iterations, solved;
+    double tolerance, shift;
+    tmass_real *X;     /* block x 3n: the subspace (Ritz vectors after each iteration) */
+    tmass_real *Y;     /* block x 3n: (K + shift M)^-1 M X */
+    tmass_real *KY;    /* block x 3n: K Y, then K X */
+    tmass_real *diag;  /* 3n: shift M */
+    tmass_real *rhs;   /* 3n */
+    double *Kr, *Mr, *V, *L, *work; /* block x block */
+    double *theta, *frequency;      /* block */
+};
+
+TMASSDEF tmass_modal_desc tmass_modal_default_desc(void)
+{
+    tmass_modal_desc d;
+    d.count = 6;
+    d.max_iterations = 200;
+    d.tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-4 : 1e-8);
+    d.shift = 0;
+    d.internal_cookie = TMASS__MODAL_COOKIE;
+    return d;
+}
+
+static void tmass__modal_layout(tmass_modal *md, tmass__carver *c, size_t n3)
+{
+    size_t q = (size_t)md->block;
+    TMASS__CARVE(c, md->X, tmass_real, q * n3);
+    TMASS__CARVE(c, md->Y, tmass_real, q * n3);
+    TMASS__CARVE(c, md->KY, tmass_real, q * n3);
+    TMASS__CARVE(c, md->diag, tmass_real, n3);
+    TMASS__CARVE(c, md->rhs, tmass_real, n3);
+    TMASS__CARVE(c, md->Kr, double, q * q);
+    TMASS__CARVE(c, md->Mr, double, q * q);
+    TMASS__CARVE(c, md->V, double, q * q);
+    TMASS__CARVE(c, md->L, double, q * q);
+    TMASS__CARVE(c, md->work, double, q * q);
+    TMASS__CARVE(c, md->theta, double, q);
+    TMASS__CARVE(c, md->frequency, double, q);
+}
+
+TMASSDEF int tmass_modal_create(const tmass_model *m, const tmass_modal_desc *d, tmass_modal **out)
+{
+    tmass_modal tmp, *md;
+    tmass__carver c;
+    size_t n3;
+    int q;
+    if (!out) return TMASS_ERR_ARG;
+    *out = NULL;
+    if (!m || !d) return TMASS_ERR_ARG;
+    if (d->internal_cookie != TMASS__MODAL_COOKIE) return TMASS_ERR_DESC;
+    if (d->count < 1 || d->max_iterations < 1 || !(tmass__finite((double)d->tolerance) && d->tolerance > 0) ||
+        !(tmass__finite((double)d->shift) && d->shift >= 0))
+        return TMASS_ERR_ARG;
+    n3 = 3 * (size_t)m->node_count;
+    q = d->count + 8 > 2 * d->count ? d->count + 8 : 2 * d->count;
+    if ((size_t)q > n3) q = (int)n3;
+    if (d->count > q) return TMASS_ERR_ARG;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.block = q;
+    c.base = NULL;
+    c.offset = sizeof(tmass_modal);
+    tmass__modal_layout(&tmp, &c, n3);
+    tmp.bytes = c.offset;
+    md = (tmass_modal *)tmass__alloc(&m->allocator, tmp.bytes);
+    if (!md) return TMASS_ERR_ALLOC;
+    memset(md, 0, tmp.bytes);
+    c.base = (char *)md;
+    c.offset = sizeof(tmass_modal);
+    tmass__modal_layout(&tmp, &c, n3);
+    tmp.allocator = m->allocator;
+    tmp.count = d->count;
+    tmp.node_count = m->node_count;
+    tmp.max_iterations = d->max_iterations;
+    tmp.tolerance = (double)d->tolerance;
+    tmp.shift = (double)d->shift;
+    *md = tmp;
+    *out = md;
+    return TMASS_OK;
+}
+
+TMASSDEF void tmass_modal_destroy(tmass_modal *md)
+{
+    tmass_allocator a;
+    if (!md) return;
+    a = md->allocator;
+    tmass__free(&a, md, md->bytes);
+}
+
+TMASSDEF int tmass_modal_count(const tmass_modal *md) { return md && md->solved ? md->count : 0; }
+
+TMASSDEF double tmass_modal_frequency(const tmass_modal *md, int i)
+{
+    if (!md || !md->solved || i < 0 || i >= md->count) return -1.0;
+    return md->frequency[i];
+}
+
+TMASSDEF const tmass_real *tmass_modal_shape(const tmass_modal *md, int i)
+{
+    if (!md || !md->solved || i < 0 || i >= md->count) return NULL;
+    return md->X + (size_t)i * 3 * (size_t)md->node_count;
+}
+
+/* Symmetric eigenproblem A = V diag(w) V^T (q x q, row-major, A destroyed) by cyclic
+   Jacobi rotations; w ascending with V's columns. */
+static void tmass__jacobi_eigen(double *A, int q, double *V, double *w)
+{
+    int i, j, k, sweep;
+    for (i = 0; i < q; i++)
+        for (j = 0; j < q; j++) V[i * q + j] = i == j;
+    for (sweep = 0; sweep < 100; sweep++) {
+        double off = 0.0, diag = 0.0;
+        for (i = 0; i < q; i++)
+            for (j = 0; j < q; j++) {
+                if (i == j) diag += A[i * q + i] * A[i * q + i];
+                else off += A[i * q + j] * A[i * q + j];
+            }
+        if (off <= 1e-30 * diag || off == 0.0) break;
+        for (i = 0; i < q; i++)
+            for (j = i + 1; j < q; j++) {
+                double aij = A[i * q + j], t, cs, sn, tau;
+                if (aij == 0.0) continue;
+                tau = (A[j * q + j] - A[i * q + i]) / (2.0 * aij);
+                t = (tau >= 0 ? 1.0 : -1.0) / (fabs(tau) + sqrt(1.0 + tau * tau));
+                cs = 1.0 / sqrt(1.0 + t * t);
+                sn = t * cs;
+                for (k = 0; k < q; k++) { /* A = J^T A J */
+                    double aki = A[k * q + i], akj = A[k * q + j];
+                    A[k * q + i] = cs * aki - sn * akj;
+                    A[k * q + j] = sn * aki + cs * akj;
+                }
+                for (k = 0; k < q; k++) {
+                    double aik = A[i * q + k], ajk = A[j * q + k];
+                    A[i * q + k] = cs * aik - sn * ajk;
+                    A[j * q + k] = sn * aik + cs * ajk;
+                }
+                for (k = 0; k < q; k++) {
+                    double vki = V[k * q + i], vkj = V[k * q + j];
+                    V[k * q + i] = cs * vki - sn * vkj;
+                    V[k * q + j] = sn * vki + cs * vkj;
+                }
+            }
+    }
+    for (i = 0; i < q; i++) w[i] = A[i * q + i];
+    for (i = 1; i < q; i++) /* insertion sort, ascending, columns along */
+        for (j = i; j > 0 && w[j] < w[j - 1]; j--) {
+            double t = w[j];
+            w[j] = w[j - 1];
+            w[j - 1] = t;
+            for (k = 0; k < q; k++) {
+                t = V[k * q + j];
+                V[k * q + j] = V[k * q + j - 1];
+                V[k * q + j - 1] = t;
+            }
+        }
+}
+
+/* Rayleigh-Ritz on span(Y): Kr = Y^T K Y, Mr = Y^T M Y; Kr Q = Mr Q Theta through
+   Mr = L L^T and the symmetric L^-1 Kr L^-T; Q = L^-T V (in V). 0, or -1 when Mr is not
+   positive definite (a collapsed subspace). */
+static int tmass__modal_ritz(tmass_modal *md, const tmass_model *m, int q)
+{
+    int n3 = 3 * m->node_count, i, j, k;
+    double *Kr = md->Kr, *Mr = md->Mr, *L = md->L, *W = md->work;
+    for (i = 0; i < q; i++)
+        for (j = 0; j <= i; j++) {
+            const tmass_real *yi = md->Y + (size_t)i * n3, *yj = md->Y + (size_t)j * n3, *kyj = md->KY + (size_t)j * n3;
+            double kk = 0.0, mm = 0.0;
+            for (k = 0; k < n3; k++) {
+                kk += (double)yi[k] * (double)kyj[k];
+                mm += (double)yi[k] * (double)m->mass[k / 3] * (double)yj[k];
+            }
+            Kr[i * q + j] = Kr[j * q + i] = kk;
+            Mr[i * q + j] = Mr[j * q + i] = mm;
+        }
+    for (j = 0; j < q; j++) { /* Cholesky Mr = L L^T */
+        double d = Mr[j * q + j];
+        for (k = 0; k < j; k++) d -= L[j * q + k] * L[j * q + k];
+        if (!(d > 0)) return -1;
+        L[j * q + j] = sqrt(d);
+        for (i = j + 1; i < q; i++) {
+            double s = Mr[i * q + j];
+            for (k = 0; k < j; k++) s -= L[i * q + k] * L[j * q + k];
+            L[i * q + j] = s / L[j * q + j];
+        }
+        for (i = 0; i < j; i++) L[i * q + j] = 0.0;
+    }
+    /* W = L^-1 Kr (forward substitution per column), then Kr = L^-1 W^T = L^-1 Kr L^-T */
+    for (k = 0; k < 2; k++) {
+        for (j = 0; j < q; j++)
+            for (i = 0; i < q; i++) {
+                double s = k == 0 ? Kr[i * q + j] : W[j * q + i];
+                int l;
+                for (l = 0; l < i; l++) s -= L[i * q + l] * (k == 0 ? W[l * q + j] : Kr[l * q + j]);
+                if (k == 0) W[i * q + j] = s / L[i * q + i];
+                else Kr[i * q + j] = s / L[i * q + i];
+            }
+    }
+    for (i = 0; i < q; i++) /* symmetrise the round-off */
+        for (j = 0; j < i; j++) Kr[i * q + j] = Kr[j * q + i] = 0.5 * (Kr[i * q + j] + Kr[j * q + i]);
+    tmass__jacobi_eigen(Kr, q, W, md->theta);
+    /* V = L^-T W (back substitution per column) */
+    for (j = 0; j < q; j++)
+        for (i = q - 1; i >= 0; i--) {
+            double s = W[i * q + j];
+            for (k = i + 1; k < q; k++) s -= L[k * q + i] * md->V[k * q + j];
+            md->V[i * q + j] = s / L[i * q + i];
+        }
+    return 0;
+}
+
+TMASSDEF int tmass_modal_solve(tmass_modal *md, tmass_model *m)
+{
+    int q, n3, i, j, k, it, err = TMASS_OK, free_dofs = 0, saved_iterations;
+    double shift, top = 0.0, saved_tolerance, floor;
+    unsigned seed = 12345u;
+    if (!md || !m) return TMASS_ERR_ARG;
+    md->solved = 0;
+    if (m->node_count != md->node_count) return TMASS_ERR_ARG;
+    q = md->block;
+    n3 = 3 * m->node_count;
+    memset(&m->stats, 0, sizeof m->stats);
+    if (tmass__kinds[m->kind].tangent) tmass__kinds[m->kind].tangent(m, m->disp); /* about the state */
+    for (i = 0; i < n3; i++) {
+        double kii = (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)], mi = (double)m->mass[i / 3];
+        free_dofs += m->free_mask[i] > 0;
+        if (m->free_mask[i] > 0 && mi > 0 && kii / mi > top) top = kii / mi;
+    }
+    if (free_dofs < q) q = free_dofs; /* the whole space */
+    if (md->count > q) return TMASS_ERR_ARG;
+    shift = md->shift > 0 ? md->shift : (sizeof(tmass_real) == sizeof(float) ? 1e-4 : 1e-6) * top;
+    if (!(shift > 0) || !tmass__finite(shift)) return TMASS_ERR_NOT_FINITE;
+    floor = 30.0 * TMASS__EPS * top; /* round-off of K x for an M-normalised x (float: above
+                                         tolerance * shift for the rigid modes) */
+    for (i = 0; i < n3; i++) md->diag[i] = (tmass_real)(shift * (double)m->mass[i / 3]);
+    for (j = 0; j < q; j++) /* deterministic start */
+        for (i = 0; i < n3; i++) {
+            seed = seed * 1664525u + 1013904223u;
+            md->X[(size_t)j * n3 + i] = (tmass_real)((((seed >> 8) & 0xFFFFFF) / (double)0x7FFFFF - 1.0) * m->free_mask[i]);
+        }
+    saved_tolerance = (double)m->cg_tolerance;
+    saved_iterations = m->cg_max_iterations;
+    m->cg_tolerance = (tmass_real)(sizeof(tmass_real) == sizeof(float) ? 1e-5 : 1e-10);
+    if (m->cg_max_iterations < 10000) m->cg_max_iterations = 10000;
+    for (it = 0; it < md->max_iterations && !err; it++) {
+        int converged = 1;
+        for (j = 0; j < q && !err; j++) { /* Y = (K + shift M)^-1 M X */
+            tmass_real *x = md->X + (size_t)j * n3, *y = md->Y + (size_t)j * n3;
+            double guess = it > 0 ? 1.0 / (md->theta[j] + shift) : 0.0; /* y = x / (theta + shift)
+                                                                             for an eigenvector */
+            for (i = 0; i < n3; i++) {
+                md->rhs[i] = (tmass_real)((double)m->mass[i / 3] * (double)x[i] * m->free_mask[i]);
+                y[i] = (tmass_real)(guess * (double)x[i]);
+            }
+            err = tmass__linear_solve(m, md->diag, 1.0, md->rhs, y);
+            for (i = 0; i < n3; i++) y[i] *= m->free_mask[i];
+            if (!err) {
+                tmass__matvec(m, y, md->KY + (size_t)j * n3);
+                for (i = 0; i < n3; i++) md->KY[(size_t)j * n3 + i] *= m->free_mask[i];
+            }
+        }
+        if (err) break;
+        if (tmass__modal_ritz(md, m, q)) {
+            err = TMASS_ERR_NO_CONVERGENCE;
+            break;
+        }
+        for (j = 0; j < q; j++) { /* X = Y V, and K X = KY V into Y's place column by column */
+            tmass_real *x = md->X + (size_t)j * n3;
+            for (i = 0; i < n3; i++) {
+                double s = 0.0;
+                for (k = 0; k < q; k++) s += (double)md->Y[(size_t)k * n3 + i] * md->V[k * q + j];
+                x[i] = (tmass_real)s;
+            }
+        }
+        for (j = 0; j < md->count; j++) { /* residuals of the wanted pairs */
+            const tmass_real *x = md->X + (size_t)j * n3;
+            double rr = 0.0, theta = md->theta[j];
+            for (i = 0; i < n3; i++) {
+                double kx = 0.0, mi = (double)m->mass[i / 3], r;
+                if (!(m->free_mask[i] > 0) || !(mi > 0)) continue;
+                for (k = 0; k < q; k++) kx += (double)md->KY[(size_t)k * n3 + i] * md->V[k * q + j];
+                r = kx - theta * mi * (double)x[i];
+                rr += r * r / mi;
+            }
+            if (!tmass__finite(rr)) err = TMASS_ERR_NOT_FINITE;
+            if (!(sqrt(rr) <= md->tolerance * (fabs(theta) + shift) + floor)) converged = 0;
+        }
+        if (!err && converged) {
+            for (j = 0; j < md->count; j++)
+                md->frequency[j] = sqrt(md->theta[j] > 0 ? md->theta[j] : 0.0) / (2.0 * 3.14159265358979323846);
+            md->solved = 1;
+            break;
+        }
+    }
+    m->cg_tolerance = (tmass_real)saved_tolerance;
+    m->cg_max_iterations = saved_iterations;
+    m->stats.newton_iterations = it + 1;
+    if (err) return err;
+    return md->solved ? TMASS_OK : TMASS_ERR_NO_CONVERGENCE;
 }
 
 /* >>dense ----------------------------------------------------------------------------- */

@@ -644,6 +644,348 @@ static void test_probe_errors(void)
     tetmesh_free(&other_mesh);
 }
 
+/* ---- modal analysis ----------------------------------------------------------------- */
+
+/* A model of the mesh; nodes with coordinate `axis` equal to 0 pinned (axis < 0: none). */
+static tmass_model *mesh_model(const tetmesh *mesh, tmass_model_kind kind, double E, double nu, int axis,
+                               counting_allocator *count)
+{
+    tmass_desc d = tmass_default_desc();
+    tmass_model *m = NULL;
+    tmass_real *x = (tmass_real *)malloc(sizeof(tmass_real) * 3 * (size_t)mesh->node_count);
+    int i;
+    for (i = 0; i < 3 * mesh->node_count; i++) x[i] = (tmass_real)mesh->nodes[i];
+    d.rest_positions = x;
+    d.node_count = mesh->node_count;
+    d.tets = mesh->tets;
+    d.tet_count = mesh->tet_count;
+    d.kind = kind;
+    d.young_modulus = (tmass_real)E;
+    d.poisson_ratio = (tmass_real)nu;
+    d.density = (tmass_real)1000;
+    if (count) {
+        d.allocator.alloc = count_alloc;
+        d.allocator.free = count_free;
+        d.allocator.user = count;
+    }
+    i = tmass_create(&d, &m);
+    free(x);
+    if (i) return NULL;
+    if (axis >= 0)
+        for (i = 0; i < mesh->node_count; i++)
+            if (mesh->nodes[3 * i + axis] == 0.0) tmass_fix_node(m, i);
+    return m;
+}
+
+/* Symmetric eigenvalues (ascending) of a dense n x n matrix by cyclic Jacobi, in the
+   test's own code. */
+static void dense_eigenvalues(double *A, int n, double *w)
+{
+    int i, j, k, sweep;
+    for (sweep = 0; sweep < 60; sweep++) {
+        double off = 0.0;
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) off += A[i * n + j] * A[i * n + j];
+        if (off < 1e-40) break;
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) {
+                double a = A[i * n + j], th, t, c, sn;
+                if (fabs(a) < 1e-300) continue;
+                th = (A[j * n + j] - A[i * n + i]) / (2 * a);
+                t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
+                c = 1 / sqrt(t * t + 1);
+                sn = t * c;
+                for (k = 0; k < n; k++) {
+                    double x = A[k * n + i], y = A[k * n + j];
+                    A[k * n + i] = c * x - sn * y;
+                    A[k * n + j] = sn * x + c * y;
+                }
+                for (k = 0; k < n; k++) {
+                    double x = A[i * n + k], y = A[j * n + k];
+                    A[i * n + k] = c * x - sn * y;
+                    A[j * n + k] = sn * x + c * y;
+                }
+            }
+    }
+    for (i = 0; i < n; i++) w[i] = A[i * n + i];
+    for (i = 1; i < n; i++)
+        for (j = i; j > 0 && w[j] < w[j - 1]; j--) {
+            double t = w[j];
+            w[j] = w[j - 1];
+            w[j - 1] = t;
+        }
+}
+
+/* The lowest frequencies equal a dense eigen-solve of the same discrete problem (K by
+   columns from the model's forces, M^-1/2 K M^-1/2 by Jacobi in the test), both kinds, on
+   a cube pinned at its base; shapes M-orthonormal to round-off and true eigenvectors
+   (residual); the model's state untouched; no allocation in the solve. */
+static void test_modal_matches_dense(void)
+{
+    tetmesh mesh;
+    int kind;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        counting_allocator count = {0, 0, 0, 0};
+        tmass_model *m = mesh_model(&mesh, (tmass_model_kind)kind, 1e4, 0.3, 2, &count);
+        tmass_modal_desc d = tmass_modal_default_desc();
+        tmass_modal *md = NULL;
+        int n, n3, i, j, k, nf = 0, *map, allocs;
+        double *K, *A, *w, worst = 0.0, orth = 0.0, res = 0.0, eps = 1e-7;
+        tmass_real *x;
+        REQUIRE(m != NULL);
+        n = tmass_node_count(m);
+        n3 = 3 * n;
+        map = (int *)malloc(sizeof(int) * (size_t)n3);
+        for (i = 0; i < n3; i++)
+            if (!tmass_node_pinned(m, i / 3)) map[nf++] = i;
+        K = (double *)calloc((size_t)nf * nf, sizeof(double));
+        A = (double *)calloc((size_t)nf * nf, sizeof(double));
+        w = (double *)calloc((size_t)nf, sizeof(double));
+        x = (tmass_real *)malloc(sizeof(tmass_real) * (size_t)n3);
+        for (j = 0; j < nf; j++) { /* K e_j = -(f(eps e_j) - f(-eps e_j)) / (2 eps) */
+            double sgn;
+            for (sgn = -1; sgn <= 1; sgn += 2) {
+                memcpy(x, tmass_rest_positions(m), sizeof(tmass_real) * (size_t)n3);
+                x[map[j]] = (tmass_real)((double)x[map[j]] + sgn * (IS_FLOAT ? 1e-3 : eps));
+                tmass_set_positions(m, x);
+                tmass_forces(m);
+                for (i = 0; i < nf; i++)
+                    K[i * nf + j] -= sgn * (double)tmass_forces(m)[map[i]] / (2 * (IS_FLOAT ? 1e-3 : eps));
+            }
+        }
+        memcpy(x, tmass_rest_positions(m), sizeof(tmass_real) * (size_t)n3);
+        tmass_set_positions(m, x);
+        for (i = 0; i < nf; i++)
+            for (j = 0; j < nf; j++)
+                A[i * nf + j] = 0.5 * (K[i * nf + j] + K[j * nf + i]) /
+                                sqrt((double)tmass_masses(m)[map[i] / 3] * (double)tmass_masses(m)[map[j] / 3]);
+        dense_eigenvalues(A, nf, w);
+        allocs = count.allocs;
+        CHECK_INT(TMASS_OK, tmass_modal_create(m, &d, &md));
+        CHECK_INT(allocs + 1, count.allocs);
+        REQUIRE(md != NULL);
+        CHECK_INT(0, tmass_modal_count(md));
+        allocs = count.allocs;
+        CHECK_INT(TMASS_OK, tmass_modal_solve(md, m));
+        CHECK_INT(allocs, count.allocs);
+        CHECK_INT(6, tmass_modal_count(md));
+        for (i = 0; i < 6; i++) {
+            double f = sqrt(w[i]) / (2 * PI), e = fabs(tmass_modal_frequency(md, i) - f) / f;
+            if (e > worst) worst = e;
+            for (j = 0; j <= i; j++) {
+                const tmass_real *a = tmass_modal_shape(md, i), *b = tmass_modal_shape(md, j);
+                double s = 0.0;
+                for (k = 0; k < n3; k++) s += (double)a[k] * (double)tmass_masses(m)[k / 3] * (double)b[k];
+                s -= i == j;
+                if (fabs(s) > orth) orth = fabs(s);
+            }
+            { /* |K phi - lambda M phi|_M^-1 / lambda, with the dense K */
+                const tmass_real *a = tmass_modal_shape(md, i);
+                double lambda = pow(2 * PI * tmass_modal_frequency(md, i), 2), rr = 0.0;
+                for (j = 0; j < nf; j++) {
+                    double r = -lambda * (double)tmass_masses(m)[map[j] / 3] * (double)a[map[j]];
+                    for (k = 0; k < nf; k++) r += K[j * nf + k] * (double)a[map[k]];
+                    rr += r * r / (double)tmass_masses(m)[map[j] / 3];
+                }
+                if (sqrt(rr) / lambda > res) res = sqrt(rr) / lambda;
+            }
+        }
+        printf("    %s: f = %.5f %.5f %.5f %.5f %.5f %.5f Hz; dense: worst relative difference %.2e, "
+               "M-orthonormality %.2e, residual %.2e, %d CG iterations\n",
+               kind ? "springs" : "tensor", tmass_modal_frequency(md, 0), tmass_modal_frequency(md, 1),
+               tmass_modal_frequency(md, 2), tmass_modal_frequency(md, 3), tmass_modal_frequency(md, 4),
+               tmass_modal_frequency(md, 5), worst, orth, res, tmass_last_stats(m)->cg_iterations);
+        CHECK(worst < (IS_FLOAT ? 1e-3 : 1e-7));
+        CHECK(orth < (IS_FLOAT ? 1e-4 : 1e-12));
+        CHECK(res < (IS_FLOAT ? 1e-2 : 1e-6));
+        for (i = 0; i < n3; i++) CHECK((double)tmass_positions(m)[i] == (double)x[i]);
+        CHECK(tmass_modal_frequency(md, 6) < 0 && tmass_modal_shape(md, 6) == NULL && tmass_modal_shape(md, -1) == NULL);
+        tmass_modal_destroy(md);
+        tmass_destroy(m);
+        CHECK_INT(count.allocs, count.frees);
+        free(map); free(K); free(A); free(w); free(x);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* A free body (nothing pinned): six rigid modes at 0 Hz within round-off (the automatic
+   shift makes K + shift M definite), the seventh elastic. Both kinds. */
+static void test_modal_free_cube_rigid_modes(void)
+{
+    tetmesh mesh;
+    int kind, i;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    for (kind = 0; kind < 2; kind++) {
+        tmass_model *m = mesh_model(&mesh, (tmass_model_kind)kind, 1e4, 0.3, -1, NULL);
+        tmass_modal_desc d = tmass_modal_default_desc();
+        tmass_modal *md = NULL;
+        double worst = 0.0, f7;
+        REQUIRE(m != NULL);
+        d.count = 7;
+        CHECK_INT(TMASS_OK, tmass_modal_create(m, &d, &md));
+        REQUIRE(md != NULL);
+        CHECK_INT(TMASS_OK, tmass_modal_solve(md, m));
+        for (i = 0; i < 6; i++)
+            if (tmass_modal_frequency(md, i) > worst) worst = tmass_modal_frequency(md, i);
+        f7 = tmass_modal_frequency(md, 6);
+        printf("    %s free cube: six rigid modes up to %.2e Hz, first elastic %.4f Hz\n", kind ? "springs" : "tensor",
+               worst, f7);
+        CHECK(worst < (IS_FLOAT ? 1e-2 : 1e-5) * f7);
+        CHECK(f7 > 0.5);
+        tmass_modal_destroy(md);
+        tmass_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* The mode whose shape is the most axial (largest share of M-weighted x motion). */
+static int most_axial(const tmass_modal *md, const tmass_model *m)
+{
+    int i, k, best = -1;
+    double best_share = 0.0;
+    for (i = 0; i < tmass_modal_count(md); i++) {
+        const tmass_real *a = tmass_modal_shape(md, i);
+        double sx = 0.0, st = 0.0;
+        for (k = 0; k < 3 * tmass_node_count(m); k++) {
+            double e = (double)tmass_masses(m)[k / 3] * (double)a[k] * (double)a[k];
+            st += e;
+            if (k % 3 == 0) sx += e;
+        }
+        if (sx / st > best_share) {
+            best_share = sx / st;
+            best = i;
+        }
+    }
+    return best;
+}
+
+/* The R3 beam (1 x 0.1 x 0.1 m, E = 1 MPa, nu = 0.3, 1000 kg/m^3, clamped at x = 0): the
+   3D frequencies of REFERENCES (0.5091 Hz first bending, 3.0531 second, 4.5101 first
+   torsion, 7.9276 first axial) within the discretisation error of linear tetrahedra,
+   which lock in bending: on 20 x 2 x 2 and 30 x 3 x 3 six-tet cells (quick builds: the
+   first only) the bending frequencies lie above the 3D value and the error falls as h^2
+   (by 1.8 to 2.6 for h / 1.5; measured 40 x 4 x 4: +8.6 % first bending, ratio 3.4 from
+   20 x 2 x 2); no mode lies below the first bending value (no spurious low mode); torsion
+   above its value (locking: +15 % on 30 x 3 x 3, +10 % on 40 x 4 x 4) and axial (no
+   locking) within 0.5 %. And the same
+   beam with nu = 0 whose first axial mode is the 1D closed form c / (4 L), c = sqrt(E /
+   rho) (nu = 0: no lateral coupling), within 0.5 % on 20 x 2 x 2. */
+static void test_modal_r3_beam(void)
+{
+    static const double ref[6] = {0.5091, 0.5091, 3.0531, 3.0531, 4.5101, 7.9276};
+    double err_prev[6] = {0, 0, 0, 0, 0, 0};
+    int level, levels = TEST_IS_QUICK ? 1 : 2, i;
+    for (level = 0; level < levels; level++) {
+        tetmesh mesh;
+        tmass_model *m;
+        tmass_modal_desc d = tmass_modal_default_desc();
+        tmass_modal *md = NULL;
+        int c = 2 + level; /* 20 x 2 x 2, then 30 x 3 x 3 */
+        tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 10 * c, c, c, TETMESH_SPLIT6);
+        m = mesh_model(&mesh, TMASS_TENSOR_MASS, 1e6, 0.3, 0, NULL);
+        REQUIRE(m != NULL);
+        CHECK_INT(TMASS_OK, tmass_modal_create(m, &d, &md));
+        REQUIRE(md != NULL);
+        CHECK_INT(TMASS_OK, tmass_modal_solve(md, m));
+        printf("    R3 beam %d x %d x %d (%d tets): f =", 10 * c, c, c, mesh.tet_count);
+        for (i = 0; i < 6; i++) printf(" %.4f", tmass_modal_frequency(md, i));
+        printf(" Hz (errors");
+        for (i = 0; i < 6; i++) printf(" %+.2f %%", 100 * (tmass_modal_frequency(md, i) / ref[i] - 1));
+        printf("), %d subspace iterations, %d CG iterations\n", tmass_last_stats(m)->newton_iterations,
+               tmass_last_stats(m)->cg_iterations);
+        CHECK(tmass_modal_frequency(md, 0) > ref[0]); /* none below the first physical mode */
+        for (i = 0; i < 4; i++) {
+            double e = tmass_modal_frequency(md, i) / ref[i] - 1;
+            CHECK(e > 0);
+            if (level > 0) CHECK(err_prev[i] / e > 1.8 && err_prev[i] / e < 2.6); /* (3/2)^2 = 2.25 */
+            err_prev[i] = e;
+        }
+        CHECK(tmass_modal_frequency(md, 4) > ref[4]); /* torsion locks too */
+        if (level > 0) {
+            CHECK(tmass_modal_frequency(md, 4) / ref[4] - 1 < 0.16);
+            CHECK_REL(ref[5], tmass_modal_frequency(md, 5), 0.005);
+            CHECK_INT(5, most_axial(md, m));
+        }
+        tmass_modal_destroy(md);
+        tmass_destroy(m);
+        tetmesh_free(&mesh);
+    }
+    { /* nu = 0: the axial mode is the 1D one */
+        tetmesh mesh;
+        tmass_model *m;
+        tmass_modal_desc d = tmass_modal_default_desc();
+        tmass_modal *md = NULL;
+        double f1d = sqrt(1e6 / 1000.0) / 4.0, f;
+        tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 20, 2, 2, TETMESH_SPLIT6);
+        m = mesh_model(&mesh, TMASS_TENSOR_MASS, 1e6, 0.0, 0, NULL);
+        REQUIRE(m != NULL);
+        d.count = 8;
+        CHECK_INT(TMASS_OK, tmass_modal_create(m, &d, &md));
+        REQUIRE(md != NULL);
+        CHECK_INT(TMASS_OK, tmass_modal_solve(md, m));
+        i = most_axial(md, m);
+        REQUIRE(i >= 0);
+        f = tmass_modal_frequency(md, i);
+        printf("    nu = 0 beam: first axial mode %d at %.4f Hz, 1D closed form c / (4 L) = %.4f Hz (%+.3f %%)\n", i, f,
+               f1d, 100 * (f / f1d - 1));
+        CHECK_REL(f1d, f, 0.005);
+        tmass_modal_destroy(md);
+        tmass_destroy(m);
+        tetmesh_free(&mesh);
+    }
+}
+
+/* Errors: a desc not from the default function, bad fields, more modes than free degrees
+   of freedom, another model size, and no convergence within the cap (count 0, state
+   kept). */
+static void test_modal_errors(void)
+{
+    tetmesh mesh, small;
+    tmass_model *m, *other;
+    tmass_modal_desc d = tmass_modal_default_desc(), bad;
+    tmass_modal *md = (tmass_modal *)&md;
+    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    box_mesh(&small, 1, 1, 1, 1, 1, 1, TETMESH_SPLIT6);
+    m = mesh_model(&mesh, TMASS_TENSOR_MASS, 1e4, 0.3, 2, NULL);
+    other = mesh_model(&small, TMASS_TENSOR_MASS, 1e4, 0.3, 2, NULL);
+    REQUIRE(m && other);
+    memset(&bad, 0, sizeof bad);
+    CHECK_INT(TMASS_ERR_DESC, tmass_modal_create(m, &bad, &md));
+    CHECK(md == NULL);
+    bad = d; bad.count = 0;             CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(m, &bad, &md));
+    bad = d; bad.tolerance = 0;         CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(m, &bad, &md));
+    bad = d; bad.shift = -1;            CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(m, &bad, &md));
+    bad = d; bad.max_iterations = 0;    CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(m, &bad, &md));
+    CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(NULL, &d, &md));
+    bad = d; bad.count = 30;            /* more than the small cube's 8 nodes have dofs */
+    CHECK_INT(TMASS_ERR_ARG, tmass_modal_create(other, &bad, &md));
+    bad.count = 13;                     /* its 4 free nodes have 12 */
+    CHECK_INT(TMASS_OK, tmass_modal_create(other, &bad, &md));
+    CHECK_INT(TMASS_ERR_ARG, tmass_modal_solve(md, other));
+    tmass_modal_destroy(md);
+    bad.count = 12;                     /* all of them: the whole space */
+    CHECK_INT(TMASS_OK, tmass_modal_create(other, &bad, &md));
+    CHECK_INT(TMASS_OK, tmass_modal_solve(md, other));
+    CHECK_INT(12, tmass_modal_count(md));
+    tmass_modal_destroy(md);
+    CHECK_INT(TMASS_OK, tmass_modal_create(m, &d, &md));
+    CHECK_INT(TMASS_ERR_ARG, tmass_modal_solve(md, other));
+    tmass_modal_destroy(md);
+    bad = d;
+    bad.max_iterations = 1;
+    CHECK_INT(TMASS_OK, tmass_modal_create(m, &bad, &md));
+    CHECK_INT(TMASS_ERR_NO_CONVERGENCE, tmass_modal_solve(md, m));
+    CHECK_INT(0, tmass_modal_count(md));
+    CHECK(tmass_modal_shape(md, 0) == NULL);
+    tmass_modal_destroy(md);
+    tmass_modal_destroy(NULL);
+    tmass_destroy(m);
+    tmass_destroy(other);
+    tetmesh_free(&mesh);
+    tetmesh_free(&small);
+}
+
 int main(int argc, char **argv)
 {
     static const test_case cases[] = {
@@ -653,6 +995,10 @@ int main(int argc, char **argv)
         TEST(test_bdf2_history_rules),
         TEST(test_probe_reads_affine_fields),
         TEST(test_probe_errors),
+        TEST(test_modal_matches_dense),
+        TEST(test_modal_free_cube_rigid_modes),
+        TEST(test_modal_r3_beam),
+        TEST(test_modal_errors),
     };
     return TEST_MAIN(argc, argv, cases);
 }
