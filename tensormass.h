@@ -54,7 +54,7 @@
        TMASS_REAL      float or double (default double). Creation computes the tensors in
                        double and stores them in TMASS_REAL. In float builds every public
                        function is renamed (tmass_step -> tmass_step_f32, and so on for all
-                       68), so mixing float and double translation units fails at link
+                       81), so mixing float and double translation units fails at link
                        time, not at run time (a test lists them all).
        TMASS_MALLOC(size, user) / TMASS_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
@@ -69,9 +69,15 @@
           tmass_set_external_force.
        4. tmass_step(m) (desc integrator and time step) or tmass_step_ex(m, dt, integrator);
           tmass_solve_static(m) for the equilibrium.
-       5. Read tmass_positions / tmass_velocities / tmass_boundary_triangles to render.
+       5. Read tmass_positions / tmass_velocities / tmass_displacements /
+          tmass_boundary_triangles to render; material points that are not nodes through
+          a probe (tmass_probe_create once, tmass_probe_positions each frame).
        6. Topology: tmass_remove_tets (cutting), tmass_tear (tearing by criteria).
        7. tmass_destroy(m).
+       Accuracy (issue 19): TMASS_BDF2 for second order in time (INTEGRATORS);
+       tmass_modal_create / tmass_modal_solve for natural frequencies and mode shapes
+       about the current state (how far the mesh is from a known frequency: the spatial
+       error, locking included; see the modal analysis part of the API below).
        Precomputed quasi-static model (haptic rates, frozen topology): create a model as
        above with its pinned nodes, then tmass_qs_create(m, &qd, &qs) (minutes on large
        meshes; tmass_qs_save / tmass_qs_load keep the result), then per haptic frame
@@ -344,7 +350,8 @@
                                    failed step keeps the state and the stored history, and
                                    the retry restarts with implicit Euler. The hybrid
                                    model's dynamic part steps with BDF2 like any model
-                                   (tmass_hybrid_step_ex); the precomputed part is static.
+                                   (tmass_hybrid_step_ex, tested); the precomputed part is
+                                   static.
    The explicit integrators check each step for divergence (ERRORS: TMASS_ERR_DIVERGED);
    one pass over the edges, no square root. Measured orders on a one-tetrahedron
    oscillator (tests): halving dt halves the error of the three Euler schemes, divides
@@ -459,7 +466,9 @@
    HISTORY
        unreleased (issue 19) TMASS_BDF2 (second-order implicit, the implicit Euler
              minimisation reused); the model block grows by 2 vectors of 3n reals (BDF2's
-             history, 48 bytes per node in double).
+             history, 48 bytes per node in double). Modal analysis (tmass_modal_*), point
+             probes (tmass_probe_*), tmass_displacements, TMASS_ERR_PROBE_OUTSIDE; the
+             kinds table gains a tangent column, the integrators table keeps_history.
        unreleased (issue 20) explicit extension points, results bit-identical: the
              private tables tmass__kinds, tmass__integrators, tmass__linear_solvers (see
              HOW TO EXTEND); TMASS_MODEL_KIND_COUNT, TMASS_INTEGRATOR_COUNT,
@@ -957,7 +966,13 @@ TMASSDEF void tmass_probe_destroy(tmass_probe *p);
    k_max the largest K_ii / m_i (the second term is the round-off of K phi: it matters in
    float only). The inner solves run to 1e-10 (float 1e-5) with at least 10,000
    iterations; stats.newton_iterations reports the subspace iterations. Deterministic
-   (fixed pseudo-random start). */
+   (fixed pseudo-random start). Measured on the R3 beam (1 x 0.1 x 0.1 m clamped,
+   E = 1 MPa, nu = 0.3; 3D reference 0.5091 Hz first bending): 0.6592 Hz on 20 x 2 x 2
+   six-tet cells, 0.5830 on 30 x 3 x 3, 0.5528 on 40 x 4 x 4 (+29, +15, +8.6 %: linear
+   tetrahedra lock in bending, the error falls as h^2), first axial 7.9644 / 7.9495 /
+   7.9428 Hz against 7.9276; no mode below the first bending one. A dense eigen-solve of
+   the same discrete problem agrees to 1e-10 (tests). Cost: about 8 subspace iterations
+   of q solves for count 6 (about 0.5 s on 30 x 3 x 3 cells, 1620 tets, one core). */
 typedef struct tmass_modal tmass_modal;
 
 typedef struct tmass_modal_desc {

@@ -1085,6 +1085,7 @@ static unsigned long long run_hashed(int threads)
         if (s == 2) tmass_remove_tets(m, list, count, NULL);
         tmass_step_ex(m, (tmass_real)1e-4, TMASS_RK4);
     }
+    for (s = 0; s < 3; s++) tmass_step_ex(m, (tmass_real)0.01, TMASS_BDF2); /* issue 19 */
     bytes = (const unsigned char *)tmass_positions(m);
     for (i = 0; i < (int)(sizeof(tmass_real) * 3 * mesh.node_count); i++)
         h = (h ^ bytes[i]) * 1099511628211ull;
@@ -1128,7 +1129,8 @@ static void test_no_allocation_after_create(void)
         CHECK(tmass_memory_bytes(m) > 0);
         allocs = c.allocs;
         tmass_fix_node(m, 0);
-        for (i = 0; i < 4; i++) tmass_step_ex(m, (tmass_real)1e-3, (tmass_integrator)i);
+        for (i = 0; i < TMASS_INTEGRATOR_COUNT; i++) tmass_step_ex(m, (tmass_real)1e-3, (tmass_integrator)i);
+        for (i = 0; i < 3; i++) tmass_step_ex(m, (tmass_real)1e-3, TMASS_BDF2); /* with history */
         tmass_solve_static(m);
         tmass_forces(m);
         tmass_remove_tets(m, list, 2, NULL);
