@@ -6,8 +6,9 @@
    position and a unit quaternion), and integrated at samples, points that know their
    neighbouring frames through shape functions. Mesh-based (tetrahedral barycentric or
    hexahedral trilinear) and meshless (Shepard, linear moving least squares) shape
-   functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff and
-   compressible Neo-Hookean samples, exact forces and stiffness (material and geometric),
+   functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
+   compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
+   samples, exact forces and stiffness (material and geometric),
    a static Newton solver and implicit Euler, both with block-Jacobi conjugate gradient,
    matrix-free or by assembled 6x6 blocks. The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
@@ -95,6 +96,48 @@
           frm_model_sample_positions / _deformation_gradients, to render or measure.
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
+   HOW TO EXTEND (each kind of extension has one table or switch; add a row, not a branch)
+       A constitutive law: a value before FRM_LAW_COUNT in frm_law (public, documented
+          with its energy and the frm_material fields it reads); in frm__law_params what
+          its FRM_LAW_PARAMS block holds (and the small-strain shear modulus that scales
+          the stabilisation and the coupling); one row of frm__laws[] (>>laws) with its
+          name, cache_size (raise FRM__LAW_CACHE_MAX if needed), energy, stress (S, energy,
+          tangent data; FRM_ERR_INVERTED where the law is undefined), differential (dS for
+          dE), definite (NULL, or how the tangent data keep the material term >= 0 for the
+          static solve's definite linearisation) and fast_path = 0. An isotropic law in
+          invariants only needs its w and derivatives next to frm__mr_derivatives. Set
+          fast_path only if frm_material_stress / frm_material_dstress (>>kernels, shared
+          with a CUDA build) implement the law, and validation in frm__validate_material
+          for its fields. The model's loops call frm__law_stress, frm__law_dstress,
+          frm__law_dP and the law's definite rule, never the law by name.
+          Tests (tests/test_frames_elem.c, test_law_*): add the law's material to
+          law_material; then force = -gradient of the table's energy and differential =
+          derivative of the stress at the law level and through the model (force and K v
+          against finite differences) run for it by themselves; add its uniaxial closed
+          form to test_law_uniaxial_closed_forms where it has one (REFERENCES R4, R5).
+       An integrator: a value before FRM_INTEGRATOR_COUNT in frm_integrator and one row of
+          frm__integrators[] (>>integrator) with name, step(m, dt) (restores the step's start
+          state on failure) and is_explicit. Linear solves go through frm__linear_solve.
+          Tests: its order of accuracy on an oscillator (halve dt, the error falls by
+          2^order), energy behaviour on a free body, bit-identical results for 1 and 2
+          threads (the determinism test of tests/test_frames.c), refusal of bad values.
+       A linear solver: a value before FRM_LINEAR_SOLVER_COUNT in frm_linear_solver and a
+          case in frm__linear_solve (>>solver) returning the FRM__CG_* statuses (OK, CAP,
+          NEGATIVE, NOT_FINITE), which the Newton loops map to FRM_ERR_NO_CONVERGENCE and
+          FRM_ERR_NOT_FINITE. Scratch vectors are named by role in frm_model (cg_r, ...,
+          newton_dx) and carved in frm__layout. Tests: the same solutions as CG to the
+          tolerance on the static and implicit scenes of tests/test_frames.c, the cap and
+          non-finite policies (issue 18).
+       A shape function: a frm__*_functions evaluator (>>shape-functions) returning weights
+          and gradients, a public frm_shape_* wrapper (with a float rename, and listed in
+          tests/test_frames_elem.c's test_float_renames) and a frm_shape value used by
+          frm_sampling_meshless. Tests: partition of unity and zero-sum gradients, linear
+          reproduction where claimed, gradients against finite differences.
+       The bench (make bench, bench/model_frames.c) must show no loss on the existing
+       scenes (or callgrind instruction counts of the force and K v loop, which are
+       deterministic on a busy machine) and, for a new law or solver, its cost and
+       accuracy on the bench's scenes next to the existing ones.
+
    UNITS: SI throughout. Positions m, Young's modulus Pa, density kg/m^3, volumes m^3,
    time s, forces N, torques N m, rotations rad (world axes), gravity m/s^2 (default 9.81
    along -z), mass_damping 1/s, stiffness_damping s.
@@ -169,9 +212,12 @@
        (g_ij, p_j the columns of G_i and P). The printed eq. 3.49 repeats [B]^4 where
        [B]^3 belongs, and the cross-product matrix of eq. A.3 has its last row's middle
        sign wrong ((-v1, v0, 0) is right); the finite-difference tests decided.
-       Laws (per sample): St Venant-Kirchhoff S = lambda tr(E) I + 2 mu E (eq. 3.53) and
+       Laws (per sample): St Venant-Kirchhoff S = lambda tr(E) I + 2 mu E (eq. 3.53),
        compressible Neo-Hookean W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
-       S = mu (I - C^-1) + lambda ln J C^-1.
+       S = mu (I - C^-1) + lambda ln J C^-1, compressible Mooney-Rivlin (heml.h's
+       HEML_MOONEY_RIVLIN) W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3) + kappa/2 (J - 1)^2,
+       and user laws W(I1, I2, J) by callbacks; the last two through
+       S = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1 (see >>laws).
        Stiffness, K = -df/dq (the thesis writes K = df/dq). Differentiating f:
            K v = sum_s v_s B^T vec(dP) + H dtheta,  dP = dF S + F dS,  dS = C : sym(F^T dF)
        where F dS is the material part (eqs. 3.67-3.70), dF S the geometric part of
@@ -365,7 +411,8 @@
        the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
        far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
        K's positive-definite part K+: the material term (positive for SVK; Neo-Hookean with
-       2 (mu - lambda ln J) kept >= 0), the geometric term dF S with the positive part of
+       2 (mu - lambda ln J) kept >= 0; Mooney-Rivlin and user laws as they are, so their
+       first static iterations may meet negative curvature), the geometric term dF S with the positive part of
        S, each frame's own rotational term (its pairs' derivative of B through the frame's
        rotation, gravity's torque, the coupling's and the stabilisation's second-order
        parts, summed) replaced by its positive part, and the stabilisation's Gauss-Newton
@@ -560,6 +607,13 @@
          chain solver, inverse actuation and the CUDA companion are not in this version.
 
    HISTORY
+       unreleased (issue 20): extension points. Laws through one table (frm__laws) with a
+             per-sample parameter block (FRM_LAW_PARAMS) and FRM_LAW_COUNT; new laws
+             FRM_LAW_MOONEY_RIVLIN (frm_material.c1, c2, bulk_modulus) and FRM_LAW_USER
+             (frm_material.user, frm_user_law / frm_law_points as in heml.h); integrators by
+             desc.integrator (frm_integrator, FRM_INTEGRATOR_COUNT; implicit_linearized = 1
+             still selects the linearised one); desc.linear_solver (frm_linear_solver, CG);
+             HOW TO EXTEND. Results of existing models bit-identical.
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
@@ -752,12 +806,55 @@ enum {
     FRM_ERR_LAST_ = -37
 };
 
-/* Constitutive laws (per sample). Both are written in terms of the Green-Lagrange strain
-   E = (F^T F - I) / 2 and the second Piola-Kirchhoff stress S (total Lagrangian, eq. 3.37). */
+/* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
+   E = (F^T F - I) / 2 and the second Piola-Kirchhoff stress S (total Lagrangian, eq. 3.37).
+   Each law reads its own constants from frm_material (see there) into a block of
+   FRM_LAW_PARAMS reals per sample; see HOW TO EXTEND for adding one. */
 typedef enum frm_law {
-    FRM_LAW_SVK = 0,        /* St Venant-Kirchhoff, W = lambda/2 tr(E)^2 + mu E:E, S eq. 3.53 */
-    FRM_LAW_NEO_HOOKEAN = 1 /* compressible, W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2 */
+    FRM_LAW_SVK = 0,           /* St Venant-Kirchhoff, W = lambda/2 tr(E)^2 + mu E:E, S eq. 3.53
+                                  (young_modulus, poisson_ratio) */
+    FRM_LAW_NEO_HOOKEAN = 1,   /* compressible, W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2
+                                  (young_modulus, poisson_ratio) */
+    FRM_LAW_MOONEY_RIVLIN = 2, /* compressible isochoric/volumetric split, the energy of heml.h's
+                                  HEML_MOONEY_RIVLIN: W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3)
+                                  + kappa/2 (J - 1)^2 (c1, c2, bulk_modulus = kappa) */
+    FRM_LAW_USER = 3,          /* any isotropic W(I1, I2, J) through callbacks (frm_user_law) */
+    FRM_LAW_COUNT              /* sentinel: the number of laws (validation), not a law */
 } frm_law;
+
+/* Reals per sample of a law's parameter block (what each law reads, in order):
+   SVK, Neo-Hookean: mu, lambda (Pa, from young_modulus and poisson_ratio);
+   Mooney-Rivlin: c1, c2, kappa (Pa); user: mu, lambda (Pa, the small-strain moduli given
+   by young_modulus and poisson_ratio; the callbacks receive the material's `user`). */
+#define FRM_LAW_PARAMS 4
+
+/* Points at which a user law is evaluated: `count` values of each array (frames passes
+   one point per call). The inputs are the invariants I1 = tr C, I2 = (I1^2 - tr C^2) / 2
+   and J = det F (> 0: frames refuses inverted samples before calling); each callback
+   fills its outputs (Pa). The same structure as heml.h's heml_law_points. */
+typedef struct frm_law_points {
+    int count;
+    const frm_real *I1, *I2, *J;
+    frm_real *w;                                       /* energy density w, J/m^3 */
+    frm_real *w_1, *w_2, *w_J;                         /* dw/dI1, dw/dI2, dw/dJ */
+    frm_real *w_11, *w_12, *w_1J, *w_22, *w_2J, *w_JJ; /* second derivatives */
+} frm_law_points;
+
+/* An isotropic law given by its derivatives (as heml.h's heml_user_law). `first` and
+   `second` are required (frm_model_create refuses FRM_LAW_USER without them: every solver
+   of frames needs the tangent); `energy` (may be NULL: the energy then counts 0) feeds
+   frm_model_energy and the line searches of the static solve and the implicit step, so
+   give it. S = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1. The law should be stress-free at
+   rest (2 w_1 + 4 w_2 + w_J = 0 at I1 = I2 = 3, J = 1) and its small-strain moduli should
+   be those of the material's young_modulus and poisson_ratio (they scale the rotation
+   stabilisation and the frame coupling). Callbacks run on the calling thread or on worker
+   threads (parallel_for / OpenMP) and must be thread-safe and deterministic. */
+typedef struct frm_user_law {
+    void (*energy)(frm_law_points *points, void *user);
+    void (*first)(frm_law_points *points, void *user);
+    void (*second)(frm_law_points *points, void *user);
+    void *user;
+} frm_user_law;
 
 /* How K * v is evaluated inside CG (see PERFORMANCE). */
 typedef enum frm_stiffness_mode {
@@ -765,6 +862,21 @@ typedef enum frm_stiffness_mode {
     FRM_STIFFNESS_PAIRS = 1, /* matrix-free: per-pair data computed once per linearisation */
     FRM_STIFFNESS_BLOCKS = 2 /* 6x6 blocks between neighbouring frames, assembled once */
 } frm_stiffness_mode;
+
+/* Time integrators of frm_model_step (see SOLVERS; HOW TO EXTEND for adding one). */
+typedef enum frm_integrator {
+    FRM_IMPLICIT_EULER = 0,            /* backward Euler: Newton minimisation of the step's incremental
+                                          potential to newton_tolerance, line search (default) */
+    FRM_IMPLICIT_EULER_LINEARIZED = 1, /* one linearised iteration per step (the thesis's eq. 3.64;
+                                          cheaper, accurate only while the step moves little) */
+    FRM_INTEGRATOR_COUNT               /* sentinel: the number of integrators, not one */
+} frm_integrator;
+
+/* Linear solvers of every Newton iteration (static solve and implicit steps). */
+typedef enum frm_linear_solver {
+    FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
+} frm_linear_solver;
 
 /* Meshless shape functions (sec. 4.1). */
 typedef enum frm_shape {
@@ -800,9 +912,15 @@ typedef void (*frm_parallel_for_fn)(int item_count, frm_task_fn task, void *task
 /* A material: law and parameters. */
 typedef struct frm_material {
     frm_law law;            /* default FRM_LAW_SVK (the thesis's law) */
-    frm_real young_modulus; /* Pa, default 1e4 */
-    frm_real poisson_ratio; /* in (-1, 0.5), default 0.3 */
+    frm_real young_modulus; /* Pa, default 1e4 (SVK, Neo-Hookean, user) */
+    frm_real poisson_ratio; /* in (-1, 0.5), default 0.3 (SVK, Neo-Hookean, user) */
     frm_real density;       /* kg/m^3, default 1000 */
+    frm_real c1, c2;        /* Pa, Mooney-Rivlin constants (>= 0, c1 + c2 > 0); default mu/4 each
+                               for the default E and nu (c1 = c2 = 961.5 Pa): small-strain
+                               shear modulus 2 (c1 + c2) */
+    frm_real bulk_modulus;  /* Pa, Mooney-Rivlin kappa (> 0), default E / (3 (1 - 2 nu)) of the
+                               default E and nu (8333.3 Pa) */
+    frm_user_law user;      /* FRM_LAW_USER: the callbacks (default all NULL) */
 } frm_material;
 
 typedef struct frm_desc {
@@ -868,10 +986,14 @@ typedef struct frm_desc {
                                   default 1e-6 (1e-4 float) */
     int newton_max_iterations; /* Newton iterations per static increment or implicit step,
                                   default 30 */
-    int implicit_linearized;   /* 0 (default): implicit Euler minimises the step's incremental
-                                  potential by Newton iterations with a line search; 1: one
-                                  linearised iteration per step (the thesis's eq. 3.64; cheaper,
-                                  accurate only while the step moves little, see SOLVERS) */
+    frm_integrator integrator; /* default FRM_IMPLICIT_EULER: implicit Euler minimises the step's
+                                  incremental potential by Newton iterations with a line search;
+                                  FRM_IMPLICIT_EULER_LINEARIZED: one linearised iteration per step
+                                  (the thesis's eq. 3.64; cheaper, accurate only while the step
+                                  moves little, see SOLVERS) */
+    int implicit_linearized;   /* the older spelling of integrator = FRM_IMPLICIT_EULER_LINEARIZED:
+                                  0 (default) or 1, which selects the linearised integrator */
+    frm_linear_solver linear_solver; /* default FRM_LINEAR_SOLVER_CG */
     int max_increments;        /* static solve: load increments at most (continuation), default 64 */
     frm_real min_increment;    /* static solve: smallest load fraction of an increment before the
                                   solve gives up, default 1e-4 */
@@ -1892,7 +2014,6 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__ALIGN 64
 #define FRM__SAMPLE_CHUNK 64  /* samples per task of the per-sample passes */
 #define FRM__FRAME_CHUNK 32   /* frames per task of the per-frame passes */
-#define FRM__VECS 10          /* 6n scratch vectors */
 #define FRM__IS_FLOAT (sizeof(frm_real) == sizeof(float))
 /* tolerance on sum w = 1 and sum grad w = 0 (relative to sum |grad w|): a few roundings
    of 16 terms in frm_real */
@@ -1907,16 +2028,6 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #define FRM__DRIVEN 2
 
 /* scratch vector roles (6 per frame each) */
-#define FRM__V_R 0     /* CG residual */
-#define FRM__V_Z 1     /* CG preconditioned residual */
-#define FRM__V_P 2     /* CG direction */
-#define FRM__V_Q 3     /* CG A p */
-#define FRM__V_X 4     /* solution (Newton step, velocity change) */
-#define FRM__V_B 5     /* right-hand side */
-#define FRM__V_F 6     /* total generalized force */
-#define FRM__V_T 7     /* temporary */
-#define FRM__V_DV 8    /* previous velocity change (warm start) */
-#define FRM__V_DRIVE 9 /* driven frames' velocity change */
 
 struct frm_model {
     int frame_count, sample_count, pair_count, block_count, sq_total;
@@ -1930,7 +2041,9 @@ struct frm_model {
     /* settings */
     frm_real gravity[3], time_step, mass_damping, stiffness_damping;
     frm_real cg_tolerance, newton_tolerance;
-    int cg_max_iterations, newton_max_iterations, implicit_linearized, max_increments;
+    int cg_max_iterations, newton_max_iterations, max_increments;
+    int integrator;    /* frm_integrator: the row of frm__integrators frm_model_step runs */
+    int linear_solver; /* frm_linear_solver: the solver frm__linear_solve runs */
     double min_increment, precision_limit, h_min; /* h_min: smallest rest lever (see precision_limit) */
     double load_scale;                            /* continuation: fraction of gravity and external loads */
     int stiffness_mode, has_blocks;
@@ -1973,14 +2086,19 @@ struct frm_model {
     int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
 
     /* samples */
-    frm_real *s_rest, *s_volume, *s_mu, *s_lambda, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_rest, *s_volume, *s_couple; /* s_couple: c of the coupling */
+    frm_real *s_mu;         /* small-strain shear modulus (Pa): scales the stabilisation and the coupling */
+    frm_real *s_law_params; /* FRM_LAW_PARAMS: the law's parameter block (see frm_law, frm__laws) */
+    const frm_user_law **s_user; /* FRM_LAW_USER: the material's callbacks (in user_laws), else NULL */
+    frm_user_law *user_laws;     /* a copy of every material's callbacks (user_law_count) */
+    int user_law_count, law_cache; /* law_cache: lin_cache reals per sample, the largest cache_size in use */
     frm_real *s_hstab; /* g = gamma h^2 of the stabilisation's divergence term (m^2) */
     frm_real *s_stabY; /* 9: Y = sum of Z_k over the pairs of frames without unseen rotations, at the linearisation */
     frm_real *s_stabD; /* 1: D at the linearisation */
     unsigned char *s_law, *s_stab; /* s_stab: 1 if a neighbour has f_stab_on */
     unsigned char *s_inverted;     /* 1: det F <= 0 at the start of the step or solve */
     int *s_start;
-    frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, FRM_LAW_CACHE at the linearisation */
+    frm_real *lin_F, *lin_S, *lin_cache; /* 9, 6, law_cache at the linearisation */
     frm_real *s_pos, *s_F;               /* outputs: 3, 9 */
 
     /* pairs */
@@ -1997,7 +2115,14 @@ struct frm_model {
     int *chunk_err;
 
     /* scratch */
-    frm_real *vec[FRM__VECS];
+    /* 6 reals per frame each, named by role */
+    frm_real *cg_r, *cg_z, *cg_p, *cg_q; /* CG residual, preconditioned residual, direction, A p */
+    frm_real *newton_dx;                 /* a Newton iteration's solution (step, velocity change) */
+    frm_real *newton_rhs;                /* its right-hand side */
+    frm_real *total_force;               /* total generalized force */
+    frm_real *work;                      /* temporary: a load, a trial force, K v */
+    frm_real *warm_dv;                   /* the previous step's velocity change (CG warm start) */
+    frm_real *drive_dv;                  /* driven frames' velocity change (Newton step: their dq) */
     frm_real *backup;      /* 13 per frame: position, orientation, velocity */
     frm_real *start_state; /* 13 per frame: the state a static solve started from */
 
@@ -2160,6 +2285,363 @@ static void frm__quat_normalized(const frm_real *q, frm_real *out)
     for (k = 0; k < 4; k++) out[k] = (frm_real)(q[k] / n);
 }
 
+/* >>laws -------------------------------------------------------------------------------- */
+/* Every constitutive law is one row of frm__laws[], indexed by frm_law. A law reads its
+   parameter block (FRM_LAW_PARAMS reals per sample, filled by frm__law_params at creation)
+   and, for FRM_LAW_USER, the material's callbacks; it returns through:
+     energy        W at F = I + H (J/m^3); 0 or FRM_ERR_INVERTED
+     stress        S (6, Voigt), W and the tangent data (cache_size reals) differential reads
+     differential  dS for a strain variation dE (6) at the state stress cached
+     definite      NULL, or the change of the cached tangent data that keeps the material
+                   part of K positive where the law allows it (used by the definite
+                   linearisation of the static solve's first iterations, see SOLVERS)
+     fast_path     1: the model's loops may evaluate the law by the inlined kernels
+                   frm_material_stress / frm_material_dstress (the >>kernels section, shared
+                   with a CUDA build), which implement SVK and Neo-Hookean only. A law without
+                   the flag always goes through its own functions. The law tests compare
+                   the path the model uses (frm__law_stress, frm__law_dstress) with finite
+                   differences of each law's `energy`, so a flag set on the wrong law fails.
+   frm__law_stress, frm__law_dstress, frm__law_dP, frm__law_tangent_columns (below) and the
+   pair-mode K v loop (frm__apply_chunks, which tests the flag before the call to keep the
+   old instruction count) are the only readers of fast_path; the model's loops never name
+   a law. */
+
+#define FRM__LAW_CACHE_MAX 23 /* the largest cache_size of frm__laws (the invariant laws) */
+
+typedef struct frm__law_ops {
+    const char *name;
+    int cache_size;
+    int (*energy)(const frm_real *params, const frm_user_law *user, const frm_real H[9], frm_real *psi);
+    int (*stress)(const frm_real *params, const frm_user_law *user, const frm_real H[9], frm_real S[6], frm_real *psi,
+                  frm_real *cache);
+    void (*differential)(const frm_real *params, const frm_user_law *user, const frm_real *cache, const frm_real dE[6],
+                         frm_real dS[6]);
+    void (*definite)(const frm_real *params, frm_real *cache);
+    int fast_path;
+} frm__law_ops;
+
+/* SVK and Neo-Hookean: the kernels' formulas (frm_material_stress, frm_material_dstress),
+   params = (mu, lambda). */
+static int frm__svk_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                           frm_real *psi, frm_real *cache)
+{
+    (void)user;
+    return frm_material_stress(FRM_LAW_SVK, p[0], p[1], H, S, psi, cache);
+}
+
+static void frm__svk_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                  const frm_real dE[6], frm_real dS[6])
+{
+    (void)user;
+    frm_material_dstress(FRM_LAW_SVK, p[0], p[1], cache, dE, dS);
+}
+
+static int frm__nh_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                          frm_real *psi, frm_real *cache)
+{
+    (void)user;
+    return frm_material_stress(FRM_LAW_NEO_HOOKEAN, p[0], p[1], H, S, psi, cache);
+}
+
+static void frm__nh_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                 const frm_real dE[6], frm_real dS[6])
+{
+    (void)user;
+    frm_material_dstress(FRM_LAW_NEO_HOOKEAN, p[0], p[1], cache, dE, dS);
+}
+
+/* Neo-Hookean's tangent 2 (mu - lambda ln J) C^-1 dE C^-1 kept >= 0: ln J (cache[6]) capped
+   at mu / lambda. */
+static void frm__nh_definite(const frm_real *p, frm_real *cache)
+{
+    if (p[1] * cache[6] > p[0]) cache[6] = p[0] / p[1];
+}
+
+/* Invariant laws (Mooney-Rivlin, user): W(I1, I2, J) with I1 = tr C, I2 = (I1^2 - tr C^2)/2,
+   J = det F. Evaluated in double:
+       S  = 2 w_1 I + 2 w_2 (I1 I - C) + J w_J C^-1
+       dS = 2 dw_1 I + 2 dw_2 (I1 I - C) + 2 w_2 (dI1 I - 2 dE) + (dJ w_J + J dw_J) C^-1
+            - 2 J w_J C^-1 dE C^-1,
+   dI1 = 2 tr dE, dI2 = 2 (I1 tr dE - C : dE), dJ = J C^-1 : dE, dw_a = sum_b w_ab dI_b.
+   Cache (23): C^-1 (6), C (6), I1, J, w_1, w_2, w_J, w_11, w_12, w_1J, w_22, w_2J, w_JJ.
+   Unlike the Neo-Hookean kernel, the stress at small strain is a difference of terms of
+   the size of the moduli (2 w_1 + 4 w_2 + J w_J = 0 at rest): relative round-off of the
+   stress is eps(double) of the moduli, then rounded to frm_real. */
+typedef struct frm__invariants {
+    double I1, I2, J, w, d1[3], d2[6]; /* d1: w_1, w_2, w_J; d2: w_11, w_12, w_1J, w_22, w_2J, w_JJ */
+} frm__invariants;
+
+/* C (6, Voigt), C^-1 (6), I1, I2, J from H; 0 or FRM_ERR_INVERTED. */
+static int frm__invariants_of(const frm_real H[9], double C[6], double Ci[6], frm__invariants *v)
+{
+    double F[9], J, tr2;
+    int r;
+    for (r = 0; r < 9; r++) F[r] = (double)H[r] + (r % 4 == 0 ? 1.0 : 0.0);
+    C[0] = F[0] * F[0] + F[3] * F[3] + F[6] * F[6];
+    C[1] = F[1] * F[1] + F[4] * F[4] + F[7] * F[7];
+    C[2] = F[2] * F[2] + F[5] * F[5] + F[8] * F[8];
+    C[3] = F[1] * F[2] + F[4] * F[5] + F[7] * F[8];
+    C[4] = F[0] * F[2] + F[3] * F[5] + F[6] * F[8];
+    C[5] = F[0] * F[1] + F[3] * F[4] + F[6] * F[7];
+    J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) + F[2] * (F[3] * F[7] - F[4] * F[6]);
+    if (!(J > 0)) return FRM_ERR_INVERTED;
+    Ci[0] = (C[1] * C[2] - C[3] * C[3]) / (J * J);
+    Ci[1] = (C[0] * C[2] - C[4] * C[4]) / (J * J);
+    Ci[2] = (C[0] * C[1] - C[5] * C[5]) / (J * J);
+    Ci[3] = (C[4] * C[5] - C[0] * C[3]) / (J * J);
+    Ci[4] = (C[5] * C[3] - C[1] * C[4]) / (J * J);
+    Ci[5] = (C[3] * C[4] - C[2] * C[5]) / (J * J);
+    v->I1 = C[0] + C[1] + C[2];
+    tr2 = C[0] * C[0] + C[1] * C[1] + C[2] * C[2] + 2 * (C[3] * C[3] + C[4] * C[4] + C[5] * C[5]);
+    v->I2 = 0.5 * (v->I1 * v->I1 - tr2);
+    v->J = J;
+    return 0;
+}
+
+/* Mooney-Rivlin (heml.h's HEML_MOONEY_RIVLIN, eqs. 21-25 of the HEML paper), p = (c1, c2,
+   kappa): W = c1 (I1 J^-2/3 - 3) + c2 (I2 J^-4/3 - 3) + kappa/2 (J - 1)^2,
+       w_1 = c1 J^-2/3, w_2 = c2 J^-4/3, w_J = -2/3 c1 I1 J^-5/3 - 4/3 c2 I2 J^-7/3 + kappa (J - 1),
+       w_11 = w_12 = w_22 = 0, w_1J = -2/3 c1 J^-5/3, w_2J = -4/3 c2 J^-7/3,
+       w_JJ = 10/9 c1 I1 J^-8/3 + 28/9 c2 I2 J^-10/3 + kappa. */
+static void frm__mr_derivatives(const frm_real *p, frm__invariants *v, int order)
+{
+    double c1 = (double)p[0], c2 = (double)p[1], kappa = (double)p[2], J = v->J;
+    double a = pow(J, -2.0 / 3.0), b = a * a; /* J^-2/3, J^-4/3 */
+    v->w = c1 * (v->I1 * a - 3) + c2 * (v->I2 * b - 3) + 0.5 * kappa * (J - 1) * (J - 1);
+    if (order < 1) return;
+    v->d1[0] = c1 * a;
+    v->d1[1] = c2 * b;
+    v->d1[2] = (-2.0 / 3.0 * c1 * v->I1 * a - 4.0 / 3.0 * c2 * v->I2 * b) / J + kappa * (J - 1);
+    if (order < 2) return;
+    v->d2[0] = v->d2[1] = v->d2[3] = 0;
+    v->d2[2] = -2.0 / 3.0 * c1 * a / J;
+    v->d2[4] = -4.0 / 3.0 * c2 * b / J;
+    v->d2[5] = (10.0 / 9.0 * c1 * v->I1 * a + 28.0 / 9.0 * c2 * v->I2 * b) / (J * J) + kappa;
+}
+
+/* The user's callbacks at one point: order 0 energy, 1 and first, 2 and second. */
+static void frm__user_derivatives(const frm_user_law *u, frm__invariants *v, int order)
+{
+    frm_real I1 = (frm_real)v->I1, I2 = (frm_real)v->I2, J = (frm_real)v->J, w = 0, d[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    frm_law_points pt;
+    int k;
+    pt.count = 1;
+    pt.I1 = &I1;
+    pt.I2 = &I2;
+    pt.J = &J;
+    pt.w = &w;
+    pt.w_1 = d;
+    pt.w_2 = d + 1;
+    pt.w_J = d + 2;
+    pt.w_11 = d + 3;
+    pt.w_12 = d + 4;
+    pt.w_1J = d + 5;
+    pt.w_22 = d + 6;
+    pt.w_2J = d + 7;
+    pt.w_JJ = d + 8;
+    if (u->energy) u->energy(&pt, u->user);
+    v->w = (double)w;
+    if (order >= 1) u->first(&pt, u->user);
+    if (order >= 2) u->second(&pt, u->user);
+    for (k = 0; k < 3; k++) v->d1[k] = (double)d[k];
+    for (k = 0; k < 6; k++) v->d2[k] = (double)d[3 + k];
+}
+
+static void frm__invariant_derivatives(const frm_real *p, const frm_user_law *user, frm__invariants *v, int order)
+{
+    if (user) frm__user_derivatives(user, v, order);
+    else frm__mr_derivatives(p, v, order);
+}
+
+static int frm__invariant_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    double C[6], Ci[6];
+    frm__invariants v;
+    int e = frm__invariants_of(H, C, Ci, &v);
+    if (e) return e;
+    frm__invariant_derivatives(p, user, &v, 0);
+    *psi = (frm_real)v.w;
+    return 0;
+}
+
+static int frm__invariant_stress(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real S[6],
+                                 frm_real *psi, frm_real *cache)
+{
+    double C[6], Ci[6], a, b, c;
+    frm__invariants v;
+    int k, e = frm__invariants_of(H, C, Ci, &v);
+    if (e) return e;
+    frm__invariant_derivatives(p, user, &v, cache ? 2 : 1);
+    a = 2 * v.d1[0] + 2 * v.d1[1] * v.I1; /* S = a I - b C + c C^-1 */
+    b = 2 * v.d1[1];
+    c = v.J * v.d1[2];
+    for (k = 0; k < 6; k++) S[k] = (frm_real)((k < 3 ? a : 0.0) - b * C[k] + c * Ci[k]);
+    *psi = (frm_real)v.w;
+    if (cache) {
+        for (k = 0; k < 6; k++) {
+            cache[k] = (frm_real)Ci[k];
+            cache[6 + k] = (frm_real)C[k];
+        }
+        cache[12] = (frm_real)v.I1;
+        cache[13] = (frm_real)v.J;
+        for (k = 0; k < 3; k++) cache[14 + k] = (frm_real)v.d1[k];
+        for (k = 0; k < 6; k++) cache[17 + k] = (frm_real)v.d2[k];
+    }
+    return 0;
+}
+
+static void frm__invariant_differential(const frm_real *p, const frm_user_law *user, const frm_real *cache,
+                                        const frm_real dE[6], frm_real dS[6])
+{
+    const frm_real *Ci = cache, *C = cache + 6, *w = cache + 14, *h = cache + 17;
+    double I1 = (double)cache[12], J = (double)cache[13], tr = (double)dE[0] + dE[1] + dE[2], CdE = 0, CidE = 0;
+    double dI1, dI2, dJ, dw1, dw2, dwJ, x[9], c[9], d[9], t[9], a, b, g, q;
+    int k, r;
+    (void)p;
+    (void)user;
+    for (k = 0; k < 6; k++) {
+        double f = k < 3 ? 1.0 : 2.0;
+        CdE += f * (double)C[k] * (double)dE[k];
+        CidE += f * (double)Ci[k] * (double)dE[k];
+    }
+    dI1 = 2 * tr;
+    dI2 = 2 * (I1 * tr - CdE);
+    dJ = J * CidE;
+    dw1 = (double)h[0] * dI1 + (double)h[1] * dI2 + (double)h[2] * dJ;
+    dw2 = (double)h[1] * dI1 + (double)h[3] * dI2 + (double)h[4] * dJ;
+    dwJ = (double)h[2] * dI1 + (double)h[4] * dI2 + (double)h[5] * dJ;
+    /* x = C^-1 dE C^-1 */
+    c[0] = Ci[0], c[4] = Ci[1], c[8] = Ci[2], c[5] = c[7] = Ci[3], c[2] = c[6] = Ci[4], c[1] = c[3] = Ci[5];
+    d[0] = dE[0], d[4] = dE[1], d[8] = dE[2], d[5] = d[7] = dE[3], d[2] = d[6] = dE[4], d[1] = d[3] = dE[5];
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) t[3 * r + k] = d[3 * r] * c[k] + d[3 * r + 1] * c[3 + k] + d[3 * r + 2] * c[6 + k];
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) x[3 * r + k] = c[3 * r] * t[k] + c[3 * r + 1] * t[3 + k] + c[3 * r + 2] * t[6 + k];
+    a = 2 * dw1 + 2 * dw2 * I1 + 2 * (double)w[1] * dI1; /* dS = a I - g C - 4 w_2 dE + q C^-1 - b x */
+    g = 2 * dw2;
+    q = dJ * (double)w[2] + J * dwJ;
+    b = 2 * J * (double)w[2];
+    dS[0] = (frm_real)(a - g * C[0] - 4 * (double)w[1] * dE[0] + q * Ci[0] - b * x[0]);
+    dS[1] = (frm_real)(a - g * C[1] - 4 * (double)w[1] * dE[1] + q * Ci[1] - b * x[4]);
+    dS[2] = (frm_real)(a - g * C[2] - 4 * (double)w[1] * dE[2] + q * Ci[2] - b * x[8]);
+    dS[3] = (frm_real)(-g * C[3] - 4 * (double)w[1] * dE[3] + q * Ci[3] - b * 0.5 * (x[5] + x[7]));
+    dS[4] = (frm_real)(-g * C[4] - 4 * (double)w[1] * dE[4] + q * Ci[4] - b * 0.5 * (x[2] + x[6]));
+    dS[5] = (frm_real)(-g * C[5] - 4 * (double)w[1] * dE[5] + q * Ci[5] - b * 0.5 * (x[1] + x[3]));
+}
+
+/* The energy of the built-in kernels alone (the stress discarded). */
+static int frm__svk_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    frm_real S[6];
+    (void)user;
+    return frm_material_stress(FRM_LAW_SVK, p[0], p[1], H, S, psi, NULL);
+}
+
+/* Neo-Hookean's energy written out on its own (not through the kernel), so that the law
+   tests check the kernel's stress against an independent energy:
+   W = mu (tr E - ln J) + lambda/2 ln^2 J, tr E = (I1 - 3)/2. */
+static int frm__nh_energy(const frm_real *p, const frm_user_law *user, const frm_real H[9], frm_real *psi)
+{
+    double C[6], Ci[6], lnJ;
+    frm__invariants v;
+    int e = frm__invariants_of(H, C, Ci, &v);
+    (void)user;
+    if (e) return e;
+    lnJ = log(v.J);
+    *psi = (frm_real)((double)p[0] * (0.5 * (v.I1 - 3) - lnJ) + 0.5 * (double)p[1] * lnJ * lnJ);
+    return 0;
+}
+
+static const frm__law_ops frm__laws[FRM_LAW_COUNT] = {
+    /* name, cache_size, energy, stress, differential, definite, fast_path */
+    {"St Venant-Kirchhoff", 0, frm__svk_energy, frm__svk_stress, frm__svk_differential, NULL, 1},
+    {"Neo-Hookean", FRM_LAW_CACHE, frm__nh_energy, frm__nh_stress, frm__nh_differential, frm__nh_definite, 1},
+    {"Mooney-Rivlin", FRM__LAW_CACHE_MAX, frm__invariant_energy, frm__invariant_stress, frm__invariant_differential,
+     NULL, 0},
+    {"user", FRM__LAW_CACHE_MAX, frm__invariant_energy, frm__invariant_stress, frm__invariant_differential, NULL, 0}};
+
+/* One entry per law, no more, no less (negative array size otherwise). */
+typedef char frm__laws_cover_every_law[(sizeof frm__laws / sizeof frm__laws[0] == FRM_LAW_COUNT) ? 1 : -1];
+
+/* The model's path: the inlined kernels for a law with fast_path, its own functions
+   otherwise. user is the material's callbacks for FRM_LAW_USER, NULL for the others. */
+static inline int frm__law_stress(int law, const frm_real *params, const frm_user_law *user, const frm_real H[9],
+                                  frm_real S[6], frm_real *psi, frm_real *cache)
+{
+    if (frm__laws[law].fast_path) return frm_material_stress(law, params[0], params[1], H, S, psi, cache);
+    return frm__laws[law].stress(params, user, H, S, psi, cache);
+}
+
+static inline void frm__law_dstress(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                                    const frm_real dE[6], frm_real dS[6])
+{
+    if (frm__laws[law].fast_path) frm_material_dstress(law, params[0], params[1], cache, dE, dS);
+    else frm__laws[law].differential(params, user, cache, dE, dS);
+}
+
+/* dP = dF S + F dS, dS = dS/dE : sym(F^T dF): frm_sample_dP for a fast_path law,
+   otherwise the same steps with the law's differential. */
+static inline void frm__law_dP(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                               const frm_real F[9], const frm_real S[6], const frm_real dF[9], frm_real dP[9])
+{
+    frm_real dE[6], dS[6], t[9];
+    int r, c;
+    if (frm__laws[law].fast_path) {
+        frm_sample_dP(law, params[0], params[1], cache, F, S, dF, dP);
+        return;
+    }
+    for (r = 0; r < 3; r++) /* t = F^T dF */
+        for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
+    dE[0] = t[0];
+    dE[1] = t[4];
+    dE[2] = t[8];
+    dE[3] = (frm_real)0.5 * (t[5] + t[7]);
+    dE[4] = (frm_real)0.5 * (t[2] + t[6]);
+    dE[5] = (frm_real)0.5 * (t[1] + t[3]);
+    frm__laws[law].differential(params, user, cache, dE, dS);
+    frm_first_piola(dF, S, dP);
+    frm_first_piola(F, dS, t);
+    for (r = 0; r < 9; r++) dP[r] += t[r];
+}
+
+/* The 6 tangent columns of one pair (frm_pair_tangent_columns through the law table). */
+static void frm__law_tangent_columns(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
+                                     const frm_real F[9], const frm_real S[6], const frm_real grad[3],
+                                     const frm_real G[9], frm_real cols[54])
+{
+    int c, k;
+    if (frm__laws[law].fast_path) {
+        frm_pair_tangent_columns(law, params[0], params[1], cache, F, S, grad, G, cols);
+        return;
+    }
+    for (c = 0; c < 6; c++) {
+        frm_real dq[6] = {0, 0, 0, 0, 0, 0}, dF[9];
+        for (k = 0; k < 9; k++) dF[k] = 0;
+        dq[c] = 1;
+        frm_pair_dF(dq, grad, G, dF);
+        frm__law_dP(law, params, user, cache, F, S, dF, cols + 9 * c);
+    }
+}
+
+/* A material's parameter block (FRM_LAW_PARAMS reals) and its small-strain shear modulus
+   (which scales the rotation stabilisation and the frame coupling). */
+static void frm__law_params(const frm_material *mat, frm_real *params, frm_real *shear_modulus)
+{
+    double E = (double)mat->young_modulus, nu = (double)mat->poisson_ratio;
+    int k;
+    for (k = 0; k < FRM_LAW_PARAMS; k++) params[k] = 0;
+    if (mat->law == FRM_LAW_MOONEY_RIVLIN) {
+        params[0] = mat->c1;
+        params[1] = mat->c2;
+        params[2] = mat->bulk_modulus;
+        *shear_modulus = (frm_real)(2.0 * ((double)mat->c1 + (double)mat->c2));
+        return;
+    }
+    params[0] = (frm_real)(E / (2.0 * (1.0 + nu)));
+    params[1] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
+    *shear_modulus = params[0];
+}
+
 /* >>parallel --------------------------------------------------------------------------- */
 
 typedef void (*frm__range_fn)(void *ctx, int begin, int end);
@@ -2237,7 +2719,6 @@ static void frm__layout(frm_model *m, frm__carver *c)
 {
     size_t n = (size_t)m->frame_count, S = (size_t)m->sample_count, P = (size_t)m->pair_count;
     size_t B = (size_t)m->block_count, sq = (size_t)m->sq_total;
-    int k;
     FRM__CARVE(c, m->disp, frm_real, 3 * n);
     FRM__CARVE(c, m->pos, frm_real, 3 * n);
     FRM__CARVE(c, m->quat, frm_real, 4 * n);
@@ -2280,7 +2761,9 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_rest, frm_real, 3 * S);
     FRM__CARVE(c, m->s_volume, frm_real, S);
     FRM__CARVE(c, m->s_mu, frm_real, S);
-    FRM__CARVE(c, m->s_lambda, frm_real, S);
+    FRM__CARVE(c, m->s_law_params, frm_real, FRM_LAW_PARAMS * S);
+    FRM__CARVE(c, m->s_user, const frm_user_law *, S);
+    FRM__CARVE(c, m->user_laws, frm_user_law, m->user_law_count);
     FRM__CARVE(c, m->s_couple, frm_real, S);
     FRM__CARVE(c, m->s_hstab, frm_real, S);
     if (m->stab_on) {
@@ -2293,7 +2776,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->s_start, int, S + 1);
     FRM__CARVE(c, m->lin_F, frm_real, 9 * S);
     FRM__CARVE(c, m->lin_S, frm_real, 6 * S);
-    FRM__CARVE(c, m->lin_cache, frm_real, FRM_LAW_CACHE * S);
+    FRM__CARVE(c, m->lin_cache, frm_real, (size_t)m->law_cache * S);
     FRM__CARVE(c, m->s_pos, frm_real, 3 * S);
     FRM__CARVE(c, m->s_F, frm_real, 9 * S);
     FRM__CARVE(c, m->p_frame, int, P);
@@ -2310,7 +2793,16 @@ static void frm__layout(frm_model *m, frm__carver *c)
     if (m->stab_on) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
-    for (k = 0; k < FRM__VECS; k++) FRM__CARVE(c, m->vec[k], frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_r, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_z, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_p, frm_real, 6 * n);
+    FRM__CARVE(c, m->cg_q, frm_real, 6 * n);
+    FRM__CARVE(c, m->newton_dx, frm_real, 6 * n);
+    FRM__CARVE(c, m->newton_rhs, frm_real, 6 * n);
+    FRM__CARVE(c, m->total_force, frm_real, 6 * n);
+    FRM__CARVE(c, m->work, frm_real, 6 * n);
+    FRM__CARVE(c, m->warm_dv, frm_real, 6 * n);
+    FRM__CARVE(c, m->drive_dv, frm_real, 6 * n);
     FRM__CARVE(c, m->backup, frm_real, 13 * n);
     FRM__CARVE(c, m->start_state, frm_real, 13 * n);
 }
@@ -2325,15 +2817,31 @@ static int frm__fail(const frm_desc *d, int code, const char *detail)
 
 static int frm__validate_material(const frm_material *mat, int index, char *msg, size_t size)
 {
-    if ((int)mat->law != FRM_LAW_SVK && (int)mat->law != FRM_LAW_NEO_HOOKEAN) {
+    if ((unsigned)mat->law >= FRM_LAW_COUNT) {
         snprintf(msg, size, "material %d: unknown law %d", index, (int)mat->law);
         return FRM_ERR_MATERIAL;
     }
-    if (!(frm__finite((double)mat->young_modulus) && mat->young_modulus > 0)) {
+    if (mat->law == FRM_LAW_USER && (!mat->user.first || !mat->user.second)) {
+        snprintf(msg, size, "material %d: a user law needs its first and second callbacks", index);
+        return FRM_ERR_MATERIAL;
+    }
+    if (mat->law == FRM_LAW_MOONEY_RIVLIN) {
+        if (!(frm__finite((double)mat->c1) && frm__finite((double)mat->c2) && mat->c1 >= 0 && mat->c2 >= 0 &&
+              mat->c1 + mat->c2 > 0)) {
+            snprintf(msg, size, "material %d: Mooney-Rivlin c1 %g, c2 %g", index, (double)mat->c1, (double)mat->c2);
+            return FRM_ERR_MATERIAL;
+        }
+        if (!(frm__finite((double)mat->bulk_modulus) && mat->bulk_modulus > 0)) {
+            snprintf(msg, size, "material %d: bulk modulus %g", index, (double)mat->bulk_modulus);
+            return FRM_ERR_MATERIAL;
+        }
+    }
+    if (mat->law != FRM_LAW_MOONEY_RIVLIN && !(frm__finite((double)mat->young_modulus) && mat->young_modulus > 0)) {
         snprintf(msg, size, "material %d: Young's modulus %g", index, (double)mat->young_modulus);
         return FRM_ERR_YOUNG_MODULUS;
     }
-    if (!(frm__finite((double)mat->poisson_ratio) && mat->poisson_ratio > -1 && mat->poisson_ratio < 0.5)) {
+    if (mat->law != FRM_LAW_MOONEY_RIVLIN &&
+        !(frm__finite((double)mat->poisson_ratio) && mat->poisson_ratio > -1 && mat->poisson_ratio < 0.5)) {
         snprintf(msg, size, "material %d: Poisson ratio %g", index, (double)mat->poisson_ratio);
         return FRM_ERR_POISSON_RATIO;
     }
@@ -2361,6 +2869,8 @@ static int frm__validate_settings(const frm_desc *d)
         !(frm__finite((double)d->precision_limit) && d->precision_limit >= 0) || d->implicit_linearized < 0 ||
         d->implicit_linearized > 1)
         return frm__fail(d, FRM_ERR_SOLVER, "solver tolerances, caps and regularization");
+    if ((unsigned)d->integrator >= FRM_INTEGRATOR_COUNT) return frm__fail(d, FRM_ERR_SOLVER, "integrator");
+    if ((unsigned)d->linear_solver >= FRM_LINEAR_SOLVER_COUNT) return frm__fail(d, FRM_ERR_SOLVER, "linear_solver");
     if (!(frm__finite((double)d->frame_coupling) && d->frame_coupling >= 0))
         return frm__fail(d, FRM_ERR_ARG, "frame_coupling must be finite and >= 0");
     if (!(frm__finite((double)d->rotation_stabilization) && d->rotation_stabilization >= 0))
@@ -2500,6 +3010,12 @@ static frm_material frm__default_material(void)
     mat.young_modulus = (frm_real)1e4;
     mat.poisson_ratio = (frm_real)0.3;
     mat.density = (frm_real)1000;
+    mat.c1 = mat.c2 = (frm_real)(1e4 / (8 * 1.3)); /* mu / 4 of E = 1e4 Pa, nu = 0.3 */
+    mat.bulk_modulus = (frm_real)(1e4 / (3 * 0.4));  /* E / (3 (1 - 2 nu)) */
+    mat.user.energy = NULL;
+    mat.user.first = NULL;
+    mat.user.second = NULL;
+    mat.user.user = NULL;
     return mat;
 }
 
@@ -2514,7 +3030,9 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.cg_max_iterations = 1000;
     d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-6);
     d.newton_max_iterations = 30;
+    d.integrator = FRM_IMPLICIT_EULER;
     d.implicit_linearized = 0;
+    d.linear_solver = FRM_LINEAR_SOLVER_CG;
     d.max_increments = 64;
     d.min_increment = (frm_real)1e-4;
     d.precision_limit = (frm_real)1e-4;
@@ -2735,19 +3253,25 @@ static int frm__invisible_rotations(const frm_desc *d, const int *rev_start, con
 static void frm__update_frames(frm_model *m);
 static void frm__rest_diagonal(frm_model *m);
 
-FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
-{
-    frm_model tmp, *m;
-    frm__carver carver;
-    frm_allocator alloc;
-    int err, i, s, p, k, n, S, P, *marker, *rev_start, *rev_pair, *pair_sample, *cursor;
-    size_t tmp_bytes;
-    char *tmp_block;
-    char msg[120];
+/* Creation reads top to bottom: validate the description, size the model (temporary
+   frame -> pair tables, block pattern and stabilisation counts), lay out its one block of
+   memory, precompute what the rest state determines. */
 
-    if (!out) return FRM_ERR_ARG;
-    *out = NULL;
-    if (!d) return FRM_ERR_ARG;
+/* The temporary tables of creation, one allocation: marker[n], cursor[n], rev_start[n+1],
+   rev_pair[P], pair_sample[P]. */
+typedef struct frm__create_tables {
+    char *block;
+    size_t bytes;
+    int *marker, *cursor, *rev_start, *rev_pair, *pair_sample;
+} frm__create_tables;
+
+/* Stage 1: every check of the description (counts, settings, materials, neighbour table). */
+static int frm__create_validate(const frm_desc *d)
+{
+    frm_allocator alloc;
+    size_t bytes;
+    char *block;
+    int err;
     /* not made by frm_model_default_desc: every field, the log callback included, may be
        garbage, so refuse without calling it */
     if (d->internal_cookie != FRM__COOKIE) return FRM_ERR_DESC;
@@ -2759,80 +3283,107 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         return frm__fail(d, FRM_ERR_NEIGHBOR_TABLE, "the four neighbour arrays are required");
     err = frm__validate_settings(d);
     if (err) return err;
-    n = d->frame_count;
-    S = d->sample_count;
     alloc = d->allocator;
+    bytes = sizeof(int) * (size_t)d->frame_count;
+    block = (char *)frm__alloc(&alloc, bytes);
+    if (!block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    err = frm__validate(d, (int *)block);
+    frm__free(&alloc, block, bytes);
+    return err;
+}
 
-    tmp_bytes = sizeof(int) * (size_t)n;
-    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
-    err = frm__validate(d, (int *)tmp_block);
-    frm__free(&alloc, tmp_block, tmp_bytes);
-    if (err) return err;
+static void frm__create_free_tables(const frm_desc *d, frm__create_tables *t)
+{
+    frm_allocator alloc = d->allocator;
+    frm__free(&alloc, t->block, t->bytes);
+    t->block = NULL;
+}
 
-    /* temporary tables: marker[n], cursor[n], rev_start[n+1], rev_pair[P], pair_sample[P] */
-    P = d->neighbor_start[S];
-    tmp_bytes = sizeof(int) * (3 * (size_t)n + 1 + 2 * (size_t)P);
-    tmp_block = (char *)frm__alloc(&alloc, tmp_bytes);
-    if (!tmp_block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
-    marker = (int *)tmp_block;
-    cursor = marker + n;
-    rev_start = cursor + n;
-    rev_pair = rev_start + n + 1;
-    pair_sample = rev_pair + P;
-    frm__build_reverse(n, S, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample, cursor);
+/* Stage 2: the temporary tables and every count the layout needs, into *tmp. */
+static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_tables *t)
+{
+    frm_allocator alloc = d->allocator;
+    int n = d->frame_count, S = d->sample_count, P = d->neighbor_start[S], i, s;
+    t->bytes = sizeof(int) * (3 * (size_t)n + 1 + 2 * (size_t)P);
+    t->block = (char *)frm__alloc(&alloc, t->bytes);
+    if (!t->block) return frm__fail(d, FRM_ERR_ALLOC, "temporary tables");
+    t->marker = (int *)t->block;
+    t->cursor = t->marker + n;
+    t->rev_start = t->cursor + n;
+    t->rev_pair = t->rev_start + n + 1;
+    t->pair_sample = t->rev_pair + P;
+    frm__build_reverse(n, S, d->neighbor_start, d->neighbor_frames, t->rev_start, t->rev_pair, t->pair_sample,
+                       t->cursor);
 
-    memset(&tmp, 0, sizeof tmp);
-    tmp.frame_count = n;
-    tmp.sample_count = S;
-    tmp.pair_count = P;
-    tmp.sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
-    tmp.frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
-    tmp.has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
-    if (tmp.has_blocks) {
+    memset(tmp, 0, sizeof *tmp);
+    tmp->frame_count = n;
+    tmp->sample_count = S;
+    tmp->pair_count = P;
+    tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
+    tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
+    tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    if (tmp->has_blocks) {
         long long blocks, sq = 0;
-        for (i = 0; i < n; i++) marker[i] = -1;
-        blocks = frm__block_pattern(n, d->neighbor_start, d->neighbor_frames, rev_start, rev_pair, pair_sample,
-                                    marker, NULL, NULL);
+        for (i = 0; i < n; i++) t->marker[i] = -1;
+        blocks = frm__block_pattern(n, d->neighbor_start, d->neighbor_frames, t->rev_start, t->rev_pair,
+                                    t->pair_sample, t->marker, NULL, NULL);
         for (s = 0; s < S; s++) {
             long long c = d->neighbor_start[s + 1] - d->neighbor_start[s];
             sq += c * c;
         }
         if (blocks > 200000000 || sq > 2000000000) {
-            frm__free(&alloc, tmp_block, tmp_bytes);
+            frm__create_free_tables(d, t);
             return frm__fail(d, FRM_ERR_ALLOC, "block pattern too large; use FRM_STIFFNESS_PAIRS");
         }
-        tmp.block_count = (int)blocks;
-        tmp.sq_total = (int)sq;
+        tmp->block_count = (int)blocks;
+        tmp->sq_total = (int)sq;
     }
-    tmp.stab_beta = d->rotation_stabilization;
-    tmp.stab_gamma = d->rotation_divergence;
-    if (tmp.stab_beta > 0)
+    tmp->stab_beta = d->rotation_stabilization;
+    tmp->stab_gamma = d->rotation_divergence;
+    if (tmp->stab_beta > 0)
         for (i = 0; i < n; i++) {
             double N[6];
-            tmp.stab_frames += frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+            tmp->stab_frames += frm__invisible_rotations(d, t->rev_start, t->rev_pair, t->pair_sample, i, N);
         }
-    tmp.stab_on = tmp.stab_frames > 0 || tmp.stab_gamma > 0;
+    tmp->stab_on = tmp->stab_frames > 0 || tmp->stab_gamma > 0;
+    tmp->user_law_count = d->materials ? d->material_count : 1;
+    for (s = 0; s < S; s++) {
+        const frm_material *mat =
+            d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
+        if (frm__laws[mat->law].cache_size > tmp->law_cache) tmp->law_cache = frm__laws[mat->law].cache_size;
+    }
+    return FRM_OK;
+}
+
+/* Stage 3: measure, allocate (zeroed) and carve the model's one block; the model struct
+   sits at its start. */
+static int frm__create_layout(const frm_desc *d, frm_model *tmp, frm_model **out)
+{
+    frm__carver carver;
+    frm_allocator alloc = d->allocator;
     carver.base = NULL;
     carver.offset = sizeof(frm_model);
-    frm__layout(&tmp, &carver);
-    tmp.block_bytes = carver.offset;
-    tmp.block = frm__alloc(&alloc, tmp.block_bytes);
-    if (!tmp.block) {
-        frm__free(&alloc, tmp_block, tmp_bytes);
-        return frm__fail(d, FRM_ERR_ALLOC, "model block");
-    }
-    memset(tmp.block, 0, tmp.block_bytes);
-    carver.base = (char *)tmp.block;
+    frm__layout(tmp, &carver);
+    tmp->block_bytes = carver.offset;
+    tmp->block = frm__alloc(&alloc, tmp->block_bytes);
+    if (!tmp->block) return frm__fail(d, FRM_ERR_ALLOC, "model block");
+    memset(tmp->block, 0, tmp->block_bytes);
+    carver.base = (char *)tmp->block;
     carver.offset = sizeof(frm_model);
-    frm__layout(&tmp, &carver);
-    m = (frm_model *)tmp.block;
-    *m = tmp;
+    frm__layout(tmp, &carver);
+    *out = (frm_model *)tmp->block;
+    **out = *tmp;
+    (*out)->allocator = alloc;
+    return FRM_OK;
+}
 
-    m->allocator = alloc;
+/* Stage 4a: the settings the solvers read. */
+static void frm__create_settings(frm_model *m, const frm_desc *d)
+{
+    int k;
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
-    m->parallel = P >= d->parallel_min_pairs;
+    m->parallel = m->pair_count >= d->parallel_min_pairs;
     for (k = 0; k < 3; k++) m->gravity[k] = d->gravity[k];
     m->time_step = d->time_step;
     m->mass_damping = d->mass_damping;
@@ -2841,15 +3392,21 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     m->cg_max_iterations = d->cg_max_iterations;
     m->newton_tolerance = d->newton_tolerance;
     m->newton_max_iterations = d->newton_max_iterations;
-    m->implicit_linearized = d->implicit_linearized;
+    /* implicit_linearized = 1 is the older spelling of the linearised integrator */
+    m->integrator = d->implicit_linearized ? FRM_IMPLICIT_EULER_LINEARIZED : (int)d->integrator;
+    m->linear_solver = (int)d->linear_solver;
     m->max_increments = d->max_increments;
     m->min_increment = (double)d->min_increment;
     m->precision_limit = (double)d->precision_limit;
     m->load_scale = 1;
     m->stiffness_mode = d->stiffness_mode;
     m->regularization = (double)d->static_regularization;
+}
 
-    /* frames */
+/* Stage 4b: frames' rest poses, the reverse table, the frames with unseen rotations. */
+static void frm__create_frames(frm_model *m, const frm_desc *d, const frm__create_tables *t)
+{
+    int n = m->frame_count, P = m->pair_count, i, k;
     memcpy(m->rest_pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
     memcpy(m->pos, d->frame_positions, sizeof(frm_real) * 3 * (size_t)n);
     for (i = 0; i < n; i++) {
@@ -2861,32 +3418,46 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
         memcpy(m->target + 7 * i, m->rest_pos + 3 * i, 3 * sizeof(frm_real));
         memcpy(m->target + 7 * i + 3, q, 4 * sizeof(frm_real));
     }
-    memcpy(m->rev_start, rev_start, sizeof(int) * ((size_t)n + 1));
-    memcpy(m->rev_pair, rev_pair, sizeof(int) * (size_t)P);
-    memcpy(m->p_sample, pair_sample, sizeof(int) * (size_t)P);
+    memcpy(m->rev_start, t->rev_start, sizeof(int) * ((size_t)n + 1));
+    memcpy(m->rev_pair, t->rev_pair, sizeof(int) * (size_t)P);
+    memcpy(m->p_sample, t->pair_sample, sizeof(int) * (size_t)P);
     if (m->stab_frames) /* beta N: the unseen rotations of frames with collinear samples */
         for (i = 0; i < n; i++) {
             double N[6];
-            m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, rev_start, rev_pair, pair_sample, i, N);
+            m->f_stab_on[i] = (unsigned char)frm__invisible_rotations(d, t->rev_start, t->rev_pair, t->pair_sample, i, N);
             for (k = 0; k < 6; k++) m->f_stab[6 * i + k] = (frm_real)(N[k] * (double)m->stab_beta);
-            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++) m->s_stab[pair_sample[m->rev_pair[k]]] = 1;
+            for (k = m->rev_start[i]; m->f_stab_on[i] && k < m->rev_start[i + 1]; k++)
+                m->s_stab[t->pair_sample[m->rev_pair[k]]] = 1;
         }
+}
 
-
-    /* samples */
+/* Stage 4c: samples' rest data and laws (parameter blocks, user callbacks). */
+static void frm__create_samples(frm_model *m, const frm_desc *d)
+{
+    int S = m->sample_count, s;
     memcpy(m->s_rest, d->sample_positions, sizeof(frm_real) * 3 * (size_t)S);
     memcpy(m->s_volume, d->sample_volumes, sizeof(frm_real) * (size_t)S);
     memcpy(m->s_start, d->neighbor_start, sizeof(int) * ((size_t)S + 1));
     for (s = 0; s < S; s++) {
         const frm_material *mat =
             d->materials ? d->materials + (d->sample_materials ? d->sample_materials[s] : 0) : &d->material;
-        double E = (double)mat->young_modulus, nu = (double)mat->poisson_ratio;
-        m->s_mu[s] = (frm_real)(E / (2.0 * (1.0 + nu)));
-        m->s_lambda[s] = (frm_real)(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)));
+        frm__law_params(mat, m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_mu + s);
         m->s_law[s] = (unsigned char)mat->law;
+        m->s_user[s] = NULL;
+        if (mat->law == FRM_LAW_USER) {
+            int u = d->materials ? (int)(mat - d->materials) : 0;
+            m->user_laws[u] = mat->user;
+            m->s_user[s] = m->user_laws + u;
+        }
     }
+}
 
-    /* pairs: lbar = Rbar^T (pbar_s - xbar_i) (eq. 3.33), in double */
+/* Stage 4d: pairs' weights, gradients and rest levers lbar = Rbar^T (pbar_s - xbar_i)
+   (eq. 3.33, in double); per sample the coupling constant, the stabilisation's h^2 and
+   the smallest lever h_min. */
+static void frm__create_pairs(frm_model *m, const frm_desc *d)
+{
+    int S = m->sample_count, P = m->pair_count, s, p;
     memcpy(m->p_frame, d->neighbor_frames, sizeof(int) * (size_t)P);
     memcpy(m->p_weight, d->neighbor_weights, sizeof(frm_real) * (size_t)P);
     memcpy(m->p_grad, d->neighbor_gradients, sizeof(frm_real) * 3 * (size_t)P);
@@ -2927,32 +3498,72 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
             else m->s_hstab[s] = 0; /* zero-order (Shepard): left to the thesis's model */
         }
     }
+}
+
+/* Stage 4e: the block pattern and the block index of every (pair, other slot of its
+   sample). */
+static void frm__create_blocks(frm_model *m, int *marker)
+{
+    int n = m->frame_count, S = m->sample_count, i, s;
+    if (!m->has_blocks) return;
+    for (i = 0; i < n; i++) marker[i] = -1;
+    frm__block_pattern(n, m->s_start, m->p_frame, m->rev_start, m->rev_pair, m->p_sample, marker, m->blk_start,
+                       m->blk_col);
+    m->sq_start[0] = 0;
+    for (s = 0; s < S; s++) {
+        int b = m->s_start[s], c = m->s_start[s + 1] - b, a, q;
+        m->sq_start[s + 1] = m->sq_start[s] + c * c;
+        for (a = 0; a < c; a++)
+            for (q = 0; q < c; q++)
+                m->pair_blk[m->sq_start[s] + a * c + q] = frm__find_block(m, m->p_frame[b + a], m->p_frame[b + q]);
+    }
+}
+
+/* Stage 4: everything the rest state determines; fails only on a frame without mass. */
+static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_tables *t)
+{
+    char msg[120];
+    int i;
+    frm__create_settings(m, d);
+    frm__create_frames(m, d, t);
+    frm__create_samples(m, d);
+    frm__create_pairs(m, d);
     i = frm__compute_masses(m, d);
     if (i >= 0) {
-        frm__free(&alloc, tmp_block, tmp_bytes);
-        frm__free(&alloc, m->block, m->block_bytes);
         snprintf(msg, sizeof msg, "frame %d carries no mass", i);
         return frm__fail(d, FRM_ERR_FRAME_UNUSED, msg);
     }
-
-    /* block pattern and the block index of every (pair, other slot of its sample) */
-    if (m->has_blocks) {
-        for (i = 0; i < n; i++) marker[i] = -1;
-        frm__block_pattern(n, m->s_start, m->p_frame, m->rev_start, m->rev_pair, m->p_sample, marker, m->blk_start,
-                           m->blk_col);
-        m->sq_start[0] = 0;
-        for (s = 0; s < S; s++) {
-            int b = m->s_start[s], c = m->s_start[s + 1] - b, a, q;
-            m->sq_start[s + 1] = m->sq_start[s] + c * c;
-            for (a = 0; a < c; a++)
-                for (q = 0; q < c; q++)
-                    m->pair_blk[m->sq_start[s] + a * c + q] = frm__find_block(m, m->p_frame[b + a], m->p_frame[b + q]);
-        }
-    }
-    frm__free(&alloc, tmp_block, tmp_bytes);
+    frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
+    return FRM_OK;
+}
+
+FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
+{
+    frm_model tmp, *m = NULL;
+    frm__create_tables tables;
+    frm_allocator alloc;
+    int err;
+    if (!out) return FRM_ERR_ARG;
+    *out = NULL;
+    if (!d) return FRM_ERR_ARG;
+    memset(&tables, 0, sizeof tables);
+    err = frm__create_validate(d);
+    if (err) return err;
+    err = frm__create_size(d, &tmp, &tables);
+    if (err) return err;
+    err = frm__create_layout(d, &tmp, &m);
+    if (!err) err = frm__create_precompute(m, d, &tables);
+    frm__create_free_tables(d, &tables);
+    if (err) {
+        if (m) {
+            alloc = m->allocator;
+            frm__free(&alloc, m->block, m->block_bytes);
+        }
+        return err;
+    }
     *out = m;
     return FRM_OK;
 }
@@ -3122,12 +3733,13 @@ static void frm__force_chunks(void *vctx, int begin, int end)
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
-            frm_real F[9], H[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
+            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
             frm_real offset[3 * FRM_MAX_NEIGHBORS], sT[9 * FRM_MAX_NEIGHBORS], stq[3 * FRM_MAX_NEIGHBORS];
             frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
                                    m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
                                    ctx->outputs ? m->s_pos + 3 * s : NULL);
-            e = frm_material_stress(m->s_law[s], m->s_mu[s], m->s_lambda[s], H, S, &psi, cache);
+            const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+            e = frm__law_stress(m->s_law[s], prm, m->s_user[s], H, S, &psi, cache);
             memcpy(F, H, sizeof F);
             F[0] += 1; /* F = I + H */
             F[4] += 1;
@@ -3156,16 +3768,15 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
                 if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
-                                              Neo-Hookean tangent's 2 (mu - lambda ln J) kept >= 0 */
+                                              law's tangent data made definite where it has a rule */
                     double Sd[6];
                     for (r = 0; r < 6; r++) Sd[r] = (double)S[r];
                     frm__positive_part3(Sd);
                     for (r = 0; r < 6; r++) S[r] = (frm_real)Sd[r];
-                    if (m->s_law[s] == FRM_LAW_NEO_HOOKEAN && m->s_lambda[s] * cache[6] > m->s_mu[s])
-                        cache[6] = m->s_mu[s] / m->s_lambda[s];
+                    if (frm__laws[m->s_law[s]].definite) frm__laws[m->s_law[s]].definite(prm, cache);
                 }
                 memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
-                memcpy(m->lin_cache + FRM_LAW_CACHE * (size_t)s, cache, sizeof cache);
+                memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
                 for (k = 0; k < n; k++) {
                     frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
@@ -3359,8 +3970,16 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
             frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
             for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
-            frm_sample_dP(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                          m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, dF, dP);
+            {
+                int law = m->s_law[s];
+                const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+                if (frm__laws[law].fast_path)
+                    frm_sample_dP(law, prm[0], prm[1], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                  m->lin_S + 6 * (size_t)s, dF, dP);
+                else
+                    frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                m->lin_S + 6 * (size_t)s, dF, dP);
+            }
             if (m->s_stab[s]) {
                 frm_real dPx[9];
                 const frm_real *dth[FRM_MAX_NEIGHBORS];
@@ -3526,9 +4145,9 @@ static void frm__diag_chunks(void *vctx, int begin, int end)
                 int p = m->rev_pair[e], s = m->p_sample[p], a = p - m->s_start[s];
                 frm_real cols[54], K[36], rows[18 * FRM_MAX_NEIGHBORS];
                 for (k = 0; k < 36; k++) K[k] = 0;
-                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
-                                         m->p_G + 9 * (size_t)p, cols);
+                frm__law_tangent_columns(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
+                                         m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                         m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 frm_pair_block(m->s_volume[s], cols, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, K);
                 if (m->s_stab[s])
@@ -3580,9 +4199,9 @@ static void frm__assemble_chunks(void *vctx, int begin, int end)
             for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
                 int p = m->rev_pair[e], s = m->p_sample[p], b = m->s_start[s], n = m->s_start[s + 1] - b, a = p - b, q;
                 frm_real cols[54], rows[18 * FRM_MAX_NEIGHBORS];
-                frm_pair_tangent_columns(m->s_law[s], m->s_mu[s], m->s_lambda[s], m->lin_cache + FRM_LAW_CACHE * (size_t)s,
-                                         m->lin_F + 9 * (size_t)s, m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p,
-                                         m->p_G + 9 * (size_t)p, cols);
+                frm__law_tangent_columns(m->s_law[s], m->s_law_params + FRM_LAW_PARAMS * (size_t)s, m->s_user[s],
+                                         m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                                         m->lin_S + 6 * (size_t)s, m->p_grad + 3 * (size_t)p, m->p_G + 9 * (size_t)p, cols);
                 if (m->s_stab[s]) frm__stab_columns(m, s, a, cols, rows);
                 for (q = 0; q < n; q++) {
                     frm_real *K = m->blocks + 36 * (size_t)m->pair_blk[m->sq_start[s] + a * n + q];
@@ -3869,7 +4488,7 @@ static double frm__dot(const frm_model *m, const frm_real *a, const frm_real *b)
    fixed order. */
 static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
-    frm_real *r = m->vec[FRM__V_R], *z = m->vec[FRM__V_Z], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
+    frm_real *r = m->cg_r, *z = m->cg_z, *p = m->cg_p, *q = m->cg_q;
     int k, it, n6 = 6 * m->frame_count, status = FRM__CG_OK, nonzero = 0;
     double bb, rr, rz, tol2;
     frm__mask(m, b);
@@ -3922,6 +4541,21 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
     m->lin_iterations = it;
     return status;
+}
+
+/* Every linear solve of the header goes through here: (a_mass M + a_stiff K) x = b over
+   the free components to |r| <= tolerance |b|, by the model's linear_solver. Returns the
+   FRM__CG_* statuses (OK, CAP, NEGATIVE, NOT_FINITE), which the Newton loops map to
+   FRM_OK, FRM_ERR_NO_CONVERGENCE (cap; negative curvature when no retry helps) and
+   FRM_ERR_NOT_FINITE. A new solver (e.g. issue 15's block-tridiagonal one) adds a
+   frm_linear_solver value and a case here, with the same statuses. */
+static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
+{
+    switch (m->linear_solver) {
+    case FRM_LINEAR_SOLVER_CG:
+    default:
+        return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+    }
 }
 
 static void frm__copy_state(const frm_model *m, frm_real *dst)
@@ -4075,7 +4709,7 @@ static double frm__potential_change(const frm_model *m, double W, double W0, con
    (f: the total force, m->force the internal one). */
 static double frm__static_scale(const frm_model *m, const frm_real *f, double *load_norm)
 {
-    frm_real *load = m->vec[FRM__V_T];
+    frm_real *load = m->work;
     double l, reaction;
     int k;
     for (k = 0; k < 6 * m->frame_count; k++) load[k] = f[k] - m->force[k];
@@ -4092,7 +4726,7 @@ static double frm__static_scale(const frm_model *m, const frm_real *f, double *l
    |f| after, *scale the residual's scale. */
 static int frm__newton_iteration(frm_model *m, int first, double tol, int *converged, double *res, double *scale)
 {
-    frm_real *f = m->vec[FRM__V_F], *dq = m->vec[FRM__V_X], *trial_f = m->vec[FRM__V_T];
+    frm_real *f = m->total_force, *dq = m->newton_dx, *trial_f = m->work;
     double W0, norm, slope, best = HUGE_VAL, best_alpha = 0, noise, eta, ref;
     int err, h, attempt, accepted = 0;
     *converged = 0;
@@ -4134,7 +4768,7 @@ static int frm__newton_iteration(frm_model *m, int first, double tol, int *conve
                                                                                               : m->regularization;
         frm__build_precond(m, 0.0, 1.0);
         memset(dq, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
-        cg = frm__cg(m, 0.0, 1.0, eta, f, dq);
+        cg = frm__linear_solve(m, 0.0, 1.0, eta, f, dq);
         m->solve_regularization = 0;
         if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
         if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE; /* one CG policy: capped is not converged */
@@ -4300,7 +4934,8 @@ static void frm__set_load(frm_model *m, double lambda, const frm_real g_full[3])
    FRM_ERR_UNSTABLE or a force pass's error. */
 static int frm__check_minimum(frm_model *m)
 {
-    frm_real *b = m->vec[FRM__V_B], *x = m->vec[FRM__V_X], *p = m->vec[FRM__V_P], *q = m->vec[FRM__V_Q];
+    /* p, q: CG's direction and its product, which the probe reads after CG stops */
+    frm_real *b = m->newton_rhs, *x = m->newton_dx, *p = m->cg_p, *q = m->cg_q;
     int k, cg, err, n6 = 6 * m->frame_count;
     double pq = 0, scale = 0, eps = FRM__IS_FLOAT ? FLT_EPSILON : DBL_EPSILON;
     err = frm__force_pass(m, 1, 0, NULL);
@@ -4316,6 +4951,8 @@ static int frm__check_minimum(frm_model *m)
         b[k] = (frm_real)((double)(h & 0xffffu) / 32768.0 - 1.0);
         x[k] = 0;
     }
+    /* a curvature probe, not a linear solve: it needs CG's own direction of negative
+       curvature, so it calls CG whatever desc.linear_solver chose (the one direct call) */
     cg = frm__cg(m, 0.0, 1.0, FRM__IS_FLOAT ? 1e-5 : 1e-7, b, x);
     m->solve_regularization = 0;
     if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
@@ -4382,7 +5019,7 @@ FRMDEF int frm_model_solve_static(frm_model *m)
     if (!err) err = frm__check_minimum(m);
     m->stats.residual_force = (frm_real)res;
     m->stats.residual = (frm_real)(scale > 0 ? res / scale : (res > 0 ? HUGE_VAL : 0));
-    memset(m->vec[FRM__V_DV], 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    memset(m->warm_dv, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     if (err) {
         memcpy(m->backup, m->start_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
         frm__restore_state(m);
@@ -4424,8 +5061,8 @@ static int frm__drive_velocities(frm_model *m, double dt, frm_real *drive)
    targets, which enter the right-hand side through K. */
 static int frm__implicit_linearized(frm_model *m, double dt)
 {
-    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X], *t = m->vec[FRM__V_T];
-    frm_real *drive = m->vec[FRM__V_DRIVE];
+    frm_real *f = m->total_force, *b = m->newton_rhs, *dv = m->newton_dx, *t = m->work;
+    frm_real *drive = m->drive_dv;
     double a_mass = 1.0 + dt * (double)m->mass_damping, a_stiff = dt * dt + dt * (double)m->stiffness_damping;
     int err, i, k, cg, attempt, any_driven;
     frm__save_state(m);
@@ -4449,8 +5086,8 @@ static int frm__implicit_linearized(frm_model *m, double dt)
             frm__stiffness_product(m, drive, t, 0);
             for (k = 0; k < 6 * m->frame_count; k++) b[k] -= (frm_real)(a_stiff * t[k]);
         }
-        memcpy(dv, m->vec[FRM__V_DV], sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
-        cg = frm__cg(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
+        memcpy(dv, m->warm_dv, sizeof(frm_real) * 6 * (size_t)m->frame_count); /* warm start */
+        cg = frm__linear_solve(m, a_mass, a_stiff, (double)m->cg_tolerance, b, dv);
         if (attempt || cg != FRM__CG_NEGATIVE) break;
         /* M + dt^2 K is indefinite here (compressed samples, the rotations' second-order terms,
            gravity, at a large dt): the step uses K's positive-definite part instead, which
@@ -4486,7 +5123,7 @@ static int frm__implicit_linearized(frm_model *m, double dt)
         frm__restore_state(m);
         return err;
     }
-    memcpy(m->vec[FRM__V_DV], dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    memcpy(m->warm_dv, dv, sizeof(frm_real) * 6 * (size_t)m->frame_count);
     frm__update_frames(m);
     m->lin_valid = 0;
     m->stats.newton_iterations = 1;
@@ -4506,6 +5143,48 @@ static void frm__step_displacement(const frm_model *m, frm_real *dq)
     frm__mask(m, dq);
 }
 
+/* The implicit Newton's residual r = dt f - M (v - v_t) - dt D v (momentum, N s), with
+   dq = dt v the step's displacement and kq = K dq (zero without stiffness damping). */
+static void frm__implicit_residual(const frm_model *m, double dt, const frm_real *f, const frm_real *dq,
+                                   const frm_real *kq, frm_real *b)
+{
+    double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        double mq[6], mv[6];
+        frm__mass_apply(m, i, dq + 6 * i, mq);
+        frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
+        for (k = 0; k < 6; k++)
+            b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
+                                      beta_d * (double)kq[6 * i + k]);
+    }
+    frm__mask(m, b);
+}
+
+/* After a converged implicit step: velocities are the step's displacement over dt (driven
+   frames: the same, fixed: zero); their change is the next step's CG warm start. */
+static void frm__implicit_velocities(frm_model *m, double dt)
+{
+    int i, k;
+    for (i = 0; i < m->frame_count; i++) {
+        const frm_real *s = m->inc_state + 13 * (size_t)i;
+        frm_real *v = m->vel + 6 * i, w[3];
+        if (m->state[i] == FRM__FIXED) {
+            for (k = 0; k < 6; k++) v[k] = 0;
+            continue;
+        }
+        frm__quat_delta(s + 3, m->quat + 4 * i, w);
+        for (k = 0; k < 3; k++) {
+            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
+            v[3 + k] = (frm_real)((double)w[k] / dt);
+        }
+        for (k = 0; k < 6; k++) {
+            if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
+            m->warm_dv[6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
+        }
+    }
+}
+
 /* Implicit Euler as the minimisation of the step's incremental potential (our form of eq.
    3.64 taken to convergence). With dq the step's displacement, v = dq / dt, v_t the start
    velocity, M the mass at the start of the step and D = alpha M + beta K:
@@ -4519,12 +5198,14 @@ static void frm__step_displacement(const frm_model *m, frm_real *dq)
    their targets from the first iteration. */
 static int frm__implicit_newton(frm_model *m, double dt)
 {
-    frm_real *f = m->vec[FRM__V_F], *b = m->vec[FRM__V_B], *dv = m->vec[FRM__V_X];
-    frm_real *dq = m->vec[FRM__V_DRIVE], *kd = m->vec[FRM__V_P];
+    frm_real *f = m->total_force, *b = m->newton_rhs, *dv = m->newton_dx;
+    /* kd and kq share CG's direction and residual: they are used between CG solves only
+       and recomputed after each (the one place these roles alias) */
+    frm_real *dq = m->drive_dv, *kd = m->cg_p;
     double alpha_d = (double)m->mass_damping, beta_d = (double)m->stiffness_damping;
     double a_mass = 1.0 + dt * alpha_d, a_stiff = dt * dt + dt * beta_d, ref = 0, norm = 0, previous = 0;
     int err, i, k, it, cg = FRM__CG_CAP, attempt, converged = 0, n6 = 6 * m->frame_count;
-    frm_real *kq = m->vec[FRM__V_R]; /* K dq; CG overwrites it, so it is recomputed after */
+    frm_real *kq = m->cg_r; /* K dq; CG overwrites it, so it is recomputed after */
     frm__copy_state(m, m->inc_state);
     frm__mass_update(m);
     frm__apply_driven(m);
@@ -4540,16 +5221,7 @@ static int frm__implicit_newton(frm_model *m, double dt)
             frm__step_displacement(m, dq);
             if (beta_d != 0) frm__stiffness_product(m, dq, kq, 0);
             else memset(kq, 0, sizeof(frm_real) * (size_t)n6);
-            /* r = dt f - M (v - v_t) - dt D v, with dq = dt v */
-            for (i = 0; i < m->frame_count; i++) {
-                double mq[6], mv[6];
-                frm__mass_apply(m, i, dq + 6 * i, mq);
-                frm__mass_apply(m, i, m->inc_state + 13 * (size_t)i + 7, mv);
-                for (k = 0; k < 6; k++)
-                    b[6 * i + k] = (frm_real)(dt * (double)f[6 * i + k] - (mq[k] / dt - mv[k]) - alpha_d * mq[k] -
-                                              beta_d * (double)kq[6 * i + k]);
-            }
-            frm__mask(m, b);
+            frm__implicit_residual(m, dt, f, dq, kq, b);
             norm = sqrt(frm__dot(m, b, b));
             if (!frm__finite(norm)) return FRM_ERR_NOT_FINITE;
             if (it == 0 && attempt == 0) {
@@ -4575,10 +5247,10 @@ static int frm__implicit_newton(frm_model *m, double dt)
             if (eta > 1e-3) eta = 1e-3;
             if (eta < (double)m->cg_tolerance) eta = (double)m->cg_tolerance;
             if (it == 0) /* warm start: the new velocity, about the start one plus the last step's change */
-                for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->vec[FRM__V_DV][k];
+                for (k = 0; k < n6; k++) dv[k] = m->vel[k] + m->warm_dv[k];
             else
                 memset(dv, 0, sizeof(frm_real) * (size_t)n6);
-            cg = frm__cg(m, a_mass, a_stiff, eta, b, dv);
+            cg = frm__linear_solve(m, a_mass, a_stiff, eta, b, dv);
             if (cg == FRM__CG_NOT_FINITE) return FRM_ERR_NOT_FINITE;
             if (cg == FRM__CG_CAP) return FRM_ERR_NO_CONVERGENCE;
             if (cg == FRM__CG_OK || attempt) break;
@@ -4639,34 +5311,14 @@ static int frm__implicit_newton(frm_model *m, double dt)
     m->stats.residual_force = (frm_real)norm;
     m->stats.residual = (frm_real)(ref > 0 ? norm / ref : 0);
     if (!converged) return FRM_ERR_NO_CONVERGENCE;
-    /* velocities: the step's displacement over dt (driven frames: the same, fixed: zero) */
-    for (i = 0; i < m->frame_count; i++) {
-        const frm_real *s = m->inc_state + 13 * (size_t)i;
-        frm_real *v = m->vel + 6 * i, w[3];
-        if (m->state[i] == FRM__FIXED) {
-            for (k = 0; k < 6; k++) v[k] = 0;
-            continue;
-        }
-        frm__quat_delta(s + 3, m->quat + 4 * i, w);
-        for (k = 0; k < 3; k++) {
-            v[k] = (frm_real)(((double)m->disp[3 * i + k] - (double)s[k]) / dt);
-            v[3 + k] = (frm_real)((double)w[k] / dt);
-        }
-        for (k = 0; k < 6; k++) {
-            if (m->state[i] == FRM__FREE && ((m->axes[i] >> k) & 1)) v[k] = 0;
-            m->vec[FRM__V_DV][6 * i + k] = v[k] - s[7 + k]; /* the next step's warm start */
-        }
-    }
+    frm__implicit_velocities(m, dt);
     return FRM_OK;
 }
 
-static int frm__implicit_step(frm_model *m, double dt)
+/* The Newton implicit Euler step (FRM_IMPLICIT_EULER): minimise, accept or restore. */
+static int frm__implicit_euler(frm_model *m, double dt)
 {
-    int err = frm__check_precision(m);
-    if (err) return err;
-    frm__inversions(m, 1);
-    if (m->implicit_linearized) return frm__implicit_linearized(m, dt);
-    err = frm__implicit_newton(m, dt);
+    int err = frm__implicit_newton(m, dt);
     if (!err) err = frm__accept(m);
     if (err) {
         frm__paste_state(m, m->inc_state);
@@ -4675,6 +5327,31 @@ static int frm__implicit_step(frm_model *m, double dt)
     frm__update_frames(m);
     m->lin_valid = 0;
     return FRM_OK;
+}
+
+/* Every integrator is one row, indexed by frm_integrator. step(m, dt) advances the state
+   by dt (s) from a state whose precision and inversions frm__implicit_step has checked,
+   and leaves the state of the step's start on failure. */
+typedef struct frm__integrator_ops {
+    const char *name;
+    int (*step)(frm_model *m, double dt);
+    int is_explicit; /* 1: needs no linear solve (none yet) */
+} frm__integrator_ops;
+
+static const frm__integrator_ops frm__integrators[FRM_INTEGRATOR_COUNT] = {
+    {"implicit Euler", frm__implicit_euler, 0},
+    {"implicit Euler, linearised", frm__implicit_linearized, 0}};
+
+/* One entry per integrator (negative array size otherwise). */
+typedef char frm__integrators_cover_every_integrator[(sizeof frm__integrators / sizeof frm__integrators[0] ==
+                                                      FRM_INTEGRATOR_COUNT) ? 1 : -1];
+
+static int frm__implicit_step(frm_model *m, double dt)
+{
+    int err = frm__check_precision(m);
+    if (err) return err;
+    frm__inversions(m, 1);
+    return frm__integrators[m->integrator].step(m, dt);
 }
 
 FRMDEF int frm_model_step(frm_model *m)
@@ -4912,8 +5589,8 @@ FRMDEF int frm_model_total_forces(frm_model *m, const frm_real **out)
     if (!m || !out) return FRM_ERR_ARG;
     err = frm__force_pass(m, 0, 0, NULL);
     if (err) return err;
-    frm__total_force(m, m->vec[FRM__V_F]);
-    *out = m->vec[FRM__V_F];
+    frm__total_force(m, m->total_force);
+    *out = m->total_force;
     return FRM_OK;
 }
 

@@ -3,7 +3,7 @@
    make bench         the full run (under 10 minutes on 2 cores): bench/results/
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
-   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,kernels]
+   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels]
                      [--filter TEXT] [--repeats N] [--threads N] [--budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
@@ -21,7 +21,11 @@
       alone with --parts sweep): every model entry over E, nu, static and implicit Euler
       at dt 1e-6 to 1 s, each run right, an error code, or a success with a wrong answer
       (the count issue 18 wants at zero). sweep.csv.
-   3. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
+   3. time (>>time, alone with --parts time): the R3 beam and the R2 cantilever released
+      from a static deflection, implicit Euler and BDF2 at dt = T/20 to T/400: period
+      error, amplitude decay per period, seconds of computing per simulated second.
+      time.csv.
+   4. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
       the memory-bandwidth bound of the bytes each header says its kernel moves, with the
       bandwidth measured in the same run by a STREAM triad. kernels.csv.
 
@@ -65,13 +69,13 @@ static const bench_models_fn registry[] = {
 #define BIT(i) (1u << (i))
 #define PI 3.14159265358979323846
 static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", "semi-implicit-euler", "rk4",
-                                                              "implicit-euler", "static"};
+                                                              "implicit-euler", "static", "bdf2"};
 
 /* >>options and environment */
 typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
-    int parts; /* bits: 1 trade, 2 stability, 4 kernels */
+    int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time */
     double budget; /* s: a configuration slower than this stops its refinement */
 } options;
 
@@ -388,15 +392,38 @@ static double period_of(const double *z, int n, double dt)
        (w dt)^2 / 3: 0.13 % at T/100);
      semi-implicit (symplectic) Euler: cos theta = 1 - (w dt)^2 / 2, so
        w = 2 sin(w_h dt / 2) / dt (reads high by (w dt)^2 / 24);
-     RK4: the error is (w dt)^4 / 120, below 1e-7 at the bench's steps: left as measured.
+     RK4: the error is (w dt)^4 / 120, below 1e-7 at the bench's steps: left as measured;
+     BDF2: theta = bdf2_turn(w dt) (below), inverted by bisection: the period reads long
+       by about (w dt)^2 / 3 too (0.131 % at T/100, as implicit Euler's 0.132 %), but the
+       amplitude decays by 0.04 % a period there against implicit Euler's 18 %.
    The first mode of a linear(ised) lumped-mass model is such an oscillator, so the
    correction is exact for it; the other modes decay faster under the Euler schemes. */
+static double bdf2_turn(double x)
+{
+    /* BDF2 on y' = i w y: (3/2 - i x) z^2 - 2 z + 1/2 = 0, the principal root
+       z = (2 + sqrt(1 + 2 i x)) / (3 - 2 i x), x = w dt; its argument */
+    double r = sqrt(sqrt(1 + 4 * x * x)), a = 0.5 * atan2(2 * x, 1);
+    double nr = 2 + r * cos(a), ni = r * sin(a);
+    return atan2(nr * 2 * x + ni * 3, nr * 3 - ni * 2 * x);
+}
+
 static double integrator_frequency(int integrator, double f_h, double dt)
 {
     double wh = 2 * PI * f_h, x = wh * dt;
     if (integrator == BENCH_EXPLICIT_EULER || integrator == BENCH_IMPLICIT_EULER)
         return x < 0.5 * PI ? tan(x) / dt / (2 * PI) : NAN;
     if (integrator == BENCH_SEMI_IMPLICIT_EULER) return 2 * sin(0.5 * x) / dt / (2 * PI);
+    if (integrator == BENCH_BDF2) {
+        double lo = 0, hi = 4 * x;
+        int i;
+        if (!(x > 0 && x < 1)) return NAN;
+        for (i = 0; i < 60; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (bdf2_turn(mid) < x) lo = mid;
+            else hi = mid;
+        }
+        return 0.5 * (lo + hi) / dt / (2 * PI);
+    }
     return f_h;
 }
 
@@ -1436,6 +1463,118 @@ static void run_sweep(const options *o, const bench_model *const *models, int co
            total.unjudged, now() - t0);
 }
 
+/* >>time: accuracy in time (issue 19). The R3 beam (1 x 0.1 x 0.1 m, 10 x 1 x 1 cells,
+   E = 1 MPa, released from its static deflection under a small load) and the R2 soft
+   cantilever (16 x 1 x 1 m, 16 x 1 x 1 cells, released from its large static sag under
+   gravity), per primary model entry (double) and implicit integrator, at dt = T/20, T/50,
+   T/100, T/400, T the model's own period: measured first at dt = T_est/800 (BDF2 where
+   the entry has it, else implicit Euler with its exact phase correction for a linear
+   mode, integrator_frequency; within 2e-5 of the limit either way), T_est
+   R3's 3D period or R2's Euler-Bernoulli estimate (4.43 s). Each run lasts 2.2 T.
+   Columns:
+   - period_error: the period from the tip's zero crossings against that reference
+     period: the integrator's error alone, not the mesh's (the zero crossings also carry
+     the higher modes the release excites, which the schemes damp differently).
+   - decay_per_period: the tip's peak one period after the first peak over that first
+     peak (1 = no numerical damping). The first peak comes after the release's transient,
+     so the higher modes have mostly died out; implicit Euler's theory for the first mode
+     alone is (1 + (w dt)^2)^(-T/(2 dt)): 0.821 at T/100.
+   - cost: seconds of computing per simulated second (step time / dt). */
+static FILE *time_csv;
+
+/* Tip signal z (n + 1 samples from the release) of one run, and its step time. */
+static int time_run(const bench_model *m, const bench_body *b0, int integrator, double dt, int n, double *z,
+                    double *step_s)
+{
+    bench_body b = *b0;
+    double g0[3] = {0, 0, 0}, t0;
+    void *sim = NULL;
+    int s, err = m->create(&b, &sim);
+    if (!err) err = m->solve_static(sim);
+    if (!err) err = m->set_gravity(sim, g0);
+    if (!err) z[0] = -tip_deflection(m, sim, &b);
+    t0 = now();
+    for (s = 1; s <= n && !err; s++) {
+        err = m->step(sim, dt, integrator);
+        z[s] = -tip_deflection(m, sim, &b);
+    }
+    *step_s = (now() - t0) / (s > 1 ? s - 1 : 1);
+    if (!err && !all_finite(m, sim)) err = -9999;
+    if (sim) m->destroy(sim);
+    return err;
+}
+
+/* The first peak of |z| after the first zero crossing, and the peak of the same sign one
+   period (two crossings) later: their ratio, or NAN. */
+static double decay_per_period(const double *z, int n)
+{
+    int i, crossings = 0;
+    double peak[3] = {0, 0, 0};
+    for (i = 1; i <= n && crossings < 4; i++) {
+        if ((z[i - 1] < 0) != (z[i] < 0)) crossings++;
+        if (crossings >= 1 && crossings <= 3 && fabs(z[i]) > peak[crossings - 1]) peak[crossings - 1] = fabs(z[i]);
+    }
+    return crossings >= 4 && peak[0] > 0 ? peak[2] / peak[0] : NAN;
+}
+
+static void time_model(const bench_model *m, const options *o)
+{
+    static const int divisions[4] = {20, 50, 100, 400};
+    static const int integrators[2] = {BENCH_IMPLICIT_EULER, BENCH_BDF2};
+    int scene, i, d;
+    if (!m->primary || strcmp(m->precision, "double") || !(m->integrators & BIT(BENCH_IMPLICIT_EULER)) ||
+        !(m->integrators & BIT(BENCH_STATIC)))
+        return; /* the primary entries in double: the time error does not depend on the precision */
+    for (scene = 0; scene < 2; scene++) {
+        bench_body b = scene ? make_body(16, 1, 1, 16, 1, 1, 40e3, 0.3, 5.0 / 16.0) : make_body(1, 0.1, 0.1, 10, 1, 1, 1e6, 0.3, 1000);
+        double T = scene ? 4.43 : 1.0 / 0.5091, T_ref, step_s, *z;
+        int ref_it = (m->integrators & BIT(BENCH_BDF2)) ? BENCH_BDF2 : BENCH_IMPLICIT_EULER;
+        int n_ref = (int)ceil(1.3 * 800 * 1.7), err; /* three crossings of a period up to 1.7 T_est */
+        if (!scene) b.gravity[2] = -0.01;
+        z = (double *)malloc(sizeof(double) * (size_t)(ceil(2.2 * 800 * 1.7) + 1));
+        if (!z) return;
+        err = time_run(m, &b, ref_it, T / 800, n_ref, z, &step_s);
+        T_ref = err ? NAN : 1.0 / integrator_frequency(ref_it, 1.0 / period_of(z, n_ref + 1, T / 800), T / 800);
+        for (i = 0; i < 2 && T_ref > 0; i++) {
+            if (!(m->integrators & BIT(integrators[i]))) continue;
+            for (d = 0; d < (o->quick ? 2 : 4); d++) {
+                double dt = T_ref / divisions[d], Th = NAN, decay = NAN;
+                int n = (int)ceil(2.2 * divisions[d]);
+                if (n > (int)ceil(2.2 * 800 * 1.7)) n = (int)ceil(2.2 * 800 * 1.7);
+                err = time_run(m, &b, integrators[i], dt, n, z, &step_s);
+                if (!err) {
+                    Th = period_of(z, n + 1, dt);
+                    decay = decay_per_period(z, n);
+                }
+                printf("  %-10s %-12s %-6s %-3s %-15s T/%-4d period %+9.3f %%  decay/period %.4f  %8.3g s/s  code %d\n",
+                       m->model, m->variant, m->precision, scene ? "R2" : "R3", integrator_name[integrators[i]],
+                       divisions[d], 100 * (Th / T_ref - 1), decay, step_s / dt, err);
+                csv_prefix(time_csv);
+                fprintf(time_csv, "%s,%s,%s,%s,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", m->model, m->variant, m->precision,
+                        scene ? "R2" : "R3", integrator_name[integrators[i]], divisions[d], dt, T_ref,
+                        Th / T_ref - 1, decay, step_s / dt, err);
+            }
+        }
+        free(z);
+    }
+    fflush(stdout);
+}
+
+static void run_time(const options *o, const bench_model *const *models, int count)
+{
+    int i;
+    double t0 = now();
+    printf("\naccuracy in time: R3 beam and R2 cantilever released from a static deflection, implicit integrators at "
+           "dt = T/20 to T/400;\n  period error against the same model at T/1600, amplitude decay per period, seconds "
+           "of computing per simulated second (see bench.c >>time)\n");
+    time_csv = open_csv(o, "time.csv",
+                        "model,variant,precision,scene,integrator,steps_per_period,time_step,reference_period,"
+                        "period_error,decay_per_period,cost_per_simulated_second,status");
+    for (i = 0; i < count; i++) time_model(models[i], o);
+    fclose(time_csv);
+    printf("  time: %.1f s\n", now() - t0);
+}
+
 /* >>kernels */
 
 /* STREAM triad a = b + s c over three arrays of n doubles: best of five, GB/s (24 bytes
@@ -1612,7 +1751,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,kernels] [--filter TEXT] "
+    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels] [--filter TEXT] "
                     "[--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
@@ -1627,7 +1766,7 @@ int main(int argc, char **argv)
     o.repeats = 3;
     o.threads = 2;
     o.out = "bench/results";
-    o.parts = 15;
+    o.parts = 31;
     o.budget = 2;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
@@ -1639,7 +1778,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--parts") && i + 1 < argc) {
             const char *p = argv[++i];
             o.parts = (strstr(p, "trade") ? 1 : 0) | (strstr(p, "stability") ? 2 | 8 : 0) | (strstr(p, "kernels") ? 4 : 0) |
-                      (strstr(p, "sweep") ? 8 : 0);
+                      (strstr(p, "sweep") ? 8 : 0) | (strstr(p, "time") ? 16 : 0);
         } else usage();
     }
     if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
@@ -1668,6 +1807,8 @@ int main(int argc, char **argv)
     if (o.parts & 2) run_stability(&o, models, count);
     set_threads(1);
     if (o.parts & 8) run_sweep(&o, models, count);
+    set_threads(1);
+    if (o.parts & 16) run_time(&o, models, count);
     if (o.parts & 4) run_kernels(&o, models, count);
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;

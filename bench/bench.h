@@ -17,7 +17,8 @@ enum {
     BENCH_RK4 = 2,
     BENCH_IMPLICIT_EULER = 3,
     BENCH_STATIC = 4, /* a static (equilibrium) solver */
-    BENCH_INTEGRATOR_COUNT = 5
+    BENCH_BDF2 = 5,   /* second-order backward differentiation (issue 19) */
+    BENCH_INTEGRATOR_COUNT = 6
 };
 
 /* What an adapter call returns besides 0 (ok) and the library's own negative codes. */

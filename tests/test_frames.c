@@ -928,7 +928,7 @@ static void check_definite(scene *sc, const char *name, unsigned seed, int *foun
     frm_model *m = sc->m;
     int n = frm_model_frame_count(m), i, trial, cg;
     frm_real *v = alloc_reals(6 * n), *Kp = alloc_reals(6 * n), *Kb = alloc_reals(6 * n), *b = alloc_reals(6 * n);
-    frm_real *x = alloc_reals(6 * n), *p = m->vec[FRM__V_P];
+    frm_real *x = alloc_reals(6 * n), *p = m->cg_p;
     double worst_neg = HUGE_VAL, scale = 0, worst_mode = 0, pKp = 0, pKpp = 0, pp = 0;
     /* a direction of negative curvature of K, if CG meets one */
     REQUIRE(frm__force_pass(m, 1, 0, NULL) == FRM_OK);
