@@ -329,8 +329,10 @@
                                    unlike the implicit midpoint rule or Newmark's average
                                    acceleration, energy-conserving only for linear
                                    problems), while a resolved mode keeps its amplitude:
-                                   decay per period of an undamped mode (tests, the
-                                   schemes' closed forms to 4 digits)
+                                   decay per period of an undamped mode (measured on a
+                                   one-tetrahedron oscillator and on the R3 beam released
+                                   from its first bending mode, read by a tip probe; both
+                                   equal the schemes' closed forms to 4 digits)
                                        dt     implicit Euler   BDF2
                                        T/20   62.1 %           3.95 %
                                        T/50   32.5 %           0.301 %
