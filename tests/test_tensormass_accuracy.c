@@ -949,7 +949,7 @@ static void test_bdf2_r3_beam_mode(void)
 {
     static const tmass_integrator integ[2] = {TMASS_IMPLICIT_EULER, TMASS_BDF2};
     tetmesh mesh;
-    tmass_real tip[3] = {1.0f, 0.05f, 0.05f}, g[3] = {0, 0, 0}, *start;
+    tmass_real tip[3] = {1, 0, 0}, g[3] = {0, 0, 0}, *start; /* tetmesh_beam: y, z centred on 0 */
     double pe[2][2], lg[2][2], f;
     int k, l, n3, i;
     tetmesh_beam(&mesh, 1.0, 0.1, 0.1, 20, 2, 2, TETMESH_SPLIT6);
