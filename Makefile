@@ -56,7 +56,7 @@ TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 COMPILE_ONLY := test_compile_all test_compile_static
 # the programs each configuration builds and runs (all of them unless listed here)
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
-TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_tensormass test_tensormass_qs
+TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
@@ -70,10 +70,14 @@ TESTS_clang-float := $(filter-out test_compile_static,$(TESTS))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a
 # test program of a configuration named "examples"
+# tests/test_packaging.sh (CMake and pkg-config consumers) and tests/test_viewer.sh (the
+# viewer headless under Xvfb) count the same way; each skips with one line and RESULT 0 0
+# when its tools are absent.
 RESULTS := $(foreach c,$(CONFIGS),$(foreach t,$(TESTS_$(c)),build/$(c)/$(t).result)) \
-           build/examples/test_examples.result
+           build/examples/test_examples.result build/packaging/test_packaging.result \
+           build/viewer/test_viewer.result
 
-.PHONY: all test test-run examples bench bench-quick clean
+.PHONY: all test test-run examples viewer bench bench-quick clean
 # keep the test binaries between runs (they are intermediate files of the .result rules)
 .SECONDARY:
 all: test
@@ -111,6 +115,57 @@ build/examples/test_examples.result: tests/test_examples.sh $(foreach e,$(EXAMPL
 	@sh tests/test_examples.sh build/examples build/tmp/examples > build/examples/test_examples.log 2>&1; \
 	  echo "$$?" > build/examples/test_examples.status; \
 	  grep '^RESULT ' build/examples/test_examples.log > $@ || echo "RESULT 0 1 crashed" > $@
+
+build/packaging/test_packaging.result: tests/test_packaging.sh tests/consumer/CMakeLists.txt \
+    tests/consumer/main.c CMakeLists.txt cmake/softbodyConfig.cmake.in cmake/softbody.pc.in $(HEADERS)
+	@mkdir -p build/packaging
+	@sh tests/test_packaging.sh build/tmp/packaging > build/packaging/test_packaging.log 2>&1; \
+	  echo "$$?" > build/packaging/test_packaging.status; \
+	  grep '^RESULT ' build/packaging/test_packaging.log > $@ || echo "RESULT 0 1 crashed" > $@
+
+# The viewer (examples/viewer/, issue 17): GLFW and OpenGL 3.3 core, built when pkg-config
+# finds glfw3 (Debian: libglfw3-dev, libgl-dev), otherwise one line and success. sim.c (the
+# three headers) is compiled twice, double and float, so precision switches live; -O1 keeps
+# the build of the headers short (about 8 s of CPU; the models still step at interactive
+# rates on the built-in scenes).
+VIEWER_SRC := $(wildcard examples/viewer/*.c)
+VIEWER_DEPS := $(wildcard examples/viewer/*.h) examples/tetmesh.h $(HEADERS)
+VIEWER_OBJS := $(patsubst examples/viewer/%.c,build/viewer/%.o,$(filter-out examples/viewer/sim.c,$(VIEWER_SRC))) \
+               build/viewer/sim_double.o build/viewer/sim_float.o
+VIEWER_CC := gcc -std=c99 -O1 $(WARN)
+HAVE_GLFW := $(shell pkg-config --exists glfw3 2>/dev/null && echo yes)
+
+ifeq ($(HAVE_GLFW),yes)
+VIEWER_BIN := build/viewer/viewer
+viewer: $(VIEWER_BIN)
+else
+VIEWER_BIN :=
+viewer:
+	@echo "viewer: skipped (pkg-config cannot find glfw3; on Debian: apt-get install libglfw3-dev libgl-dev)"
+endif
+
+# the viewer headless under Xvfb (tests/test_viewer.sh; skipped with a line without GLFW or
+# xvfb-run)
+build/viewer/test_viewer.result: tests/test_viewer.sh tests/png_check.c $(VIEWER_BIN)
+	@mkdir -p build/viewer
+	@sh tests/test_viewer.sh build/viewer/viewer build/tmp/viewer > build/viewer/test_viewer.log 2>&1; \
+	  echo "$$?" > build/viewer/test_viewer.status; \
+	  grep '^RESULT ' build/viewer/test_viewer.log > $@ || echo "RESULT 0 1 crashed" > $@
+
+build/viewer/sim_double.o: examples/viewer/sim.c $(VIEWER_DEPS)
+	@mkdir -p build/viewer
+	$(VIEWER_CC) -c -o $@ $<
+
+build/viewer/sim_float.o: examples/viewer/sim.c $(VIEWER_DEPS)
+	@mkdir -p build/viewer
+	$(VIEWER_CC) -DVW_FLOAT -c -o $@ $<
+
+build/viewer/%.o: examples/viewer/%.c $(VIEWER_DEPS)
+	@mkdir -p build/viewer
+	$(VIEWER_CC) $(shell pkg-config --cflags glfw3 2>/dev/null) -c -o $@ $<
+
+build/viewer/viewer: $(VIEWER_OBJS)
+	$(VIEWER_CC) -o $@ $(VIEWER_OBJS) $(shell pkg-config --libs glfw3 2>/dev/null) -lm
 
 # The bench: bench.c plus every adapter bench/model_*.c compiled twice (double, float).
 # Built for this machine; the flags and git revision go into every CSV row.

@@ -131,6 +131,7 @@ static int hm_step(void *v, double dt, int integrator)
     if (integrator == BENCH_SEMI_IMPLICIT_EULER) /* eq. 32 is the symplectic Euler */
         return heml_step_ex(((hm_sim *)v)->m, (heml_real)dt, HEML_SEMI_EXPLICIT_EULER);
     if (integrator == BENCH_IMPLICIT_EULER) return heml_step_ex(((hm_sim *)v)->m, (heml_real)dt, HEML_IMPLICIT_EULER);
+    if (integrator == BENCH_BDF2) return heml_step_ex(((hm_sim *)v)->m, (heml_real)dt, HEML_BDF2);
     return BENCH_UNSUPPORTED;
 }
 
@@ -203,7 +204,7 @@ static int hm_kernel(void *v, int kernel)
     return BENCH_UNSUPPORTED;
 }
 
-#define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+#define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC) | (1u << BENCH_BDF2))
 #define HM_FUNCTIONS                                                                                          \
     hm_destroy, hm_dof, hm_node_count, hm_rest, hm_position, hm_pin, hm_release, hm_set_gravity, hm_solve_static, \
         hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL

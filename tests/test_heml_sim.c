@@ -816,6 +816,8 @@ static unsigned long long run_hashed(int threads, int job_system)
     }
     heml_solve_static(m);
     heml_step_ex(m, (heml_real)0.01, HEML_IMPLICIT_EULER);
+    heml_step_ex(m, (heml_real)0.01, HEML_BDF2); /* its implicit Euler start, then a BDF2 step */
+    heml_step_ex(m, (heml_real)0.01, HEML_BDF2);
     bytes = (const unsigned char *)heml_positions(m);
     for (i = 0; i < (int)(sizeof(heml_real) * 3 * mesh.node_count); i++) h = (h ^ bytes[i]) * 1099511628211ull;
     CHECK(mesh.tet_count >= HEML_PARALLEL_MIN_TETS);
@@ -877,6 +879,8 @@ static void test_no_allocation_after_create(void)
     clamp_x0(m, &mesh);
     heml_step_ex(m, (heml_real)1e-3, HEML_SEMI_EXPLICIT_EULER);
     heml_step_ex(m, (heml_real)1e-2, HEML_IMPLICIT_EULER);
+    heml_step_ex(m, (heml_real)1e-2, HEML_BDF2);
+    heml_step_ex(m, (heml_real)1e-2, HEML_BDF2);
     heml_solve_static(m);
     heml_compute_forces(m);
     for (i = 0; i < 3 * mesh.node_count; i++) dx[i] = (heml_real)(i % 5);
