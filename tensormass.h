@@ -54,7 +54,7 @@
        TMASS_REAL      float or double (default double). Creation computes the tensors in
                        double and stores them in TMASS_REAL. In float builds every public
                        function is renamed (tmass_step -> tmass_step_f32, and so on for all
-                       81), so mixing float and double translation units fails at link
+                       82), so mixing float and double translation units fails at link
                        time, not at run time (a test lists them all).
        TMASS_MALLOC(size, user) / TMASS_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
@@ -469,7 +469,8 @@
        unreleased (issue 19) TMASS_BDF2 (second-order implicit, the implicit Euler
              minimisation reused); the model block grows by 2 vectors of 3n reals (BDF2's
              history, 48 bytes per node in double). Modal analysis (tmass_modal_*), point
-             probes (tmass_probe_*), tmass_displacements, TMASS_ERR_PROBE_OUTSIDE; the
+             probes (tmass_probe_*), tmass_displacements, tmass_set_damping,
+             TMASS_ERR_PROBE_OUTSIDE; the
              kinds table gains a tangent column, the integrators table keeps_history.
        unreleased (issue 20) explicit extension points, results bit-identical: the
              private tables tmass__kinds, tmass__integrators, tmass__linear_solvers (see
@@ -541,6 +542,7 @@ typedef TMASS_REAL tmass_real;
 #define tmass_set_external_force tmass_set_external_force_f32
 #define tmass_clear_external_forces tmass_clear_external_forces_f32
 #define tmass_set_gravity tmass_set_gravity_f32
+#define tmass_set_damping tmass_set_damping_f32
 #define tmass_set_solver tmass_set_solver_f32
 #define tmass_step tmass_step_f32
 #define tmass_step_ex tmass_step_ex_f32
@@ -837,6 +839,10 @@ TMASSDEF int tmass_set_external_force(tmass_model *m, int i, const tmass_real f[
 TMASSDEF void tmass_clear_external_forces(tmass_model *m);
 /* Gravity, m/s^2. */
 TMASSDEF int tmass_set_gravity(tmass_model *m, const tmass_real g[3]);
+/* Rayleigh damping after creation (as desc.mass_damping, 1/s, and desc.stiffness_damping,
+   s; finite and >= 0, else TMASS_ERR_DAMPING and nothing changes), for later steps. Like
+   frm_model_set_damping (frames.h) and heml_set_mass_damping (heml.h). */
+TMASSDEF int tmass_set_damping(tmass_model *m, tmass_real mass_damping, tmass_real stiffness_damping);
 /* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves. */
 TMASSDEF int tmass_set_solver(tmass_model *m, tmass_real tolerance, int max_iterations);
 
@@ -3674,6 +3680,17 @@ TMASSDEF int tmass_set_gravity(tmass_model *m, const tmass_real g[3])
     int r;
     if (!m || !tmass__vec3_finite(g)) return TMASS_ERR_ARG;
     for (r = 0; r < 3; r++) m->gravity[r] = g[r];
+    return TMASS_OK;
+}
+
+TMASSDEF int tmass_set_damping(tmass_model *m, tmass_real mass_damping, tmass_real stiffness_damping)
+{
+    if (!m) return TMASS_ERR_ARG;
+    if (!(tmass__finite((double)mass_damping) && mass_damping >= 0) ||
+        !(tmass__finite((double)stiffness_damping) && stiffness_damping >= 0))
+        return TMASS_ERR_DAMPING;
+    m->mass_damping = mass_damping;
+    m->stiffness_damping = stiffness_damping;
     return TMASS_OK;
 }
 

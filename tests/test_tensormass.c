@@ -1504,7 +1504,7 @@ static void test_float_renames_every_entry_point(void)
         N(tmass_version), N(tmass_error_string), N(tmass_default_desc), N(tmass_create),
         N(tmass_destroy), N(tmass_fix_node), N(tmass_set_displacement), N(tmass_release_node),
         N(tmass_node_pinned), N(tmass_set_external_force), N(tmass_clear_external_forces),
-        N(tmass_set_gravity), N(tmass_set_solver), N(tmass_step), N(tmass_step_ex),
+        N(tmass_set_gravity), N(tmass_set_damping), N(tmass_set_solver), N(tmass_step), N(tmass_step_ex),
         N(tmass_solve_static), N(tmass_node_count), N(tmass_tet_count), N(tmass_live_tet_count),
         N(tmass_edge_count), N(tmass_positions), N(tmass_displacements), N(tmass_probe_create),
         N(tmass_probe_positions), N(tmass_probe_displacements), N(tmass_probe_velocities),

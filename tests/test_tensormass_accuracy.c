@@ -373,6 +373,34 @@ static void test_bdf2_damped_recurrence(void)
     tmass_destroy(m);
 }
 
+/* tmass_set_damping: a model given its damping after creation steps bit-identically to
+   one created with it (implicit Euler and BDF2); bad values refused, nothing changed. */
+static void test_set_damping(void)
+{
+    double A[9];
+    tmass_model *a = oscillator3(0.0, 0.0, A), *b = oscillator3(0.7, 0.01, A);
+    tmass_real x[12];
+    int s;
+    REQUIRE(a && b);
+    CHECK_INT(TMASS_ERR_DAMPING, tmass_set_damping(a, (tmass_real)-1, 0));
+    CHECK_INT(TMASS_ERR_DAMPING, tmass_set_damping(a, 0, (tmass_real)(0.0 * HUGE_VAL)));
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_damping(NULL, 0, 0));
+    CHECK(a->mass_damping == 0 && a->stiffness_damping == 0);
+    CHECK_INT(TMASS_OK, tmass_set_damping(a, (tmass_real)0.7, (tmass_real)0.01));
+    memcpy(x, tmass_rest_positions(a), sizeof x);
+    x[9] = (tmass_real)((double)x[9] + 0.01);
+    tmass_set_positions(a, x);
+    tmass_set_positions(b, x);
+    for (s = 0; s < 20; s++) {
+        tmass_integrator integ = s < 10 ? TMASS_IMPLICIT_EULER : TMASS_BDF2;
+        CHECK_INT(TMASS_OK, tmass_step_ex(a, (tmass_real)0.05, integ));
+        CHECK_INT(TMASS_OK, tmass_step_ex(b, (tmass_real)0.05, integ));
+    }
+    CHECK(memcmp(a->disp, b->disp, sizeof(tmass_real) * 12) == 0 && memcmp(a->vel, b->vel, sizeof(tmass_real) * 12) == 0);
+    tmass_destroy(a);
+    tmass_destroy(b);
+}
+
 /* A cube of 2 x 2 x 2 cells, bottom pinned, under gravity, of either kind. */
 static tmass_model *cube_model(tmass_model_kind kind, tetmesh *mesh)
 {
@@ -1072,6 +1100,7 @@ int main(int argc, char **argv)
         TEST(test_bdf2_order),
         TEST(test_bdf2_damped_recurrence),
         TEST(test_bdf2_history_rules),
+        TEST(test_set_damping),
         TEST(test_probe_reads_affine_fields),
         TEST(test_probe_errors),
         TEST(test_modal_matches_dense),
