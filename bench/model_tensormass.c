@@ -129,6 +129,7 @@ static int tm_step(void *v, double dt, int integrator)
 {
     static const tmass_integrator map[4] = {TMASS_EXPLICIT_EULER, TMASS_SEMI_IMPLICIT_EULER, TMASS_RK4,
                                             TMASS_IMPLICIT_EULER};
+    if (integrator == BENCH_BDF2) return tmass_step_ex(((tm_sim *)v)->m, (tmass_real)dt, TMASS_BDF2);
     if (integrator < 0 || integrator > 3) return BENCH_UNSUPPORTED;
     return tmass_step_ex(((tm_sim *)v)->m, (tmass_real)dt, map[integrator]);
 }
@@ -265,7 +266,7 @@ static int tm_haptic(int quick, double update_seconds[3], int *surface_nodes, do
 }
 
 #define TM_ALL ((1u << BENCH_EXPLICIT_EULER) | (1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_RK4) | \
-                (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC))
+                (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC) | (1u << BENCH_BDF2))
 
 static const bench_model tm_models[] = {
     {"tensormass", "linear", "linear", BENCH_PRECISION, TM_ALL, 0, 1, "tet", tm_create_tensor, tm_destroy, tm_dof,

@@ -483,8 +483,9 @@ static void test_hybrid_equals_whole(void)
 
 /* The fig. 5 loop in time: with damping, implicit steps far beyond the explicit limit stay
    stable (the coupling stiffness is implicit) and settle on the whole model's steady
-   state; a tool moving on the precomputed part changes its contacts every few steps. */
-static void test_hybrid_dynamics_settle(void)
+   state; a tool moving on the precomputed part changes its contacts every few steps.
+   Implicit Euler, and BDF2 (issue 19: the dynamic part steps like any model). */
+static void hybrid_dynamics_settle(tmass_integrator integ)
 {
     tetmesh mesh;
     tmass_real *rest;
@@ -509,7 +510,7 @@ static void test_hybrid_dynamics_settle(void)
         u[2] = (tmass_real)(0.004 * (s < 100 ? s / 100.0 : 1.0));
         if (s % 10 == 5 && s < 150) tmass_hybrid_release_node(h, tool); /* lost and regained */
         else tmass_hybrid_set_displacement(h, tool, u);
-        CHECK_INT(TMASS_OK, tmass_hybrid_step_ex(h, (tmass_real)0.01, TMASS_IMPLICIT_EULER));
+        CHECK_INT(TMASS_OK, tmass_hybrid_step_ex(h, (tmass_real)0.01, integ));
     }
     whole = beam_model(&mesh, rest);
     {
@@ -521,8 +522,9 @@ static void test_hybrid_dynamics_settle(void)
         if (fabs((double)tmass_positions(whole)[i] - mesh.nodes[i]) > scale)
             scale = fabs((double)tmass_positions(whole)[i] - mesh.nodes[i]);
     worst = compare_positions(tmass_hybrid_positions(h), &mesh, whole);
-    printf("    after 2 s of 10 ms implicit steps: max |x_hybrid - x_whole_static| / max |u| = %.2e\n",
-           worst / scale);
+    printf("    after 2 s of 10 ms %s steps: max |x_hybrid - x_whole_static| / max |u| = %.2e\n",
+           integ == TMASS_BDF2 ? "BDF2" : "implicit Euler", worst / scale);
+    if (integ == TMASS_BDF2) CHECK_INT(1, tmass_hybrid_dynamic_part(h)->history_ready); /* BDF2 proper */
     CHECK(worst <= 1e-3 * scale);
     tmass_hybrid_destroy(h);
     tmass_destroy(whole);
@@ -531,6 +533,9 @@ static void test_hybrid_dynamics_settle(void)
     free(fixed);
     tetmesh_free(&mesh);
 }
+
+static void test_hybrid_dynamics_settle(void) { hybrid_dynamics_settle(TMASS_IMPLICIT_EULER); }
+static void test_hybrid_dynamics_settle_bdf2(void) { hybrid_dynamics_settle(TMASS_BDF2); }
 
 /* Cutting a precomputed tetrahedron is refused with nothing removed; the boundary of the
    whole live mesh stays equal to an independent extraction after cuts at the interface. */
@@ -795,6 +800,7 @@ static const test_case cases[] = {
     TEST(test_qs_validation),
     TEST(test_hybrid_equals_whole),
     TEST(test_hybrid_dynamics_settle),
+    TEST(test_hybrid_dynamics_settle_bdf2),
     TEST(test_hybrid_topology),
     TEST(test_hybrid_validation),
     TEST(test_qs_pinned_not_at_rest),
