@@ -439,9 +439,8 @@
        creation, after frm_model_set_poses / _set_velocities / _fix_frame / _release_frame /
        _set_frame_axes / _set_integrator, a static solve or Newton step, driving a frame that
        was not driven (a new target of a driven frame keeps it), and any step whose dt
-       differs from the history's, is one implicit Euler step. A failed step keeps the state
-       and the history (a retry at the same dt is BDF2 again; at another dt, implicit
-       Euler). Measured (tests/test_frames.c test_i19_oscillator_decay: a one-degree-of-
+       differs from the history's, is one implicit Euler step, and so is the step after a
+       failed one (which keeps the state; as in heml.h and tensormass.h). Measured (tests/test_frames.c test_i19_oscillator_decay: a one-degree-of-
        freedom oscillator of frames; amplitude decay a period, period error), against the
        closed-form roots to 4 digits:
            dt       implicit Euler           BDF2
@@ -5647,7 +5646,8 @@ static int frm__implicit_euler(frm_model *m, double dt)
    velocities serve as the coordinate velocities (they differ by phi x omega / 2 at q_{n-1},
    of second order in the rotation over a step: neglected, as implicit Euler neglects the
    gyroscopic terms). Without a history made with the same dt, one implicit Euler step.
-   The history is the start state of the last successful step; a failed step keeps it. */
+   The history is the start state of the last successful step; after a failed step (state
+   kept) the next step is implicit Euler. */
 static int frm__bdf2(frm_model *m, double dt)
 {
     frm__step_target t;
@@ -5672,7 +5672,11 @@ static int frm__bdf2(frm_model *m, double dt)
         t.warm_scale = 1.5;
         err = frm__implicit_solve(m, &t);
     }
-    if (err) return err;
+    if (err) { /* the state and the history are kept; the next step restarts (as heml.h and
+                  tensormass.h do after a failed step) */
+        m->history_valid = 0;
+        return err;
+    }
     memcpy(m->history, m->inc_state, sizeof(frm_real) * 13 * (size_t)m->frame_count);
     m->history_valid = 1;
     m->history_dt = dt;
