@@ -1858,6 +1858,67 @@ static void test_modal_r3_time_order(void)
     frm_sampling_free(&s);
 }
 
+
+/* Many points in a larger mesh (1,600 tetrahedra, 5,000 points: random, and every node):
+   each found through the element bins, exact under an affine field of the frames
+   (weights of the containing tetrahedron), in milliseconds. */
+static void test_probe_many(void)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {4, 0.8, 0.8};
+    static const double A[9] = {1.1, 0.2, -0.1, 0.05, 0.9, 0.3, -0.2, 0.1, 1.2}, b[3] = {0.1, 0.2, 0.3};
+    tetmesh t;
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_probe_desc pd = frm_probe_default_desc();
+    frm_model *m = NULL;
+    frm_probe *p = NULL;
+    frm_real *x, *pts, *pos, *quat, *out;
+    int i, r, count, nodes;
+    unsigned seed = 11;
+    double worst = 0, t0;
+    REQUIRE(tetmesh_box(&t, lo, hi, 20, 4, 4, TETMESH_SPLIT5) == TETMESH_OK);
+    nodes = t.node_count;
+    count = 5000 > nodes ? 5000 : nodes;
+    x = alloc_reals(3 * nodes), pts = alloc_reals(3 * count), pos = alloc_reals(3 * nodes), quat = alloc_reals(4 * nodes);
+    out = alloc_reals(3 * count);
+    for (i = 0; i < 3 * nodes; i++) x[i] = (frm_real)t.nodes[i];
+    REQUIRE(frm_sampling_tets(&s, x, nodes, t.tets, t.tet_count, 1, NULL, NULL) == FRM_OK);
+    frm_sampling_apply(&s, &d);
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    for (i = 0; i < count; i++)
+        for (r = 0; r < 3; r++) {
+            seed = seed * 1664525u + 1013904223u;
+            pts[3 * i + r] = i < nodes ? x[3 * i + r] : (frm_real)(hi[r] * (((seed >> 8) & 0xFFFF) / 65535.0));
+        }
+    pd.kind = FRM_PROBE_TETS;
+    pd.elements = t.tets;
+    pd.element_count = t.tet_count;
+    t0 = (double)clock();
+    REQUIRE(frm_probe_create(m, &pd, pts, count, &p) == FRM_OK);
+    t0 = ((double)clock() - t0) / CLOCKS_PER_SEC;
+    for (i = 0; i < nodes; i++) {
+        for (r = 0; r < 3; r++) {
+            pos[3 * i + r] = (frm_real)(A[3 * r] * x[3 * i] + A[3 * r + 1] * x[3 * i + 1] + A[3 * r + 2] * x[3 * i + 2] + b[r]);
+            quat[4 * i + r] = 0;
+        }
+        quat[4 * i + 3] = 1;
+    }
+    REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+    REQUIRE(frm_probe_positions(p, m, out) == FRM_OK);
+    for (i = 0; i < count; i++)
+        for (r = 0; r < 3; r++) {
+            double e = A[3 * r] * pts[3 * i] + A[3 * r + 1] * pts[3 * i + 1] + A[3 * r + 2] * pts[3 * i + 2] + b[r];
+            if (fabs(e - (double)out[3 * i + r]) > worst) worst = fabs(e - (double)out[3 * i + r]);
+        }
+    printf("    %d points in %d tetrahedra: found in %.3f s, affine field %.1e m\n", count, t.tet_count, t0, worst);
+    CHECK(worst < (IS_FLOAT ? 1e-5 : 1e-12));
+    frm_probe_destroy(p);
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    tetmesh_free(&t);
+    free(x), free(pts), free(pos), free(quat), free(out);
+}
+
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
@@ -1876,6 +1937,7 @@ static const test_case cases[] = {
     TEST(test_integrator_choice),
     TEST(test_probe_kinds),
     TEST(test_probe_refusals),
+    TEST(test_probe_many),
     TEST(test_modal_r3),
     TEST(test_modal_closed_forms),
     TEST(test_modal_r3_time_order),
