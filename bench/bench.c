@@ -1466,8 +1466,9 @@ static void run_sweep(const options *o, const bench_model *const *models, int co
 /* >>time: accuracy in time (issue 19). The R3 beam (1 x 0.1 x 0.1 m, 10 x 1 x 1 cells,
    E = 1 MPa, released from its static deflection under a small load) and the R2 soft
    cantilever (16 x 1 x 1 m, 16 x 1 x 1 cells, released from its large static sag under
-   gravity), for the first primary double entry of each header and each implicit
-   integrator, at dt = T/20, T/50,
+   gravity), for the first primary double entry of each header and each of its
+   integrators (the explicit ones too: at these steps, far above their stable step, they
+   end in an error code, which is the row's answer), at dt = T/20, T/50,
    T/100, T/400, T the model's own period: measured first at dt = T_est/800 (BDF2 where
    the entry has it, else implicit Euler with its exact phase correction for a linear
    mode, integrator_frequency; within 2e-5 of the limit either way), T_est
@@ -1531,7 +1532,8 @@ static double decay_per_period(const double *z, int n, double dt, double T_h)
 static void time_model(const bench_model *m, const options *o)
 {
     static const int divisions[4] = {20, 50, 100, 400};
-    static const int integrators[2] = {BENCH_IMPLICIT_EULER, BENCH_BDF2};
+    static const int integrators[5] = {BENCH_EXPLICIT_EULER, BENCH_SEMI_IMPLICIT_EULER, BENCH_RK4,
+                                       BENCH_IMPLICIT_EULER, BENCH_BDF2};
     int scene, i, d;
     if (!m->primary || strcmp(m->precision, "double") || !(m->integrators & BIT(BENCH_IMPLICIT_EULER)) ||
         !(m->integrators & BIT(BENCH_STATIC)))
@@ -1546,7 +1548,7 @@ static void time_model(const bench_model *m, const options *o)
         if (!z) return;
         err = time_run(m, &b, ref_it, T / 800, n_ref, z, &step_s);
         T_ref = err ? NAN : 1.0 / integrator_frequency(ref_it, 1.0 / period_of(z, n_ref + 1, T / 800), T / 800);
-        for (i = 0; i < 2 && T_ref > 0; i++) {
+        for (i = 0; i < 5 && T_ref > 0; i++) {
             if (!(m->integrators & BIT(integrators[i]))) continue;
             for (d = 0; d < (o->quick ? 2 : 4); d++) {
                 double dt = T_ref / divisions[d], Th = NAN, decay = NAN;
@@ -1575,7 +1577,7 @@ static void run_time(const options *o, const bench_model *const *models, int cou
 {
     int i;
     double t0 = now();
-    printf("\naccuracy in time: R3 beam and R2 cantilever released from a static deflection, implicit integrators at "
+    printf("\naccuracy in time: R3 beam and R2 cantilever released from a static deflection, every integrator at "
            "dt = T/20 to T/400;\n  period error against the same model at T/1600, amplitude decay per period, seconds "
            "of computing per simulated second (see bench.c >>time)\n");
     time_csv = open_csv(o, "time.csv",
