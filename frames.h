@@ -7394,11 +7394,12 @@ static void frm__element_box(const frm_probe_desc *d, const double *X, int e, do
     int nodes = d->kind == FRM_PROBE_TETS ? 4 : 8, a, r;
     const int *el = d->elements + (size_t)nodes * (size_t)e;
     double size = 0;
-    for (a = 0; a < nodes; a++)
+    for (r = 0; r < 3; r++) lo[r] = hi[r] = X[3 * el[0] + r]; /* set before the loop: gcc -O3 warned */
+    for (a = 1; a < nodes; a++)
         for (r = 0; r < 3; r++) {
             double x = X[3 * el[a] + r];
-            if (a == 0 || x < lo[r]) lo[r] = x;
-            if (a == 0 || x > hi[r]) hi[r] = x;
+            if (x < lo[r]) lo[r] = x;
+            if (x > hi[r]) hi[r] = x;
         }
     for (r = 0; r < 3; r++)
         if (hi[r] - lo[r] > size) size = hi[r] - lo[r];

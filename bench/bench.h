@@ -91,6 +91,10 @@ typedef struct bench_model {
        2,000 surface nodes); fills the median seconds per update with 1, 2, 3 contacts */
     int (*haptic)(int quick, double update_seconds[3], int *surface_nodes, double *precompute_seconds,
                   double *memory_bytes);
+    /* optional (NULL): the displacement u (m) of the material point whose rest position
+       (with the offset) is p, through the model's point probe (issue 19); 0 or an error
+       (then the caller falls back to node averages) */
+    int (*probe)(void *sim, const double p[3], double u[3]);
 } bench_model;
 
 /* An adapter's table: *count entries. */

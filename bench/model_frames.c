@@ -21,6 +21,7 @@
 #include "model_common.h"
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 typedef struct fr_sim {
     frm_model *m;
@@ -28,11 +29,15 @@ typedef struct fr_sim {
     int integrator;       /* frm_integrator of the model (FRM_IMPLICIT_EULER at creation) */
     double *rest;         /* 3 per frame, with the offset, in double */
     frm_real *v, *out;    /* K*v kernel vectors, 6 per frame */
+    int *elements, element_count, hex; /* the mesh (frame indices), for the point probe */
+    frm_probe *probe;     /* the last probed point (fr_probe) */
+    double probe_at[3];
 } fr_sim;
 
 /* Frames and samples of the body: hexahedral (8 sub-cell samples a cell) or tetrahedral
    (the centroid of each tet); node coordinates in double, copied to frm_real. */
-static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **rest)
+static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **rest, int **elements,
+                       int *element_count)
 {
     frm_real *x;
     double *nodes;
@@ -51,7 +56,8 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
         bench_to_reals(mesh.nodes, x, 3 * n);
         err = frm_sampling_hexes(s, x, n, mesh.hexes, mesh.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
         nodes = mesh.nodes;
-        free(mesh.hexes);
+        *elements = mesh.hexes;
+        *element_count = mesh.hex_count;
     } else {
         tetmesh mesh;
         if (bench_body_mesh(b, &mesh)) return FRM_ERR_ALLOC;
@@ -61,11 +67,14 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
         bench_to_reals(mesh.nodes, x, 3 * n);
         err = frm_sampling_tets(s, x, n, mesh.tets, mesh.tet_count, 1, NULL, NULL);
         nodes = mesh.nodes;
-        free(mesh.tets);
+        *elements = mesh.tets;
+        *element_count = mesh.tet_count;
     }
     free(x);
     if (err) {
         free(nodes);
+        free(*elements);
+        *elements = NULL;
         return err;
     }
     *rest = nodes;
@@ -81,7 +90,8 @@ static int fr_create(const bench_body *b, int hex, frm_law law, void **out)
     int i, err;
     *out = NULL;
     if (b->exclude) return BENCH_UNSUPPORTED; /* frames do not cut */
-    err = fr_sampling(b, hex, &smp, &rest);
+    int *elements = NULL, element_count = 0;
+    err = fr_sampling(b, hex, &smp, &rest, &elements, &element_count);
     if (err) return err;
     s = (fr_sim *)calloc(1, sizeof *s);
     if (s) {
@@ -92,6 +102,7 @@ static int fr_create(const bench_body *b, int hex, frm_law law, void **out)
         if (s) free(s->v), free(s->out);
         free(s);
         free(rest);
+        free(elements);
         frm_sampling_free(&smp);
         return FRM_ERR_ALLOC;
     }
@@ -106,11 +117,14 @@ static int fr_create(const bench_body *b, int hex, frm_law law, void **out)
     err = frm_model_create(&d, &s->m);
     frm_sampling_free(&smp);
     if (err) {
-        free(s->v), free(s->out), free(s), free(rest);
+        free(s->v), free(s->out), free(s), free(rest), free(elements);
         return err;
     }
     s->frames = frm_model_frame_count(s->m);
     s->rest = rest;
+    s->elements = elements;
+    s->element_count = element_count;
+    s->hex = hex;
     bench_kernel_direction(s->v, 6 * s->frames);
     if (b->clamp)
         for (i = 0; i < s->frames; i++)
@@ -128,8 +142,9 @@ static void fr_destroy(void *v)
 {
     fr_sim *s = (fr_sim *)v;
     if (!s) return;
+    frm_probe_destroy(s->probe);
     frm_model_destroy(s->m);
-    free(s->rest), free(s->v), free(s->out), free(s);
+    free(s->rest), free(s->v), free(s->out), free(s->elements), free(s);
 }
 
 static int fr_dof(void *v) { return 6 * ((fr_sim *)v)->frames; }
@@ -215,6 +230,30 @@ static int fr_forces(void *v, double *f)
     return err;
 }
 
+/* The displacement at rest point p, through a probe on the sampling's mesh made at the
+   first call for p. */
+static int fr_probe(void *v, const double p[3], double u[3])
+{
+    fr_sim *s = (fr_sim *)v;
+    frm_real q[3], r[3];
+    int k, err;
+    if (!s->probe || memcmp(p, s->probe_at, sizeof s->probe_at)) {
+        frm_probe_desc d = frm_probe_default_desc();
+        frm_probe_destroy(s->probe);
+        s->probe = NULL;
+        d.kind = s->hex ? FRM_PROBE_HEXES : FRM_PROBE_TETS;
+        d.elements = s->elements;
+        d.element_count = s->element_count;
+        for (k = 0; k < 3; k++) q[k] = (frm_real)p[k];
+        err = frm_probe_create(s->m, &d, q, 1, &s->probe);
+        if (err) return err;
+        memcpy(s->probe_at, p, sizeof s->probe_at);
+    }
+    err = frm_probe_displacements(s->probe, s->m, r);
+    for (k = 0; k < 3; k++) u[k] = (double)r[k];
+    return err;
+}
+
 static double fr_elements(void *v) { return (double)frm_model_pair_count(((fr_sim *)v)->m); }
 
 static double fr_kernel_bytes(void *v, int kernel)
@@ -249,7 +288,7 @@ static int fr_kernel(void *v, int kernel)
 #define FR_ALL ((1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_BDF2) | (1u << BENCH_STATIC))
 #define FR_FUNCTIONS                                                                                          \
     fr_destroy, fr_dof, fr_node_count, fr_rest, fr_position, fr_pin, fr_release, fr_set_gravity, fr_solve_static, \
-        fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL
+        fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL, fr_probe
 
 static const bench_model fr_models[] = {
     {"frames", "svk hex8", "svk", BENCH_PRECISION, FR_ALL, 1, 1, "pair", fr_create_svk_hex, FR_FUNCTIONS},

@@ -26,6 +26,8 @@ typedef struct hm_sim {
     int *tet_nodes;
     double *rest; /* 3n, with the offset, in double */
     heml_real *dx, *out; /* K*v kernel vectors */
+    heml_probe *probe;   /* the last probed point (hm_probe) */
+    double probe_at[3];
 } hm_sim;
 
 static int hm_create(const bench_body *b, heml_law law, void **out)
@@ -88,6 +90,7 @@ static void hm_destroy(void *v)
 {
     hm_sim *s = (hm_sim *)v;
     if (!s) return;
+    heml_probe_destroy(s->probe);
     heml_destroy(s->m);
     free(s->tet_nodes);
     free(s->rest);
@@ -142,6 +145,25 @@ static int hm_forces(void *v, double *f)
     if (!g) return HEML_ERR_ARG;
     bench_to_doubles(g, f, 3 * s->nodes);
     return 0;
+}
+
+/* The displacement at rest point p, through a probe made at the first call for p. */
+static int hm_probe(void *v, const double p[3], double u[3])
+{
+    hm_sim *s = (hm_sim *)v;
+    heml_real q[3], r[3];
+    int k, err;
+    if (!s->probe || memcmp(p, s->probe_at, sizeof s->probe_at)) {
+        heml_probe_destroy(s->probe);
+        s->probe = NULL;
+        for (k = 0; k < 3; k++) q[k] = (heml_real)p[k];
+        err = heml_probe_create(s->m, q, 1, &s->probe);
+        if (err) return err;
+        memcpy(s->probe_at, p, sizeof s->probe_at);
+    }
+    err = heml_probe_displacements(s->probe, s->m, r);
+    for (k = 0; k < 3; k++) u[k] = (double)r[k];
+    return err;
 }
 
 static double hm_elements(void *v) { return (double)((hm_sim *)v)->tets; }
@@ -207,7 +229,7 @@ static int hm_kernel(void *v, int kernel)
 #define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC) | (1u << BENCH_BDF2))
 #define HM_FUNCTIONS                                                                                          \
     hm_destroy, hm_dof, hm_node_count, hm_rest, hm_position, hm_pin, hm_release, hm_set_gravity, hm_solve_static, \
-        hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL
+        hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL, hm_probe
 
 static const bench_model hm_models[] = {
     {"heml", "svk", "svk", BENCH_PRECISION, HM_ALL, 1, 1, "tet", hm_create_svk, HM_FUNCTIONS},

@@ -30,6 +30,8 @@ typedef struct tm_sim {
     int *tet_nodes; /* 4 per tet, for cutting by centroid */
     double *rest;   /* 3n, with the offset */
     double offset[3];
+    tmass_probe *probe; /* the last probed point (tm_probe); dropped by a cut */
+    double probe_at[3];
 } tm_sim;
 
 static int tm_create(const bench_body *b, tmass_model_kind kind, void **out)
@@ -89,6 +91,7 @@ static void tm_destroy(void *v)
 {
     tm_sim *s = (tm_sim *)v;
     if (!s) return;
+    tmass_probe_destroy(s->probe);
     tmass_destroy(s->m);
     free(s->tet_nodes);
     free(s->rest);
@@ -154,6 +157,27 @@ static int tm_cut(void *v, int (*inside)(const double c[3], void *user), void *u
     }
     err = tmass_remove_tets(s->m, list, n, removed);
     free(list);
+    tmass_probe_destroy(s->probe); /* its tetrahedron may be gone */
+    s->probe = NULL;
+    return err;
+}
+
+/* The displacement at rest point p, through a probe made at the first call for p. */
+static int tm_probe(void *v, const double p[3], double u[3])
+{
+    tm_sim *s = (tm_sim *)v;
+    tmass_real q[3], r[3];
+    int k, err;
+    if (!s->probe || memcmp(p, s->probe_at, sizeof s->probe_at)) {
+        tmass_probe_destroy(s->probe);
+        s->probe = NULL;
+        for (k = 0; k < 3; k++) q[k] = (tmass_real)p[k];
+        err = tmass_probe_create(s->m, q, 1, &s->probe);
+        if (err) return err;
+        memcpy(s->probe_at, p, sizeof s->probe_at);
+    }
+    err = tmass_probe_displacements(s->probe, s->m, r);
+    for (k = 0; k < 3; k++) u[k] = (double)r[k];
     return err;
 }
 
@@ -271,10 +295,10 @@ static int tm_haptic(int quick, double update_seconds[3], int *surface_nodes, do
 static const bench_model tm_models[] = {
     {"tensormass", "linear", "linear", BENCH_PRECISION, TM_ALL, 0, 1, "tet", tm_create_tensor, tm_destroy, tm_dof,
      tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
-     tm_cut, tm_elements, tm_bytes_tensor, tm_kernel_tensor, tm_haptic},
+     tm_cut, tm_elements, tm_bytes_tensor, tm_kernel_tensor, tm_haptic, tm_probe},
     {"tensormass", "springs", "springs", BENCH_PRECISION, TM_ALL, 1, 1, "tet", tm_create_springs, tm_destroy, tm_dof,
      tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
-     tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL},
+     tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL, tm_probe},
 };
 
 const bench_model *BENCH_TABLE(int *count);
