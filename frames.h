@@ -1923,13 +1923,11 @@ FRM_HOSTDEV static inline void frm_pair_dF(const frm_real dq[6], const frm_real 
     }
 }
 
-/* Per sample: dP = dF S + F dS, dS = dS/dE : sym(F^T dF) (the material part, eqs.
-   3.67-3.69, and the geometric part dF S, eqs. 3.71-3.73, in one). */
-FRM_HOSTDEV static inline void frm_sample_dP(int law, frm_real mu, frm_real lambda, const frm_real *cache,
-                                             const frm_real F[9], const frm_real S[6], const frm_real dF[9],
-                                             frm_real dP[9])
+/* The strain variation dE = sym(F^T dF) (Voigt: xx, yy, zz, yz, xz, xy), the first half of
+   frm_sample_dP, shared with the law table's general path (frm__law_dP). */
+FRM_HOSTDEV static inline void frm_strain_variation(const frm_real F[9], const frm_real dF[9], frm_real dE[6])
 {
-    frm_real dE[6], dS[6], t[9];
+    frm_real t[9];
     int r, c;
     for (r = 0; r < 3; r++) /* t = F^T dF */
         for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
@@ -1939,10 +1937,30 @@ FRM_HOSTDEV static inline void frm_sample_dP(int law, frm_real mu, frm_real lamb
     dE[3] = (frm_real)0.5 * (t[5] + t[7]);
     dE[4] = (frm_real)0.5 * (t[2] + t[6]);
     dE[5] = (frm_real)0.5 * (t[1] + t[3]);
-    frm_material_dstress(law, mu, lambda, cache, dE, dS);
+}
+
+/* dP = dF S + F dS from the stress S and its variation dS, the second half of
+   frm_sample_dP. */
+FRM_HOSTDEV static inline void frm_piola_variation(const frm_real F[9], const frm_real S[6], const frm_real dF[9],
+                                                   const frm_real dS[6], frm_real dP[9])
+{
+    frm_real t[9];
+    int r;
     frm_first_piola(dF, S, dP);
     frm_first_piola(F, dS, t);
     for (r = 0; r < 9; r++) dP[r] += t[r];
+}
+
+/* Per sample: dP = dF S + F dS, dS = dS/dE : sym(F^T dF) (the material part, eqs.
+   3.67-3.69, and the geometric part dF S, eqs. 3.71-3.73, in one). */
+FRM_HOSTDEV static inline void frm_sample_dP(int law, frm_real mu, frm_real lambda, const frm_real *cache,
+                                             const frm_real F[9], const frm_real S[6], const frm_real dF[9],
+                                             frm_real dP[9])
+{
+    frm_real dE[6], dS[6];
+    frm_strain_variation(F, dF, dE);
+    frm_material_dstress(law, mu, lambda, cache, dE, dS);
+    frm_piola_variation(F, S, dF, dS, dP);
 }
 
 /* Pass 1 of K v: what one pair gives its frame, v B^T vec(dP):
@@ -2842,24 +2860,14 @@ static inline void frm__law_dstress(int law, const frm_real *params, const frm_u
 static inline void frm__law_dP(int law, const frm_real *params, const frm_user_law *user, const frm_real *cache,
                                const frm_real F[9], const frm_real S[6], const frm_real dF[9], frm_real dP[9])
 {
-    frm_real dE[6], dS[6], t[9];
-    int r, c;
+    frm_real dE[6], dS[6];
     if (frm__laws[law].fast_path) {
         frm_sample_dP(law, params[0], params[1], cache, F, S, dF, dP);
         return;
     }
-    for (r = 0; r < 3; r++) /* t = F^T dF */
-        for (c = 0; c < 3; c++) t[3 * r + c] = F[r] * dF[c] + F[3 + r] * dF[3 + c] + F[6 + r] * dF[6 + c];
-    dE[0] = t[0];
-    dE[1] = t[4];
-    dE[2] = t[8];
-    dE[3] = (frm_real)0.5 * (t[5] + t[7]);
-    dE[4] = (frm_real)0.5 * (t[2] + t[6]);
-    dE[5] = (frm_real)0.5 * (t[1] + t[3]);
+    frm_strain_variation(F, dF, dE);
     frm__laws[law].differential(params, user, cache, dE, dS);
-    frm_first_piola(dF, S, dP);
-    frm_first_piola(F, dS, t);
-    for (r = 0; r < 9; r++) dP[r] += t[r];
+    frm_piola_variation(F, S, dF, dS, dP);
 }
 
 /* The 6 tangent columns of one pair (frm_pair_tangent_columns through the law table). */

@@ -2511,6 +2511,72 @@ static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
     damped_beam_with(sc, alpha, beta, amplitude, FRM_IMPLICIT_EULER);
 }
 
+/* The assembled K (symmetric part) and the mass blocks of the free frames, dense, N = 6 nf. */
+static int dense_system(frm_model *m, int *map, double **K, double **M)
+{
+    int n = frm_model_frame_count(m), nf = 0, i, j, a, b, N;
+    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(m, i) ? -1 : nf++;
+    N = 6 * nf;
+    *K = (double *)calloc((size_t)N * N, sizeof(double));
+    *M = (double *)calloc((size_t)N * N, sizeof(double));
+    if (frm_model_assemble_stiffness(m) != FRM_OK) return 0;
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++) {
+            frm_real B[36];
+            if (map[i] < 0 || map[j] < 0) continue;
+            if (frm_model_stiffness_block(m, i, j, B) != FRM_OK) continue;
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) (*K)[(6 * map[i] + a) * N + 6 * map[j] + b] = (double)B[6 * a + b];
+        }
+    for (i = 0; i < n; i++) {
+        frm_real B[36];
+        if (map[i] < 0) continue;
+        if (frm_model_mass_block(m, i, B) != FRM_OK) return 0;
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) (*M)[(6 * map[i] + a) * N + 6 * map[i] + b] = (double)B[6 * a + b];
+    }
+    return N;
+}
+
+/* One step of the linearised recurrence from (u, v) with step h (both schemes' form):
+       (M (1 + alpha h) + (h^2 + beta h) K) v1 = M v - h K u,   u1 = u + h v1
+   in place; A and rhs are N x N and N scratch. */
+static void recurrence_step(const double *M, const double *K, double *A, double *rhs, int N, double h, double alpha,
+                            double beta, double *u, double *v)
+{
+    int a, b;
+    for (a = 0; a < N; a++) {
+        double t = 0;
+        for (b = 0; b < N; b++) {
+            t += M[a * N + b] * v[b] - h * K[a * N + b] * u[b];
+            A[a * N + b] = M[a * N + b] * (1 + alpha * h) + (h * h + beta * h) * K[a * N + b];
+        }
+        rhs[a] = t;
+    }
+    dense_solve(A, rhs, N);
+    for (a = 0; a < N; a++) {
+        v[a] = rhs[a];
+        u[a] += h * v[a];
+    }
+}
+
+/* The free frames' displacements against the recurrence's u: relative 2-norm of the
+   difference (uf: 6 n scratch). */
+static double recurrence_error(scene *sc, const int *map, double *uf, const double *u)
+{
+    double err = 0, top = 0;
+    int i, a, n = frm_model_frame_count(sc->m);
+    frame_displacements(sc->m, &sc->s, uf);
+    for (i = 0; i < n; i++)
+        if (map[i] >= 0)
+            for (a = 0; a < 6; a++) {
+                double d = uf[6 * i + a] - u[6 * map[i] + a];
+                err += d * d;
+                top += u[6 * map[i] + a] * u[6 * map[i] + a];
+            }
+    return sqrt(err / top);
+}
+
 /* Implicit Euler with Rayleigh damping (alpha M + beta K) and a non-zero start velocity
    against the closed form of its discrete recurrence, computed here from the assembled K
    and the mass blocks:
@@ -2520,65 +2586,27 @@ static void damped_beam(scene *sc, double alpha, double beta, double amplitude)
 static void test_i18_implicit_recurrence(void)
 {
     scene sc;
-    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err = 0, top = 0;
-    int n, nf = 0, i, j, a, b, step, steps = 20, *map;
+    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err;
+    int n, i, a, step, steps = 20, N, *map;
     double *K, *M, *A, *u, *v, *rhs, *uf;
     damped_beam(&sc, alpha, beta, amp);
     n = frm_model_frame_count(sc.m);
     map = (int *)malloc(sizeof(int) * (size_t)n);
-    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(sc.m, i) ? -1 : nf++;
-    K = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
-    M = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
-    A = (double *)calloc((size_t)36 * nf * nf, sizeof(double));
-    u = (double *)calloc((size_t)6 * n, sizeof(double));
-    v = (double *)calloc((size_t)6 * nf, sizeof(double));
-    rhs = (double *)calloc((size_t)6 * nf, sizeof(double));
+    N = dense_system(sc.m, map, &K, &M);
+    REQUIRE(N > 0);
+    A = (double *)calloc((size_t)N * N, sizeof(double));
+    u = (double *)calloc((size_t)N, sizeof(double));
+    v = (double *)calloc((size_t)N, sizeof(double));
+    rhs = (double *)calloc((size_t)N, sizeof(double));
     uf = (double *)calloc((size_t)6 * n, sizeof(double));
-    REQUIRE(frm_model_assemble_stiffness(sc.m) == FRM_OK);
-    for (i = 0; i < n; i++)
-        for (j = 0; j < n; j++) {
-            frm_real B[36];
-            if (map[i] < 0 || map[j] < 0) continue;
-            if (frm_model_stiffness_block(sc.m, i, j, B) != FRM_OK) continue;
-            for (a = 0; a < 6; a++)
-                for (b = 0; b < 6; b++) K[(6 * map[i] + a) * 6 * nf + 6 * map[j] + b] = (double)B[6 * a + b];
-        }
-    for (i = 0; i < n; i++) {
-        frm_real B[36];
-        if (map[i] < 0) continue;
-        REQUIRE(frm_model_mass_block(sc.m, i, B) == FRM_OK);
-        for (a = 0; a < 6; a++)
-            for (b = 0; b < 6; b++) M[(6 * map[i] + a) * 6 * nf + 6 * map[i] + b] = (double)B[6 * a + b];
-    }
     for (i = 0; i < n; i++)
         if (map[i] >= 0)
             for (a = 0; a < 6; a++) v[6 * map[i] + a] = (double)frm_model_velocities(sc.m)[6 * i + a];
     for (step = 0; step < steps; step++) {
-        int N = 6 * nf;
         REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
-        for (a = 0; a < N; a++) {
-            double s = 0;
-            for (b = 0; b < N; b++) {
-                s += M[a * N + b] * v[b] - dt * K[a * N + b] * u[b];
-                A[a * N + b] = M[a * N + b] * (1 + alpha * dt) + (dt * dt + beta * dt) * K[a * N + b];
-            }
-            rhs[a] = s;
-        }
-        dense_solve(A, rhs, N);
-        for (a = 0; a < N; a++) {
-            v[a] = rhs[a];
-            u[a] += dt * v[a];
-        }
+        recurrence_step(M, K, A, rhs, N, dt, alpha, beta, u, v);
     }
-    frame_displacements(sc.m, &sc.s, uf);
-    for (i = 0; i < n; i++)
-        if (map[i] >= 0)
-            for (a = 0; a < 6; a++) {
-                double d = uf[6 * i + a] - u[6 * map[i] + a];
-                err += d * d;
-                top += u[6 * map[i] + a] * u[6 * map[i] + a];
-            }
-    err = sqrt(err / top);
+    err = recurrence_error(&sc, map, uf, u);
     printf("    %d steps of %.2f s, alpha %.2f, beta %.2f: frames against the recurrence %.2e (relative)\n", steps, dt, alpha,
            beta, err);
     CHECK(err < (IS_FLOAT ? 2e-2 : 1e-4));
@@ -3257,32 +3285,6 @@ static void test_i18_settings_validation(void)
 
 /* ---- issue 19: BDF2 ---------------------------------------------------------------------- */
 
-/* The assembled K (symmetric part) and the mass blocks of the free frames, dense, N = 6 nf. */
-static int dense_system(frm_model *m, int *map, double **K, double **M)
-{
-    int n = frm_model_frame_count(m), nf = 0, i, j, a, b, N;
-    for (i = 0; i < n; i++) map[i] = frm_model_frame_state(m, i) ? -1 : nf++;
-    N = 6 * nf;
-    *K = (double *)calloc((size_t)N * N, sizeof(double));
-    *M = (double *)calloc((size_t)N * N, sizeof(double));
-    if (frm_model_assemble_stiffness(m) != FRM_OK) return 0;
-    for (i = 0; i < n; i++)
-        for (j = 0; j < n; j++) {
-            frm_real B[36];
-            if (map[i] < 0 || map[j] < 0) continue;
-            if (frm_model_stiffness_block(m, i, j, B) != FRM_OK) continue;
-            for (a = 0; a < 6; a++)
-                for (b = 0; b < 6; b++) (*K)[(6 * map[i] + a) * N + 6 * map[j] + b] = (double)B[6 * a + b];
-        }
-    for (i = 0; i < n; i++) {
-        frm_real B[36];
-        if (map[i] < 0) continue;
-        if (frm_model_mass_block(m, i, B) != FRM_OK) return 0;
-        for (a = 0; a < 6; a++)
-            for (b = 0; b < 6; b++) (*M)[(6 * map[i] + a) * N + 6 * map[i] + b] = (double)B[6 * a + b];
-    }
-    return N;
-}
 
 /* BDF2 with Rayleigh damping and a non-zero start velocity against its discrete recurrence
    on the assembled K and M (linear regime): the first step implicit Euler, then with
@@ -3293,8 +3295,8 @@ static int dense_system(frm_model *m, int *map, double **K, double **M)
 static void test_i19_bdf2_recurrence(void)
 {
     scene sc;
-    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err = 0, top = 0;
-    int n, i, a, b, step, steps = 20, N, *map;
+    double alpha = 0.5, beta = 0.02, dt = 0.05, amp = IS_FLOAT ? 1e-3 : 1e-7, err;
+    int n, i, a, step, steps = 20, N, *map;
     double *K, *M, *A, *u, *v, *up, *vp, *rhs, *uf;
     damped_beam_with(&sc, alpha, beta, amp, FRM_BDF2);
     n = frm_model_frame_count(sc.m);
@@ -3312,36 +3314,15 @@ static void test_i19_bdf2_recurrence(void)
         if (map[i] >= 0)
             for (a = 0; a < 6; a++) v[6 * map[i] + a] = (double)frm_model_velocities(sc.m)[6 * i + a];
     for (step = 0; step < steps; step++) {
-        double h = step == 0 ? dt : 2 * dt / 3;
         REQUIRE(frm_model_step_ex(sc.m, (frm_real)dt) == FRM_OK);
         for (a = 0; a < N; a++) { /* ubar, vbar (the first step: u_n, v_n) into up, vp */
             double ub = step == 0 ? u[a] : (4 * u[a] - up[a]) / 3, vb = step == 0 ? v[a] : (4 * v[a] - vp[a]) / 3;
             up[a] = u[a], vp[a] = v[a];
             u[a] = ub, v[a] = vb;
         }
-        for (a = 0; a < N; a++) {
-            double t = 0;
-            for (b = 0; b < N; b++) {
-                t += M[a * N + b] * v[b] - h * K[a * N + b] * u[b];
-                A[a * N + b] = M[a * N + b] * (1 + alpha * h) + (h * h + beta * h) * K[a * N + b];
-            }
-            rhs[a] = t;
-        }
-        dense_solve(A, rhs, N);
-        for (a = 0; a < N; a++) {
-            v[a] = rhs[a];
-            u[a] += h * v[a];
-        }
+        recurrence_step(M, K, A, rhs, N, step == 0 ? dt : 2 * dt / 3, alpha, beta, u, v);
     }
-    frame_displacements(sc.m, &sc.s, uf);
-    for (i = 0; i < n; i++)
-        if (map[i] >= 0)
-            for (a = 0; a < 6; a++) {
-                double d = uf[6 * i + a] - u[6 * map[i] + a];
-                err += d * d;
-                top += u[6 * map[i] + a] * u[6 * map[i] + a];
-            }
-    err = sqrt(err / top);
+    err = recurrence_error(&sc, map, uf, u);
     printf("    BDF2, %d steps of %.2f s, alpha %.2f, beta %.2f: frames against the recurrence %.2e (relative)\n", steps, dt,
            alpha, beta, err);
     CHECK(err < (IS_FLOAT ? 2e-2 : 1e-4));
