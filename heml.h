@@ -303,6 +303,66 @@
        limit dt -> infinity (A_i = alpha_i, B_i = 0: the fully relaxed equilibrium) and
        leaves the state relaxed there.
 
+   NEAR-INCOMPRESSIBLE BODIES (desc.nodal_pressure = 1; off by default, and then every
+       result is bit-identical to 0.3.0): average nodal pressure tetrahedra (Bonet and
+       Burton 1998's ANP element, the volumetric part moved from the tetrahedra to the
+       nodes), for every law but mass-spring, user laws included. P1 tetrahedra lock near
+       nu = 0.5 because every tetrahedron must keep its own volume (one constraint per
+       tetrahedron, about 5 per node against 3 degrees of freedom per node); here the
+       volume is constrained per node (one per node). Our formulation, in energy form so
+       that forces and differential follow exactly:
+           W = sum_e Vol_e (w(F_e) - U(J_e)) + sum_a sum_mat W_a,mat U_mat(J_a),
+       U(J) = w(J^(1/3) I) the law's energy on a pure dilation (I1 = 3 J^(2/3), I2 =
+       3 J^(4/3)), continued below J0 by its quadratic Taylor polynomial (J^(2/3) has no
+       second derivative at 0); W_a,mat = sum Vol_e / 4 over node a's tetrahedra of that
+       material, V_a = sum_mat W_a,mat, and the nodal volume ratio J_a = sum_e Vol_e J_e /
+       (4 V_a) (current over rest nodal volume). So each tetrahedron keeps its law minus
+       the law's own dilation energy, w - U, which has no bulk stiffness at small strain
+       (Neo-Hookean: w - U = mu/2 (I1 - 3 J^(2/3)), the isochoric part exactly; split
+       Mooney-Rivlin: U = kappa/2 (J - 1)^2, its volumetric term exactly; St Venant-
+       Kirchhoff: w - U is O(strain^3)), and the nodes carry the volumetric energy. A
+       homogeneous deformation gives every J_a = J_e = J, the two U terms cancel, and the
+       stress is the law's P(F) (the patch test) for any law; rigid motions give J = 1 and
+       zero force. Our choice where the papers offer several: U from the law itself (no
+       separate volumetric law to specify, user laws work unchanged) rather than Bonet and
+       Burton's assumed split, and the nodal energy weighted per material (a node on a
+       material interface carries each material's U on its own volume share).
+       Forces: dW/dx = sum_e Vol_e (dw - U'(J_e) dJ_e) + sum_a V_a P_a dJ_a with the nodal
+       pressure P_a = sum_mat W_a,mat U'_mat(J_a) / V_a and dJ_a = sum_e Vol_e dJ_e / (4 V_a),
+       so regrouped per tetrahedron:
+           w_J  ->  w_J - U'(J_e) + p_e,   p_e = (P_a + P_b + P_c + P_d) / 4
+       (and s0 the same), its four nodes' mean pressure: the P1 force kernel unchanged.
+       Differential: dp_e = sum_{a in e} dP_a / 4, dP_a = (sum_mat W_a,mat U''_mat(J_a) /
+       V_a) dJ_a, so in the element's differential w_JJ -> w_JJ - U''(J_e) and dw_J gains
+       dp_e: the exact tangent, which couples a node to its neighbours' neighbours
+       (through J_a), matrix-free. Each pass (force, energy, differential, stresses) is
+       three: the tetrahedra scatter Vol (J - 1) / 4 (the differential also Vol dJ / 4 =
+       Vol cof F : dH / 4) into two scalars per node (coloured as the force pass); a node
+       pass (chunks of 1024 nodes) evaluates U', U'' (and U) at J_a in blocks of 16
+       through the law's own row of heml__laws (one evaluation per material present); the
+       usual pass then gathers the four P_a (and dP_a) and evaluates the element's U at
+       J_e besides the law. U', U'' are formed from the law's s0 and second derivatives at
+       the dilation point: U' = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1), s = J^(1/3), s - 1 =
+       (J - 1) / (s^2 + s + 1), without cancellation at rest. It runs the general path
+       (not the vectorised Neo-Hookean kernels). Prony: the nodal pressure enters w_J
+       before the filter, so it relaxes with the rest of the stress. Inversion: the
+       continued U is restoring below J0 at the nodes; a single tetrahedron's own
+       resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
+       the bulk part. Memory: 6 reals per node plus one per node and material.
+       Measured (tests/test_heml_solve.c, Cook's membrane R10, nu = 0.4999, corner u_y in
+       mm at N x N x 1 cells, N = 4, 8, 16, 32; converged about 6.9):
+           six tetrahedra per cell   plain 2.15 2.17 2.22 2.38   nodal 2.65 4.38 5.99 6.61
+           five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
+       so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
+       it and converge (as O(h)) towards the published value. What it does not fix
+       (LIMITS): the static solve's Krylov iterations (Cook, N = 16: about 430 at nu = 0.3,
+       17,000 at nu = 0.4999, with or without nodal pressure: the conditioning is the
+       bulk-to-shear ratio, which the Jacobi and rigid-body coarse preconditioner does
+       not address), and the nodal pressure field oscillates between neighbouring nodes
+       near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
+       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
+       smoothed, e.g. as the element means p_e, not node by node.
+
    INTEGRATORS (the desc picks a default, heml_step_ex picks per call)
        HEML_SEMI_EXPLICIT_EULER  eq. 32: v1 = v + dt a(u, v), u1 = u + dt v1, lumped masses
                              m_i = sum rho Vol / 4 (sec. 3.3). One force evaluation per
@@ -623,7 +683,16 @@
 
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
-         to 0.5 or a stiff penalty): refine the mesh across thin parts.
+         to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
+         desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
+         BODIES), which removes the volumetric locking, not the bending one.
+       - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
+         shear ratio (about 40 times more at nu = 0.4999 than at nu = 0.3 on Cook's
+         membrane: no preconditioner for the volumetric part yet); the nodal pressure
+         oscillates between neighbouring nodes near nu = 0.5 (smooth the pressure before
+         reading it); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
+         laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
          (HEML_ERR_DIVERGED) catches growth of more than twice the energy the body was
          given, so slower growth below that still passes: respect the time-step estimate.
@@ -1947,11 +2016,25 @@ static void heml__dilation(const heml__mat *mt, heml_real jm1_0, const heml_real
 {
     heml_real dd[HEML__W], sv[HEML__W], sm[HEML__W];
     int k;
+    for (k = 0; k < HEML__W; k++) { /* s = J^(1/3): Halley from the tangent 1 + (J - 1) / 3,
+                                       to round-off in 4 steps for J in [1/8, 8] (vectorised;
+                                       libm's cbrt is a call) */
+        heml_real jc = heml__max(jm1[k], jm1_0), x = 1 + jc, t = 1 + jc / 3;
+        int r;
+        for (r = 0; r < 4; r++) {
+            heml_real t3 = t * t * t;
+            t = t * (t3 + 2 * x) / (2 * t3 + x);
+        }
+        sv[k] = t;
+    }
     for (k = 0; k < HEML__W; k++) {
-        heml_real j = jm1[k], jc = heml__max(j, jm1_0), t = (heml_real)cbrt(1.0 + (double)jc);
+        heml_real jc = heml__max(jm1[k], jm1_0);
+        if (jc < (heml_real)-0.875 || jc > 7) sv[k] = (heml_real)cbrt(1.0 + (double)jc);
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real j = jm1[k], jc = heml__max(j, jm1_0), t = sv[k];
         heml_real t1 = jc / (t * t + t + 1), t2 = t1 * (t + 1);
         dd[k] = j - jc;
-        sv[k] = t;
         sm[k] = t1;
         s->jm1[k] = jc;
         s->I1m3[k] = 3 * t2;

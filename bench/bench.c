@@ -1098,7 +1098,10 @@ static void run_stability(const options *o, const bench_model *const *models, in
     stability_csv = open_csv(o, "stability.csv", "test,model,variant,precision,setting,parameter,value,error,outcome,code");
     stability_clock = now();
     for (i = 0; i < count; i++) {
-        if (!models[i]->primary) continue;
+        if (!models[i]->primary) {
+            if (strchr(models[i]->variant, '+')) stability_poisson(models[i], o); /* an option-on variant */
+            continue;
+        }
         stability_time_step(models[i], o);
         stability_poisson(models[i], o);
         stability_squash(models[i]);

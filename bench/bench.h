@@ -53,7 +53,9 @@ typedef struct bench_body {
 
 typedef struct bench_model {
     const char *model;     /* header: "tensormass", "heml", "frames" */
-    const char *variant;   /* law / kind / shape function, as shown in tables */
+    const char *variant;   /* law / kind / shape function, as shown in tables; "law+option"
+                              names a non-primary entry with a volumetric option on (e.g.
+                              heml's "neo-hookean+nodal-p"): it also runs the Poisson rows */
     const char *law;       /* "linear", "springs", "svk", "neo-hookean", "mooney-rivlin":
                               which closed forms (R4 SVK, R5 Neo-Hookean) apply */
     const char *precision; /* "double" or "float" */

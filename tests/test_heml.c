@@ -1569,6 +1569,41 @@ static void test_nodal_pressure_patch(void)
     tetmesh_free(&mesh);
 }
 
+/* nodal_pressure refused where it cannot work: a value other than 0 or 1, mass-spring, a
+   user law without second derivatives (HEML_ERR_NODAL_PRESSURE, nothing created). */
+static void test_nodal_pressure_refused(void)
+{
+    tetmesh mesh;
+    heml_material springs = material_of(HEML_MASS_SPRING), user = material_of(HEML_USER), nh = material_of(HEML_NEO_HOOKEAN);
+    heml_model *m = NULL;
+    heml_desc d = heml_default_desc();
+    heml_real *x;
+    int i;
+    box_mesh(&mesh, 1, 1, 1, 1, 1, 1, TETMESH_SPLIT6);
+    x = alloc_reals(3 * mesh.node_count);
+    for (i = 0; i < 3 * mesh.node_count; i++) x[i] = (heml_real)mesh.nodes[i];
+    d.rest_positions = x;
+    d.node_count = mesh.node_count;
+    d.tets = mesh.tets;
+    d.tet_count = mesh.tet_count;
+    d.material = nh;
+    d.nodal_pressure = 2;
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, heml_create(&d, &m));
+    CHECK(m == NULL);
+    d.nodal_pressure = 1;
+    d.material = springs;
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, heml_create(&d, &m));
+    user.user.second = NULL;
+    d.material = user;
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, heml_create(&d, &m));
+    CHECK(m == NULL);
+    d.material = nh;
+    CHECK_INT(HEML_OK, heml_create(&d, &m));
+    heml_destroy(m);
+    free(x);
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_log_accuracy),
     TEST(test_forces_are_energy_gradient),
@@ -1586,6 +1621,7 @@ static const test_case cases[] = {
     TEST(test_law_table_forces_and_differentials),
     TEST(test_nodal_pressure_gradient_and_differential),
     TEST(test_nodal_pressure_patch),
+    TEST(test_nodal_pressure_refused),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
