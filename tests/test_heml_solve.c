@@ -1239,13 +1239,17 @@ static void test_nodal_pressure_cook(void)
 {
     double u5, u6, u6p, jump;
     int it5, it6, it6p;
-    CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump));
-    printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u5, it5, jump);
+    if (TEST_IS_QUICK) { /* (the reduced builds: the six-tetrahedron split only) */
+        u5 = 0;
+    } else {
+        CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump));
+        printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u5, it5, jump);
+    }
     CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump));
     printf("    split 6, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u6, it6, jump);
     CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump));
     printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov\n", u6p, it6p);
-    CHECK(fabs(u5 - u6) <= 0.05 * u6);
+    if (!TEST_IS_QUICK) CHECK(fabs(u5 - u6) <= 0.05 * u6);
     CHECK(u6 >= 1.8 * u6p);
     CHECK(u5 <= 6.9 * 1.02 && u6 <= 6.9 * 1.02);
 }
