@@ -1127,6 +1127,9 @@ static void test_validation_errors(void)
     d = base; d.inversion_threshold = (heml_real)NAN; CHECK_INT(HEML_ERR_THRESHOLD, try_create(&d));
     d = base; d.time_step = 0;                       CHECK_INT(HEML_ERR_TIME_STEP, try_create(&d));
     d = base; d.time_step = (heml_real)-1e-3;        CHECK_INT(HEML_ERR_TIME_STEP, try_create(&d));
+    d = base; d.nodal_pressure = 2;                  CHECK_INT(HEML_ERR_NODAL_PRESSURE, try_create(&d));
+    d = base; d.nodal_pressure = 1; d.material = heml_material_from_young(HEML_MASS_SPRING, 1e4, 0.3);
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, try_create(&d));
     d = base; d.mass_damping = -1;                   CHECK_INT(HEML_ERR_DAMPING, try_create(&d));
     d = base; d.mass_damping = (heml_real)NAN;       CHECK_INT(HEML_ERR_DAMPING, try_create(&d));
     d = base; d.integrator = (heml_integrator)9;     CHECK_INT(HEML_ERR_INTEGRATOR, try_create(&d));
