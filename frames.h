@@ -710,7 +710,8 @@
    map reaches it (Newton from the centre, parametric coordinates in [-tol, 1 + tol]),
    FRM_PROBE_MESHLESS the frames and weights frm_sampling_meshless would give a sample
    there (desc.shape: Shepard or MLS, nearest or radius support). A point in no element
-   is FRM_ERR_ARG (no nearest-element fallback beyond the tolerance). Then, per point,
+   is FRM_ERR_POINT_OUTSIDE (no nearest-element fallback beyond the tolerance; meshless: a
+   point farther from each of its frames than that frame's farthest sample). Then, per point,
    p = pbar + sum_i w_i (u_i + (Q_i - I) abar_i), abar_i = pbar - xbar_i (eq. 3.34 in the
    kernels' displacement form), and its velocity sum_i w_i (v_i + omega_i x Q_i abar_i):
    exact for rigid motions with any weights, and for affine fields of the frames'
@@ -812,6 +813,10 @@ typedef FRM_REAL frm_real;
 #define frm_sampling_free frm_sampling_free_f32
 #define frm_shape_default_desc frm_shape_default_desc_f32
 #define frm_poisson_default_desc frm_poisson_default_desc_f32
+#define frm_part_default frm_part_default_f32
+#define frm_parts_combine frm_parts_combine_f32
+#define frm_assembly_apply frm_assembly_apply_f32
+#define frm_assembly_free frm_assembly_free_f32
 #define frm_model_default_desc frm_model_default_desc_f32
 #define frm_model_create frm_model_create_f32
 #define frm_model_destroy frm_model_destroy_f32
@@ -862,6 +867,9 @@ typedef FRM_REAL frm_real;
 #define frm_probe_displacements frm_probe_displacements_f32
 #define frm_probe_velocities frm_probe_velocities_f32
 #define frm_probe_count frm_probe_count_f32
+#define frm_probe_jacobian frm_probe_jacobian_f32
+#define frm_probe_jacobian_transpose frm_probe_jacobian_transpose_f32
+#define frm_probe_add_external frm_probe_add_external_f32
 #define frm_probe_destroy frm_probe_destroy_f32
 #define frm_modal_default_desc frm_modal_default_desc_f32
 #define frm_modal_create frm_modal_create_f32
@@ -929,13 +937,15 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_SURFACE, -33, "triangle surface not closed or encloses no volume") \
     X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept") \
     X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept") \
-    X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept")
+    X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
+    X(FRM_ERR_POINT_OUTSIDE, -37, "a mapped point lies outside the body: in no element, or farther from each of its frames than that frame's farthest sample") \
+    X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -37
+    FRM_ERR_LAST_ = -39
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1319,6 +1329,55 @@ FRMDEF void frm_sampling_free(frm_sampling *s);
 FRMDEF frm_shape_desc frm_shape_default_desc(void);
 FRMDEF frm_poisson_desc frm_poisson_default_desc(void);
 
+/* ---- several parts in one model (issue 14; 2013 paper sec. 4.2 and fig. 5): each part
+   has its own sampling (frames, samples, neighbour table, any shape functions), material
+   and density, and says which of the model's frames its frames are, so parts share frames
+   where the caller says (the interface frames of a split body, the surface frames of two
+   organs a connective layer joins). frm_parts_combine makes one sampling of them with a
+   material per part; the model built from it is one mechanical system (one mass, one
+   stiffness, one solve): a shared frame gets the mass, forces and stiffness of every part
+   whose samples use it. ---- */
+
+typedef struct frm_part {
+    const frm_sampling *sampling; /* the part alone: its frames, samples and neighbour table (read
+                                     during frm_parts_combine only) */
+    frm_material material;        /* law, constants and density of every sample of the part
+                                     (default: frm_model_default_desc's material) */
+    const int *frame_map;         /* sampling->frame_count model frame indices: the part's frame j is
+                                     the model's frame frame_map[j] (distinct within the part);
+                                     NULL: frame j is the model's frame j */
+} frm_part;
+
+/* The combined model description's arrays, owned (frm_assembly_free). */
+typedef struct frm_assembly {
+    frm_sampling sampling;   /* the model's frame_count frames (rest positions from the parts
+                                that give them), the samples of part 0, then part 1, ... with
+                                their neighbour tables mapped to the model's frames */
+    frm_material *materials; /* part_count: part k's material */
+    int *sample_materials;   /* sample_count: the part of each sample */
+    int *part_samples;       /* part_count + 1: part k's samples are part_samples[k] ..
+                                part_samples[k + 1] - 1 */
+    int part_count;
+    size_t bytes;            /* of the block holding materials, sample_materials, part_samples */
+} frm_assembly;
+
+/* A part with the default material and no frame map. */
+FRMDEF frm_part frm_part_default(void);
+/* Combines part_count parts into a model of frame_count frames. Every model frame must be
+   given by at least one part; parts giving the same frame must give it the same rest
+   position (within 1e-9 of the body's size; float 1e-5). Errors: FRM_ERR_ARG (NULL,
+   part_count < 1, frame_count < 1, a part without frames or samples), FRM_ERR_PART_FRAME (a
+   map index out of range or repeated within a part, NULL map with more part frames than
+   frame_count, a model frame no part gives, rest positions that differ), FRM_ERR_ALLOC;
+   *out is then empty. Materials are validated by frm_model_create. */
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, int frame_count,
+                             const frm_allocator *allocator);
+/* Points the description's frames, samples, neighbour table, materials and sample_materials
+   at the assembly (which must outlive frm_model_create, not the model). */
+FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d);
+/* Frees the assembly's arrays and empties it. */
+FRMDEF void frm_assembly_free(frm_assembly *a);
+
 /* ---- model ---- */
 
 /* A description with the documented defaults; always start from it. */
@@ -1494,7 +1553,9 @@ FRMDEF frm_probe_desc frm_probe_default_desc(void);
 /* Finds each of the `count` rest points (3 each, m) in the description's elements (or its
    meshless neighbours among the model's rest frames) and keeps its frames, weights and rest
    levers pbar - xbar_i. Allocates one block (the model's allocator). Errors: FRM_ERR_DESC
-   (no cookie), FRM_ERR_ARG (NULL, count < 1, non-finite point, a point in no element),
+   (no cookie), FRM_ERR_ARG (NULL, count < 1, non-finite point), FRM_ERR_POINT_OUTSIDE (a
+   point in no element; meshless: no frame within the radius, or farther from each of its
+   frames than that frame's farthest sample in the model, beyond 1e-3 + tolerance of it),
    FRM_ERR_INDEX_RANGE (an element's frame index), FRM_ERR_SAMPLING (shape settings),
    FRM_ERR_NO_NEIGHBOR / FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
 FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
@@ -1507,6 +1568,31 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
 FRMDEF int frm_probe_positions(const frm_probe *p, const frm_model *m, frm_real *out);
 FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_real *out);
 FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out);
+/* Mapped points (issue 14): a probe is the mapping p = M(q) of its points from the frames
+   (thesis eq. 4.11), the way to embed a render mesh, contact points or another model's
+   nodes in a frames body. Its Jacobian at the model's current state, J = dp/dq, with q's
+   variations as everywhere in frames.h (6 per frame: translation, then rotation dtheta
+   about world axes, R -> exp([dtheta]x) R):
+       J dq = sum_i w_i (dx_i + dtheta_i x a_i),   a_i = Q_i abar_i = R_i lbar_i,
+   and its transpose, the generalized forces of point forces f_n (the virtual work
+   dq . J^T f = sum_n f_n . dp_n), per frame i
+       force sum_n w_in f_n (eq. 4.12),   torque sum_n w_in a_in x f_n,
+   the thesis's eq. 4.13 with the frame's own prediction a_in of the point for p_n - x_i
+   (equal for rigid motions; ours is the exact transpose, so work is conserved across an
+   interface). frm_probe_jacobian: dq 6 per frame -> out 3 per point (m for rad and m, or
+   m/s for a velocity). frm_probe_jacobian_transpose: f 3 per point (N) -> out 6 per frame
+   (N, N m about the frame's origin, world axes), overwriting every frame's six values
+   (add = 0) or adding to them (add = 1). No allocation; FRM_ERR_ARG for NULL or a probe
+   made for a model with another frame count. */
+FRMDEF int frm_probe_jacobian(const frm_probe *p, const frm_model *m, const frm_real *dq, frm_real *out);
+FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, const frm_real *f, frm_real *out,
+                                        int add);
+/* Adds J^T f (forces f, 3 per point, N, at the current state) to the model's external
+   loads (frm_model_set_external's force and torque), which stay constant through the next
+   steps and solves until frm_model_clear_external or frm_model_set_external: call it once
+   per step with the points' current forces (a staggered coupling, a render mesh's
+   contact). FRM_ERR_ARG as above, or a non-finite force (nothing added). */
+FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f);
 /* Points of the probe. */
 FRMDEF int frm_probe_count(const frm_probe *p);
 /* Frees the probe. NULL is allowed. */
@@ -7303,6 +7389,149 @@ FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int
     return err;
 }
 
+/* >>parts ------------------------------------------------------------------------------ */
+
+FRMDEF frm_part frm_part_default(void)
+{
+    frm_part p;
+    frm_desc d = frm_model_default_desc();
+    memset(&p, 0, sizeof p);
+    p.material = d.material;
+    return p;
+}
+
+FRMDEF void frm_assembly_free(frm_assembly *a)
+{
+    frm_allocator al;
+    if (!a) return;
+    al = a->sampling.allocator;
+    if (a->materials) frm__free(&al, a->materials, a->bytes);
+    frm_sampling_free(&a->sampling);
+    memset(a, 0, sizeof *a);
+}
+
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, int frame_count,
+                             const frm_allocator *allocator)
+{
+    long long samples = 0, pairs = 0;
+    double lo[3], hi[3], size = 0, tol;
+    int k, i, j, r, s0 = 0, p0 = 0, err, first = 1;
+    int *given;
+    frm_allocator al;
+    frm__carver c;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!parts || part_count < 1 || frame_count < 1 || part_count > 100000000 || frame_count > 100000000) return FRM_ERR_ARG;
+    memset(&al, 0, sizeof al);
+    if (allocator) al = *allocator;
+    for (k = 0; k < part_count; k++) {
+        const frm_sampling *s = parts[k].sampling;
+        if (!s || s->frame_count < 1 || s->sample_count < 1 || !s->frame_positions || !s->sample_positions ||
+            !s->sample_volumes || !s->neighbor_start || !s->neighbor_frames || !s->neighbor_weights ||
+            !s->neighbor_gradients)
+            return FRM_ERR_ARG;
+        if (!parts[k].frame_map && s->frame_count > frame_count) return FRM_ERR_PART_FRAME;
+        for (j = 0; j < s->frame_count; j++) {
+            int g = parts[k].frame_map ? parts[k].frame_map[j] : j;
+            if (g < 0 || g >= frame_count) return FRM_ERR_PART_FRAME;
+            for (r = 0; r < 3; r++) {
+                double x = (double)s->frame_positions[3 * j + r];
+                if (first || x < lo[r]) lo[r] = x;
+                if (first || x > hi[r]) hi[r] = x;
+            }
+            first = 0;
+        }
+        samples += s->sample_count;
+        pairs += s->neighbor_start[s->sample_count];
+    }
+    if (samples > 100000000 || pairs > 1600000000) return FRM_ERR_ARG;
+    for (r = 0; r < 3; r++)
+        if (hi[r] - lo[r] > size) size = hi[r] - lo[r];
+    tol = (sizeof(frm_real) < sizeof(double) ? 1e-5 : 1e-9) * (size > 0 ? size : 1);
+    err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, &al);
+    if (err) return err;
+    out->part_count = part_count;
+    c.base = NULL;
+    c.offset = 0;
+    FRM__CARVE(&c, out->materials, frm_material, part_count);
+    FRM__CARVE(&c, out->sample_materials, int, samples);
+    FRM__CARVE(&c, out->part_samples, int, part_count + 1);
+    FRM__CARVE(&c, given, int, frame_count); /* scratch: the last part (+ 1) that gave each model frame */
+    out->bytes = c.offset;
+    c.base = (char *)frm__alloc(&al, out->bytes);
+    if (!c.base) {
+        frm_assembly_free(out);
+        return FRM_ERR_ALLOC;
+    }
+    c.offset = 0;
+    FRM__CARVE(&c, out->materials, frm_material, part_count);
+    FRM__CARVE(&c, out->sample_materials, int, samples);
+    FRM__CARVE(&c, out->part_samples, int, part_count + 1);
+    FRM__CARVE(&c, given, int, frame_count);
+    memset(given, 0, sizeof(int) * (size_t)frame_count);
+    out->sampling.neighbor_start[0] = 0;
+    for (k = 0; k < part_count && !err; k++) {
+        const frm_part *pt = parts + k;
+        const frm_sampling *s = pt->sampling;
+        out->materials[k] = pt->material;
+        out->part_samples[k] = s0;
+        for (j = 0; j < s->frame_count && !err; j++) { /* frames: first giver sets, the others must agree */
+            int g = pt->frame_map ? pt->frame_map[j] : j;
+            frm_real *x = out->sampling.frame_positions + 3 * g;
+            if (given[g] == k + 1) { /* repeated within this part */
+                err = FRM_ERR_PART_FRAME;
+                break;
+            }
+            if (!given[g])
+                for (r = 0; r < 3; r++) x[r] = s->frame_positions[3 * j + r];
+            else
+                for (r = 0; r < 3; r++)
+                    if (!(fabs((double)x[r] - (double)s->frame_positions[3 * j + r]) <= tol)) err = FRM_ERR_PART_FRAME;
+            given[g] = k + 1;
+        }
+        for (i = 0; i < s->sample_count && !err; i++) {
+            int a = s->neighbor_start[i], b = s->neighbor_start[i + 1], e;
+            if (a < 0 || b < a || b - a > FRM_MAX_NEIGHBORS) {
+                err = FRM_ERR_NEIGHBOR_TABLE;
+                break;
+            }
+            for (r = 0; r < 3; r++) out->sampling.sample_positions[3 * (s0 + i) + r] = s->sample_positions[3 * i + r];
+            out->sampling.sample_volumes[s0 + i] = s->sample_volumes[i];
+            out->sample_materials[s0 + i] = k;
+            for (e = a; e < b; e++) {
+                int f = s->neighbor_frames[e], q = p0 + e - a;
+                if (f < 0 || f >= s->frame_count) {
+                    err = FRM_ERR_NEIGHBOR_TABLE;
+                    break;
+                }
+                out->sampling.neighbor_frames[q] = pt->frame_map ? pt->frame_map[f] : f;
+                out->sampling.neighbor_weights[q] = s->neighbor_weights[e];
+                for (r = 0; r < 3; r++) out->sampling.neighbor_gradients[3 * q + r] = s->neighbor_gradients[3 * e + r];
+            }
+            p0 += b - a;
+            out->sampling.neighbor_start[s0 + i + 1] = p0;
+        }
+        s0 += s->sample_count;
+    }
+    out->part_samples[part_count] = s0;
+    for (j = 0; j < frame_count && !err; j++)
+        if (!given[j]) err = FRM_ERR_PART_FRAME;
+    if (err) {
+        frm_assembly_free(out);
+        return err;
+    }
+    return FRM_OK;
+}
+
+FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d)
+{
+    if (!a || !d) return;
+    frm_sampling_apply(&a->sampling, d);
+    d->materials = a->materials;
+    d->material_count = a->part_count;
+    d->sample_materials = a->sample_materials;
+}
+
 /* >>probes ----------------------------------------------------------------------------- */
 
 struct frm_probe {
@@ -7485,7 +7714,7 @@ static void frm__bins_free(frm__bins *b, const frm_allocator *a)
 
 /* The frames and weights of one point p: n (<= FRM_MAX_NEIGHBORS) into idx, w. */
 static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const frm__grid *grid, const frm__bins *bins,
-                            const double *X, const double p[3], int *idx, double *w, int *n)
+                            const double *X, const double *reach, const double p[3], int *idx, double *w, int *n)
 {
     double tol = (double)d->tolerance, best = -HUGE_VAL;
     int e, a, r, nodes = d->kind == FRM_PROBE_TETS ? 4 : 8, cell, q;
@@ -7497,8 +7726,13 @@ static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const f
             err;
         int c = frm__grid_query(grid, X, p, k, sh->support == FRM_SUPPORT_RADIUS ? (double)sh->radius : 0.0,
                                 FRM_MAX_NEIGHBORS, idx, dist);
-        if (c == 0) return FRM_ERR_NO_NEIGHBOR;
+        if (c == 0) return FRM_ERR_POINT_OUTSIDE;
         if (c > FRM_MAX_NEIGHBORS) return FRM_ERR_TOO_MANY_NEIGHBORS;
+        if (reach) { /* inside the support of at least one of its frames (issue 14) */
+            int in = 0;
+            for (i = 0; i < c && !in; i++) in = dist[i] <= reach[idx[i]] * (1 + 1e-3 + tol);
+            if (!in) return FRM_ERR_POINT_OUTSIDE;
+        }
         for (i = 0; i < c; i++)
             for (r = 0; r < 3; r++) Xn[3 * i + r] = X[3 * idx[i] + r];
         if (sh->shape == FRM_SHAPE_MLS) { /* as frm_sampling_meshless */
@@ -7550,7 +7784,7 @@ static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const f
             for (a = 0; a < nodes; a++) idx[a] = el[a], w[a] = ww[a];
         }
     }
-    return *n ? FRM_OK : FRM_ERR_ARG;
+    return *n ? FRM_OK : FRM_ERR_POINT_OUTSIDE;
 }
 
 FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
@@ -7579,10 +7813,17 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
         for (i = 0; i < nodes * d->element_count; i++)
             if (d->elements[i] < 0 || d->elements[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
     }
-    xbytes = sizeof(double) * 3 * (size_t)m->frame_count;
+    xbytes = sizeof(double) * 4 * (size_t)m->frame_count; /* rest positions, then each frame's reach */
     X = (double *)frm__alloc(&m->allocator, xbytes);
     if (!X) return FRM_ERR_ALLOC;
     for (i = 0; i < 3 * m->frame_count; i++) X[i] = (double)m->rest_pos[i];
+    for (i = 0; i < m->frame_count; i++) X[3 * m->frame_count + i] = 0;
+    for (k = 0; k < m->pair_count; k++) { /* reach: the frame's farthest sample (its rest lever) */
+        const frm_real *a = m->p_rlev + 3 * (size_t)k;
+        double len = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+        double *reach = X + 3 * m->frame_count + m->p_frame[k];
+        if (len > *reach) *reach = len;
+    }
     memset(&grid, 0, sizeof grid);
     memset(&bins, 0, sizeof bins);
     if (d->kind == FRM_PROBE_MESHLESS)
@@ -7626,7 +7867,7 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
             double pt[3], w[FRM_MAX_NEIGHBORS];
             int idx[FRM_MAX_NEIGHBORS + 1], n;
             for (r = 0; r < 3; r++) pt[r] = (double)rest_points[3 * i + r];
-            err = frm__probe_point(m, d, &grid, &bins, X, pt, idx, w, &n);
+            err = frm__probe_point(m, d, &grid, &bins, X, X + 3 * m->frame_count, pt, idx, w, &n);
             if (err) break;
             if (pass == 1) {
                 p->start[i] = pairs;
@@ -7688,6 +7929,58 @@ FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_r
 }
 FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out) { return frm__probe_eval(p, m, out, 2); }
 FRMDEF int frm_probe_count(const frm_probe *p) { return p ? p->count : 0; }
+
+FRMDEF int frm_probe_jacobian(const frm_probe *p, const frm_model *m, const frm_real *dq, frm_real *out)
+{
+    int i, k, r;
+    if (!p || !m || !dq || !out || p->frame_count != m->frame_count) return FRM_ERR_ARG;
+    for (i = 0; i < p->count; i++) {
+        double acc[3] = {0, 0, 0};
+        for (k = p->start[i]; k < p->start[i + 1]; k++) { /* w (dx + dtheta x Q abar) */
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            const frm_real *Q = m->rel + 9 * p->frame[k], *v = dq + 6 * p->frame[k];
+            double l[3];
+            for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+            acc[0] += w * ((double)v[0] + (double)v[4] * l[2] - (double)v[5] * l[1]);
+            acc[1] += w * ((double)v[1] + (double)v[5] * l[0] - (double)v[3] * l[2]);
+            acc[2] += w * ((double)v[2] + (double)v[3] * l[1] - (double)v[4] * l[0]);
+        }
+        for (r = 0; r < 3; r++) out[3 * i + r] = (frm_real)acc[r];
+    }
+    return FRM_OK;
+}
+
+/* Points in order, each adding to its frames: the sums' order is fixed (deterministic). */
+FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, const frm_real *f, frm_real *out,
+                                        int add)
+{
+    int i, k, r;
+    if (!p || !m || !f || !out || p->frame_count != m->frame_count) return FRM_ERR_ARG;
+    if (!add) memset(out, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    for (i = 0; i < p->count; i++) {
+        const double fx = (double)f[3 * i], fy = (double)f[3 * i + 1], fz = (double)f[3 * i + 2];
+        for (k = p->start[i]; k < p->start[i + 1]; k++) { /* w (f, Q abar x f) */
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            const frm_real *Q = m->rel + 9 * p->frame[k];
+            frm_real *o = out + 6 * p->frame[k];
+            double l[3];
+            for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+            o[0] = (frm_real)((double)o[0] + w * fx);
+            o[1] = (frm_real)((double)o[1] + w * fy);
+            o[2] = (frm_real)((double)o[2] + w * fz);
+            o[3] = (frm_real)((double)o[3] + w * (l[1] * fz - l[2] * fy));
+            o[4] = (frm_real)((double)o[4] + w * (l[2] * fx - l[0] * fz));
+            o[5] = (frm_real)((double)o[5] + w * (l[0] * fy - l[1] * fx));
+        }
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f)
+{
+    if (!p || !m || !f || p->frame_count != m->frame_count || !frm__all_finite(f, 3 * (size_t)p->count)) return FRM_ERR_ARG;
+    return frm_probe_jacobian_transpose(p, m, f, m->ext, 1);
+}
 
 FRMDEF void frm_probe_destroy(frm_probe *p)
 {

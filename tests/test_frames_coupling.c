@@ -1,0 +1,624 @@
+/* Tests of frames.h's coupling (issue 14): mapped points (probes as a mapping of the frames:
+   positions, velocities, the Jacobian J and J^T), several parts in one model, and their
+   refusals. frames.h only: glue tests with the other headers go here later. */
+#define FRAMES_IMPLEMENTATION
+#include "../frames.h"
+#include "test.h"
+#include "fixtures.h"
+
+#define IS_FLOAT (sizeof(frm_real) == sizeof(float))
+
+/* ---- scenes ---------------------------------------------------------------------------- */
+
+/* Columns [cx0, cx1) of a grid of nx x ny x nz box cells (hx, hy, hz m) as a hexahedral
+   sampling of its own (points^3 sub-cell samples a cell); map (may be NULL) receives each
+   local node's index in the whole grid, node (i, j, k) being i + (nx + 1) (j + (ny + 1) k).
+   Cells in x-fastest order; local nodes likewise. */
+static int grid_part(frm_sampling *s, int nx, int ny, int nz, double hx, double hy, double hz, int cx0, int cx1,
+                     int points, int *map)
+{
+    int lx = cx1 - cx0, nn = (lx + 1) * (ny + 1) * (nz + 1), nc = lx * ny * nz, i, j, k, c, a, err;
+    frm_real *x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)nn);
+    int *hex = (int *)malloc(sizeof(int) * 8 * (size_t)nc);
+    for (k = 0; k <= nz; k++)
+        for (j = 0; j <= ny; j++)
+            for (i = 0; i <= lx; i++) {
+                int l = i + (lx + 1) * (j + (ny + 1) * k);
+                x[3 * l] = (frm_real)(hx * (i + cx0));
+                x[3 * l + 1] = (frm_real)(hy * j);
+                x[3 * l + 2] = (frm_real)(hz * k);
+                if (map) map[l] = (i + cx0) + (nx + 1) * (j + (ny + 1) * k);
+            }
+    for (c = 0; c < nc; c++) /* cell (c % lx, c / lx % ny, c / (lx ny)), corner a = (a&1, a>>1&1, a>>2) */
+        for (a = 0; a < 8; a++)
+            hex[8 * c + a] = (c % lx + (a & 1)) + (lx + 1) * ((c / lx % ny + (a >> 1 & 1)) + (ny + 1) * (c / (lx * ny) + (a >> 2)));
+    err = frm_sampling_hexes(s, x, nn, hex, nc, points, FRM_QUADRATURE_SUBCELL, NULL);
+    free(x);
+    free(hex);
+    return err;
+}
+
+/* The cell list of grid_part (whole grid) for a hexahedral probe. */
+static int *grid_hexes(int nx, int ny, int nz)
+{
+    int nc = nx * ny * nz, c, a;
+    int *hex = (int *)malloc(sizeof(int) * 8 * (size_t)nc);
+    for (c = 0; c < nc; c++)
+        for (a = 0; a < 8; a++)
+            hex[8 * c + a] = (c % nx + (a & 1)) + (nx + 1) * ((c / nx % ny + (a >> 1 & 1)) + (ny + 1) * (c / (nx * ny) + (a >> 2)));
+    return hex;
+}
+
+/* A model of the 2 x 0.5 x 0.5 m box on 4 x 1 x 1 cells: kind 0 hexahedral frames (8
+   sub-cell samples a cell), 1 Shepard and 2 MLS meshless frames at the same nodes with
+   samples at the sub-cell centres; pd the matching probe description (hex: the cells in
+   *hexes, freed by the caller). */
+static int small_scene(int kind, frm_model **m, frm_sampling *s, frm_probe_desc *pd, int **hexes)
+{
+    frm_desc d = frm_model_default_desc();
+    int err;
+    *pd = frm_probe_default_desc();
+    *hexes = NULL;
+    if (kind == 0) {
+        err = grid_part(s, 4, 1, 1, 0.5, 0.5, 0.5, 0, 4, 2, NULL);
+        *hexes = grid_hexes(4, 1, 1);
+        pd->kind = FRM_PROBE_HEXES;
+        pd->elements = *hexes;
+        pd->element_count = 4;
+    } else {
+        frm_sampling h;
+        err = grid_part(&h, 4, 1, 1, 0.5, 0.5, 0.5, 0, 4, 2, NULL);
+        if (err) return err;
+        pd->kind = FRM_PROBE_MESHLESS;
+        if (kind == 2) {
+            pd->shape.shape = FRM_SHAPE_MLS;
+            pd->shape.nearest = 10;
+        }
+        err = frm_sampling_meshless(s, h.frame_positions, h.frame_count, h.sample_positions, h.sample_count, (frm_real)0.5,
+                                    &pd->shape, NULL);
+        frm_sampling_free(&h);
+    }
+    if (err) return err;
+    frm_sampling_apply(s, &d);
+    d.material.young_modulus = (frm_real)1e5;
+    return frm_model_create(&d, m);
+}
+
+/* Quaternion (x, y, z, w) of the rotation vector th. */
+static void quat_of(const double th[3], double q[4])
+{
+    double a = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]), s = a > 0 ? sin(a / 2) / a : 0.5;
+    q[0] = s * th[0], q[1] = s * th[1], q[2] = s * th[2], q[3] = cos(a / 2);
+}
+
+/* c = a b (Hamilton, (x, y, z, w)). */
+static void quat_mul(const double a[4], const double b[4], double c[4])
+{
+    c[0] = a[3] * b[0] + b[3] * a[0] + a[1] * b[2] - a[2] * b[1];
+    c[1] = a[3] * b[1] + b[3] * a[1] + a[2] * b[0] - a[0] * b[2];
+    c[2] = a[3] * b[2] + b[3] * a[2] + a[0] * b[1] - a[1] * b[0];
+    c[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+}
+
+/* Rotation matrix of a unit quaternion (row-major). */
+static void quat_matrix(const double q[4], double R[9])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - z * w), R[2] = 2 * (x * z + y * w);
+    R[3] = 2 * (x * y + z * w), R[4] = 1 - 2 * (x * x + z * z), R[5] = 2 * (y * z - x * w);
+    R[6] = 2 * (x * z - y * w), R[7] = 2 * (y * z + x * w), R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* Sets a random deformed state: each frame moved by up to `du` m and turned by up to `dth`
+   rad about a random axis, random velocities; the poses in pos / quat (double). */
+static int random_state(frm_model *m, double du, double dth, unsigned seed, double *pos, double *quat)
+{
+    int n = frm_model_frame_count(m), i, r;
+    const frm_real *x0 = frm_model_rest_positions(m);
+    frm_real *P = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n), *Q = (frm_real *)malloc(sizeof(frm_real) * 4 * (size_t)n);
+    frm_real *V = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+    int err;
+    for (i = 0; i < n; i++) {
+        double th[3], q[4];
+        for (r = 0; r < 3; r++) pos[3 * i + r] = (double)x0[3 * i + r] + du * rnd(&seed);
+        for (r = 0; r < 3; r++) th[r] = dth * rnd(&seed);
+        quat_of(th, q);
+        for (r = 0; r < 4; r++) quat[4 * i + r] = q[r];
+        for (r = 0; r < 3; r++) P[3 * i + r] = (frm_real)pos[3 * i + r];
+        for (r = 0; r < 4; r++) Q[4 * i + r] = (frm_real)q[r];
+        for (r = 0; r < 6; r++) V[6 * i + r] = (frm_real)rnd(&seed);
+    }
+    err = frm_model_set_poses(m, P, Q);
+    if (!err) err = frm_model_set_velocities(m, V);
+    free(P), free(Q), free(V);
+    return err;
+}
+
+/* Sets the poses (pos, quat) moved by eps along dq (6 per frame: translation, world
+   rotation vector applied on the left, R -> exp([eps dtheta]x) R). */
+static int perturbed_poses(frm_model *m, const double *pos, const double *quat, const double *dq, double eps)
+{
+    int n = frm_model_frame_count(m), i, r, err;
+    frm_real *P = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n), *Q = (frm_real *)malloc(sizeof(frm_real) * 4 * (size_t)n);
+    for (i = 0; i < n; i++) {
+        double th[3], dqq[4], q[4];
+        for (r = 0; r < 3; r++) P[3 * i + r] = (frm_real)(pos[3 * i + r] + eps * dq[6 * i + r]);
+        for (r = 0; r < 3; r++) th[r] = eps * dq[6 * i + 3 + r];
+        quat_of(th, dqq);
+        quat_mul(dqq, quat + 4 * i, q);
+        for (r = 0; r < 4; r++) Q[4 * i + r] = (frm_real)q[r];
+    }
+    err = frm_model_set_poses(m, P, Q);
+    free(P), free(Q);
+    return err;
+}
+
+/* Random points inside the 2 x 0.5 x 0.5 box, kept 0.02 m from its faces. */
+static void box_points(frm_real *pts, int count, unsigned seed)
+{
+    int i;
+    for (i = 0; i < count; i++) {
+        pts[3 * i] = (frm_real)(1.0 + 0.98 * rnd(&seed));
+        pts[3 * i + 1] = (frm_real)(0.25 + 0.23 * rnd(&seed));
+        pts[3 * i + 2] = (frm_real)(0.25 + 0.23 * rnd(&seed));
+    }
+}
+
+/* ---- mapped points ------------------------------------------------------------------------- */
+
+static const char *kind_names[3] = {"hexahedra", "Shepard", "MLS"};
+
+/* A rigid motion of all frames (rotation 0.9 rad about a skew axis, a translation, a rigid
+   velocity field) moves every mapped point rigidly: positions R pbar + t, velocities
+   v0 + w x p, and J applied to the rigid field's generalized velocities gives the same
+   velocities (any weights: every frame predicts the same point). Tolerance: round-off of
+   levers of order 1 m (1e-12 double, 2e-6 float). */
+static void test_mapped_rigid_motion(void)
+{
+    double tol = IS_FLOAT ? 4e-6 : 1e-12, th[3] = {0.3, -0.6, 0.6}, q[4], R[9], t[3] = {0.4, -1.0, 2.0};
+    double w[3] = {0.5, -0.2, 0.7}, v0[3] = {-1, 0.5, 2};
+    int kind, i, r;
+    quat_of(th, q);
+    quat_matrix(q, R);
+    for (kind = 0; kind < 3; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = NULL;
+        int *hexes, n, np = 40;
+        frm_real pts[3 * 40], P[3 * 40], V[3 * 40], JV[3 * 40], *pos, *quat, *vel;
+        double worst_p = 0, worst_v = 0, worst_j = 0;
+        REQUIRE(small_scene(kind, &m, &s, &pd, &hexes) == FRM_OK);
+        box_points(pts, np, 7u + (unsigned)kind);
+        REQUIRE(frm_probe_create(m, &pd, pts, np, &p) == FRM_OK);
+        n = frm_model_frame_count(m);
+        pos = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
+        quat = (frm_real *)malloc(sizeof(frm_real) * 4 * (size_t)n);
+        vel = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        for (i = 0; i < n; i++) {
+            const frm_real *xb = frm_model_rest_positions(m) + 3 * i;
+            double x[3];
+            for (r = 0; r < 3; r++) x[r] = R[3 * r] * xb[0] + R[3 * r + 1] * xb[1] + R[3 * r + 2] * xb[2] + t[r];
+            for (r = 0; r < 3; r++) pos[3 * i + r] = (frm_real)x[r];
+            for (r = 0; r < 4; r++) quat[4 * i + r] = (frm_real)q[r];
+            vel[6 * i] = (frm_real)(v0[0] + w[1] * x[2] - w[2] * x[1]);
+            vel[6 * i + 1] = (frm_real)(v0[1] + w[2] * x[0] - w[0] * x[2]);
+            vel[6 * i + 2] = (frm_real)(v0[2] + w[0] * x[1] - w[1] * x[0]);
+            for (r = 0; r < 3; r++) vel[6 * i + 3 + r] = (frm_real)w[r];
+        }
+        REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+        REQUIRE(frm_model_set_velocities(m, vel) == FRM_OK);
+        REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+        REQUIRE(frm_probe_velocities(p, m, V) == FRM_OK);
+        REQUIRE(frm_probe_jacobian(p, m, vel, JV) == FRM_OK);
+        for (i = 0; i < np; i++) {
+            double x[3], vv[3];
+            for (r = 0; r < 3; r++) x[r] = R[3 * r] * pts[3 * i] + R[3 * r + 1] * pts[3 * i + 1] + R[3 * r + 2] * pts[3 * i + 2] + t[r];
+            vv[0] = v0[0] + w[1] * x[2] - w[2] * x[1];
+            vv[1] = v0[1] + w[2] * x[0] - w[0] * x[2];
+            vv[2] = v0[2] + w[0] * x[1] - w[1] * x[0];
+            for (r = 0; r < 3; r++) {
+                if (fabs((double)P[3 * i + r] - x[r]) > worst_p) worst_p = fabs((double)P[3 * i + r] - x[r]);
+                if (fabs((double)V[3 * i + r] - vv[r]) > worst_v) worst_v = fabs((double)V[3 * i + r] - vv[r]);
+                if (fabs((double)JV[3 * i + r] - vv[r]) > worst_j) worst_j = fabs((double)JV[3 * i + r] - vv[r]);
+            }
+        }
+        printf("    %-9s: positions %.1e m, velocities %.1e m/s, J v %.1e m/s\n", kind_names[kind], worst_p, worst_v, worst_j);
+        CHECK(worst_p < 4 * tol);
+        CHECK(worst_v < 10 * tol);
+        CHECK(worst_j < 10 * tol);
+        free(pos), free(quat), free(vel), free(hexes);
+        frm_probe_destroy(p);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+}
+
+/* J^T f is the generalized force of the point forces: in a random deformed state (frames
+   moved 0.05 m, turned up to 0.4 rad), for random forces f and random directions dq,
+   (J^T f) . dq equals d/de sum_n f_n . p_n(q + e dq) by central differences of the mapped
+   positions (the model's own eq. 3.34 evaluation, not J), and J dq equals the positions'
+   difference quotient. Tolerance: the central difference's error O(e^2) (e = 1e-4: 1e-8
+   relative) plus the positions' round-off over 2 e (1e-16 / 1e-4 in double; float e =
+   1e-2, 6e-8 / 1e-2 and the e^2 term 1e-4): 1e-6 double, 3e-3 float, relative to
+   sum |terms|. */
+static void test_mapped_virtual_work(void)
+{
+    double eps = IS_FLOAT ? 1e-2 : 1e-4, tol = IS_FLOAT ? 3e-3 : 1e-6, worst_w = 0, worst_j = 0;
+    int kind, trial, i;
+    for (kind = 0; kind < 3; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = NULL;
+        int *hexes, n, np = 30;
+        unsigned seed = 99u + (unsigned)kind;
+        frm_real pts[3 * 30], f[3 * 30], Pp[3 * 30], Pm[3 * 30], J[3 * 30], *jtf, *dqr;
+        double *pos, *quat, *dq;
+        REQUIRE(small_scene(kind, &m, &s, &pd, &hexes) == FRM_OK);
+        n = frm_model_frame_count(m);
+        box_points(pts, np, 11u + (unsigned)kind);
+        REQUIRE(frm_probe_create(m, &pd, pts, np, &p) == FRM_OK);
+        pos = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+        quat = (double *)malloc(sizeof(double) * 4 * (size_t)n);
+        dq = (double *)malloc(sizeof(double) * 6 * (size_t)n);
+        jtf = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        dqr = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(random_state(m, 0.05, 0.4, seed, pos, quat) == FRM_OK);
+        for (i = 0; i < 3 * np; i++) f[i] = (frm_real)rnd(&seed);
+        for (trial = 0; trial < 3; trial++) {
+            double work = 0, fd = 0, scale = 0;
+            for (i = 0; i < 6 * n; i++) dq[i] = rnd(&seed), dqr[i] = (frm_real)dq[i];
+            REQUIRE(perturbed_poses(m, pos, quat, dq, 0) == FRM_OK);
+            REQUIRE(frm_probe_jacobian_transpose(p, m, f, jtf, 0) == FRM_OK);
+            REQUIRE(frm_probe_jacobian(p, m, dqr, J) == FRM_OK);
+            for (i = 0; i < 6 * n; i++) work += (double)jtf[i] * dq[i], scale += fabs((double)jtf[i] * dq[i]);
+            REQUIRE(perturbed_poses(m, pos, quat, dq, eps) == FRM_OK);
+            REQUIRE(frm_probe_positions(p, m, Pp) == FRM_OK);
+            REQUIRE(perturbed_poses(m, pos, quat, dq, -eps) == FRM_OK);
+            REQUIRE(frm_probe_positions(p, m, Pm) == FRM_OK);
+            for (i = 0; i < 3 * np; i++) {
+                double d = ((double)Pp[i] - (double)Pm[i]) / (2 * eps);
+                fd += (double)f[i] * d;
+                if (fabs(d - (double)J[i]) > worst_j) worst_j = fabs(d - (double)J[i]);
+            }
+            if (fabs(work - fd) / scale > worst_w) worst_w = fabs(work - fd) / scale;
+        }
+        free(pos), free(quat), free(dq), free(jtf), free(dqr), free(hexes);
+        frm_probe_destroy(p);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+    printf("    (J^T f) . dq against the work's central difference: %.1e relative; J dq: %.1e m\n", worst_w, worst_j);
+    CHECK(worst_w < tol);
+    CHECK(worst_j < 10 * tol);
+}
+
+/* A point at a frame's rest position follows that frame exactly (interpolating weights:
+   hexahedra, Shepard; MLS does not interpolate): position x_i, velocity v_i, in a random
+   deformed state. And J^T of a unit force there is that force on frame i alone with no
+   torque. Tolerance: the weights' round-off times the levers (1e-14 double, 1e-6 float). */
+static void test_mapped_point_at_frame(void)
+{
+    double tol = IS_FLOAT ? 1e-6 : 1e-13, worst = 0, worst_f = 0;
+    int kind, i, r;
+    for (kind = 0; kind < 2; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = NULL;
+        int *hexes, n;
+        frm_real *P, *V, *F, *jtf;
+        double *pos, *quat;
+        REQUIRE(small_scene(kind, &m, &s, &pd, &hexes) == FRM_OK);
+        n = frm_model_frame_count(m);
+        REQUIRE(frm_probe_create(m, &pd, frm_model_rest_positions(m), n, &p) == FRM_OK);
+        pos = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+        quat = (double *)malloc(sizeof(double) * 4 * (size_t)n);
+        P = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
+        V = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
+        F = (frm_real *)calloc(3 * (size_t)n, sizeof(frm_real));
+        jtf = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(random_state(m, 0.1, 0.5, 5u, pos, quat) == FRM_OK);
+        REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+        REQUIRE(frm_probe_velocities(p, m, V) == FRM_OK);
+        for (i = 0; i < n; i++)
+            for (r = 0; r < 3; r++) {
+                double ep = fabs((double)P[3 * i + r] - (double)frm_model_positions(m)[3 * i + r]);
+                double ev = fabs((double)V[3 * i + r] - (double)frm_model_velocities(m)[6 * i + r]);
+                if (ep > worst) worst = ep;
+                if (ev > worst) worst = ev;
+            }
+        F[3 * 3 + 1] = 1; /* unit force along y at frame 3 */
+        REQUIRE(frm_probe_jacobian_transpose(p, m, F, jtf, 0) == FRM_OK);
+        for (i = 0; i < 6 * n; i++) {
+            double e = fabs((double)jtf[i] - (i == 6 * 3 + 1 ? 1.0 : 0.0));
+            if (e > worst_f) worst_f = e;
+        }
+        free(pos), free(quat), free(P), free(V), free(F), free(jtf), free(hexes);
+        frm_probe_destroy(p);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+    printf("    points at the frames' rest positions: %.1e (m, m/s), J^T of a unit force %.1e\n", worst, worst_f);
+    CHECK(worst < tol);
+    CHECK(worst_f < tol);
+}
+
+/* Forces at mapped points as external loads: frm_probe_add_external adds J^T f, whose total
+   force is sum f_n and whose moment about the origin, sum_i x_i x F_i + tau_i, is
+   sum_n p_n x f_n exactly in any state (p_n = sum_i w_i (x_i + a_i)); a clamped beam loaded
+   at mapped points of its tip then solves statically, and its clamp's reaction balances
+   the load (the solver's convergence). Then a free body in zero gravity pushed for one
+   implicit step by a point force gains the momentum F dt (the frames' masses sum to the
+   body's). Tolerances: round-off (1e-12 double, 1e-5 float) and the static solve's
+   newton_tolerance relative to the load (1e-6 double, 1e-4 float). */
+static void test_mapped_external_loads(void)
+{
+    frm_model *m = NULL;
+    frm_sampling s;
+    frm_probe_desc pd;
+    frm_probe *p = NULL;
+    frm_desc d = frm_model_default_desc();
+    int *hexes, n, i, r;
+    double tol = IS_FLOAT ? 1e-5 : 1e-12, sumF[3] = {0, 0, 0}, mom[3] = {0, 0, 0}, want[3] = {0, 0, 0}, tot[3] = {0, 0, 0};
+    double pos[3 * 20], quat[4 * 20];
+    frm_real pts[3 * 4] = {2, 0.1f, 0.1f, 2, 0.4f, 0.1f, 2, 0.4f, 0.4f, 2, 0.1f, 0.4f}, f[3 * 4], P[3 * 4];
+    const frm_real *x, *tf;
+    (void)d;
+    REQUIRE(small_scene(0, &m, &s, &pd, &hexes) == FRM_OK);
+    n = frm_model_frame_count(m);
+    REQUIRE(n <= 20);
+    REQUIRE(frm_probe_create(m, &pd, pts, 4, &p) == FRM_OK);
+    for (i = 0; i < 4; i++) f[3 * i] = (frm_real)(0.5 * i), f[3 * i + 1] = (frm_real)1, f[3 * i + 2] = (frm_real)(-2 - i);
+    /* (a) exact totals in a deformed state */
+    REQUIRE(random_state(m, 0.05, 0.3, 3u, pos, quat) == FRM_OK);
+    frm_model_clear_external(m);
+    REQUIRE(frm_probe_add_external(p, m, f) == FRM_OK);
+    REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+    {
+        frm_real *jtf = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(frm_probe_jacobian_transpose(p, m, f, jtf, 0) == FRM_OK);
+        x = frm_model_positions(m);
+        for (i = 0; i < n; i++) {
+            const frm_real *F = jtf + 6 * i;
+            for (r = 0; r < 3; r++) sumF[r] += (double)F[r];
+            mom[0] += (double)x[3 * i + 1] * F[2] - (double)x[3 * i + 2] * F[1] + F[3];
+            mom[1] += (double)x[3 * i + 2] * F[0] - (double)x[3 * i] * F[2] + F[4];
+            mom[2] += (double)x[3 * i] * F[1] - (double)x[3 * i + 1] * F[0] + F[5];
+        }
+        free(jtf);
+    }
+    for (i = 0; i < 4; i++) {
+        const frm_real *pp = P + 3 * i, *ff = f + 3 * i;
+        want[0] += (double)pp[1] * ff[2] - (double)pp[2] * ff[1];
+        want[1] += (double)pp[2] * ff[0] - (double)pp[0] * ff[2];
+        want[2] += (double)pp[0] * ff[1] - (double)pp[1] * ff[0];
+        for (r = 0; r < 3; r++) tot[r] += (double)ff[r];
+    }
+    for (r = 0; r < 3; r++) {
+        CHECK_NEAR(tot[r], sumF[r], 10 * tol);
+        CHECK_NEAR(want[r], mom[r], 100 * tol);
+    }
+    CHECK_INT(FRM_ERR_ARG, frm_probe_add_external(p, NULL, f));
+    /* (b) a clamped beam loaded at its tip through the probe */
+    {
+        double reaction[3] = {0, 0, 0}, scale = 0;
+        frm_real zero[3] = {0, 0, 0};
+        frm_real *rest = (frm_real *)malloc(sizeof(frm_real) * 7 * (size_t)n);
+        for (i = 0; i < n; i++) {
+            for (r = 0; r < 3; r++) rest[3 * i + r] = frm_model_rest_positions(m)[3 * i + r];
+            for (r = 0; r < 4; r++) rest[3 * n + 4 * i + r] = (frm_real)(r == 3);
+        }
+        REQUIRE(frm_model_set_poses(m, rest, rest + 3 * n) == FRM_OK);
+        free(rest);
+        REQUIRE(frm_model_set_gravity(m, zero) == FRM_OK);
+        for (i = 0; i < n; i++)
+            if (frm_model_rest_positions(m)[3 * i] == 0) REQUIRE(frm_model_fix_frame(m, i) == FRM_OK);
+        frm_model_clear_external(m);
+        for (i = 0; i < 4; i++) f[3 * i] = 0, f[3 * i + 1] = 0, f[3 * i + 2] = (frm_real)-0.5;
+        REQUIRE(frm_probe_add_external(p, m, f) == FRM_OK);
+        REQUIRE(frm_model_solve_static(m) == FRM_OK);
+        REQUIRE(frm_model_total_forces(m, &tf) == FRM_OK);
+        for (i = 0; i < n; i++)
+            if (frm_model_frame_state(m, i) == 1)
+                for (r = 0; r < 3; r++) reaction[r] += (double)tf[6 * i + r];
+        x = frm_model_positions(m);
+        scale = 2.0;
+        printf("    tip load 2 N through 4 mapped points: sag %.4f m, clamp carries %.6f N\n", 0.5 - (double)x[3 * 14 + 2], -reaction[2]);
+        CHECK_NEAR(-2.0, reaction[2], (IS_FLOAT ? 1e-3 : 1e-5) * scale);
+        CHECK(0.5 - (double)x[3 * 14 + 2] > 0);
+    }
+    free(hexes);
+    frm_probe_destroy(p);
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+}
+
+/* ---- refusals ---------------------------------------------------------------------------- */
+
+/* A mapped point outside the body: in no hexahedron, or (meshless) farther from each of its
+   frames than that frame's farthest sample; the probe is then not made. */
+static void test_mapped_point_outside(void)
+{
+    int kind;
+    for (kind = 0; kind < 3; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = (frm_probe *)&p;
+        int *hexes;
+        frm_real far_pt[6] = {1, 0.25f, 0.25f, 5, 3, -4}, near_pt[3] = {2.01f, 0.25f, 0.25f};
+        REQUIRE(small_scene(kind, &m, &s, &pd, &hexes) == FRM_OK);
+        CHECK_INT(FRM_ERR_POINT_OUTSIDE, frm_probe_create(m, &pd, far_pt, 2, &p));
+        CHECK(p == NULL);
+        if (kind == 0) CHECK_INT(FRM_ERR_POINT_OUTSIDE, frm_probe_create(m, &pd, near_pt, 1, &p));
+        else { /* a point just outside the surface is still within its frames' support */
+            CHECK_INT(FRM_OK, frm_probe_create(m, &pd, near_pt, 1, &p));
+            frm_probe_destroy(p);
+        }
+        free(hexes);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+}
+
+/* ---- several parts ----------------------------------------------------------------------- */
+
+/* A cantilever (4 x 1 x 1 m on 8 x 2 x 2 cells, clamped at x = 0, gravity) built as one
+   part and as two parts meeting at x = 2 m (columns 0-3 and 4-7, each sampled alone, their
+   interface frames shared by the frame map) gives the same static sag and the same
+   implicit step: both models are the same discrete system (same samples, weights, volumes
+   and materials; only the samples' order differs, so the sums' round-off does), solved to
+   newton_tolerance 1e-10 (float 1e-5): the answers agree to the solves' tolerance times
+   the condition of the system, measured 1e-12 relative in double; checked at 1e-7 (float
+   2e-3 relative: float's Newton stops on the round-off floor). The masses add up: with
+   the second part's density doubled, the frames' masses sum to rho1 V1 + rho2 V2. */
+static int beam_model(int split, double rho2, frm_model **m)
+{
+    frm_desc d = frm_model_default_desc();
+    int map0[5 * 3 * 3], map1[5 * 3 * 3], err;
+    frm_sampling a, b;
+    frm_assembly as;
+    frm_part parts[2];
+    parts[0] = frm_part_default();
+    parts[1] = frm_part_default();
+    if (!split) {
+        err = grid_part(&a, 8, 2, 2, 0.5, 0.5, 0.5, 0, 8, 2, NULL);
+        if (err) return err;
+        parts[0].sampling = &a;
+        parts[0].material.young_modulus = (frm_real)1e8;
+        err = frm_parts_combine(&as, parts, 1, 81, NULL);
+        frm_sampling_free(&a);
+    } else {
+        err = grid_part(&a, 8, 2, 2, 0.5, 0.5, 0.5, 0, 4, 2, map0);
+        if (!err) err = grid_part(&b, 8, 2, 2, 0.5, 0.5, 0.5, 4, 8, 2, map1);
+        if (err) return err;
+        parts[0].sampling = &a;
+        parts[0].frame_map = map0;
+        parts[1].sampling = &b;
+        parts[1].frame_map = map1;
+        parts[0].material.young_modulus = parts[1].material.young_modulus = (frm_real)1e8;
+        parts[1].material.density = (frm_real)rho2;
+        err = frm_parts_combine(&as, parts, 2, 81, NULL);
+        frm_sampling_free(&a);
+        frm_sampling_free(&b);
+    }
+    if (err) return err;
+    frm_assembly_apply(&as, &d);
+    d.newton_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-10);
+    d.cg_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-10);
+    err = frm_model_create(&d, m);
+    frm_assembly_free(&as);
+    if (!err) {
+        int i;
+        for (i = 0; i < 81; i += 9) frm_model_fix_frame(*m, i);
+    }
+    return err;
+}
+
+static void test_parts_split_equals_whole(void)
+{
+    frm_model *whole = NULL, *split = NULL, *heavy = NULL;
+    double tol = IS_FLOAT ? 2e-3 : 1e-7, diff = 0, size = 0, mass = 0, blk;
+    frm_real M[36];
+    int i, pass;
+    REQUIRE(beam_model(0, 1000, &whole) == FRM_OK);
+    REQUIRE(beam_model(1, 1000, &split) == FRM_OK);
+    CHECK_INT(frm_model_sample_count(whole), frm_model_sample_count(split));
+    CHECK_INT(frm_model_pair_count(whole), frm_model_pair_count(split));
+    for (pass = 0; pass < 2; pass++) {
+        const frm_real *a, *b;
+        diff = size = 0;
+        if (pass == 0) {
+            REQUIRE(frm_model_solve_static(whole) == FRM_OK);
+            REQUIRE(frm_model_solve_static(split) == FRM_OK);
+        } else { /* one implicit step from the static state with the load doubled */
+            frm_real g[3] = {0, 0, (frm_real)-19.62};
+            REQUIRE(frm_model_set_gravity(whole, g) == FRM_OK);
+            REQUIRE(frm_model_set_gravity(split, g) == FRM_OK);
+            REQUIRE(frm_model_step(whole) == FRM_OK);
+            REQUIRE(frm_model_step(split) == FRM_OK);
+        }
+        a = frm_model_displacements(whole);
+        b = frm_model_displacements(split);
+        for (i = 0; i < 3 * 81; i++) {
+            if (fabs((double)a[i] - (double)b[i]) > diff) diff = fabs((double)a[i] - (double)b[i]);
+            if (fabs((double)a[i]) > size) size = fabs((double)a[i]);
+        }
+        printf("    %s: tip sag %.6f m whole, %.6f m split, largest difference %.1e of it\n",
+               pass ? "implicit step" : "static      ", -(double)a[3 * 80 + 2], -(double)b[3 * 80 + 2], diff / size);
+        CHECK(size > 1e-3);
+        CHECK(diff <= tol * size);
+        if (pass == 1) {
+            a = frm_model_velocities(whole);
+            b = frm_model_velocities(split);
+            diff = size = 0;
+            for (i = 0; i < 6 * 81; i++) {
+                if (fabs((double)a[i] - (double)b[i]) > diff) diff = fabs((double)a[i] - (double)b[i]);
+                if (fabs((double)a[i]) > size) size = fabs((double)a[i]);
+            }
+            CHECK(diff <= tol * size);
+        }
+    }
+    REQUIRE(beam_model(1, 2000, &heavy) == FRM_OK);
+    for (i = 0; i < 81; i++) {
+        REQUIRE(frm_model_mass_block(heavy, i, M) == FRM_OK);
+        mass += (double)M[0];
+    }
+    blk = 1000 * 2 + 2000 * 2; /* two halves of 2 x 1 x 1 m^3 */
+    CHECK_NEAR(blk, mass, blk * (IS_FLOAT ? 1e-5 : 1e-12));
+    frm_model_destroy(whole);
+    frm_model_destroy(split);
+    frm_model_destroy(heavy);
+}
+
+/* Refusals of frm_parts_combine: a map index out of range, repeated within a part, a model
+   frame no part gives, shared frames at different rest positions; NULL and counts. */
+static void test_parts_refusals(void)
+{
+    frm_sampling a, b;
+    frm_assembly as;
+    frm_part parts[2];
+    int map0[5 * 3 * 3], map1[5 * 3 * 3], keep;
+    REQUIRE(grid_part(&a, 8, 2, 2, 0.5, 0.5, 0.5, 0, 4, 1, map0) == FRM_OK);
+    REQUIRE(grid_part(&b, 8, 2, 2, 0.5, 0.5, 0.5, 4, 8, 1, map1) == FRM_OK);
+    parts[0] = frm_part_default();
+    parts[1] = frm_part_default();
+    parts[0].sampling = &a, parts[0].frame_map = map0;
+    parts[1].sampling = &b, parts[1].frame_map = map1;
+    CHECK_INT(FRM_OK, frm_parts_combine(&as, parts, 2, 81, NULL));
+    CHECK_INT(81, as.sampling.frame_count);
+    CHECK_INT(a.sample_count + b.sample_count, as.sampling.sample_count);
+    CHECK_INT(a.sample_count, as.part_samples[1]);
+    frm_assembly_free(&as);
+    CHECK_INT(FRM_ERR_ARG, frm_parts_combine(NULL, parts, 2, 81, NULL));
+    CHECK_INT(FRM_ERR_ARG, frm_parts_combine(&as, NULL, 2, 81, NULL));
+    CHECK_INT(FRM_ERR_ARG, frm_parts_combine(&as, parts, 0, 81, NULL));
+    CHECK_INT(FRM_ERR_ARG, frm_parts_combine(&as, parts, 2, 0, NULL));
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 80, NULL)); /* frame 80 out of range */
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 82, NULL)); /* frame 81 given by no part */
+    CHECK(as.sampling.frame_positions == NULL && as.materials == NULL);
+    keep = map1[3];
+    map1[3] = -1;
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 81, NULL));
+    map1[3] = map1[2]; /* repeated within part 1 */
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 81, NULL));
+    map1[3] = keep;
+    keep = map1[0];
+    map1[0] = 0; /* part 1's frame at x = 2 m put on the model's frame at x = 0 (part 0 gives it) */
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 81, NULL));
+    map1[0] = keep;
+    parts[1].frame_map = NULL; /* identity: part 1's frames 0.. are the model's 0.., at other places */
+    CHECK_INT(FRM_ERR_PART_FRAME, frm_parts_combine(&as, parts, 2, 81, NULL));
+    frm_sampling_free(&a);
+    frm_sampling_free(&b);
+}
+
+static const test_case cases[] = {
+    TEST(test_mapped_rigid_motion),      TEST(test_mapped_virtual_work), TEST(test_mapped_point_at_frame),
+    TEST(test_mapped_external_loads),    TEST(test_mapped_point_outside), TEST(test_parts_split_equals_whole),
+    TEST(test_parts_refusals),
+};
+
+int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
