@@ -814,6 +814,7 @@ typedef FRM_REAL frm_real;
 #define frm_shape_default_desc frm_shape_default_desc_f32
 #define frm_poisson_default_desc frm_poisson_default_desc_f32
 #define frm_part_default frm_part_default_f32
+#define frm_rigid_body_default frm_rigid_body_default_f32
 #define frm_parts_combine frm_parts_combine_f32
 #define frm_assembly_apply frm_assembly_apply_f32
 #define frm_assembly_free frm_assembly_free_f32
@@ -939,13 +940,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept") \
     X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
     X(FRM_ERR_POINT_OUTSIDE, -37, "a mapped point lies outside the body: in no element, or farther from each of its frames than that frame's farthest sample") \
-    X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses")
+    X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses") \
+    X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -39
+    FRM_ERR_LAST_ = -40
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1075,6 +1077,14 @@ typedef struct frm_desc {
     const frm_real *frame_orientations; /* 4 * frame_count rest orientations, unit quaternions
                                            (x, y, z, w), or NULL for the identity */
     int frame_count;                    /* >= 1 */
+    const frm_real *frame_masses;   /* rigid bodies (issue 14): frame_count own masses, kg (>= 0; 0 for a
+                                       frame that carries only its samples' mass), or NULL for none;
+                                       added to the mass the samples give the frame (see MASS).
+                                       frm_parts_combine fills it for its rigid bodies */
+    const frm_real *frame_inertias; /* 6 per frame: own inertia about the frame's origin in its rest axes
+                                       (xx, yy, zz, yz, xz, xy), kg m^2, positive definite where the
+                                       own mass is > 0, zero elsewhere; NULL: none. The own mass sits
+                                       at the frame's origin (its centre of mass: gravity acts there) */
 
     /* samples (integration points) */
     const frm_real *sample_positions; /* 3 * sample_count rest positions, m */
@@ -1348,32 +1358,59 @@ typedef struct frm_part {
                                      NULL: frame j is the model's frame j */
 } frm_part;
 
+/* A rigid body (issue 14; 2013 paper sec. 4.2): one model frame with its own mass and
+   inertia (not from samples), its origin at the body's centre of mass. Part frames mapped
+   onto it (frame_map[j] = frame) are attached: they move rigidly with the body ("the frames
+   of the interface have a rigid motion w.r.t. the rigid body") and are eliminated through
+   the rigid map (see RIGID BODIES): the samples that used them use the body's frame, so the
+   deformable part's reaction moves the body. A body no part attaches to is a free rigid
+   body. */
+typedef struct frm_rigid_body {
+    int frame;            /* the model frame that is the body (default -1: set it) */
+    frm_real position[3]; /* m, its rest position: the centre of mass */
+    frm_real mass;        /* kg, > 0 */
+    frm_real inertia[6];  /* kg m^2, the inertia tensor about the centre of mass in world axes at rest
+                             (xx, yy, zz, yz, xz, xy), symmetric positive definite */
+} frm_rigid_body;
+
 /* The combined model description's arrays, owned (frm_assembly_free). */
 typedef struct frm_assembly {
     frm_sampling sampling;   /* the model's frame_count frames (rest positions from the parts
-                                that give them), the samples of part 0, then part 1, ... with
-                                their neighbour tables mapped to the model's frames */
+                                that give them, a rigid body's from the body), the samples of
+                                part 0, then part 1, ... with their neighbour tables mapped to
+                                the model's frames (entries of frames attached to one rigid
+                                body merged) */
     frm_material *materials; /* part_count: part k's material */
     int *sample_materials;   /* sample_count: the part of each sample */
     int *part_samples;       /* part_count + 1: part k's samples are part_samples[k] ..
                                 part_samples[k + 1] - 1 */
-    int part_count;
-    size_t bytes;            /* of the block holding materials, sample_materials, part_samples */
+    frm_real *frame_masses;   /* frame_count: the rigid bodies' masses, 0 elsewhere (kg) */
+    frm_real *frame_inertias; /* 6 per frame: the rigid bodies' inertias, 0 elsewhere (kg m^2) */
+    int part_count, rigid_count;
+    frm_allocator allocator;  /* the one the arrays came from */
+    size_t bytes;             /* of the block holding the arrays above but the sampling's */
 } frm_assembly;
 
 /* A part with the default material and no frame map. */
 FRMDEF frm_part frm_part_default(void);
-/* Combines part_count parts into a model of frame_count frames. Every model frame must be
-   given by at least one part; parts giving the same frame must give it the same rest
-   position (within 1e-9 of the body's size; float 1e-5). Errors: FRM_ERR_ARG (NULL,
-   part_count < 1, frame_count < 1, a part without frames or samples), FRM_ERR_PART_FRAME (a
-   map index out of range or repeated within a part, NULL map with more part frames than
-   frame_count, a model frame no part gives, rest positions that differ), FRM_ERR_ALLOC;
-   *out is then empty. Materials are validated by frm_model_create. */
-FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, int frame_count,
-                             const frm_allocator *allocator);
-/* Points the description's frames, samples, neighbour table, materials and sample_materials
-   at the assembly (which must outlive frm_model_create, not the model). */
+/* A rigid body with every field zero and frame -1 (to be set). */
+FRMDEF frm_rigid_body frm_rigid_body_default(void);
+/* Combines part_count parts and rigid_count rigid bodies (rigids may be NULL for 0) into a
+   model of frame_count frames. Every model frame must be given by a part or be a rigid
+   body's; parts giving the same (non-rigid) frame must give it the same rest position
+   (within 1e-9 of the body's size; float 1e-5); part frames mapped onto a rigid body's
+   frame are attached to it (any rest position). Errors: FRM_ERR_ARG (NULL, part_count < 1,
+   frame_count < 1, a part without frames or samples, a body's position not finite),
+   FRM_ERR_PART_FRAME (a map index out of range, or repeated within a part on a non-rigid
+   frame, a NULL map with more part frames than frame_count, a model frame nobody gives,
+   rest positions that differ, a body's frame out of range or two bodies on one frame),
+   FRM_ERR_RIGID (a body's mass not > 0, its inertia not positive definite),
+   FRM_ERR_NEIGHBOR_TABLE (a part's row malformed), FRM_ERR_ALLOC; *out is then empty.
+   Materials and the merged table are validated by frm_model_create. */
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
+                             int rigid_count, int frame_count, const frm_allocator *allocator);
+/* Points the description's frames, samples, neighbour table, materials, sample_materials
+   and (with rigid bodies) frame_masses and frame_inertias at the assembly (which must outlive frm_model_create, not the model). */
 FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d);
 /* Frees the assembly's arrays and empties it. */
 FRMDEF void frm_assembly_free(frm_assembly *a);
@@ -3293,6 +3330,27 @@ static int frm__validate_neighbors(const frm_desc *d, int *marker)
     return FRM_OK;
 }
 
+/* A frame's own mass and inertia (J: xx, yy, zz, yz, xz, xy, or NULL): mass 0 with no
+   inertia (NULL or zero), or mass > 0 with a positive definite J (Sylvester's criterion with
+   room for rounding); all finite. */
+static int frm__rigid_valid(double mass, const frm_real *J)
+{
+    double a, b, c, yz, xz, xy, m2, m3;
+    int k, zero = 1;
+    if (!frm__finite(mass) || mass < 0) return 0;
+    if (J)
+        for (k = 0; k < 6; k++) {
+            if (!frm__finite((double)J[k])) return 0;
+            zero &= J[k] == 0;
+        }
+    if (mass == 0) return zero;
+    if (!J) return 0;
+    a = (double)J[0], b = (double)J[1], c = (double)J[2], yz = (double)J[3], xz = (double)J[4], xy = (double)J[5];
+    m2 = a * b - xy * xy;
+    m3 = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
+    return a > 0 && m2 > 1e-12 * a * b && m3 > 1e-12 * a * b * c;
+}
+
 /* Everything but the frames' masses (checked once they are computed). marker: frame_count
    ints of scratch. */
 static int frm__validate(const frm_desc *d, int *marker)
@@ -3311,6 +3369,15 @@ static int frm__validate(const frm_desc *d, int *marker)
                 snprintf(msg, sizeof msg, "orientation of frame %d is not a unit quaternion", i);
                 return frm__fail(d, FRM_ERR_QUATERNION, msg);
             }
+    for (i = 0; i < d->frame_count && (d->frame_masses || d->frame_inertias); i++) {
+        double mass = d->frame_masses ? (double)d->frame_masses[i] : 0;
+        const frm_real *J = d->frame_inertias ? d->frame_inertias + 6 * (size_t)i : NULL;
+        if (!frm__rigid_valid(mass, J)) {
+            snprintf(msg, sizeof msg, "frame %d: own mass %g kg, inertia not positive definite or given without mass", i,
+                     mass);
+            return frm__fail(d, FRM_ERR_RIGID, msg);
+        }
+    }
     for (s = 0; s < 3 * d->sample_count; s++)
         if (!frm__finite((double)d->sample_positions[s])) {
             snprintf(msg, sizeof msg, "position of sample %d is not finite", s / 3);
@@ -3503,6 +3570,14 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
             ml[9] -= mu * l[0] * l[1];
         }
     }
+    if (d->frame_masses) /* rigid bodies' own mass at the origin and inertia (issue 14) */
+        for (c = 0; c < m->frame_count; c++) {
+            double *ml = m->mass_local + 10 * (size_t)c, own = (double)d->frame_masses[c];
+            ml[0] += own;
+            m->grav_local[4 * (size_t)c] += own;
+            if (d->frame_inertias)
+                for (k = 0; k < 6; k++) ml[4 + k] += (double)d->frame_inertias[6 * (size_t)c + k];
+        }
     for (c = 0; c < m->frame_count; c++)
         if (!(m->mass_local[10 * (size_t)c] > 0)) return c;
     return -1;
@@ -7402,26 +7477,61 @@ FRMDEF frm_part frm_part_default(void)
 
 FRMDEF void frm_assembly_free(frm_assembly *a)
 {
-    frm_allocator al;
     if (!a) return;
-    al = a->sampling.allocator;
-    if (a->materials) frm__free(&al, a->materials, a->bytes);
+    if (a->materials) frm__free(&a->allocator, a->materials, a->bytes);
     frm_sampling_free(&a->sampling);
     memset(a, 0, sizeof *a);
 }
 
-FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, int frame_count,
-                             const frm_allocator *allocator)
+/* Part k's sample i mapped to the model's frames: its entries with frames on one rigid body
+   merged (their weights and gradients add: the frames predict the same point, see RIGID
+   BODIES). n entries into f, w, g; FRM_ERR_NEIGHBOR_TABLE for a malformed row. */
+static int frm__part_row(const frm_part *pt, int i, const unsigned char *rigid, int *f, double *w, double *g, int *n)
+{
+    const frm_sampling *s = pt->sampling;
+    int a = s->neighbor_start[i], b = s->neighbor_start[i + 1], e, q, r;
+    *n = 0;
+    if (a < 0 || b <= a || b - a > FRM_MAX_NEIGHBORS || b > s->pair_count) return FRM_ERR_NEIGHBOR_TABLE;
+    for (e = a; e < b; e++) {
+        int lf = s->neighbor_frames[e], gf;
+        if (lf < 0 || lf >= s->frame_count) return FRM_ERR_NEIGHBOR_TABLE;
+        gf = pt->frame_map ? pt->frame_map[lf] : lf;
+        q = 0;
+        while (q < *n && !(rigid[gf] && f[q] == gf)) q++;
+        if (q == *n) {
+            f[q] = gf, w[q] = 0;
+            for (r = 0; r < 3; r++) g[3 * q + r] = 0;
+            (*n)++;
+        }
+        w[q] += (double)s->neighbor_weights[e];
+        for (r = 0; r < 3; r++) g[3 * q + r] += (double)s->neighbor_gradients[3 * e + r];
+    }
+    return FRM_OK;
+}
+
+FRMDEF frm_rigid_body frm_rigid_body_default(void)
+{
+    frm_rigid_body b;
+    memset(&b, 0, sizeof b);
+    b.frame = -1;
+    return b;
+}
+
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
+                             int rigid_count, int frame_count, const frm_allocator *allocator)
 {
     long long samples = 0, pairs = 0;
-    double lo[3], hi[3], size = 0, tol;
-    int k, i, j, r, s0 = 0, p0 = 0, err, first = 1;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, size = 0, tol;
+    int k, i, j, r, s0 = 0, p0 = 0, err = FRM_OK, first = 1, pass;
     int *given;
+    unsigned char *rigid;
     frm_allocator al;
     frm__carver c;
     if (!out) return FRM_ERR_ARG;
     memset(out, 0, sizeof *out);
-    if (!parts || part_count < 1 || frame_count < 1 || part_count > 100000000 || frame_count > 100000000) return FRM_ERR_ARG;
+    if (!parts || part_count < 1 || frame_count < 1 || part_count > 100000000 || frame_count > 100000000 ||
+        rigid_count < 0 || (rigid_count > 0 && !rigids))
+        return FRM_ERR_ARG;
     memset(&al, 0, sizeof al);
     if (allocator) al = *allocator;
     for (k = 0; k < part_count; k++) {
@@ -7442,42 +7552,79 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             first = 0;
         }
         samples += s->sample_count;
-        pairs += s->neighbor_start[s->sample_count];
     }
-    if (samples > 100000000 || pairs > 1600000000) return FRM_ERR_ARG;
+    for (k = 0; k < rigid_count; k++) {
+        const frm_rigid_body *rb = rigids + k;
+        if (rb->frame < 0 || rb->frame >= frame_count) return FRM_ERR_PART_FRAME;
+        if (!frm__all_finite(rb->position, 3)) return FRM_ERR_ARG;
+        if (!frm__rigid_valid((double)rb->mass, rb->inertia) || !(rb->mass > 0)) return FRM_ERR_RIGID;
+    }
+    if (samples > 100000000) return FRM_ERR_ARG;
     for (r = 0; r < 3; r++)
         if (hi[r] - lo[r] > size) size = hi[r] - lo[r];
     tol = (sizeof(frm_real) < sizeof(double) ? 1e-5 : 1e-9) * (size > 0 ? size : 1);
-    err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, &al);
-    if (err) return err;
-    out->part_count = part_count;
+    /* the block of the assembly's own arrays and the scratch marks */
     c.base = NULL;
-    c.offset = 0;
-    FRM__CARVE(&c, out->materials, frm_material, part_count);
-    FRM__CARVE(&c, out->sample_materials, int, samples);
-    FRM__CARVE(&c, out->part_samples, int, part_count + 1);
-    FRM__CARVE(&c, given, int, frame_count); /* scratch: the last part (+ 1) that gave each model frame */
-    out->bytes = c.offset;
-    c.base = (char *)frm__alloc(&al, out->bytes);
-    if (!c.base) {
-        frm_assembly_free(out);
-        return FRM_ERR_ALLOC;
+    for (pass = 0; pass < 2; pass++) {
+        c.offset = 0;
+        FRM__CARVE(&c, out->materials, frm_material, part_count);
+        FRM__CARVE(&c, out->sample_materials, int, samples);
+        FRM__CARVE(&c, out->part_samples, int, part_count + 1);
+        FRM__CARVE(&c, out->frame_masses, frm_real, frame_count);
+        FRM__CARVE(&c, out->frame_inertias, frm_real, 6 * (size_t)frame_count);
+        FRM__CARVE(&c, given, int, frame_count); /* scratch: the last part (+ 1) that gave each model frame */
+        FRM__CARVE(&c, rigid, unsigned char, frame_count); /* scratch: the frame is a rigid body's */
+        if (pass == 0) {
+            out->bytes = c.offset;
+            c.base = (char *)frm__alloc(&al, out->bytes);
+            if (!c.base) {
+                memset(out, 0, sizeof *out);
+                return FRM_ERR_ALLOC;
+            }
+        }
     }
-    c.offset = 0;
-    FRM__CARVE(&c, out->materials, frm_material, part_count);
-    FRM__CARVE(&c, out->sample_materials, int, samples);
-    FRM__CARVE(&c, out->part_samples, int, part_count + 1);
-    FRM__CARVE(&c, given, int, frame_count);
+    out->part_count = part_count;
+    out->rigid_count = rigid_count;
+    out->allocator = al;
     memset(given, 0, sizeof(int) * (size_t)frame_count);
+    memset(rigid, 0, (size_t)frame_count);
+    memset(out->frame_masses, 0, sizeof(frm_real) * (size_t)frame_count);
+    memset(out->frame_inertias, 0, sizeof(frm_real) * 6 * (size_t)frame_count);
+    for (k = 0; k < rigid_count; k++) {
+        const frm_rigid_body *rb = rigids + k;
+        if (rigid[rb->frame]) err = FRM_ERR_PART_FRAME; /* two bodies on one frame */
+        rigid[rb->frame] = 1;
+        out->frame_masses[rb->frame] = rb->mass;
+        for (r = 0; r < 6; r++) out->frame_inertias[6 * (size_t)rb->frame + r] = rb->inertia[r];
+    }
+    /* the merged pairs (frames on one rigid body become one entry) */
+    for (k = 0; k < part_count && !err; k++)
+        for (i = 0; i < parts[k].sampling->sample_count && !err; i++) {
+            int f[FRM_MAX_NEIGHBORS], n;
+            double w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS];
+            err = frm__part_row(parts + k, i, rigid, f, w, g, &n);
+            pairs += n;
+        }
+    if (!err && pairs > 1600000000) err = FRM_ERR_ARG;
+    if (!err) err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, &al);
+    if (err) {
+        frm_assembly_free(out);
+        return err;
+    }
+    for (k = 0; k < rigid_count; k++) { /* a body gives its frame */
+        for (r = 0; r < 3; r++) out->sampling.frame_positions[3 * rigids[k].frame + r] = rigids[k].position[r];
+        given[rigids[k].frame] = -1;
+    }
     out->sampling.neighbor_start[0] = 0;
     for (k = 0; k < part_count && !err; k++) {
         const frm_part *pt = parts + k;
         const frm_sampling *s = pt->sampling;
         out->materials[k] = pt->material;
         out->part_samples[k] = s0;
-        for (j = 0; j < s->frame_count && !err; j++) { /* frames: first giver sets, the others must agree */
+        for (j = 0; j < s->frame_count && !err; j++) { /* frames: the first giver sets, the others agree */
             int g = pt->frame_map ? pt->frame_map[j] : j;
             frm_real *x = out->sampling.frame_positions + 3 * g;
+            if (rigid[g]) continue; /* attached to a body: moves with it rigidly */
             if (given[g] == k + 1) { /* repeated within this part */
                 err = FRM_ERR_PART_FRAME;
                 break;
@@ -7490,25 +7637,18 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             given[g] = k + 1;
         }
         for (i = 0; i < s->sample_count && !err; i++) {
-            int a = s->neighbor_start[i], b = s->neighbor_start[i + 1], e;
-            if (a < 0 || b < a || b - a > FRM_MAX_NEIGHBORS) {
-                err = FRM_ERR_NEIGHBOR_TABLE;
-                break;
-            }
+            int f[FRM_MAX_NEIGHBORS], n, e;
+            double w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS];
+            err = frm__part_row(pt, i, rigid, f, w, g, &n);
             for (r = 0; r < 3; r++) out->sampling.sample_positions[3 * (s0 + i) + r] = s->sample_positions[3 * i + r];
             out->sampling.sample_volumes[s0 + i] = s->sample_volumes[i];
             out->sample_materials[s0 + i] = k;
-            for (e = a; e < b; e++) {
-                int f = s->neighbor_frames[e], q = p0 + e - a;
-                if (f < 0 || f >= s->frame_count) {
-                    err = FRM_ERR_NEIGHBOR_TABLE;
-                    break;
-                }
-                out->sampling.neighbor_frames[q] = pt->frame_map ? pt->frame_map[f] : f;
-                out->sampling.neighbor_weights[q] = s->neighbor_weights[e];
-                for (r = 0; r < 3; r++) out->sampling.neighbor_gradients[3 * q + r] = s->neighbor_gradients[3 * e + r];
+            for (e = 0; e < n; e++) {
+                out->sampling.neighbor_frames[p0 + e] = f[e];
+                out->sampling.neighbor_weights[p0 + e] = (frm_real)w[e];
+                for (r = 0; r < 3; r++) out->sampling.neighbor_gradients[3 * (p0 + e) + r] = (frm_real)g[3 * e + r];
             }
-            p0 += b - a;
+            p0 += n;
             out->sampling.neighbor_start[s0 + i + 1] = p0;
         }
         s0 += s->sample_count;
@@ -7530,6 +7670,8 @@ FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d)
     d->materials = a->materials;
     d->material_count = a->part_count;
     d->sample_materials = a->sample_materials;
+    d->frame_masses = a->rigid_count > 0 ? a->frame_masses : NULL;
+    d->frame_inertias = a->rigid_count > 0 ? a->frame_inertias : NULL;
 }
 
 /* >>probes ----------------------------------------------------------------------------- */

@@ -87,7 +87,7 @@ static void test_float_renames(void)
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
         NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions),
-        NAME(frm_part_default), NAME(frm_parts_combine), NAME(frm_assembly_apply), NAME(frm_assembly_free),
+        NAME(frm_part_default), NAME(frm_rigid_body_default), NAME(frm_parts_combine), NAME(frm_assembly_apply), NAME(frm_assembly_free),
         NAME(frm_probe_default_desc), NAME(frm_probe_create), NAME(frm_probe_positions), NAME(frm_probe_displacements),
         NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_jacobian), NAME(frm_probe_jacobian_transpose),
         NAME(frm_probe_add_external), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
