@@ -941,13 +941,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
     X(FRM_ERR_POINT_OUTSIDE, -37, "a mapped point lies outside the body: in no element, or farther from each of its frames than that frame's farthest sample") \
     X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses") \
-    X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite")
+    X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite") \
+    X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -40
+    FRM_ERR_LAST_ = -41
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1091,6 +1092,19 @@ typedef struct frm_desc {
     const frm_real *sample_volumes;   /* sample_count volumes, m^3, > 0; they should add up
                                          to the body's volume */
     int sample_count;                 /* >= 1 */
+    const frm_real *sample_sizes;     /* optional sample_count values h^2 (m^2, finite, >= 0): each
+                                         sample's mean squared rest lever sum |w| |lbar|^2 / sum |w|,
+                                         the length scale of the rotation stabilisation's divergence
+                                         term and of the frame coupling (see MODEL); NULL: computed
+                                         from the table. frm_parts_combine gives the values of the
+                                         parts' own tables where frames attached to a rigid body were
+                                         merged (whose levers to the body's origin are not the
+                                         sample's size) */
+    const unsigned char *sample_linear; /* optional sample_count flags: 1 where the sample's weights
+                                           reproduce linear fields (sum_k xbar_k grad w_k^T = I: it
+                                           carries the divergence term), 0 where not; NULL: checked
+                                           from the table (to 1e-3). frm_parts_combine gives the
+                                           parts' own with rigid bodies, as sample_sizes */
 
     /* neighbour table, compressed rows: sample s uses entries neighbor_start[s] to
        neighbor_start[s + 1] - 1 (1 to FRM_MAX_NEIGHBORS of them). Fill it yourself or
@@ -1386,6 +1400,10 @@ typedef struct frm_assembly {
                                 part_samples[k + 1] - 1 */
     frm_real *frame_masses;   /* frame_count: the rigid bodies' masses, 0 elsewhere (kg) */
     frm_real *frame_inertias; /* 6 per frame: the rigid bodies' inertias, 0 elsewhere (kg m^2) */
+    frm_real *sample_sizes;   /* sample_count: h^2 of each sample from its part's own table (m^2, see
+                                 desc.sample_sizes), given to the model with rigid bodies */
+    unsigned char *sample_linear; /* sample_count: its part's weights reproduce linear fields (see
+                                     desc.sample_linear), given to the model with rigid bodies */
     int part_count, rigid_count;
     frm_allocator allocator;  /* the one the arrays came from */
     size_t bytes;             /* of the block holding the arrays above but the sampling's */
@@ -3388,6 +3406,11 @@ static int frm__validate(const frm_desc *d, int *marker)
             snprintf(msg, sizeof msg, "volume %g of sample %d", (double)d->sample_volumes[s], s);
             return frm__fail(d, FRM_ERR_SAMPLE_VOLUME, msg);
         }
+    for (s = 0; d->sample_sizes && s < d->sample_count; s++)
+        if (!(frm__finite((double)d->sample_sizes[s]) && d->sample_sizes[s] >= 0)) {
+            snprintf(msg, sizeof msg, "size %g of sample %d", (double)d->sample_sizes[s], s);
+            return frm__fail(d, FRM_ERR_SAMPLE_SIZE, msg);
+        }
     err = frm__validate_neighbors(d, marker);
     if (err) return err;
     if (!d->materials) {
@@ -3914,9 +3937,13 @@ static void frm__create_pairs(frm_model *m, const frm_desc *d)
         }
         if (lmax > 0 && sqrt(lmax) < m->h_min) m->h_min = sqrt(lmax); /* the sample's support size */
         h2 = wsum > 0 ? h2 / wsum : 0;
+        if (d->sample_sizes) h2 = (double)d->sample_sizes[s]; /* the parts' own (rigid bodies, issue 14) */
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
         m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
-        if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
+        if (m->stab_gamma > 0 && d->sample_linear) { /* as the description says (rigid bodies, issue 14) */
+            if (d->sample_linear[s]) m->s_stab[s] = 1;
+            else m->s_hstab[s] = 0;
+        } else if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
                                     sum_k xbar_k grad w_k^T = I, i.e. sum_k abar_k grad w_k^T = -I */
             double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, err = 0;
             int q, r;
@@ -7572,6 +7599,8 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
         FRM__CARVE(&c, out->part_samples, int, part_count + 1);
         FRM__CARVE(&c, out->frame_masses, frm_real, frame_count);
         FRM__CARVE(&c, out->frame_inertias, frm_real, 6 * (size_t)frame_count);
+        FRM__CARVE(&c, out->sample_sizes, frm_real, samples);
+        FRM__CARVE(&c, out->sample_linear, unsigned char, samples);
         FRM__CARVE(&c, given, int, frame_count); /* scratch: the last part (+ 1) that gave each model frame */
         FRM__CARVE(&c, rigid, unsigned char, frame_count); /* scratch: the frame is a rigid body's */
         if (pass == 0) {
@@ -7639,7 +7668,24 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
         for (i = 0; i < s->sample_count && !err; i++) {
             int f[FRM_MAX_NEIGHBORS], n, e;
             double w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS];
+            double h2 = 0, wsum = 0, A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, lin = 0;
             err = frm__part_row(pt, i, rigid, f, w, g, &n);
+            for (e = s->neighbor_start[i]; e < s->neighbor_start[i + 1] && !err; e++) { /* as frm__create_pairs */
+                double l2 = 0, aw = fabs((double)s->neighbor_weights[e]), l[3];
+                int q;
+                for (r = 0; r < 3; r++) {
+                    l[r] = (double)(frm_real)((double)s->sample_positions[3 * i + r] -
+                                              (double)s->frame_positions[3 * s->neighbor_frames[e] + r]);
+                    l2 += l[r] * l[r];
+                }
+                h2 += aw * l2;
+                wsum += aw;
+                for (r = 0; r < 3; r++)
+                    for (q = 0; q < 3; q++) A[3 * r + q] += l[r] * (double)s->neighbor_gradients[3 * e + q];
+            }
+            for (r = 0; r < 9; r++) lin += fabs(A[r]);
+            out->sample_sizes[s0 + i] = (frm_real)(wsum > 0 ? h2 / wsum : 0);
+            out->sample_linear[s0 + i] = lin <= 1e-3;
             for (r = 0; r < 3; r++) out->sampling.sample_positions[3 * (s0 + i) + r] = s->sample_positions[3 * i + r];
             out->sampling.sample_volumes[s0 + i] = s->sample_volumes[i];
             out->sample_materials[s0 + i] = k;
@@ -7672,6 +7718,8 @@ FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d)
     d->sample_materials = a->sample_materials;
     d->frame_masses = a->rigid_count > 0 ? a->frame_masses : NULL;
     d->frame_inertias = a->rigid_count > 0 ? a->frame_inertias : NULL;
+    d->sample_sizes = a->rigid_count > 0 ? a->sample_sizes : NULL;
+    d->sample_linear = a->rigid_count > 0 ? a->sample_linear : NULL;
 }
 
 /* >>probes ----------------------------------------------------------------------------- */
