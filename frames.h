@@ -11,8 +11,10 @@
    samples, exact forces and stiffness (material and geometric),
    a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
    gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
-   frequencies and modes about the current state) and point probes (a material point's
-   position, displacement and velocity through the shape functions). The per-sample and per-frame math are
+   frequencies and modes about the current state), point probes (a material point's
+   position, displacement and velocity through the shape functions) that double as mapped
+   points (their Jacobian J and J^T: point forces as frame loads, coupling), and coupling:
+   one model from several parts sharing frames, rigid bodies (see COUPLING). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
    gathers them through a reverse table.
@@ -85,6 +87,8 @@
        1. Frames, samples and the neighbour table: frm_sampling_hexes / _tets (mesh-based),
           frm_sampling_meshless (given points), frm_sampling_box / _surface (Poisson disks);
           or fill the table yourself (any weights that sum to one, gradients to zero).
+          Several parts (own sampling, material, density) sharing frames, and rigid bodies:
+          frm_parts_combine, then frm_assembly_apply instead of frm_sampling_apply (COUPLING).
        2. frm_desc d = frm_model_default_desc(); frm_sampling_apply(&s, &d); set the
           material (or a per-sample table), gravity, time step, solver settings.
        3. frm_model_create(&d, &m) validates everything and allocates all memory once.
@@ -99,7 +103,9 @@
        6. Read frm_model_positions / _orientations / _velocities / _displacements, and
           frm_model_sample_positions / _deformation_gradients, to render or measure; any
           material point through a probe (frm_probe_create once, then frm_probe_positions
-          / _displacements / _velocities; see PROBES); natural frequencies and modes about
+          / _displacements / _velocities; see PROBES: this is how a frames body is rendered,
+          a render mesh's vertices as mapped points; forces at them as loads through
+          frm_probe_add_external, see COUPLING); natural frequencies and modes about
           the current state with frm_modal_create / _solve (see MODAL ANALYSIS).
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
@@ -167,7 +173,8 @@
    about 1 kB (BDF2's history included: 25 reals); frm_model_memory_bytes tells. A probe
    makes one allocation at frm_probe_create (through the model's allocator: about 40 bytes
    per (point, frame) pair) plus temporaries freed before it returns. The description's arrays are read during frm_model_create only. The samplings
-   allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
+   allocate their arrays in one block each (frm_sampling_free) and free their temporaries;
+   frm_parts_combine two blocks (the sampling's and its own: frm_assembly_free).
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
    names it, and the optional desc.log callback receives a detailed message for validation
@@ -183,6 +190,13 @@
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
+   Coupling (issue 14): frm_parts_combine refuses a malformed frame map (FRM_ERR_PART_FRAME:
+   an index out of range or repeated within a part, a model frame nobody gives, shared frames
+   at different rest positions) and a rigid body with mass <= 0 or an inertia not symmetric
+   positive definite (FRM_ERR_RIGID, as creation does for desc.frame_masses / _inertias, and
+   FRM_ERR_SAMPLE_SIZE for desc.sample_sizes); frm_probe_create a point outside the body
+   (FRM_ERR_POINT_OUTSIDE: in no element, or farther from each of its meshless frames than
+   that frame's farthest sample).
    A step or solve never reports success with an unconverged or unchecked result: one that
    meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
    FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
@@ -673,8 +687,19 @@
        - BDF2 treats orientations in the tangent coordinates at the current one and keeps
          the mass at the step's start: second order for translations and small rotations
          per step, first order in the terms of frames spinning fast (see SOLVERS).
-       - At most 16 neighbours per sample. Coupling between objects, the block-tridiagonal
-         chain solver, inverse actuation and the CUDA companion are not in this version.
+       - Coupling (issue 14): the frames' equations of motion neglect the centripetal and
+         gyroscopic terms (omega x (omega x c), omega x J omega), so a body spinning with mass
+         off its frame's origin does not conserve its momentum exactly; each step does
+         conserve sum_i M_i(t_n) v (its start masses): measured on a rigid block turning at 1
+         rad/s with a beam's first cell merged onto it, 1e-2 of sum |m v| over 0.4 s, the same
+         at dt and dt / 2 (tests/test_frames_coupling.c). A rigid body is a frame with its
+         own mass at its origin (its centre of mass); no joints, no contact, no constraints
+         between bodies but shared or attached frames. Mesh-based probes on a combined model
+         need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
+         attached to a rigid body (the attached frames are no longer frames of the model).
+       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes, the
+         block-tridiagonal chain solver, inverse actuation and the CUDA companion are not in
+         this version.
 
    MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
@@ -701,7 +726,8 @@
    default model, more: every frame turning alike moves no material (frame_coupling > 0
    removes them; LIMITS).
 
-   PROBES (issue 19): frm_probe_create(m, &desc, rest_points, count, &p) finds each point
+   PROBES (issue 19; mapped points, issue 14: see COUPLING): frm_probe_create(m, &desc,
+   rest_points, count, &p) finds each point
    once, among the elements whose bounding box (widened by 1e-3 of its size) covers the
    point's cell of a temporary uniform grid of about one cell per element (5,000 points in
    1,600 tetrahedra: 12 ms): FRM_PROBE_TETS the tetrahedron of desc.elements (frame indices) containing it
@@ -717,7 +743,61 @@
    exact for rigid motions with any weights, and for affine fields of the frames'
    positions with tetrahedral, hexahedral and MLS weights (tests/test_frames_elem.c).
 
+   COUPLING (issue 14; Bosman, Duriez & Cotin 2013 sec. 4.2 and fig. 5; thesis sec. 4.2)
+       Mapped points. A probe is the mapping p = M(q) of eq. 4.11 from the frames to any
+       points given by their rest positions (eq. 3.34 with the weights found once; see
+       PROBES): a render mesh (frm_probe_positions each frame: this is how a frames body is
+       drawn), contact points, another model's nodes. Its Jacobian at the current state,
+       J dq = sum_i w_i (dx_i + dtheta_i x a_i) with a_i = Q_i abar_i the frame's own lever
+       to the point (frm_probe_jacobian; velocities are J v), and the transpose
+       (frm_probe_jacobian_transpose) give a point force f_n to frame i as the force
+       w_in f_n (eq. 4.12) and the torque w_in a_in x f_n: eq. 4.13 with the frame's own
+       prediction a_in for p_n - x_i. They differ once frames disagree about a point (under
+       strain); ours is the exact transpose of the mapping, so the work f . dp equals the
+       frames' generalized work (tested by finite differences) and a coupling through it
+       neither creates nor loses energy; the total force sum f_n and moment sum p_n x f_n
+       are carried exactly in any state. frm_probe_add_external adds J^T f to the external
+       loads (constant through the following steps and solves: once per step for a
+       staggered coupling). What a stiff coupling needs (J and J^T as products, no
+       allocation) is public; the coupled implicit solve itself is not here (LIMITS).
+       Measured cost: see README (bench kernels part, "frames mapped point").
+       Several parts (frm_parts_combine): each part's samples keep their weights and
+       gradients, their frames are renumbered by the part's frame_map into the model's;
+       frames several parts give are one frame (same rest position required), so a shared
+       frame receives the mass, forces and stiffness of every part whose samples use it
+       (the 2013 paper's sharing of frames between connective tissue and organs: the DoF
+       sharing of thesis fig. 4.5, assembled by the existing solvers as one system). Each
+       part has one material (law, constants, density: desc.materials with a material per
+       part); split a part to give it several. A body split into two parts sharing their
+       interface frames is the same discrete model as the whole, samples reordered:
+       static sag and an implicit step agree to 4e-12 (tests/test_frames_coupling.c).
+       Rigid bodies (frm_rigid_body): a frame with its own mass and inertia (not from
+       samples; desc.frame_masses / frame_inertias, added to the frame's mass block and
+       gravity at its origin). Part frames mapped onto a body's frame are attached: they
+       move rigidly with it (x_j = x_b + Q_b (xbar_j - xbar_b), R_j = Q_b Rbar_j). The
+       thesis couples them by bilateral constraints (fig. 4.7); we eliminate them through
+       the rigid map, exactly: an attached frame predicts a sample at
+       x_j + R_j lbar_j = x_b + Q_b (pbar - xbar_b), the body's own prediction, so in each
+       sample the entries of frames attached to one body merge into one entry of the body's
+       frame with the summed weight and gradient (p and F of eq. 3.34, 3.40 unchanged, and
+       with them the energy, forces, stiffness, mass and gravity); the merged table is an
+       ordinary one, so every solver, the mass and the reaction on the body come for free
+       and nothing changes in the solvers. Only the stabilisation's per-sample length h^2
+       and linear flag depend on levers: they are taken from the parts' own tables
+       (desc.sample_sizes, sample_linear). Tests: a beam on a fixed block sags as the beam
+       with its face frames fixed (1.6e-15 m), a beam on a free block falls with g (the
+       momentum gains M g t to 2e-7) while the beam springs back from its sag, the
+       momentum balance of each step with an internal impulse (7e-10), a weight on a strap
+       reaches the strap's extension within 0.15 % (static solve and damped steps).
+
    HISTORY
+       unreleased (issue 14): coupling: mapped points (frm_probe_jacobian,
+             frm_probe_jacobian_transpose, frm_probe_add_external; frm_probe_desc.nodes,
+             node_frames, node_count), several parts (frm_part, frm_parts_combine,
+             frm_assembly_apply / _free), rigid bodies (frm_rigid_body, desc.frame_masses,
+             frame_inertias, sample_sizes, sample_linear); FRM_ERR_POINT_OUTSIDE (was
+             FRM_ERR_ARG for a probe point in no element), FRM_ERR_PART_FRAME, FRM_ERR_RIGID,
+             FRM_ERR_SAMPLE_SIZE. Results of existing models bit-identical.
        unreleased (issue 19): FRM_BDF2 (see SOLVERS), frm_model_set_integrator,
              frm_model_set_damping, frm_model_displacements, frm_model_rest_positions,
              point probes (frm_probe_*), modal analysis (frm_modal_*). Results of existing models bit-identical; the
@@ -1595,6 +1675,14 @@ typedef struct frm_probe_desc {
                               samplings put frame i at node i), read during frm_probe_create only */
     int element_count;
     frm_shape_desc shape;  /* MESHLESS: default frm_shape_default_desc() */
+    const frm_real *nodes; /* TETS, HEXES, optional (issue 14): node_count rest positions (3 each, m) of the
+                              mesh's nodes: `elements` then holds node indices and node_frames[node] is
+                              the model frame of each node (frm_parts_combine's frame_map of the part the
+                              mesh sampled; several nodes may share a frame, e.g. frames attached to a
+                              rigid body). NULL: elements hold frame indices, at the frames' rest
+                              positions. Read during frm_probe_create only */
+    const int *node_frames;
+    int node_count;
     frm_real tolerance;    /* dimensionless, default 1e-6: a point at most this far outside an element
                               (barycentric or parametric coordinate down to -tolerance) counts as
                               in it (the element most inside wins); farther: FRM_ERR_ARG */
@@ -7984,9 +8072,9 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
     frm__grid grid;
     frm__bins bins;
     frm_probe tmp, *p;
-    double *X;
+    double *X, *G;
     size_t xbytes;
-    int err = FRM_OK, i, k, r, pass, pairs = 0, nodes;
+    int err = FRM_OK, i, k, r, pass, pairs = 0, nodes, geo;
     if (out) *out = NULL;
     if (!m || !d || !out) return FRM_ERR_ARG;
     if (d->internal_cookie != FRM__PROBE_COOKIE) return FRM_ERR_DESC;
@@ -7999,14 +8087,23 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
         err = frm__check_shape(&d->shape);
         if (err) return err;
     } else {
+        int range = d->nodes ? d->node_count : m->frame_count;
         if (!d->elements || d->element_count < 1) return FRM_ERR_ARG;
+        if (d->nodes && (d->node_count < 1 || !d->node_frames || !frm__all_finite(d->nodes, 3 * (size_t)d->node_count)))
+            return FRM_ERR_ARG;
         for (i = 0; i < nodes * d->element_count; i++)
-            if (d->elements[i] < 0 || d->elements[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
+            if (d->elements[i] < 0 || d->elements[i] >= range) return FRM_ERR_INDEX_RANGE;
+        for (i = 0; d->nodes && i < d->node_count; i++)
+            if (d->node_frames[i] < 0 || d->node_frames[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
     }
-    xbytes = sizeof(double) * 4 * (size_t)m->frame_count; /* rest positions, then each frame's reach */
+    geo = d->kind != FRM_PROBE_MESHLESS && d->nodes ? d->node_count : 0;
+    /* rest positions, each frame's reach, then the elements' own nodes */
+    xbytes = sizeof(double) * (4 * (size_t)m->frame_count + 3 * (size_t)geo);
     X = (double *)frm__alloc(&m->allocator, xbytes);
     if (!X) return FRM_ERR_ALLOC;
     for (i = 0; i < 3 * m->frame_count; i++) X[i] = (double)m->rest_pos[i];
+    G = geo ? X + 4 * (size_t)m->frame_count : X;
+    for (i = 0; i < 3 * geo; i++) G[i] = (double)d->nodes[i];
     for (i = 0; i < m->frame_count; i++) X[3 * m->frame_count + i] = 0;
     for (k = 0; k < m->pair_count; k++) { /* reach: the frame's farthest sample (its rest lever) */
         const frm_real *a = m->p_rlev + 3 * (size_t)k;
@@ -8020,7 +8117,7 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
         err = frm__grid_build(&grid, X, m->frame_count, d->shape.support == FRM_SUPPORT_RADIUS ? (double)d->shape.radius : 0.0,
                               &m->allocator);
     else
-        err = frm__bins_build(&bins, d, X, m->frame_count, &m->allocator);
+        err = frm__bins_build(&bins, d, G, geo ? geo : m->frame_count, &m->allocator);
     memset(&tmp, 0, sizeof tmp);
     p = NULL;
     /* pass 0 counts the pairs, pass 1 fills the block */
@@ -8057,7 +8154,8 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
             double pt[3], w[FRM_MAX_NEIGHBORS];
             int idx[FRM_MAX_NEIGHBORS + 1], n;
             for (r = 0; r < 3; r++) pt[r] = (double)rest_points[3 * i + r];
-            err = frm__probe_point(m, d, &grid, &bins, X, X + 3 * m->frame_count, pt, idx, w, &n);
+            err = frm__probe_point(m, d, &grid, &bins, G, X + 3 * m->frame_count, pt, idx, w, &n);
+            for (k = 0; geo && k < n && !err; k++) idx[k] = d->node_frames[idx[k]]; /* nodes -> frames */
             if (err) break;
             if (pass == 1) {
                 p->start[i] = pairs;

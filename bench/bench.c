@@ -1768,6 +1768,29 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
         }
         printf("\n");
     }
+    /* mapped points (issue 14): a render mesh's vertices inside the elements, about 30,000
+       (quick: 4,000) */
+    for (i = 0; i < count; i++) {
+        const bench_model *m = models[i];
+        static const char *what[3] = {"mapped-positions", "mapped-velocities", "mapped-JTf"};
+        double ns[3];
+        int n = o->quick ? 8 : 16, points = 0, c;
+        bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
+        void *sim = NULL;
+        if (!m->mapped || !m->primary || m->create(&b, &sim)) continue;
+        set_threads(1);
+        m->step(sim, 1e-5, BENCH_IMPLICIT_EULER); /* a generic deformed state */
+        if (!m->mapped(sim, &points, ns)) {
+            printf("%s %s %s mapped points (%d, 1 thread): positions %.1f ns, velocities %.1f ns, J^T f %.1f ns a point\n",
+                   m->model, m->variant, m->precision, points, ns[0], ns[1], ns[2]);
+            for (c = 0; c < 3; c++) {
+                csv_prefix(f);
+                fprintf(f, "%s,%s,%s,%s,1,%d,point,%.4g,,,,%.4g\n", m->model, m->variant, m->precision, what[c], points,
+                        ns[c], bandwidth[1]);
+            }
+        }
+        m->destroy(sim);
+    }
     fclose(f);
 }
 

@@ -837,6 +837,57 @@ static void test_rigid_momentum(void)
     CHECK(d1 < 2e-2);
 }
 
+/* Mapped points on a combined model through the part's own mesh (probe nodes and
+   node_frames = the part's frame map): on the beam attached to the block, in a random state
+   of the model's frames (block and beam), a point at an attached node's rest position
+   follows the block rigidly, x_b + Q_b (pbar - xbar_b), and a point at any other node
+   follows its frame; round-off tolerance (1e-13 double, 2e-6 float). */
+static void test_mapped_points_on_parts(void)
+{
+    frm_model *m = NULL;
+    frm_sampling s;
+    frm_probe_desc pd = frm_probe_default_desc();
+    frm_probe *p = NULL;
+    int map[20], i, r, next = 1, *hexes = grid_hexes(4, 1, 1);
+    double pos[3 * 17], quat[4 * 17], R[9], worst = 0, tol = IS_FLOAT ? 2e-6 : 1e-13;
+    frm_real P[3 * 20];
+    REQUIRE(rigid_beam(&m, 500) == FRM_OK);
+    REQUIRE(grid_part(&s, 4, 1, 1, 0.5, 0.5, 0.5, 0, 4, 2, NULL) == FRM_OK);
+    for (i = 0; i < 20; i++) map[i] = i % 5 == 0 ? 0 : next++;
+    pd.kind = FRM_PROBE_HEXES;
+    pd.elements = hexes;
+    pd.element_count = 4;
+    pd.nodes = s.frame_positions;
+    pd.node_count = 20;
+    pd.node_frames = map;
+    REQUIRE(frm_probe_create(m, &pd, s.frame_positions, 20, &p) == FRM_OK);
+    REQUIRE(random_state(m, 0.05, 0.5, 21u, pos, quat) == FRM_OK);
+    REQUIRE(frm_probe_positions(p, m, P) == FRM_OK);
+    quat_matrix(quat, R);
+    for (i = 0; i < 20; i++) {
+        double want[3];
+        if (map[i] == 0) {
+            double a[3];
+            for (r = 0; r < 3; r++) a[r] = (double)s.frame_positions[3 * i + r] - (double)frm_model_rest_positions(m)[r];
+            for (r = 0; r < 3; r++) want[r] = pos[r] + R[3 * r] * a[0] + R[3 * r + 1] * a[1] + R[3 * r + 2] * a[2];
+        } else
+            for (r = 0; r < 3; r++) want[r] = (double)frm_model_positions(m)[3 * map[i] + r];
+        for (r = 0; r < 3; r++)
+            if (fabs((double)P[3 * i + r] - want[r]) > worst) worst = fabs((double)P[3 * i + r] - want[r]);
+    }
+    printf("    the part's nodes through its own mesh on the combined model: %.1e m\n", worst);
+    CHECK(worst < tol);
+    frm_probe_destroy(p);
+    pd.node_frames = NULL;
+    CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, s.frame_positions, 1, &p));
+    map[3] = 17;
+    pd.node_frames = map;
+    CHECK_INT(FRM_ERR_INDEX_RANGE, frm_probe_create(m, &pd, s.frame_positions, 1, &p));
+    free(hexes);
+    frm_sampling_free(&s);
+    frm_model_destroy(m);
+}
+
 /* A 1 kg rigid weight (centre 0.2 m below) hanging from a vertical strap 0.1 x 0.1 x 1 m
    (1 x 1 x 10 hexahedral cells, E = 1 MPa, nu = 0, 1 kg/m^3) whose top face is clamped:
    the weight moves down by the strap's extension m g L / (E A) + rho g L^2 / (2 E) (its own
@@ -1033,7 +1084,7 @@ static const test_case cases[] = {
     TEST(test_mapped_rigid_motion),      TEST(test_mapped_virtual_work), TEST(test_mapped_point_at_frame),
     TEST(test_mapped_external_loads),    TEST(test_mapped_point_outside), TEST(test_parts_split_equals_whole),
     TEST(test_parts_refusals),           TEST(test_rigid_fixed_equals_clamped), TEST(test_rigid_falling_beam),  TEST(test_rigid_momentum),
-    TEST(test_rigid_hanging_weight),     TEST(test_rigid_refusals),      TEST(test_coupling_no_allocation),
+    TEST(test_mapped_points_on_parts),   TEST(test_rigid_hanging_weight),     TEST(test_rigid_refusals),      TEST(test_coupling_no_allocation),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
