@@ -1700,7 +1700,7 @@ FRMDEF frm_probe_desc frm_probe_default_desc(void);
    point in no element; meshless: no frame within the radius, or farther from each of its
    frames than that frame's farthest sample in the model, beyond 1e-3 + tolerance of it),
    FRM_ERR_INDEX_RANGE (an element's frame index), FRM_ERR_SAMPLING (shape settings),
-   FRM_ERR_NO_NEIGHBOR / FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
+   FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
 FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
                             frm_probe **out);
 /* 3 values per point into out (m, m, m/s) for the model's current state: positions

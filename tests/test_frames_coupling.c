@@ -573,6 +573,68 @@ static void test_parts_split_equals_whole(void)
     frm_model_destroy(heavy);
 }
 
+/* Two kinds of parts sharing frames (the 2013 paper's fig. 5: a meshless layer on an
+   organ's surface frames): a hexahedral beam (2 x 0.5 x 0.5 m, 4 x 1 x 1 cells, E = 1e7
+   Pa, 1000 kg/m^3) and a Shepard slab on top of it (z from 0.5 to 0.9 m, E = 1e5 Pa, 300
+   kg/m^3) whose lower frames are the beam's top frames and upper frames its own. The
+   frames' masses sum to the two parts' (rho V each, exactly: every sample's mass goes to
+   its frames), the model clamped at x = 0 solves statically, and the slab's upper frames
+   sag with the beam (more than the beam's top: the soft layer hangs on it). */
+static void test_parts_mixed_kinds(void)
+{
+    frm_sampling beam, slab;
+    frm_part parts[2];
+    frm_assembly as;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m = NULL;
+    frm_real fx[3 * 20], sx[3 * 4 * 2 * 8];
+    int map[20], i, j, k, ns = 0, top = 0;
+    double mass = 0, want = 1000 * 0.5 + 300 * 2 * 0.5 * 0.4;
+    frm_real M[36];
+    REQUIRE(grid_part(&beam, 4, 1, 1, 0.5, 0.5, 0.5, 0, 4, 2, NULL) == FRM_OK);
+    for (i = 0; i < 20; i++) { /* slab frames: the beam's top nodes (z = 0.5), then a copy at z = 0.9 */
+        int node = i < 10 ? 10 + i : 10 + (i - 10);
+        for (k = 0; k < 3; k++) fx[3 * i + k] = beam.frame_positions[3 * node + k];
+        if (i >= 10) fx[3 * i + 2] = (frm_real)0.9;
+        map[i] = i < 10 ? node : 20 + (i - 10);
+    }
+    for (i = 0; i < 8; i++) /* samples: 8 x 2 x 2 cell centres of the slab */
+        for (j = 0; j < 2; j++)
+            for (k = 0; k < 2; k++, ns++) {
+                sx[3 * ns] = (frm_real)(0.125 + 0.25 * i);
+                sx[3 * ns + 1] = (frm_real)(0.125 + 0.25 * j);
+                sx[3 * ns + 2] = (frm_real)(0.6 + 0.2 * k);
+            }
+    REQUIRE(frm_sampling_meshless(&slab, fx, 20, sx, ns, (frm_real)(2 * 0.5 * 0.4), NULL, NULL) == FRM_OK);
+    parts[0] = frm_part_default();
+    parts[1] = frm_part_default();
+    parts[0].sampling = &beam;
+    parts[0].material.young_modulus = (frm_real)1e7;
+    parts[1].sampling = &slab;
+    parts[1].frame_map = map;
+    parts[1].material.young_modulus = (frm_real)1e5;
+    parts[1].material.density = 300;
+    REQUIRE(frm_parts_combine(&as, parts, 2, NULL, 0, 30, NULL) == FRM_OK);
+    frm_assembly_apply(&as, &d);
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+    frm_assembly_free(&as);
+    for (i = 0; i < 30; i++) {
+        REQUIRE(frm_model_mass_block(m, i, M) == FRM_OK);
+        mass += (double)M[0];
+        if (frm_model_rest_positions(m)[3 * i] == 0) REQUIRE(frm_model_fix_frame(m, i) == FRM_OK);
+    }
+    CHECK_NEAR(want, mass, want * (IS_FLOAT ? 1e-5 : 1e-12));
+    REQUIRE(frm_model_solve_static(m) == FRM_OK);
+    top = 29; /* the slab's frame above the beam's tip (x = 2, y = 0.5) */
+    printf("    beam + meshless slab: %.1f kg, tip sag beam %.5f m, slab %.5f m\n", mass,
+           -(double)frm_model_displacements(m)[3 * 19 + 2], -(double)frm_model_displacements(m)[3 * top + 2]);
+    CHECK(-(double)frm_model_displacements(m)[3 * 19 + 2] > 0);
+    CHECK(-(double)frm_model_displacements(m)[3 * top + 2] > -(double)frm_model_displacements(m)[3 * 19 + 2]);
+    frm_model_destroy(m);
+    frm_sampling_free(&beam);
+    frm_sampling_free(&slab);
+}
+
 /* Refusals of frm_parts_combine: a map index out of range, repeated within a part, a model
    frame no part gives, shared frames at different rest positions; NULL and counts. */
 static void test_parts_refusals(void)
@@ -1083,7 +1145,7 @@ static void test_coupling_no_allocation(void)
 static const test_case cases[] = {
     TEST(test_mapped_rigid_motion),      TEST(test_mapped_virtual_work), TEST(test_mapped_point_at_frame),
     TEST(test_mapped_external_loads),    TEST(test_mapped_point_outside), TEST(test_parts_split_equals_whole),
-    TEST(test_parts_refusals),           TEST(test_rigid_fixed_equals_clamped), TEST(test_rigid_falling_beam),  TEST(test_rigid_momentum),
+    TEST(test_parts_mixed_kinds),        TEST(test_parts_refusals),      TEST(test_rigid_fixed_equals_clamped), TEST(test_rigid_falling_beam),  TEST(test_rigid_momentum),
     TEST(test_mapped_points_on_parts),   TEST(test_rigid_hanging_weight),     TEST(test_rigid_refusals),      TEST(test_coupling_no_allocation),
 };
 
