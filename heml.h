@@ -358,7 +358,9 @@
        (LIMITS): the static solve's Krylov iterations (Cook, N = 16: about 430 at nu = 0.3,
        17,000 at nu = 0.4999, with or without nodal pressure: the conditioning is the
        bulk-to-shear ratio, which the Jacobi and rigid-body coarse preconditioner does
-       not address), and the nodal pressure field oscillates between neighbouring nodes
+       not address; scaling the Jacobi diagonal's bulk share by 0.2 or 0.02 gave 14,300
+       to 21,600: the diagonal is not the cause, a volumetric (divergence-free) coarse
+       space or a block preconditioner would be), and the nodal pressure field oscillates between neighbouring nodes
        near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
        range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
        smoothed, e.g. as the element means p_e, not node by node. The bench's Poisson beam
