@@ -1919,6 +1919,183 @@ static void test_probe_many(void)
     free(x), free(pts), free(pos), free(quat), free(out);
 }
 
+
+/* ---- issue 13: volumetric averaging (F-bar) against volumetric locking ---------------- */
+
+/* A small body for the volumetric tests: mode CELLS, 2 x 1 x 1 hexahedral cells of 8
+   Gauss samples (12 frames); mode FRAMES, the same box in 10 tetrahedra with one sample
+   each. Nodes perturbed by `jitter` (an unstructured mesh). */
+static int vol_body(int mode, double jitter, frm_sampling *s, frm_real **nodes_out, int *node_count)
+{
+    frm_real *x;
+    int i, err, n;
+    unsigned seed = 777u;
+    if (mode == FRM_VOLUMETRIC_CELLS) {
+        int hex[16], c, a;
+        n = 12;
+        x = alloc_reals(3 * n);
+        for (i = 0; i < n; i++) {
+            x[3 * i] = (frm_real)(0.5 * (i % 3));
+            x[3 * i + 1] = (frm_real)(0.5 * (i / 3 % 2));
+            x[3 * i + 2] = (frm_real)(0.5 * (i / 6));
+        }
+        for (c = 0; c < 2; c++)
+            for (a = 0; a < 8; a++) hex[8 * c + a] = (c + (a & 1)) + 3 * ((a >> 1 & 1) + 2 * (a >> 2));
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)((double)x[i] + jitter * law_rand(&seed));
+        err = frm_sampling_hexes(s, x, n, hex, 2, 2, FRM_QUADRATURE_GAUSS, NULL);
+    } else {
+        tetmesh t;
+        if (tetmesh_beam(&t, 1, 0.5, 0.5, 2, 1, 1, TETMESH_SPLIT5) != TETMESH_OK) return -1;
+        n = t.node_count;
+        x = alloc_reals(3 * n);
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)(t.nodes[i] + jitter * law_rand(&seed));
+        err = frm_sampling_tets(s, x, n, t.tets, t.tet_count, 1, NULL, NULL);
+        tetmesh_free(&t);
+    }
+    if (nodes_out) *nodes_out = x;
+    else free(x);
+    if (node_count) *node_count = n;
+    return err;
+}
+
+/* The energy of the F-bar model computed here from the model's output F (independent of
+   its force code): J_bar = the averaging of MODEL (cells: volume-weighted mean J of the
+   cell; frames: J averaged at the frames with weights v_s w_si, interpolated back with
+   w_si), F_bar = (J_bar / J)^(1/3) F, E = sum_s v_s W(F_bar_s) through the law table. */
+static double vol_energy(const frm_sampling *s, int mode, int law, const frm_real *prm, const frm_user_law *user,
+                         const frm_real *F)
+{
+    int S = s->sample_count, n = s->frame_count, t, e, k, groups = mode == FRM_VOLUMETRIC_CELLS ? s->cell_count : n;
+    double *J = (double *)calloc((size_t)S, sizeof(double)), *num = (double *)calloc((size_t)groups, sizeof(double));
+    double *den = (double *)calloc((size_t)groups, sizeof(double)), E = 0;
+    for (t = 0; t < S; t++) {
+        const frm_real *f = F + 9 * t;
+        J[t] = (double)f[0] * ((double)f[4] * f[8] - (double)f[5] * f[7]) - (double)f[1] * ((double)f[3] * f[8] - (double)f[5] * f[6]) +
+               (double)f[2] * ((double)f[3] * f[7] - (double)f[4] * f[6]);
+        for (e = s->neighbor_start[t]; e < s->neighbor_start[t + 1]; e++) {
+            int g = mode == FRM_VOLUMETRIC_CELLS ? s->sample_cells[t] : s->neighbor_frames[e];
+            double w = mode == FRM_VOLUMETRIC_CELLS ? 1.0 : (double)s->neighbor_weights[e];
+            num[g] += (double)s->sample_volumes[t] * w * J[t];
+            den[g] += (double)s->sample_volumes[t] * w;
+            if (mode == FRM_VOLUMETRIC_CELLS) break;
+        }
+    }
+    for (t = 0; t < S; t++) {
+        double Jb = 0, al;
+        frm_real H[9], psi;
+        if (mode == FRM_VOLUMETRIC_CELLS) Jb = num[s->sample_cells[t]] / den[s->sample_cells[t]];
+        else
+            for (e = s->neighbor_start[t]; e < s->neighbor_start[t + 1]; e++)
+                Jb += (double)s->neighbor_weights[e] * num[s->neighbor_frames[e]] / den[s->neighbor_frames[e]];
+        al = cbrt(Jb / J[t]);
+        for (k = 0; k < 9; k++) H[k] = (frm_real)(al * (double)F[9 * t + k] - (k % 4 == 0 ? 1 : 0));
+        if (frm__laws[law].energy(prm, user, H, &psi) != 0) E = NAN;
+        E += (double)s->sample_volumes[t] * (double)psi;
+    }
+    free(J);
+    free(num);
+    free(den);
+    return E;
+}
+
+/* Random poses around rest: positions moved by `amp` m, rotations up to `rot` rad. */
+static void vol_random_poses(const frm_real *x0, int n, double amp, double rot, unsigned *seed, frm_real *pos, frm_real *quat)
+{
+    int i, k;
+    for (i = 0; i < n; i++) {
+        double th[3], a;
+        for (k = 0; k < 3; k++) pos[3 * i + k] = (frm_real)((double)x0[3 * i + k] + amp * law_rand(seed));
+        for (k = 0; k < 3; k++) th[k] = rot * law_rand(seed);
+        a = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+        for (k = 0; k < 3; k++) quat[4 * i + k] = (frm_real)(sin(0.5 * a) * th[k] / a);
+        quat[4 * i + 3] = (frm_real)cos(0.5 * a);
+    }
+}
+
+/* With the option on, per averaging mode and law: force = -gradient of vol_energy (every
+   translation by central differences), K v = -d(force)/dq along random directions (the
+   exact derivative, rotations included), and with the default stabilisation on the same
+   K v check (the F-bar stress joins the stabilisation's). Tolerances: central differences
+   with h = 1e-6 (double) leave O(h^2) ~ 1e-10 relative truncation and eps / h ~ 1e-10
+   round-off; 1e-6 as test_law_model_path; float h = 1e-3, 5e-3 for its 1e-7 round-off / h. */
+static void test_vol_derivatives(void)
+{
+    double h = IS_FLOAT ? 1e-3 : 1e-6, tol = IS_FLOAT ? 5e-3 : 1e-6;
+    int mode, law, i, k, stab;
+    for (mode = FRM_VOLUMETRIC_CELLS; mode <= FRM_VOLUMETRIC_FRAMES; mode++)
+        for (law = 0; law < FRM_LAW_COUNT; law++)
+            for (stab = 0; stab < 2; stab++) {
+                frm_sampling s;
+                frm_desc d;
+                frm_model *m = NULL;
+                frm_real *x0, *pos, *pos0, *quat, *q, *v, *Kv, *fp, *fm;
+                const frm_real *f;
+                frm_real prm[FRM_LAW_PARAMS], mu;
+                frm_material mat = law_material(law);
+                const frm_user_law *user = law == FRM_LAW_USER ? &mat.user : NULL;
+                double worst_f = 0, worst_k = 0, fn = 0, kn = 0;
+                unsigned seed = 4242u;
+                int n, N, a, side;
+                REQUIRE(vol_body(mode, 0.05, &s, &x0, &n) == FRM_OK);
+                N = 6 * n;
+                pos = alloc_reals(3 * n), pos0 = alloc_reals(3 * n), quat = alloc_reals(4 * n), q = alloc_reals(4 * n);
+                v = alloc_reals(N), Kv = alloc_reals(N), fp = alloc_reals(N), fm = alloc_reals(N);
+                d = frm_model_default_desc();
+                frm_sampling_apply(&s, &d);
+                d.material = mat;
+                d.volumetric = (frm_volumetric)mode;
+                if (!stab) d.rotation_stabilization = 0, d.rotation_divergence = 0;
+                d.gravity[0] = d.gravity[1] = d.gravity[2] = 0;
+                REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+                frm__law_params(&mat, prm, &mu);
+                vol_random_poses(x0, n, 0.06, 0.1, &seed, pos0, quat);
+                REQUIRE(frm_model_set_poses(m, pos0, quat) == FRM_OK);
+                REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+                for (i = 0; i < N; i++) fn = fmax(fn, fabs((double)f[i]));
+                memcpy(fp, f, sizeof(frm_real) * N);
+                if (!stab)
+                    for (i = 0; i < n; i++)
+                        for (a = 0; a < 3; a++) {
+                            double W[2];
+                            for (side = 0; side < 2; side++) {
+                                memcpy(pos, pos0, sizeof(frm_real) * 3 * n);
+                                pos[3 * i + a] = (frm_real)((double)pos0[3 * i + a] + (side ? -h : h));
+                                REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+                                W[side] = vol_energy(&s, mode, law, prm, user, frm_model_deformation_gradients(m));
+                            }
+                            worst_f = fmax(worst_f, fabs(-(W[0] - W[1]) / (2 * h) - (double)fp[6 * i + a]) / fn);
+                        }
+                REQUIRE(frm_model_set_poses(m, pos0, quat) == FRM_OK);
+                for (i = 0; i < N; i++) v[i] = (frm_real)law_rand(&seed);
+                REQUIRE(frm_model_prepare_stiffness(m) == FRM_OK);
+                REQUIRE(frm_model_apply_stiffness(m, v, Kv, 0) == FRM_OK);
+                for (side = 0; side < 2; side++) {
+                    double e = side ? -h : h;
+                    for (i = 0; i < n; i++) {
+                        frm_real th[3];
+                        for (k = 0; k < 3; k++) {
+                            pos[3 * i + k] = (frm_real)((double)pos0[3 * i + k] + e * (double)v[6 * i + k]);
+                            th[k] = (frm_real)(e * (double)v[6 * i + 3 + k]);
+                        }
+                        memcpy(q + 4 * i, quat + 4 * i, 4 * sizeof(frm_real));
+                        frm_quat_integrate(q + 4 * i, th);
+                    }
+                    REQUIRE(frm_model_set_poses(m, pos, q) == FRM_OK);
+                    REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+                    memcpy(side ? fm : fp, f, sizeof(frm_real) * N);
+                }
+                for (i = 0; i < N; i++) kn = fmax(kn, fabs((double)Kv[i]));
+                for (i = 0; i < N; i++) worst_k = fmax(worst_k, fabs(-((double)fp[i] - (double)fm[i]) / (2 * h) - (double)Kv[i]) / kn);
+                printf("    %-6s %-20s stab %d: force vs -grad W %.1e, K v vs -d(force) %.1e\n",
+                       mode == FRM_VOLUMETRIC_CELLS ? "cells" : "frames", frm__laws[law].name, stab, worst_f, worst_k);
+                CHECK(worst_f < tol);
+                CHECK(worst_k < tol);
+                frm_model_destroy(m);
+                frm_sampling_free(&s);
+                free(x0), free(pos), free(pos0), free(quat), free(q), free(v), free(Kv), free(fp), free(fm);
+            }
+}
+
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
@@ -1941,6 +2118,7 @@ static const test_case cases[] = {
     TEST(test_modal_r3),
     TEST(test_modal_closed_forms),
     TEST(test_modal_r3_time_order),
+    TEST(test_vol_derivatives),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
