@@ -1118,6 +1118,10 @@ typedef struct frm_desc {
                                   locking near nu = 0.5 (see MODEL, volumetric averaging). The
                                   model is then matrix-free (FRM_STIFFNESS_PAIRS: AUTO picks it,
                                   BLOCKS is refused with FRM_ERR_STIFFNESS_MODE) */
+    frm_real volumetric_stabilization; /* dimensionless eta >= 0, default 2: with volumetric averaging,
+                                          adds eta mu v / 2 ln^2(J_bar / J) per sample (mu the small-strain
+                                          shear modulus): holds the J fluctuations the average does not
+                                          see at a shear-like stiffness, which does not lock (see MODEL) */
     const int *sample_cells;   /* FRM_VOLUMETRIC_CELLS: sample_count cell indices >= 0 (the samples
                                   of a cell average their J); frm_sampling_apply sets it from
                                   frm_sampling_hexes / _tets, NULL for meshless samplings */
@@ -2407,6 +2411,7 @@ struct frm_model {
        ve_group[e]: (A x)_s = sum_{e of s} ve_back[e] y_g, y_g = sum_{e of g} ve_to[e] x_{sample e};
        NULL arrays when off */
     int vol_mode, vol_groups, vol_entries;
+    frm_real vol_eta; /* volumetric_stabilization */
     int *ve_start, *ve_group, *ve_sample, *vg_start, *vg_entry; /* S + 1, E, E, G + 1, E */
     frm_real *ve_back, *ve_to;                                  /* E, E */
     double *vg_y;                                               /* G: scratch of the averages */
@@ -3220,6 +3225,8 @@ static int frm__validate_settings(const frm_desc *d)
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
     if ((unsigned)d->volumetric >= FRM_VOLUMETRIC_COUNT) return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric");
+    if (!(frm__finite((double)d->volumetric_stabilization) && d->volumetric_stabilization >= 0))
+        return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric_stabilization must be finite and >= 0");
     if (d->volumetric != FRM_VOLUMETRIC_NONE && d->stiffness_mode == FRM_STIFFNESS_BLOCKS)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "volumetric averaging is matrix-free: no assembled blocks");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
@@ -3391,6 +3398,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.frame_coupling = 0;
     d.rotation_stabilization = (frm_real)0.5;
     d.rotation_divergence = (frm_real)4;
+    d.volumetric_stabilization = 2;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
@@ -3761,6 +3769,7 @@ static void frm__create_settings(frm_model *m, const frm_desc *d)
     m->load_scale = 1;
     m->stiffness_mode = d->stiffness_mode;
     m->regularization = (double)d->static_regularization;
+    m->vol_eta = d->volumetric_stabilization;
 }
 
 /* Stage 4b: frames' rest poses, the reverse table, the frames with unseen rotations. */
@@ -4221,9 +4230,13 @@ static void frm__vol_stress_chunks(void *vctx, int begin, int end)
             }
             for (r = 0; r < 9; r++) Fb[r] = Hb[r] + (r % 4 == 0 ? 1 : 0);
             frm_first_piola(Fb, S, P);
-            m->v_pi[s] = (P[0] * Fb[0] + P[1] * Fb[1] + P[2] * Fb[2] + P[3] * Fb[3] + P[4] * Fb[4] + P[5] * Fb[5] +
-                          P[6] * Fb[6] + P[7] * Fb[7] + P[8] * Fb[8]) / 3;
-            energy += (double)m->s_volume[s] * (double)psi;
+            {
+                /* pi~ = P_bar : F_bar / 3 + c phi, the stabilisation c phi^2 / 2 with phi = ln(J_bar / J) */
+                frm_real cst = m->vol_eta * m->s_mu[s], phi = 3 * (frm_real)log1p((double)am1);
+                m->v_pi[s] = (P[0] * Fb[0] + P[1] * Fb[1] + P[2] * Fb[2] + P[3] * Fb[3] + P[4] * Fb[4] + P[5] * Fb[5] +
+                              P[6] * Fb[6] + P[7] * Fb[7] + P[8] * Fb[8]) / 3 + cst * phi;
+                energy += (double)m->s_volume[s] * ((double)psi + 0.5 * (double)cst * (double)phi * (double)phi);
+            }
             if (ctx->linearize) {
                 memcpy(m->vl_Fbar + 9 * (size_t)s, Fb, sizeof Fb);
                 if (ctx->linearize == 2) {
@@ -4599,7 +4612,7 @@ static void frm__vol_dstress_chunks(void *vctx, int begin, int end)
             else
                 frm__law_dP(law, prm, m->s_user[s], cache, Fb, m->lin_S + 6 * (size_t)s, dFb, dP);
             for (r = 0; r < 9; r++) dpi += dP[r] * Fb[r] + (full ? Pb[r] * dFb[r] : 0);
-            dpi /= 3;
+            dpi = dpi / 3 + m->vol_eta * m->s_mu[s] * 3 * t; /* + c dphi, dphi = ebar - e */
             m->vk_dpi[s] = dpi;
             m->v_x[s] = m->s_volume[s] * (dpi - (full ? m->vl_pi[s] * m->vk_ebar[s] : 0)) / m->vl_Jbar[s];
         }

@@ -1961,9 +1961,10 @@ static int vol_body(int mode, double jitter, frm_sampling *s, frm_real **nodes_o
 /* The energy of the F-bar model computed here from the model's output F (independent of
    its force code): J_bar = the averaging of MODEL (cells: volume-weighted mean J of the
    cell; frames: J averaged at the frames with weights v_s w_si, interpolated back with
-   w_si), F_bar = (J_bar / J)^(1/3) F, E = sum_s v_s W(F_bar_s) through the law table. */
+   w_si), F_bar = (J_bar / J)^(1/3) F, E = sum_s v_s (W(F_bar_s) + eta mu / 2 ln^2(J_bar / J)) through
+   the law table (eta_mu = eta mu, the stabilisation's stiffness). */
 static double vol_energy(const frm_sampling *s, int mode, int law, const frm_real *prm, const frm_user_law *user,
-                         const frm_real *F)
+                         double eta_mu, const frm_real *F)
 {
     int S = s->sample_count, n = s->frame_count, t, e, k, groups = mode == FRM_VOLUMETRIC_CELLS ? s->cell_count : n;
     double *J = (double *)calloc((size_t)S, sizeof(double)), *num = (double *)calloc((size_t)groups, sizeof(double));
@@ -1990,7 +1991,7 @@ static double vol_energy(const frm_sampling *s, int mode, int law, const frm_rea
         al = cbrt(Jb / J[t]);
         for (k = 0; k < 9; k++) H[k] = (frm_real)(al * (double)F[9 * t + k] - (k % 4 == 0 ? 1 : 0));
         if (frm__laws[law].energy(prm, user, H, &psi) != 0) E = NAN;
-        E += (double)s->sample_volumes[t] * (double)psi;
+        E += (double)s->sample_volumes[t] * ((double)psi + 0.5 * eta_mu * log(Jb / J[t]) * log(Jb / J[t]));
     }
     free(J);
     free(num);
@@ -2044,6 +2045,7 @@ static void test_vol_derivatives(void)
                 frm_sampling_apply(&s, &d);
                 d.material = mat;
                 d.volumetric = (frm_volumetric)mode;
+                d.volumetric_stabilization = (frm_real)(law == FRM_LAW_SVK ? 0 : 1.5); /* off and on */
                 if (!stab) d.rotation_stabilization = 0, d.rotation_divergence = 0;
                 d.gravity[0] = d.gravity[1] = d.gravity[2] = 0;
                 REQUIRE(frm_model_create(&d, &m) == FRM_OK);
@@ -2061,7 +2063,8 @@ static void test_vol_derivatives(void)
                                 memcpy(pos, pos0, sizeof(frm_real) * 3 * n);
                                 pos[3 * i + a] = (frm_real)((double)pos0[3 * i + a] + (side ? -h : h));
                                 REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
-                                W[side] = vol_energy(&s, mode, law, prm, user, frm_model_deformation_gradients(m));
+                                W[side] = vol_energy(&s, mode, law, prm, user, (double)d.volumetric_stabilization * mu,
+                                                     frm_model_deformation_gradients(m));
                             }
                             worst_f = fmax(worst_f, fabs(-(W[0] - W[1]) / (2 * h) - (double)fp[6 * i + a]) / fn);
                         }
@@ -2096,6 +2099,175 @@ static void test_vol_derivatives(void)
             }
 }
 
+/* Rotation matrix (row-major) and quaternion (x, y, z, w) of the rotation by angle a about
+   the unit axis n. */
+static void vol_rotation(const double n[3], double a, double R[9], frm_real q[4])
+{
+    double c = cos(a), s = sin(a), t = 1 - c;
+    int k;
+    R[0] = c + t * n[0] * n[0], R[1] = t * n[0] * n[1] - s * n[2], R[2] = t * n[0] * n[2] + s * n[1];
+    R[3] = t * n[0] * n[1] + s * n[2], R[4] = c + t * n[1] * n[1], R[5] = t * n[1] * n[2] - s * n[0];
+    R[6] = t * n[0] * n[2] - s * n[1], R[7] = t * n[1] * n[2] + s * n[0], R[8] = c + t * n[2] * n[2];
+    for (k = 0; k < 3; k++) q[k] = (frm_real)(sin(0.5 * a) * n[k]);
+    q[3] = (frm_real)cos(0.5 * a);
+}
+
+/* Patch test with the option on, unstructured meshes (nodes moved by up to 0.05 m of 0.5 m
+   cells), every law and both modes: frames placed on a homogeneous deformation F = R U (x_i
+   = F X_i + b, every frame turned by R, U symmetric) give every sample exactly F (the
+   frames' interpolation reproduces it), so J_bar = J, F_bar = F and the model must carry
+   the homogeneous stress P(F): its forces and elastic energy equal the model's without the
+   option, whose per-sample path is the plain law (an independent evaluation), to
+   round-off (1e-10 of the largest force in double; float 1e-4: its 1e-7 rounding of
+   forces that cancel between samples). */
+static void test_vol_patch(void)
+{
+    static const double U[9] = {1.08, 0.03, -0.02, 0.03, 0.93, 0.05, -0.02, 0.05, 1.04}, axis[3] = {0.48, 0.6, 0.64};
+    double R[9], F[9], tol = IS_FLOAT ? 1e-4 : 1e-10;
+    int mode, law, i, r, c;
+    frm_real qr[4];
+    vol_rotation(axis, 0.4, R, qr);
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) F[3 * r + c] = R[3 * r] * U[c] + R[3 * r + 1] * U[3 + c] + R[3 * r + 2] * U[6 + c];
+    for (mode = FRM_VOLUMETRIC_CELLS; mode <= FRM_VOLUMETRIC_FRAMES; mode++)
+        for (law = 0; law < FRM_LAW_COUNT; law++) {
+            frm_sampling s;
+            frm_model *m[2];
+            frm_real *x0, *pos, *quat, *f[2];
+            frm_energies en[2];
+            double worst = 0, fmaxv = 0;
+            int n, on;
+            REQUIRE(vol_body(mode, 0.05, &s, &x0, &n) == FRM_OK);
+            pos = alloc_reals(3 * n), quat = alloc_reals(4 * n);
+            for (i = 0; i < n; i++) {
+                for (r = 0; r < 3; r++)
+                    pos[3 * i + r] = (frm_real)(F[3 * r] * x0[3 * i] + F[3 * r + 1] * x0[3 * i + 1] + F[3 * r + 2] * x0[3 * i + 2] + 0.3 * (r + 1));
+                memcpy(quat + 4 * i, qr, sizeof qr);
+            }
+            for (on = 0; on < 2; on++) {
+                frm_desc d = frm_model_default_desc();
+                const frm_real *g;
+                frm_sampling_apply(&s, &d);
+                d.material = law_material(law);
+                d.volumetric = on ? (frm_volumetric)mode : FRM_VOLUMETRIC_NONE;
+                d.gravity[2] = 0;
+                REQUIRE(frm_model_create(&d, &m[on]) == FRM_OK);
+                REQUIRE(frm_model_set_poses(m[on], pos, quat) == FRM_OK);
+                REQUIRE(frm_model_forces(m[on], &g) == FRM_OK);
+                f[on] = alloc_reals(6 * n);
+                memcpy(f[on], g, sizeof(frm_real) * 6 * n);
+                REQUIRE(frm_model_energy(m[on], &en[on]) == FRM_OK);
+            }
+            for (i = 0; i < 6 * n; i++) fmaxv = fmax(fmaxv, fabs((double)f[0][i]));
+            for (i = 0; i < 6 * n; i++) worst = fmax(worst, fabs((double)f[1][i] - (double)f[0][i]) / fmaxv);
+            printf("    %-6s %-20s homogeneous F: forces on vs off %.1e of max, energy %.1e relative\n",
+                   mode == FRM_VOLUMETRIC_CELLS ? "cells" : "frames", frm__laws[law].name, worst,
+                   fabs(en[1].elastic - en[0].elastic) / en[0].elastic);
+            CHECK(fmaxv > 0);
+            CHECK(worst < tol);
+            CHECK_NEAR(en[0].elastic, en[1].elastic, tol * en[0].elastic);
+            frm_model_destroy(m[0]);
+            frm_model_destroy(m[1]);
+            frm_sampling_free(&s);
+            free(x0), free(pos), free(quat), free(f[0]), free(f[1]);
+        }
+}
+
+/* Zero force under rigid motion with the option on, far from the origin too: the body's
+   rest pose offset by 1e4 m (float 1e2 m: float keeps about 1e-5 m there), then turned by
+   0.7 rad about an oblique axis and moved 10 m. Forces below 1e-6 (double) / 5e-3 (float)
+   of the force a 1 % strain gives a sample face (E 0.01 h^2, h = 0.5 m): the rounding of
+   the positions, 1e-12 m and 1e-5 m, over h. */
+static void test_vol_rigid(void)
+{
+    static const double axis[3] = {0.36, -0.48, 0.8};
+    double R[9], off = IS_FLOAT ? 1e2 : 1e4, scale = LAW_E * 0.01 * 0.25, tol = IS_FLOAT ? 5e-3 : 1e-6;
+    int mode, law, i, r;
+    frm_real q[4];
+    vol_rotation(axis, 0.7, R, q);
+    for (mode = FRM_VOLUMETRIC_CELLS; mode <= FRM_VOLUMETRIC_FRAMES; mode++)
+        for (law = 0; law < FRM_LAW_COUNT; law++) {
+            frm_sampling s;
+            frm_model *m;
+            frm_desc d = frm_model_default_desc();
+            frm_real *x0, *pos, *quat, *moved, *svol;
+            const frm_real *f;
+            double worst = 0;
+            int n, e;
+            REQUIRE(vol_body(mode, 0.05, &s, &x0, &n) == FRM_OK);
+            /* the same mesh far away: frames and samples moved (weights and gradients unchanged) */
+            moved = alloc_reals(3 * s.sample_count);
+            for (i = 0; i < 3 * s.sample_count; i++) moved[i] = (frm_real)((double)s.sample_positions[i] + off);
+            for (i = 0; i < 3 * n; i++) s.frame_positions[i] = (frm_real)((double)s.frame_positions[i] + off);
+            svol = s.sample_positions;
+            s.sample_positions = moved;
+            frm_sampling_apply(&s, &d);
+            s.sample_positions = svol;
+            d.material = law_material(law);
+            d.volumetric = (frm_volumetric)mode;
+            d.gravity[2] = 0;
+            REQUIRE(frm_model_create(&d, &m) == FRM_OK);
+            pos = alloc_reals(3 * n), quat = alloc_reals(4 * n);
+            for (i = 0; i < n; i++) {
+                for (r = 0; r < 3; r++)
+                    pos[3 * i + r] = (frm_real)(R[3 * r] * x0[3 * i] + R[3 * r + 1] * x0[3 * i + 1] + R[3 * r + 2] * x0[3 * i + 2] + off + 10);
+                memcpy(quat + 4 * i, q, sizeof q);
+            }
+            REQUIRE(frm_model_set_poses(m, pos, quat) == FRM_OK);
+            e = frm_model_forces(m, &f);
+            CHECK_INT(FRM_OK, e);
+            if (!e)
+                for (i = 0; i < 6 * n; i++) worst = fmax(worst, fabs((double)f[i]) / (i % 6 < 3 ? scale : scale * 0.5));
+            printf("    %-6s %-20s rigid motion at %.0e m: |f| %.1e of a 1 %% strain's\n",
+                   mode == FRM_VOLUMETRIC_CELLS ? "cells" : "frames", frm__laws[law].name, off, worst);
+            CHECK(worst < tol);
+            frm_model_destroy(m);
+            frm_sampling_free(&s);
+            free(x0), free(pos), free(quat), free(moved);
+        }
+}
+
+/* Refusals: unknown mode, CELLS without sample_cells or with a negative index, a negative
+   or non-finite stabilisation (FRM_ERR_VOLUMETRIC), assembled blocks with the option
+   (FRM_ERR_STIFFNESS_MODE); the option's model is matrix-free (no block storage). */
+static void test_vol_refusals(void)
+{
+    frm_sampling s;
+    frm_desc d;
+    frm_model *m = NULL;
+    int *cells;
+    REQUIRE(vol_body(FRM_VOLUMETRIC_CELLS, 0, &s, NULL, NULL) == FRM_OK);
+    CHECK(s.cell_count == 2 && s.sample_cells && s.sample_cells[0] == 0 && s.sample_cells[s.sample_count - 1] == 1);
+    cells = (int *)calloc((size_t)s.sample_count, sizeof(int));
+    d = frm_model_default_desc();
+    frm_sampling_apply(&s, &d);
+    CHECK(d.sample_cells == s.sample_cells && d.volumetric == FRM_VOLUMETRIC_NONE);
+    d.volumetric = FRM_VOLUMETRIC_COUNT;
+    CHECK_INT(FRM_ERR_VOLUMETRIC, frm_model_create(&d, &m));
+    d.volumetric = FRM_VOLUMETRIC_CELLS;
+    d.sample_cells = NULL;
+    CHECK_INT(FRM_ERR_VOLUMETRIC, frm_model_create(&d, &m));
+    cells[3] = -1;
+    d.sample_cells = cells;
+    CHECK_INT(FRM_ERR_VOLUMETRIC, frm_model_create(&d, &m));
+    cells[3] = 0;
+    d.volumetric_stabilization = -1;
+    CHECK_INT(FRM_ERR_VOLUMETRIC, frm_model_create(&d, &m));
+    d.volumetric_stabilization = (frm_real)NAN;
+    CHECK_INT(FRM_ERR_VOLUMETRIC, frm_model_create(&d, &m));
+    d.volumetric_stabilization = 2;
+    d.stiffness_mode = FRM_STIFFNESS_BLOCKS;
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_create(&d, &m));
+    CHECK(m == NULL);
+    d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    REQUIRE(frm_model_create(&d, &m) == FRM_OK); /* one cell: every sample averages with all */
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_set_stiffness_mode(m, FRM_STIFFNESS_BLOCKS));
+    CHECK_INT(FRM_ERR_STIFFNESS_MODE, frm_model_assemble_stiffness(m));
+    frm_model_destroy(m);
+    free(cells);
+    frm_sampling_free(&s);
+}
+
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
@@ -2119,6 +2291,9 @@ static const test_case cases[] = {
     TEST(test_modal_closed_forms),
     TEST(test_modal_r3_time_order),
     TEST(test_vol_derivatives),
+    TEST(test_vol_patch),
+    TEST(test_vol_rigid),
+    TEST(test_vol_refusals),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
