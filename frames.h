@@ -4340,16 +4340,14 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             } else {
                 e = frm__law_stress(m->s_law[s], prm, m->s_user[s], H, S, &psi, cache);
                 if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
+                if (!e) frm_first_piola(F, S, P);
             }
             if (e) {
                 err = e;
                 memset(m->p_out + 6 * (size_t)b, 0, sizeof(frm_real) * 6 * (size_t)n);
                 continue;
             }
-            if (!m->vol_mode) {
-                energy += (double)v * (double)psi;
-                frm_first_piola(F, S, P);
-            }
+            energy += (double)v * (double)psi; /* volumetric: 0 here, the law's energy came from stage 3 */
             if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
                 energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
             for (k = 0; k < n; k++)
