@@ -182,7 +182,11 @@
    than FRM_MAX_NEIGHBORS (16), frame indices out of range or repeated in a sample,
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
-   E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
+   E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings,
+   an unknown desc.volumetric, FRM_VOLUMETRIC_CELLS without sample_cells or with a negative
+   index, a negative or non-finite volumetric_stabilization, or a frame whose averaging
+   volume sum_s v_s w_s is not > 0 (FRM_ERR_VOLUMETRIC), FRM_STIFFNESS_BLOCKS with the
+   volumetric option (FRM_ERR_STIFFNESS_MODE).
    A step or solve never reports success with an unconverged or unchecked result: one that
    meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
    FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
@@ -322,6 +326,82 @@
        Both terms: the stabilisation's stress joins the sample's P, the frame-own torques
        apart; the unseen-rotations term's stiffness is exact too (Gauss-Newton part and
        second-order part).
+
+   VOLUMETRIC AVERAGING (issue 13; desc.volumetric, default FRM_VOLUMETRIC_NONE, which
+   leaves every result bit-identical). Near incompressibility (nu -> 0.5) a sample's own J
+   is a constraint the frames cannot all meet: the bench's Poisson beam (1 m, 3 cells
+   across) with hexahedral frames is 19 % too stiff at nu = 0.49 and 41 % at 0.499. The
+   option evaluates every sample's law (any row of the law table, user laws included) at
+   the F-bar of de Souza Neto et al. (1996),
+       F_bar_s = alpha_s F_s,   alpha_s = (J_bar_s / J_s)^(1/3),   J_bar = A J,
+   A a fixed averaging of the samples' J with A 1 = 1 (a homogeneous J is kept) and
+   v^T A = v^T (volume is conserved), and adds a stabilisation of the fluctuation:
+       E = sum_s v_s [ W(F_bar_s) + eta mu_s / 2 ln^2(J_bar_s / J_s) ]
+   (eta = desc.volumetric_stabilization, default 2; mu_s the law's small-strain shear
+   modulus). At small strain W(F_bar) is W's deviatoric part at the sample plus the bulk
+   term of the average, kappa / 2 (tr eps_bar)^2 (the B-bar element), so the bulk modulus
+   acts on one constraint per cell or frame instead of one per sample; the fluctuation
+   J_s - J_bar_s, which the average does not see, costs eta mu: a shear-like stiffness,
+   which does not lock, and without which coarse meshes have soft modes (the bench's beam
+   with hexahedral frames 2 cells across: +14.3 % at nu = 0.3 with eta = 0, +7.5 % with
+   1, +3.1 % with 2, the plain model +2.4 %; one-sample tetrahedral frames one cell across
+   with 5-tetrahedra cells: +830 % with eta = 0). The averages (choices of this library):
+       FRM_VOLUMETRIC_CELLS: mean dilatation, J_bar_s = sum_{t in c(s)} v_t J_t / V_c over
+           the sample's cell (desc.sample_cells; frm_sampling_hexes / _tets fill
+           frm_sampling.sample_cells and frm_sampling_apply sets it). For hexahedral frames
+           with several samples a cell, or any grouping of samples the user gives (e.g. the 5
+           tetrahedra of a hexahedral cell split).
+       FRM_VOLUMETRIC_FRAMES: nodal averaging through the frames, J_i = sum_t v_t w_ti J_t /
+           m_i at frame i (m_i = sum_t v_t w_ti > 0, else FRM_ERR_VOLUMETRIC), J_bar_s =
+           sum_i w_si J_i (Bonet & Burton 1998's average nodal pressure tetrahedron, in
+           F-bar form): any neighbour table with weights >= 0, e.g. one-sample tetrahedra.
+   Both are A = B N over entries e (the pairs, or one a sample): y_g = sum_{e of g} to_e
+   x_{sample e}, (A x)_s = sum_{e of s} back_e y_{group e}, and A^T the same with back and
+   to swapped, run serially in entry order (deterministic; O(entries)).
+   Forces (minus the gradient, exact): with dJ/J = e = F^-T : dF, dJ_bar / J_bar = e_bar,
+   dF_bar = alpha (dF + (e_bar - e) / 3 F) and pi~_s = P(F_bar_s) : F_bar_s / 3 + eta mu_s
+   ln(J_bar_s / J_s),
+       dE = sum_s v_s [alpha_s P_bar_s : dF_s + pi~_s (e_bar_s - e_s)],
+   and since sum_s v_s pi~_s e_bar_s = sum_t J_t e_t Q_t with Q = A^T (v pi~ / J_bar), every
+   sample's stress is
+       P_s = alpha_s P(F_bar_s) + beta_s F_s^-T,   beta_s = Q_s J_s / v_s - pi~_s,
+   which then enters the force (eq. 3.52) and the rest of the model as P did: the force pass
+   runs F and J per sample, the average, the law at F_bar, the transposed average, then
+   the pairs. Differential, exact (the averaging couples the samples of a cell, or through
+   the frames the samples two frames apart):
+       dP = alpha dP_bar + (dQ J / v - dpi~) F^-T
+            + alpha (e_bar - e) / 3 P_bar + (beta + pi~) e F^-T - beta F^-T dF^T F^-T,
+       dP_bar = the law's dP at F_bar for dF_bar,  dpi~ = (dP_bar : F_bar + P_bar : dF_bar) / 3
+            + eta mu (e_bar - e),  dQ = A^T (v (dpi~ - pi~ e_bar) / J_bar),
+   so K v is also five passes (dF and e, the average, dP_bar, the transposed average, dP
+   and the pairs). K's positive-definite part (SOLVERS) keeps the Gauss-Newton part
+   L^T (C_bar+ + eta mu) L of the map L: dF -> (dF_bar, dphi) (the law's definite
+   tangent at F_bar, the positive part of S_bar), i.e. it drops P_bar : dF_bar, pi~ e_bar,
+   the (e_bar - e) P_bar, (beta + pi~) e and beta dF^-T terms. Tested against finite
+   differences of an energy the test computes itself, for every law and both averages,
+   rotations and the stabilisation included (tests/test_frames_elem.c test_vol_*).
+   Patch test: a homogeneous deformation (the frames' interpolation reproduces it) gives
+   every sample J_bar = J, F_bar = F and the forces of the plain model to 1e-15; rigid
+   motions far from the origin give zero force. The model is matrix-free with the option
+   (AUTO takes pairs, FRM_STIFFNESS_BLOCKS is refused: the averaging couples frames beyond
+   the block pattern); the block-Jacobi preconditioner keeps the plain law's rest
+   diagonal. Memory: about 70 reals per sample and 3 per pair (entry) more. Cost, one run
+   on a loaded machine, the bench's beam 3 cells across: force pass 1.4-1.7x (hexahedra),
+   1.35x (tetrahedra), K v 1.45x and 1.5x.
+   Measured (the bench's Poisson beam: 1 m, 0.1 m square, E = 1 MPa, Timoshenko; static
+   Newton, CG iterations summed, the minimum check's probe solve included):
+       hexahedral frames, CELLS, 3 cells across (2,976 DoF): +0.70, -0.38, -0.50 % at nu =
+           0.3, 0.49, 0.499, Newton 3, 6, 9, CG 1,512, 6,221, 17,404 (plain: +0.42, -18.9,
+           -40.6 %, CG 1,553, 2,907, 14,156); 2 cells across (1,134 DoF): +3.06, +3.10,
+           +2.99 %, Newton 3, 6, 10, CG 1,016, 4,092, 10,672 (plain +2.44, -21.2, -47.5 %);
+       one-sample tetrahedral frames (the 5-tetrahedra split), 3 cells across: FRAMES +8.7,
+           -4.2, -7.1 % (plain +0.64, -9.5, -13 %: the nodal average about halves the locking,
+           it does not remove it, see LIMITS), CELLS over each grid cell's 5 tetrahedra
+           +0.82, -2.49, -2.76 %; 2 cells across FRAMES +20.5, -2.5, -7.5 %, CELLS(5) +3.9,
+           -0.02, -0.42 %.
+   nu = 0.499 no longer stalls or locks with hexahedral frames; its CG iterations grow
+   with the bulk-to-shear ratio (block Jacobi does not precondition the averaged
+   constraint): 17,404 against 1,512 at nu = 0.3 above.
 
    MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
    split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
@@ -631,7 +711,23 @@
          trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
          beam, and no convergence at 0.499). Tetrahedral frames with one sample each lock
-         less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2).
+         less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2). The volumetric
+         option (VOLUMETRIC AVERAGING) removes the volumetric locking of hexahedral frames
+         (FRM_VOLUMETRIC_CELLS: within 1.2 points of nu = 0.3's error at 0.49 and 0.499 on
+         the bench's beam 3 cells across). What it leaves:
+         one-sample tetrahedral frames with FRM_VOLUMETRIC_FRAMES (nodal averaging) are
+         still 7 % stiff at nu = 0.499 and 9-20 % soft at nu = 0.3 on the bench's beam at 3
+         and 2 cells across: the average over frames smooths the J field over two rings of
+         samples, and the frames' rotations give J fluctuations the average does not see
+         (held by eta mu only); mean dilatation over each grid cell's 5 tetrahedra does
+         better there (-2.8 % at 0.499, +0.8 % at 0.3) where the mesh has such cells. One
+         cell across, the option is soft (hexahedra +38 % at 0.49 against +20 % at 0.3,
+         tetrahedra with 5-tetrahedra cells +50 %): the one-cell rotation modes that the
+         volumetric stiffness was holding. The CG iterations of static solves grow with
+         kappa / mu (17,404 at nu = 0.499 against 1,512 at 0.3, hexahedra 3 cells across:
+         block Jacobi with the plain law's rest diagonal); the option is matrix-free (no
+         assembled blocks); its force pass costs 1.35-1.7x. Not validated on Cook's
+         membrane (issue 13 asks it of heml.h).
        - St Venant-Kirchhoff softens and can collapse under strong compression, and its
          energy has a minimum of zero at every mirror image of the rest state (F =
          diag(1, 1, -1)): a solve once settled a compressed cube's top layer there, with
@@ -936,7 +1032,7 @@ enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -37
+    FRM_ERR_LAST_ = -38
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1337,8 +1433,9 @@ FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_r
 FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int vertex_count,
                                 const int *triangles, int triangle_count, const frm_poisson_desc *p,
                                 const frm_shape_desc *shape, const frm_allocator *allocator);
-/* Points the description's frame, sample and neighbour fields at the sampling's arrays
-   (which must outlive frm_model_create, not the model). */
+/* Points the description's frame, sample and neighbour fields and sample_cells (NULL for
+   meshless samplings) at the sampling's arrays (which must outlive frm_model_create, not
+   the model); it does not set desc.volumetric. */
 FRMDEF void frm_sampling_apply(const frm_sampling *s, frm_desc *d);
 /* Frees the arrays and empties the struct. */
 FRMDEF void frm_sampling_free(frm_sampling *s);
