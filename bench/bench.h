@@ -53,9 +53,7 @@ typedef struct bench_body {
 
 typedef struct bench_model {
     const char *model;     /* header: "tensormass", "heml", "frames" */
-    const char *variant;   /* law / kind / shape function, as shown in tables; "law+option"
-                              names a non-primary entry with a volumetric option on (e.g.
-                              heml's "neo-hookean+nodal-p"): it also runs the Poisson rows */
+    const char *variant;   /* law / kind / shape function, as shown in tables */
     const char *law;       /* "linear", "springs", "svk", "neo-hookean", "mooney-rivlin":
                               which closed forms (R4 SVK, R5 Neo-Hookean) apply */
     const char *precision; /* "double" or "float" */
@@ -63,7 +61,10 @@ typedef struct bench_model {
     int nonlinear;         /* 1: geometrically exact (large deformation) */
     int primary;           /* 1: every scene; 0: a variant of a primary entry (another law)
                               that runs only the static scenes and the smallest kernels,
-                              to keep `make bench` within its time */
+                              to keep `make bench` within its time; -1: an opt-in option of
+                              a primary entry (e.g. a volumetric treatment against locking)
+                              that runs only the stability part's Poisson rows and the
+                              kernels' two smallest sizes */
     const char *element;   /* unit of the kernel counts: "tet", "pair" */
     /* 0 or the library's error code; *sim NULL on failure */
     int (*create)(const bench_body *b, void **sim);
