@@ -2135,10 +2135,8 @@ static void heml__spring_links(const heml__blk *b, int k, heml_real v[6][3])
 }
 
 /* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
-   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). With dt (differential) each term
-   t v becomes t dv + dt v, dv the links of de. */
-static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
-                                heml_real (*HEML__RESTRICT t)[HEML__W], heml_real (*HEML__RESTRICT dt)[HEML__W])
+   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). */
+static void heml__spring_forces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W])
 {
     int k, r;
     for (r = 0; r < 3; r++)
@@ -2147,15 +2145,32 @@ static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
             heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
             heml_real p1 = t[0][k] * v1, p2 = t[1][k] * v2, p3 = t[2][k] * v3;
             heml_real p4 = t[3][k] * (v2 - v1), p5 = t[4][k] * (v3 - v2), p6 = t[5][k] * (v1 - v3);
-            if (dt) {
-                heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
-                p1 = t[0][k] * d1 + dt[0][k] * v1;
-                p2 = t[1][k] * d2 + dt[1][k] * v2;
-                p3 = t[2][k] * d3 + dt[2][k] * v3;
-                p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
-                p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
-                p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
-            }
+            b->f[r][k] = -p1 + p4 - p6;
+            b->f[3 + r][k] = -p2 - p4 + p5;
+            b->f[6 + r][k] = -p3 - p5 + p6;
+        }
+}
+
+/* The differential of heml__spring_forces: each term t v becomes t dv + dt v, dv the links
+   of de. A function of its own: one loop with a branch on dt was if-converted by gcc, so
+   the force pass computed (and discarded) the differential's products from the unset
+   workspace de, whose garbage included subnormals: 15 times the Neo-Hookean force on Zen
+   (measured, issue 21). */
+static void heml__spring_dforces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W],
+                                 heml_real (*HEML__RESTRICT dt)[HEML__W])
+{
+    int k, r;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real v1 = b->H[r][k] + b->e[r][k], v2 = b->H[3 + r][k] + b->e[3 + r][k];
+            heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
+            heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
+            heml_real p1 = t[0][k] * d1 + dt[0][k] * v1;
+            heml_real p2 = t[1][k] * d2 + dt[1][k] * v2;
+            heml_real p3 = t[2][k] * d3 + dt[2][k] * v3;
+            heml_real p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
+            heml_real p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
+            heml_real p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
             b->f[r][k] = -p1 + p4 - p6;
             b->f[3 + r][k] = -p2 - p4 + p5;
             b->f[6 + r][k] = -p3 - p5 + p6;
@@ -2380,7 +2395,7 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         heml__spring_J(R, b);
         heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
-        heml__spring_forces(b, b->co, NULL);
+        heml__spring_forces(b, b->co);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
@@ -2528,7 +2543,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
                 dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
             }
         }
-        heml__spring_forces(b, b->co, dsig);
+        heml__spring_dforces(b, b->co, dsig);
         return;
     }
     /* (fast-path laws reach here only with Prony: the general path covers them, with
