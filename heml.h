@@ -1322,6 +1322,14 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #else
 #define HEML__SCALAR_FN
 #endif
+/* Vector intrinsics, only where the target has them (compile-time checks; never required):
+   the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
+   do not vectorise it; _mm*_sqrt_* round the same, correctly, so results are
+   bit-identical to the scalar path). HEML_NO_SIMD forces the portable scalar code. */
+#if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
+#include <immintrin.h>
+#define HEML__AVX 1
+#endif
 #if defined(__clang__)
 #define HEML__SCALAR_LOOP _Pragma("clang loop vectorize(disable)")
 #else
@@ -1776,6 +1784,28 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int valid, int want
         }
 }
 
+/* Jc^(-1/3) for Jc > 0, branch-free so that the law's loop vectorises (libm's cbrt is a
+   call): a first guess from the bits of the float (the exponent divided by 3, error below
+   4 %), then Newton steps r <- r (4 - Jc r^3) / 3, whose relative error e becomes about
+   2 e^2: 4 steps in double, 3 in float, to within a few ulps (libm's cbrt, correctly
+   rounded to 1 ulp, gave the same forces to round-off in the all-law tests). Valid for
+   Jc in [2^-60, 2^60]; heml__law_split sends other lanes to libm. */
+HEML__INLINE heml_real heml__inv_cbrt(heml_real Jc)
+{
+    float xf = (float)Jc, gf;
+    int i;
+    heml_real r, x3 = Jc / 3;
+    memcpy(&i, &xf, sizeof i);
+    i = 0x54a21d2a - (int)((float)i * (1.0f / 3.0f));
+    memcpy(&gf, &i, sizeof gf);
+    r = (heml_real)gf;
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    if (sizeof(heml_real) > sizeof(float)) r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    return r;
+}
+
 /* heml__law_split, the compressible Mooney-Rivlin (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
    (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
@@ -1785,12 +1815,22 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
 {
     (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
-    int k;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real Jc = b->Jc[k];
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside) /* (NaN lanes stay NaN either way) */
+        for (k = 0; k < HEML__W; k++)
+            if (b->Jc[k] < lo || b->Jc[k] > hi) rc[k] = (heml_real)(1 / cbrt((double)b->Jc[k]));
     for (k = 0; k < HEML__W; k++) {
         heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
         heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], I1 = 3 + I1m3, I2 = 3 + I2m3;
-        heml_real t = (heml_real)cbrt((double)Jc), iJ = 1 / Jc;
-        heml_real a = 1 / (t * t), bq = a * a;
+        heml_real r = rc[k], iJ = 1 / Jc;
+        heml_real a = r * r, bq = a * a;
         heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
         heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
         heml_real at = a + d * (a1 + d / 2 * a2), at1 = a1 + d * a2;
@@ -1805,14 +1845,21 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
         b->h[2][k] = c1 * at1;
         b->h[4][k] = c2 * bt1;
         b->h[5][k] = c1 * I1 * a2 + c2 * I2 * b2 + kappa;
-        if (want & HEML__WANT_ENERGY) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+    }
+    /* the energy in a loop of its own (library calls), so that the one above vectorises */
+    if (want & HEML__WANT_ENERGY)
+        for (k = 0; k < HEML__W; k++) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+            heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
+            heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], r = rc[k], iJ = 1 / Jc;
+            heml_real a = r * r, bq = a * a;
+            heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
+            heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
             double L = log1p((double)jc1), dd = (double)d;
             double am1 = expm1(-2.0 / 3.0 * L) + dd * ((double)a1 + dd / 2 * (double)a2);
             double bm1 = expm1(-4.0 / 3.0 * L) + dd * ((double)b1 + dd / 2 * (double)b2);
             b->w[k] = (heml_real)((double)c1 * (3 * am1 + (double)I1m3 * (1 + am1)) +
                                   (double)c2 * (3 * bm1 + (double)I2m3 * (1 + bm1)) + (double)kappa / 2 * jm1 * jm1);
         }
-    }
 }
 
 /* heml__law_svk (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
@@ -2075,6 +2122,24 @@ static void heml__spring_rest_links(const heml_real *HEML__RESTRICT R, heml__blk
     }
 }
 
+/* x[i] = sqrt(x[i]) for n non-negative values: vector
+   square roots where the target has them (HEML__AVX), the same correctly rounded values. */
+static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
+{
+    int i = 0;
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(double)) {
+        double *d = (double *)(void *)x;
+        for (; i + 4 <= n; i += 4) _mm256_storeu_pd(d + i, _mm256_sqrt_pd(_mm256_loadu_pd(d + i)));
+    } else {
+        float *f = (float *)(void *)x;
+        for (; i + 8 <= n; i += 8) _mm256_storeu_ps(f + i, _mm256_sqrt_ps(_mm256_loadu_ps(f + i)));
+    }
+#endif
+    HEML__SCALAR_LOOP
+    for (; i < n; i++) x[i] = (heml_real)sqrt((double)x[i]);
+}
+
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
@@ -2097,15 +2162,16 @@ static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *
             }
             dl2[l][k] = acc;
         }
-    for (l = 0; l < 6; l++) /* the square roots (library calls) */
+    for (l = 0; l < 6; l++) /* l^2 (clamped at 0) */
         for (k = 0; k < HEML__W; k++) {
-            heml_real L = S[l * HEML__W + k];
-            b->len[l][k] = (heml_real)sqrt((double)heml__max(L * L + dl2[l][k], 0));
+            heml_real L = S[l * HEML__W + k], q = L * L + dl2[l][k];
+            b->len[l][k] = q > 0 ? q : 0;
         }
+    heml__sqrt_lanes(b->len[0], 6 * HEML__W);
     for (l = 0; l < 6; l++)
         for (k = 0; k < HEML__W; k++) {
             heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k], len = b->len[l][k];
-            heml_real lc = heml__max(len, (heml_real)1e-12 * L);
+            heml_real lo = (heml_real)1e-12 * L, lc = len > lo ? len : lo;
             b->len[l][k] = lc;
             b->co[l][k] = kk * dl2[l][k] / ((lc + L) * lc); /* k (l - L) / l */
         }
