@@ -1325,10 +1325,14 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 /* Vector intrinsics, only where the target has them (compile-time checks; never required):
    the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
    do not vectorise it; _mm*_sqrt_* round the same, correctly, so results are
-   bit-identical to the scalar path). HEML_NO_SIMD forces the portable scalar code. */
+   bit-identical to the scalar path), and the node gather and scatter (heml__gather_vec).
+   HEML_NO_SIMD forces the portable scalar code. */
 #if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
 #include <immintrin.h>
 #define HEML__AVX 1
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#define HEML__AVX512 1 /* the gather's masked node loads with AVX-512 masks (else AVX's vmaskmov) */
+#endif
 #endif
 #if defined(__clang__)
 #define HEML__SCALAR_LOOP _Pragma("clang loop vectorize(disable)")
@@ -1426,6 +1430,8 @@ struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     int agg_count;                         /* aggregates of the coarse space (0: none) */
+    int simd;                              /* 1: the vector gather and scatter where compiled in
+                                              (HEML__AVX); tests set 0 to compare with the scalar path */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
     heml_linear_solver linear_solver;
@@ -1962,8 +1968,8 @@ static void heml__law_at_rest(const heml__mat *mt, heml_real jm1_0, heml__blk *b
 /* >>forces ---------------------------------------------------------------------------- */
 
 /* Links du_1, du_2, du_3 of the block's lanes from a 3n field (displacements or dx). */
-HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
-                                         heml_real (*HEML__RESTRICT e)[HEML__W])
+HEML__SCALAR_FN static void heml__gather_scalar(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                                                heml_real (*HEML__RESTRICT e)[HEML__W])
 {
     int k, r;
     HEML__SCALAR_LOOP
@@ -1981,8 +1987,8 @@ HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const he
 /* Adds the block's node forces (f on nodes 1..3, minus their sum on node 0) into out. The
    lanes go in order, so a node shared by two lanes of a block is updated twice in a
    fixed order. */
-static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
-                          heml_real *HEML__RESTRICT out)
+static void heml__scatter_scalar(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                                 heml_real *HEML__RESTRICT out)
 {
     int k, r;
     for (k = 0; k < HEML__W; k++) {
@@ -1996,6 +2002,172 @@ static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTR
             o0[r] -= (a + b) + c;
         }
     }
+}
+
+#if defined(HEML__AVX)
+/* The vector gather and scatter (AVX; AVX-512 VL masks where present), 4 lanes at a time.
+   Gather: one masked load moves a node's 3 components (the mask never faults past the
+   array's end), 4 x 4 transposes turn them into the lanes' rows. Scatter: per node a
+   16-byte (x, y) and a scalar z read-modify-write (masked stores were tried: 1.6 times
+   slower, their store-to-load forwarding fails where the next lane updates the same node).
+   The same operations in the same order as the scalar loops (the links are differences of
+   the same pairs; a node shared by lanes receives the lanes' terms in lane order, node 0
+   the same (a + b) + c), so the forces are bit-identical to the scalar path. */
+#if defined(HEML__AVX512)
+#define HEML__LOAD3D(p) _mm256_maskz_loadu_pd((__mmask8)7, (p))
+#define HEML__LOAD3F(p) _mm_maskz_loadu_ps((__mmask8)7, (p))
+#else
+#define HEML__LOAD3D(p) _mm256_maskload_pd((p), _mm256_set_epi64x(0, -1, -1, -1))
+#define HEML__LOAD3F(p) _mm_maskload_ps((p), _mm_set_epi32(0, -1, -1, -1))
+#endif
+static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                             heml_real (*HEML__RESTRICT e)[HEML__W])
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            const double *xd = (const double *)(const void *)x;
+            __m256d p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3D(xd + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m256d d[4], t0, t1, t2, t3;
+                double *row = (double *)(void *)e[3 * (j - 1)];
+                for (l = 0; l < 4; l++)
+                    d[l] = _mm256_sub_pd(HEML__LOAD3D(xd + 3 * (size_t)idx[j * HEML__W + k + l]),
+                                         p0[l]);
+                t0 = _mm256_unpacklo_pd(d[0], d[1]); /* x0 x1 z0 z1 */
+                t1 = _mm256_unpackhi_pd(d[0], d[1]); /* y0 y1 .. */
+                t2 = _mm256_unpacklo_pd(d[2], d[3]);
+                t3 = _mm256_unpackhi_pd(d[2], d[3]);
+                _mm256_storeu_pd(row + k, _mm256_permute2f128_pd(t0, t2, 0x20));
+                _mm256_storeu_pd(row + HEML__W + k, _mm256_permute2f128_pd(t1, t3, 0x20));
+                _mm256_storeu_pd(row + 2 * HEML__W + k, _mm256_permute2f128_pd(t0, t2, 0x31));
+            }
+        } else {
+            const float *xf = (const float *)(const void *)x;
+            __m128 p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3F(xf + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m128 d0, d1, d2, d3;
+                float *row = (float *)(void *)e[3 * (j - 1)];
+                d0 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k]), p0[0]);
+                d1 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 1]), p0[1]);
+                d2 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 2]), p0[2]);
+                d3 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 3]), p0[3]);
+                _MM_TRANSPOSE4_PS(d0, d1, d2, d3);
+                _mm_storeu_ps(row + k, d0);
+                _mm_storeu_ps(row + HEML__W + k, d1);
+                _mm_storeu_ps(row + 2 * HEML__W + k, d2);
+            }
+        }
+    }
+}
+
+static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                              heml_real *HEML__RESTRICT out)
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            double *od = (double *)(void *)out;
+            __m128d xy[4][4]; /* [node][lane] */
+            double zz[4][4];
+            for (j = 0; j < 4; j++) {
+                __m256d X, Y, Z, t0, t1;
+                if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                    const double *f0 = (const double *)(const void *)f[0] + k;
+                    X = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0), _mm256_loadu_pd(f0 + 3 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 6 * HEML__W));
+                    Y = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + HEML__W), _mm256_loadu_pd(f0 + 4 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 7 * HEML__W));
+                    Z = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + 2 * HEML__W), _mm256_loadu_pd(f0 + 5 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 8 * HEML__W));
+                } else {
+                    const double *fj = (const double *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm256_loadu_pd(fj);
+                    Y = _mm256_loadu_pd(fj + HEML__W);
+                    Z = _mm256_loadu_pd(fj + 2 * HEML__W);
+                }
+                t0 = _mm256_unpacklo_pd(X, Y); /* x0 y0 x2 y2 */
+                t1 = _mm256_unpackhi_pd(X, Y); /* x1 y1 x3 y3 */
+                xy[j][0] = _mm256_castpd256_pd128(t0);
+                xy[j][1] = _mm256_castpd256_pd128(t1);
+                xy[j][2] = _mm256_extractf128_pd(t0, 1);
+                xy[j][3] = _mm256_extractf128_pd(t1, 1);
+                _mm256_storeu_pd(zz[j], Z);
+            }
+            for (l = 0; l < 4; l++) { /* lanes in order: shared nodes see the scalar order */
+                for (j = 1; j < 4; j++) {
+                    double *o = od + 3 * (size_t)idx[j * HEML__W + k + l];
+                    _mm_storeu_pd(o, _mm_add_pd(_mm_loadu_pd(o), xy[j][l]));
+                    o[2] += zz[j][l];
+                }
+                {
+                    double *o = od + 3 * (size_t)idx[k + l];
+                    _mm_storeu_pd(o, _mm_sub_pd(_mm_loadu_pd(o), xy[0][l]));
+                    o[2] -= zz[0][l];
+                }
+            }
+        } else {
+            float *of = (float *)(void *)out;
+            __m128 v[4][4];
+            for (j = 0; j < 4; j++) {
+                __m128 X, Y, Z, W = _mm_setzero_ps();
+                if (j == 0) {
+                    const float *f0 = (const float *)(const void *)f[0] + k;
+                    X = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0), _mm_loadu_ps(f0 + 3 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 6 * HEML__W));
+                    Y = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + HEML__W), _mm_loadu_ps(f0 + 4 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 7 * HEML__W));
+                    Z = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + 2 * HEML__W), _mm_loadu_ps(f0 + 5 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 8 * HEML__W));
+                } else {
+                    const float *fj = (const float *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm_loadu_ps(fj);
+                    Y = _mm_loadu_ps(fj + HEML__W);
+                    Z = _mm_loadu_ps(fj + 2 * HEML__W);
+                }
+                _MM_TRANSPOSE4_PS(X, Y, Z, W);
+                v[j][0] = X, v[j][1] = Y, v[j][2] = Z, v[j][3] = W;
+            }
+            for (l = 0; l < 4; l++) {
+                for (j = 0; j < 4; j++) {
+                    float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
+                    __m128 xyo = _mm_castpd_ps(_mm_load_sd((const double *)(const void *)o)), r;
+                    r = j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]);
+                    _mm_store_sd((double *)(void *)o, _mm_castps_pd(r));
+                    o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
+                             : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
+                }
+            }
+        }
+    }
+}
+#endif
+
+/* The gather and scatter of a model: vector where compiled in and m->simd, else scalar. */
+static void heml__gather(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__gather_vec(idx, x, e);
+        return;
+    }
+#endif
+    (void)m;
+    heml__gather_scalar(idx, x, e);
+}
+
+static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HEML__W], heml_real *out)
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__scatter_vec(idx, f, out);
+        return;
+    }
+#endif
+    (void)m;
+    heml__scatter_scalar(idx, f, out);
 }
 
 /* The same with absolute values (the size of the terms each node's force sums). */
@@ -2454,7 +2626,7 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    heml__gather(idx, u, b->e);
+    heml__gather(m, idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml__spring_rest_links(R, b);
@@ -2578,8 +2750,8 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml_real sp;
     int k;
-    heml__gather(idx, u, b->e);
-    heml__gather(idx, dx, b->de);
+    heml__gather(m, idx, u, b->e);
+    heml__gather(m, idx, dx, b->de);
     if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
@@ -2720,7 +2892,7 @@ static void heml__chunks(void *vctx, int begin, int end)
             case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
                     below += b.jm1[k] < jm1_0;
                     inverted += b.jm1[k] <= -1;
@@ -2728,14 +2900,14 @@ static void heml__chunks(void *vctx, int begin, int end)
                 break;
             case HEML__DIFF:
                 heml__block_diff(m, mt, blk, p->x, p->dx, &b);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 break;
             case HEML__ABS:
                 heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 heml__scatter_abs(idx, b.f, p->out);
                 break;
             case HEML__ENERGY:
-                heml__gather(idx, p->x, b.e);
+                heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
                     heml__spring_rest_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
@@ -3845,6 +4017,7 @@ static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
     m->parallel = d->tet_count >= HEML_PARALLEL_MIN_TETS;
+    m->simd = 1;
     memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     *out = m;

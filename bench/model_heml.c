@@ -203,9 +203,9 @@ static void hm_move_groups(void *ctx, int begin, int end)
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++)
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-            heml__gather(idx, m->disp, b.e);
+            heml__gather(m, idx, m->disp, b.e);
             hm_move_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
-            heml__scatter(idx, b.f, p->out);
+            heml__scatter(m, idx, b.f, p->out);
         }
 }
 
