@@ -1684,7 +1684,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
     static kernel_span spans[256 * BENCH_KERNEL_COUNT]; /* 256 model entries at most (main) */
     int span_count = 0;
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
-    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move"};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move", "K*v-csr", "arith"};
     double bandwidth[3];
     int i, s, th, kern, sizes = o->quick ? 1 : 4, max_threads = o->threads;
     FILE *f;
@@ -1717,6 +1717,8 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
             bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
             void *sim = NULL;
             if (m->create(&b, &sim)) continue;
+            double ns1[BENCH_KERNEL_COUNT], bound1 = NAN;
+            for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++) ns1[kern] = NAN;
             /* one step under gravity, so the kernels see a generic deformed state */
             m->step(sim, 1e-5, (m->integrators & BIT(BENCH_SEMI_IMPLICIT_EULER)) ? BENCH_SEMI_IMPLICIT_EULER
                                                                                  : BENCH_IMPLICIT_EULER);
@@ -1739,6 +1741,10 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                         k->large_elems = elems, k->large_ns = ns;
                     }
                     bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
+                    if (th == 1) {
+                        ns1[kern] = ns;
+                        if (kern == BENCH_KERNEL_FORCE) bound1 = bound;
+                    }
                     printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
                            m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
                     fflush(stdout);
@@ -1747,6 +1753,16 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                             m->precision, kernel_name[kern], th, elems, m->element, ns, bytes / elems, bound,
                             ns / bound, bandwidth[th]);
                 }
+            /* the issue-21 ratios, measured in this run (1 thread) */
+            if (ns1[BENCH_KERNEL_FORCE] > 0 && (ns1[BENCH_KERNEL_ARITH] > 0 || ns1[BENCH_KERNEL_CSR] > 0)) {
+                printf("  ratios %s %s %s, %.0f elements, 1 thread: force at %.0f %% of its bandwidth bound", m->model,
+                       m->variant, m->precision, m->elements(sim), 100 * bound1 / ns1[BENCH_KERNEL_FORCE]);
+                if (ns1[BENCH_KERNEL_ARITH] > 0)
+                    printf(", %.2f x its arithmetic floor", ns1[BENCH_KERNEL_FORCE] / ns1[BENCH_KERNEL_ARITH]);
+                if (ns1[BENCH_KERNEL_CSR] > 0)
+                    printf(", K*v %.2f x the CSR product's time", ns1[BENCH_KERNEL_KV] / ns1[BENCH_KERNEL_CSR]);
+                printf("\n");
+            }
             m->destroy(sim);
         }
     }
