@@ -64,6 +64,8 @@
        HEML_STATIC     make every function static (private to the including file).
        HEML_PARALLEL_MIN_TETS
                        meshes with fewer tetrahedra run serially (default 16384).
+       HEML_NO_SIMD    no intrinsics: the portable scalar gather, scatter and square
+                       roots even where the target has AVX (results are the same bits).
 
    STEP BY STEP
        1. heml_desc d = heml_default_desc(); fill the mesh, the material (or a table of
@@ -519,7 +521,8 @@
    least a pass must move from memory: the stream plus each node's displacement read once
    and force written once (105 bytes per tetrahedron on the beam below). Tetrahedra sit in
    blocks of 16 (structure of arrays inside a block); a block's arithmetic is vectorised
-   loops over its lanes; gather and scatter are scalar loops (AVX2 has no scatter). The
+   loops over its lanes; gather and scatter are vector code where the target has AVX
+   (issue 21, below), scalar loops elsewhere. The
    Neo-Hookean force: 9 subtractions (the link displacements), H = du V^-1 (27
    multiply-adds), cof H (18), J - 1, one logarithm with its log1p correction (a
    branch-free fdlibm polynomial, which vectorises where libm's log is a call), two
@@ -616,6 +619,60 @@
    was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); the
    kernel figures above come from the Zen 3 named earlier. There the clock alone would bring
    20 ns near 15, and the bound halves with the bandwidth; neither is measured.
+   Issue 21 (this machine is not the Zen 3 above any more: /proc/cpuinfo says AMD EPYC
+   family 26 (Zen 5) with AVX-512, gcc 12 takes -march=native as znver3 plus AVX-512;
+   shared by several jobs, load 4 to 7 on 2 vCPUs, so timings move by 2x: figures are the
+   minimum of 5 to 15 interleaved runs, ns per tetrahedron, 8,640-tetrahedron beam, force /
+   differential, and instruction counts by callgrind of -march=x86-64-v3 builds, which
+   valgrind can run):
+                                    before           after         instructions (v3)
+       Neo-Hookean, -march=native   12.5 / 15.9      10.1 / 12.4
+       Neo-Hookean, x86-64-v3       13.5 / 21.1      11.4 / 17.7   213 / 278 -> 160 / 198
+       St Venant-Kirchhoff          14.6             (unchanged)   259 / 376 -> 207 / 296
+       Mooney-Rivlin (split)        39 / 45          17 / 22       490 / 606 -> 230 / 320
+       springs                      284 / 34         17            451 / 509 -> 248 / 270
+   So every law's force is within 1.5 times the Neo-Hookean force (SVK 1.17, Mooney-Rivlin
+   1.35, springs 1.34, all measured in one interleaved run before the gather change; the
+   gather and scatter serve every law alike). What changed, all bit-identical to the scalar
+   path except the cube root:
+   - the spring force: heml__spring_forces took the differential's terms under a branch on
+     dt, which gcc if-converted, so the force pass multiplied the unset workspace de, whose
+     stack garbage held subnormals (microcode assists: 15x). The differential is now
+     heml__spring_dforces. Its six square roots per tetrahedron go through
+     heml__sqrt_lanes (AVX _mm256_sqrt, correctly rounded like sqrt; libm's sqrt keeps
+     errno, so gcc does not vectorise it, and optimize("no-math-errno") on the function
+     had no effect).
+   - Mooney-Rivlin: J^-1/3 by heml__inv_cbrt (a float bit-trick guess and Newton steps,
+     3.6 ulp in double, 2 in float, where libm's cbrt is a call), its energy terms
+     (log1p, expm1 calls) in a loop of their own: the law's loop vectorises. Forces move
+     by round-off against 0.3.0's.
+   - the gather (heml__gather_vec): per lane and node one masked 3-component load
+     (AVX-512 VL masks, or AVX's vmaskmov: never reads past an array's end), differences in
+     AoS, a 4 x 4 transpose per link into the lanes' rows. The scatter (heml__scatter_vec):
+     per lane and node a 16-byte (x, y) and a scalar z read-modify-write, lanes in order;
+     masked 3-component stores were tried and lost (force 12.7 -> 20.4 ns: a masked store
+     does not forward to the next lane's load of a shared node), as did unmasked 32-byte
+     stores (they would write a neighbour node's x, a race with another colour group).
+     AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
+     conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
+     (tests compare both, bit for bit, every law).
+   - tried and not kept: software prefetch of the next block's nodes and the rest constants
+     of the block after (large meshes): no difference measurable above this machine's
+     noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns in the
+     same interleaved series: noise).
+   The bench's ratio lines (bench/bench.c, kernels part, `--filter heml`; one loaded run of
+   git ea15902 plus these kernels, double, 1 thread) put the Neo-Hookean force at 20 to 23 %
+   of its bandwidth bound at 1e3 to 1e4 tetrahedra and 13 to 14 % at 1e5 to 1e6 (goal 40 %:
+   not met), at 2.3 to 2.6 times its arithmetic floor in cache (the `arith` rows: the same
+   pass without gather and scatter; goal 2: not met, the gather/scatter still costs more than
+   the arithmetic), and the differential at 0.85 to 0.89 times a CSR product of the same
+   assembled tangent at 1e3 tetrahedra but 1.2 to 2.1 times at 1e4 to 1e6 in double; in float
+   0.46 to 0.98 times at every size (a float CSR still reads a 4-byte column index per value,
+   so halving the real size saves it less than it saves the kernel).
+   What the remaining gap needs (not done): more independent chains per block in double
+   (HEML__W = 32: a change of the chunk structure, so of every sum's order), and a
+   differential that caches F, cof F and the volumetric scalars per tetrahedron at the
+   linearisation point (88 more bytes per tetrahedron: still below the CSR's about 300).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -699,6 +756,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
+             masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
+             spring force 15x faster (no differential terms on an unset workspace) and its
+             square roots vectorised; Mooney-Rivlin's J^-1/3 by a branch-free Newton cube
+             root (forces change by round-off). See PERFORMANCE, issue 21.
        unreleased (issue 19) HEML_BDF2 (second order, the same Newton minimisation as
              implicit Euler; the model keeps its history, 2 more 3n vectors, and 2 3n
              scratch vectors); point probes (heml_probe_*); modal analysis (heml_modal_*).
