@@ -195,8 +195,23 @@ build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_com
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -DBENCH_FLOAT -c -o $@ $<
 
-build/bench/bench: bench/bench.c bench/bench.h bench/svg.h $(BENCH_OBJS)
-	gcc $(BENCH_CFLAGS) $(WARN) $(BENCH_DEFS) -o $@ bench/bench.c $(BENCH_OBJS) -lm
+# The peer (issue 21): Bullet's deformable bodies, when Debian's libbullet-dev is installed
+# (pkg-config bullet); otherwise the bench prints how to install it and skips those rows.
+# (-Wno-maybe-uninitialized: gcc 12 warns inside Bullet's own array templates.)
+BULLET := $(shell pkg-config --exists bullet 2>/dev/null && echo 1)
+ifeq ($(BULLET),1)
+BENCH_PEER_OBJS := build/bench/peer_bullet.o
+BENCH_PEER_DEFS := -DBENCH_HAVE_BULLET
+BENCH_PEER_LIBS := $(shell pkg-config --libs bullet) -lstdc++
+endif
+
+build/bench/peer_bullet.o: bench/peer_bullet.cpp bench/bench.h bench/body_mesh.h examples/tetmesh.h
+	@mkdir -p build/bench
+	g++ -std=c++11 -O3 -march=native -Wall -Wextra -Werror -Wno-maybe-uninitialized $(patsubst -I%,-isystem %,$(shell pkg-config --cflags bullet)) -c -o $@ $<
+
+build/bench/bench: bench/bench.c bench/bench.h bench/svg.h $(BENCH_OBJS) $(BENCH_PEER_OBJS)
+	gcc $(BENCH_CFLAGS) $(WARN) $(BENCH_DEFS) $(BENCH_PEER_DEFS) -o $@ bench/bench.c $(BENCH_OBJS) $(BENCH_PEER_OBJS) \
+	  $(BENCH_PEER_LIBS) -lm
 
 # The bench's 2-thread kernel rows run with passive waiting too (see ENV_omp-double): on a
 # shared machine spinning threads measure the neighbours' load, not the kernel. It costs

@@ -38,7 +38,9 @@ enum {
                                    (issue 21: the differential against an assembled matrix) */
     BENCH_KERNEL_ARITH = 5,     /* the force pass's arithmetic alone (no gather or scatter:
                                    one gathered block reused), the arithmetic floor */
-    BENCH_KERNEL_COUNT = 6
+    BENCH_KERNEL_STEP = 6,      /* one implicit step of 1 ms under gravity (per element), where
+                                   an adapter times it: the peer comparison (issue 21) */
+    BENCH_KERNEL_COUNT = 7
 };
 
 typedef struct bench_body {

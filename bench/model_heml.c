@@ -398,6 +398,7 @@ static int hm_kernel(void *v, int kernel)
         return 0;
     }
     if (kernel == BENCH_KERNEL_ARITH && !s->m->has_springs) return hm_arith(s);
+    if (kernel == BENCH_KERNEL_STEP) return heml_step_ex(s->m, (heml_real)1e-3, HEML_IMPLICIT_EULER);
     if (kernel == BENCH_KERNEL_MOVE && !s->m->has_springs) { /* (springs stream more) */
         hm_move p;
         p.m = s->m;
