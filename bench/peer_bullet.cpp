@@ -165,10 +165,10 @@ int bt_kernel(void *v, int kernel)
 const bench_model bt_models[] = {
     {"bullet", "neo-hookean", "neo-hookean", "float", 1u << BENCH_IMPLICIT_EULER, 1, 1, "tet", bt_create_nh,
      bt_destroy, bt_dof, bt_node_count, bt_rest, bt_position, bt_pin, bt_release, bt_set_gravity, bt_solve_static,
-     bt_step, bt_forces, NULL, bt_elements, bt_kernel_bytes, bt_kernel, NULL, NULL},
+     bt_step, bt_forces, NULL, bt_elements, bt_kernel_bytes, bt_kernel, NULL, NULL, NULL},
     {"bullet", "corotated", "linear", "float", 1u << BENCH_IMPLICIT_EULER, 1, 1, "tet", bt_create_corotated,
      bt_destroy, bt_dof, bt_node_count, bt_rest, bt_position, bt_pin, bt_release, bt_set_gravity, bt_solve_static,
-     bt_step, bt_forces, NULL, bt_elements, bt_kernel_bytes, bt_kernel, NULL, NULL},
+     bt_step, bt_forces, NULL, bt_elements, bt_kernel_bytes, bt_kernel, NULL, NULL, NULL},
 };
 
 } // namespace
