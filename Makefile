@@ -49,8 +49,9 @@ CC_asan-double  := gcc -std=c99 -O1 -g1 -fno-omit-frame-pointer -fsanitize=addre
 # exist only when the target has them: these two build for this machine (-march=native;
 # on a machine without AVX they test the scalar path again) and run the programs of the
 # headers that have such paths (heml.h: test_heml, whose test_vector_paths_match_scalar
-# compares them with the scalar path bit for bit), on the TEST_QUICK sizes, double with 2
-# OpenMP threads.
+# compares them with the scalar path bit for bit; in double also test_heml_sim, whose
+# thread-count determinism and allocation tests then run the vector paths), on the
+# TEST_QUICK sizes, double with 2 OpenMP threads.
 CC_simd-double  := gcc -std=c99 -O2 -march=native -fopenmp -DTEST_QUICK
 CC_simd-float   := gcc -std=c99 -O2 -march=native $(FLOAT) -DTEST_QUICK
 
@@ -68,7 +69,7 @@ COMPILE_ONLY := test_compile_all test_compile_static
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
 TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
-TESTS_simd-double := test_heml
+TESTS_simd-double := test_heml test_heml_sim
 TESTS_simd-float := test_heml
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
