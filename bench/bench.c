@@ -1100,7 +1100,8 @@ static void stability_twist(const bench_model *m, const options *o)
     stability_out(&r);
 }
 
-static void run_stability(const options *o, const bench_model *const *models, int count)
+static void run_stability(const options *o, const bench_model *const *models, int count,
+                          const bench_model *const *variants, int variant_count)
 {
     int i;
     printf("\n== 2. stability at the extremes ==\n");
@@ -1114,6 +1115,7 @@ static void run_stability(const options *o, const bench_model *const *models, in
         stability_twist(models[i], o);
         stability_far(models[i]);
     }
+    for (i = 0; i < variant_count; i++) stability_poisson(variants[i], o); /* the primary = -1 entries */
     fclose(stability_csv);
 }
 
@@ -1912,8 +1914,8 @@ static void usage(void)
 int main(int argc, char **argv)
 {
     options o;
-    static const bench_model *models[256];
-    int i, count = 0;
+    static const bench_model *models[256], *variants[64];
+    int i, count = 0, variant_count = 0;
     double t0 = now();
     memset(&o, 0, sizeof o);
     o.repeats = 3;
@@ -1941,7 +1943,10 @@ int main(int argc, char **argv)
         int n, j;
         const bench_model *table = registry[i](&n);
         for (j = 0; j < n && count < 256; j++)
-            if (selected(&o, table + j)) models[count++] = table + j;
+            if (selected(&o, table + j)) {
+                if (table[j].primary >= 0) models[count++] = table + j;
+                else if (variant_count < 64) variants[variant_count++] = table + j;
+            }
     }
     {
         const char *wait = getenv("OMP_WAIT_POLICY");
@@ -1957,7 +1962,7 @@ int main(int argc, char **argv)
     set_threads(1);
     if (o.parts & 1) run_trade(&o, models, count);
     set_threads(1);
-    if (o.parts & 2) run_stability(&o, models, count);
+    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
     set_threads(1);
     if (o.parts & 8) run_sweep(&o, models, count);
     set_threads(1);
