@@ -195,7 +195,7 @@ static double hm_kernel_bytes(void *v, int kernel)
 static void hm_block_diff(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
     const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    if (mt->fast) heml__diff_nh(mt, m->jm1_0, R, b);
+    if (mt->fast) heml__diff_nh(m, mt, blk, b);
     else {
         heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
         heml__diff_general(1, R, b);
