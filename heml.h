@@ -146,7 +146,13 @@
    heml_create only. Pointers returned by heml_positions and friends point into the model
    and stay valid until heml_destroy. Meshes of 96 nodes or more also hold the static
    solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
-   24, at most 64: up to 1.2 MB).
+   24, at most 64: up to 1.2 MB). The stiffness cache (desc.stiffness_cache = 1, the
+   default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
+   float: the model's largest array, against 80 / 40 of rest constants) when a material in
+   use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
+   incompressible Mooney-Rivlin with c2 = 0; no Prony series, no nodal pressure), none
+   otherwise; desc.stiffness_cache = 0 leaves it out (products then cost about 1.4 to 2
+   times as much, see PERFORMANCE).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -743,10 +749,37 @@
    assembled tangent at 1e3 tetrahedra but 1.2 to 2.1 times at 1e4 to 1e6 in double; in float
    0.46 to 0.98 times at every size (a float CSR still reads a 4-byte column index per value,
    so halving the real size saves it less than it saves the kernel).
-   What the remaining gap needs (not done): more independent chains per block in double
-   (HEML__W = 32: a change of the chunk structure, so of every sum's order), and a
-   differential that caches F, cof F and the volumetric scalars per tetrahedron at the
-   linearisation point (88 more bytes per tetrahedron: still below the CSR's about 300).
+   The stiffness cache (issue 21, second part; desc.stiffness_cache, default on): the
+   implicit step's and the static solve's CG multiply the tangent at one linearisation
+   point 10 to 1000 times, so what that point fixes is computed once per linear solve and
+   kept per tetrahedron. The differential is rewritten in the links (heml__diff_nh):
+       df = -2 c1 dv A - s1 (cof v : dv) cof v - s2 dcof v,
+       A = Vol G G^T (6),  v the current links (9),  s1 = U''(J) / (36 Vol),  s2 = w_J / 6,
+   from cof F = cof v cof G and cof G G^T = det G I = I / (6 Vol), G = V^-1 (the classical
+   form, exact: the finite-difference tests hold it). A product then reads 17 reals of cache
+   and the 4 indices per tetrahedron and no rest constants (152 bytes in double against the
+   uncached 96 plus a second gather, and the CSR matrix's about 280: 23 values and column
+   indices per tetrahedron on 5-tetrahedron cubes; in float 84 against 190), and costs about 110 arithmetic operations (145 through F, and
+   the logarithm and division of the uncached kernel are gone). The first product after the
+   state or the pins or J0 change fills the cache while it computes (the same apply on the
+   same values: cached and uncached products are bit-identical, tests/test_heml.c
+   test_stiffness_cache, and so are implicit steps with and without it); the cache is keyed
+   by the linearisation point and invalidated at every linear solve's start and end and by
+   every public function that changes the state, the pins, J0 or the viscous state (Prony
+   and nodal pressure models do not take the Neo-Hookean kernels and have no cache; caching
+   the general path would need about 40 reals per tetrahedron, more than a CSR row share in
+   float: not done). The cached pass prefetches the next block's cache and indices
+   (__builtin_prefetch where the compiler has it): the prefetch alone took the cached
+   product from 1.4 to 0.7-0.8 times the CSR product at 1e5 tetrahedra (interleaved, min of
+   3). Measured (bench kernels part, `--filter heml --threads 1`, loaded machine, one run;
+   interleaved minimum of 3 to 5 rounds by a harness linking the bench's adapter in
+   parentheses), Neo-Hookean K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra: double BENCH_D
+   float BENCH_F. Tried: the F form of the cache (F, U''(J) Vol, w_J Vol: 11 reals plus the
+   rest constants, 184 bytes): 0.9 to 1.05 of the CSR at 1e6 in double; one fused loop for
+   the F form's apply instead of three: no difference above noise; prefetching the rest
+   constants in the uncached general path (St Venant-Kirchhoff): none either.
+   What the force's remaining gap needs (not done): more independent chains per block in
+   double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -1310,11 +1343,15 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m);
 /* The force differential at the current positions: out = (d f / d x) dx (3n values each,
    N for dx in m; out is overwritten, caller-owned), i.e. minus the tangent stiffness
    times dx, exact for every law (the J0 continuation and Prony scaling included). One
-   pass; HEML_ERR_NO_SECOND_DERIVATIVES for a user law without `second`. */
+   pass; HEML_ERR_NO_SECOND_DERIVATIVES for a user law without `second`. With the stiffness
+   cache (desc.stiffness_cache, Neo-Hookean tetrahedra) the first call after a change of
+   the state fills it, the next ones at the same state read it (bit-identical results). */
 HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *out);
 /* Bytes one force pass (kernel 0) or one differential pass (kernel 1) must move at least:
    the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus spring and Prony data)
-   and each node's displacement (and dx) read once and force written once. */
+   and each node's displacement (and dx) read once and force written once; for kernel 1
+   the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 reals of
+   cache instead, and read dx only. */
 HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, size_t *written);
 
 /* ---- state access (pointers into the model, valid until heml_destroy) ---- */
@@ -3227,14 +3264,14 @@ typedef struct heml__pass {
    ahead (the cached stiffness product: measured 1.4 times faster on
    meshes beyond the caches, see PERFORMANCE). A hint only: nothing where the compiler has
    no prefetch builtin. */
-static void heml__prefetch_block(const heml_real *C, const int *idx)
+static void heml__prefetch_block(const heml_real *C, int rows, const int *idx)
 {
 #if defined(__GNUC__) || defined(__clang__)
     size_t o;
-    for (o = 0; o < HEML__NC * HEML__W * sizeof(heml_real); o += 64) __builtin_prefetch((const char *)C + o);
+    for (o = 0; o < (size_t)rows * HEML__W * sizeof(heml_real); o += 64) __builtin_prefetch((const char *)C + o);
     for (o = 0; o < 4 * HEML__W * sizeof(int); o += 64) __builtin_prefetch((const char *)idx + o);
 #else
-    (void)C, (void)idx;
+    (void)C, (void)rows, (void)idx;
 #endif
 }
 
@@ -3268,7 +3305,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
                     heml_real *C = m->dc + (size_t)blk * HEML__NC * HEML__W;
                     if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
-                        heml__prefetch_block(C + HEML__NC * HEML__W, idx + 4 * HEML__W);
+                        heml__prefetch_block(C + HEML__NC * HEML__W, HEML__NC, idx + 4 * HEML__W);
                     if (m->dc_pass == HEML__DC_FILL) {
                         heml__gather(m, idx, p->x, b.e);
                         heml__gather(m, idx, m->rest, b.H);
