@@ -151,8 +151,8 @@
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
    incompressible Mooney-Rivlin with c2 = 0; no Prony series, no nodal pressure), none
-   otherwise; desc.stiffness_cache = 0 leaves it out (products then cost about 1.4 to 2
-   times as much, see PERFORMANCE).
+   otherwise; desc.stiffness_cache = 0 leaves it out (each product then recomputes them:
+   see PERFORMANCE for the cost).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -771,10 +771,17 @@
    float: not done). The cached pass prefetches the next block's cache and indices
    (__builtin_prefetch where the compiler has it): the prefetch alone took the cached
    product from 1.4 to 0.7-0.8 times the CSR product at 1e5 tetrahedra (interleaved, min of
-   3). Measured (bench kernels part, `--filter heml --threads 1`, loaded machine, one run;
-   interleaved minimum of 3 to 5 rounds by a harness linking the bench's adapter in
-   parentheses), Neo-Hookean K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra: double BENCH_D
-   float BENCH_F. Tried: the F form of the cache (F, U''(J) Vol, w_J Vol: 11 reals plus the
+   3). Measured, Neo-Hookean K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra, one thread: the
+   bench (`--parts kernels --filter heml/neo-hookean/ --threads 1`, one loaded run, medians)
+   double 0.55, 0.66, 0.99, 1.16, float 0.28, 0.27, 0.30, 0.60; a harness linking the
+   bench's adapter, the three kernels interleaved, minimum of 3 to 5 rounds, over five
+   runs: double 0.45-0.54, 0.63-0.74, 0.50-0.84, 0.70-1.05, float 0.24-0.36, 0.32-0.48,
+   0.39-0.56, 0.45-0.74 (before the cache, the previous report: double 0.85-0.89 at 1e3,
+   1.2-2.1 beyond). So the goal holds in float everywhere and in double to 1e4 with a
+   margin; in double at 1e5 to 1e6 the product is at par with the CSR product (within the
+   noise of this shared machine, 3.3 times its bandwidth bound against the CSR's 1.5: its
+   gather and scatter, not its stream, now bound it; prefetching the next block's nodes
+   too showed nothing above noise). Tried: the F form of the cache (F, U''(J) Vol, w_J Vol: 11 reals plus the
    rest constants, 184 bytes): 0.9 to 1.05 of the CSR at 1e6 in double; one fused loop for
    the F form's apply instead of three: no difference above noise; prefetching the rest
    constants in the uncached general path (St Venant-Kirchhoff): none either.
@@ -1177,7 +1184,7 @@ typedef struct heml_desc {
                                         user laws with second derivatives */
     int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
                                         tetrahedron what its linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 11 reals a tetrahedron); 0: no cache, no memory */
+                                        MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */

@@ -1746,6 +1746,22 @@ static void test_stiffness_cache(void)
 #else
     box_mesh(&mesh, 4, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
 #endif
+    { /* the field is 0 or 1 */
+        heml_desc d = heml_default_desc();
+        heml_model *m = NULL;
+        heml_real *X = alloc_reals(3 * mesh.node_count);
+        int i;
+        for (i = 0; i < 3 * mesh.node_count; i++) X[i] = (heml_real)mesh.nodes[i];
+        d.rest_positions = X;
+        d.node_count = mesh.node_count;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        CHECK_INT(1, d.stiffness_cache);
+        d.stiffness_cache = 2;
+        CHECK_INT(HEML_ERR_ARG, heml_create(&d, &m));
+        CHECK(m == NULL);
+        free(X);
+    }
     for (nodal = 0; nodal < 2; nodal++)
         for (li = 0; li < NLAWS; li++) {
             heml_material mt = material_of(all_laws[li]);
