@@ -876,6 +876,12 @@ typedef FRM_REAL frm_real;
    memory, thesis sec. 4.4). */
 #define FRM_MAX_NEIGHBORS 16
 
+/* The two-level preconditioner's coarse space (desc.coarse_aggregates, see SOLVERS): the
+   default and largest number of aggregates, and the fewest frames an aggregate holds. */
+#define FRM_COARSE_AGGREGATES 64
+#define FRM_COARSE_MAX_AGGREGATES 256
+#define FRM_COARSE_MIN_FRAMES 8
+
 /* The least bytes each kernel streams per (sample, neighbour) pair (see PERFORMANCE), for
    bandwidth bounds: the force pass (pass 1 reads index, weight, gradient and rest lever,
    writes 6 reals; pass 2 reads them back with the pair index), the matrix-free K v (pass 1
@@ -1147,6 +1153,12 @@ typedef struct frm_desc {
                                        sit near 1e-7 of the diagonal; 0 gives the plain
                                        Newton step */
     frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
+    int coarse_aggregates;     /* two-level preconditioner (see SOLVERS, >>coarse): at most this
+                                  many aggregates of frames (cells of the rest bounding box, at
+                                  least FRM_COARSE_MIN_FRAMES frames each), whose rigid motions
+                                  form a coarse space solved exactly on top of block-Jacobi in
+                                  every CG solve; 0 = block-Jacobi only. Default
+                                  FRM_COARSE_AGGREGATES (0 to FRM_COARSE_MAX_AGGREGATES) */
 
     /* environment */
     frm_allocator allocator;          /* all NULL: FRM_MALLOC / FRM_FREE */
@@ -2276,6 +2288,10 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #endif
 
 #define FRM__COOKIE 0x46524D53u         /* "FRMS" */
+#ifndef FRM__COARSE_MODES
+#define FRM__COARSE_MODES 9 /* per aggregate: translation, rigid rotation, the frames' own rotation */
+#endif
+
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__PROBE_COOKIE 0x46524D51u   /* "FRMQ" */
@@ -2402,7 +2418,18 @@ struct frm_model {
                                 discontinuity or a change of dt) */
     double history_dt;       /* the step length the history was made with */
 
+    /* coarse space (>>coarse): rigid motions of aggregates of frames */
+    int agg_count;       /* aggregates (0: block-Jacobi only) */
+    int *f_agg;          /* 1 per frame: its aggregate */
+    double *coarse;      /* (6 A)^2: A_c = P^T (a_mass M + a_stiff K) P, then its Cholesky factor */
+    double *coarse_rhs;  /* 6 A: the coarse right-hand side and solution */
+    double *agg_centre;  /* 3 A: the aggregates' mean position at the coarse matrix's build */
+    frm_real *coarse_dq; /* 6 per slot of a sample (scratch): a coarse mode's dq on its frames */
+    int coarse_ready;    /* the factor matches the last frm__build_precond */
+    double precond_mass, precond_stiff; /* a_mass, a_stiff of the last frm__build_precond */
+
     int lin_valid, lin_mode, lin_iterations;
+    int lin_predict; /* the next linear solve's iterations, predicted: max(last, previous prediction / 2) (-1: none yet) */
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
 };
@@ -3074,6 +3101,71 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->history, frm_real, 13 * n);
     FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
     FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
+    if (m->agg_count) {
+        size_t D = FRM__COARSE_MODES * (size_t)m->agg_count;
+        FRM__CARVE(c, m->f_agg, int, n);
+        FRM__CARVE(c, m->coarse, double, D * D);
+        FRM__CARVE(c, m->coarse_rhs, double, D);
+        FRM__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
+        FRM__CARVE(c, m->coarse_dq, frm_real, 6 * FRM_MAX_NEIGHBORS);
+    }
+}
+
+/* >>coarse (aggregation) ---------------------------------------------------------------- */
+
+/* Bins the frames' rest positions into roughly cubic cells of their bounding box, at most
+   min(max_agg, n / FRM_COARSE_MIN_FRAMES) cells; returns the number of non-empty cells (0:
+   no coarse space, fewer than 2 aggregates) and, when agg is not NULL, each frame's cell
+   renumbered 0.. in cell order. Deterministic: a function of the rest positions only. */
+static int frm__aggregate(const frm_real *x, int n, int max_agg, int *agg)
+{
+    double lo[3], hi[3], ext[3], size, vol = 1.0, big = 0.0;
+    int dims[3], i, r, target = n / FRM_COARSE_MIN_FRAMES, cells, count = 0;
+    int used[FRM_COARSE_MAX_AGGREGATES];
+    if (target > max_agg) target = max_agg;
+    if (target < 2) return 0;
+    for (r = 0; r < 3; r++) lo[r] = hi[r] = (double)x[r];
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            double v = (double)x[3 * i + r];
+            if (v < lo[r]) lo[r] = v;
+            if (v > hi[r]) hi[r] = v;
+        }
+    for (r = 0; r < 3; r++) big = hi[r] - lo[r] > big ? hi[r] - lo[r] : big;
+    if (!(big > 0)) return 0;
+    for (r = 0; r < 3; r++) { /* a flat or thin body: its thin axes count as 1e-6 of the largest */
+        ext[r] = hi[r] - lo[r] > 1e-6 * big ? hi[r] - lo[r] : 1e-6 * big;
+        vol *= ext[r];
+    }
+    size = cbrt(vol / target);
+    for (;;) {
+        cells = 1;
+        for (r = 0; r < 3; r++) {
+            dims[r] = (int)(ext[r] / size + 0.5);
+            if (dims[r] < 1) dims[r] = 1;
+            cells *= dims[r];
+        }
+        if (cells <= target) break;
+        size *= 1.05;
+    }
+    for (i = 0; i < cells; i++) used[i] = -1;
+    for (i = 0; i < n; i++) {
+        int c = 0;
+        for (r = 2; r >= 0; r--) {
+            int k = (int)(((double)x[3 * i + r] - lo[r]) / ext[r] * dims[r]);
+            if (k >= dims[r]) k = dims[r] - 1;
+            if (k < 0) k = 0;
+            c = c * dims[r] + k;
+        }
+        if (agg) agg[i] = c;
+        used[c] = 0;
+    }
+    for (i = 0; i < cells; i++)
+        if (used[i] == 0) used[i] = count++;
+    if (count < 2) return 0;
+    if (agg)
+        for (i = 0; i < n; i++) agg[i] = used[agg[i]];
+    return count;
 }
 
 /* >>validation ------------------------------------------------------------------------- */
@@ -3148,6 +3240,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
+    if (d->coarse_aggregates < 0 || d->coarse_aggregates > FRM_COARSE_MAX_AGGREGATES)
+        return frm__fail(d, FRM_ERR_SOLVER, "coarse_aggregates must be 0 to FRM_COARSE_MAX_AGGREGATES");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return frm__fail(d, FRM_ERR_ARG, "allocator needs both alloc and free");
     return FRM_OK;
@@ -3310,6 +3404,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.rotation_stabilization = (frm_real)0.5;
     d.rotation_divergence = (frm_real)4;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    d.coarse_aggregates = FRM_COARSE_AGGREGATES;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
     return d;
@@ -3607,6 +3702,7 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
         tmp->block_count = (int)blocks;
         tmp->sq_total = (int)sq;
     }
+    tmp->agg_count = frm__aggregate(d->frame_positions, n, d->coarse_aggregates, NULL);
     tmp->stab_beta = d->rotation_stabilization;
     tmp->stab_gamma = d->rotation_divergence;
     if (tmp->stab_beta > 0)
@@ -3795,6 +3891,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     int i;
     frm__create_settings(m, d);
     frm__create_frames(m, d, t);
+    if (m->agg_count) frm__aggregate(d->frame_positions, m->frame_count, d->coarse_aggregates, m->f_agg);
     frm__create_samples(m, d);
     frm__create_pairs(m, d);
     i = frm__compute_masses(m, d);
@@ -3804,6 +3901,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     }
     frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
+    m->lin_predict = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
     return FRM_OK;
@@ -4505,7 +4603,7 @@ static int frm__choose_mode(const frm_model *m)
     if (m->stiffness_mode == FRM_STIFFNESS_PAIRS || !m->has_blocks) return FRM_STIFFNESS_PAIRS;
     if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS) return FRM_STIFFNESS_BLOCKS;
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
-    it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
+    it = m->lin_predict >= 0 ? (double)m->lin_predict + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
     pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
@@ -4684,7 +4782,261 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
                 if (((m->axes[i] >> (k / 6)) & 1) || ((m->axes[i] >> (k % 6)) & 1)) inv[k] = 0;
         for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
     }
+    m->precond_mass = a_mass;
+    m->precond_stiff = a_stiff;
+    m->coarse_ready = 0;
     return fixed;
+}
+
+/* >>coarse ------------------------------------------------------------------------------ */
+
+/* The two-level preconditioner (SOLVERS): block-Jacobi plus a coarse correction
+   P A_c^-1 P^T, P the rigid motions of the aggregates (frm__aggregate): a rigid motion
+   (t, omega) of aggregate a moves its frame i by (t + omega x d_i, omega), d_i = x_i - c_a
+   (current positions, c_a the aggregate's mean), so P_i = [I, -[d_i]x; 0, I]. Only free
+   frames without held axes take part. A_c = P^T (a_mass M + a_stiff K) P is the Galerkin
+   projection of the linearisation itself, built per sample without the fine blocks: with
+   dq_i = P_i (t, omega) a sample's dF = sum_i dx_i grad w_i^T + [dtheta_i]x G_i becomes
+   t grad_a^T + [omega]x G_a per aggregate a among its neighbours, grad_a = sum grad w_i,
+   G_a = sum (d_i grad w_i^T + G_i): a virtual pair, so the law's tangent columns and
+   frm_pair_block give its coarse blocks exactly (material and geometric parts); the
+   frame-own rotational terms (lin_hrot), the regularisation and the mass blocks
+   P_i^T M_i P_i add per frame. The rotation stabilisation and the coupling term, zero for
+   a rigid motion of a whole sample's neighbourhood, are left out (a preconditioner need not
+   be exact). Serial, in sample order: deterministic for any thread count. A_c is dense,
+   symmetrised and Cholesky-factored in double; a pivot at or below 1e-10 of its diagonal
+   (an aggregate held by fixed frames, an indefinite linearisation) drops that mode. Cost
+   per build: one tangent evaluation per (sample, aggregate) and (6 A)^3 / 3 flops. */
+static void frm__system_product(frm_model *m, double a_mass, double a_stiff, const frm_real *v, frm_real *out);
+
+/* The components of frame i that take part in the coarse space: 0 for fixed and driven
+   frames, the free axes of a free one (bit k for component k). */
+static unsigned frm__coarse_mask(const frm_model *m, int i) { return m->state[i] == FRM__FREE ? 63u & ~(unsigned)m->axes[i] : 0u; }
+
+/* dq = mask (P_i e) for the coarse direction e of frame i's aggregate (0-2: translation
+   t, 3-5: rigid rotation omega, 6-8: the frames' own rotation phi). */
+static void frm__coarse_mode(const frm_model *m, int i, int e, frm_real dq[6])
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    double d[3], v[6] = {0, 0, 0, 0, 0, 0};
+    unsigned mask = frm__coarse_mask(m, i);
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    if (e >= 6) e -= 3; /* phi: the rotation alone */
+    else if (e >= 3) { /* omega: and omega x d */
+        v[e] = 1;
+        v[0] = v[4] * d[2] - v[5] * d[1];
+        v[1] = v[5] * d[0] - v[3] * d[2];
+        v[2] = v[3] * d[1] - v[4] * d[0];
+    }
+    v[e] = 1;
+    for (r = 0; r < 6; r++) dq[r] = (mask >> r) & 1 ? (frm_real)v[r] : 0;
+}
+
+/* y += (mask P_i)^T r for frame i's 6 values r: (r_t, r_w + d x r_t, r_w) of the masked r. */
+static void frm__coarse_restrict(const frm_model *m, int i, const frm_real *rv, double *y)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], x[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    for (r = 0; r < 6; r++) x[r] = (mask >> r) & 1 ? (double)rv[r] : 0.0;
+    for (r = 0; r < 3; r++) y[r] += x[r];
+    y[3] += x[3] + (d[1] * x[2] - d[2] * x[1]);
+    y[4] += x[4] + (d[2] * x[0] - d[0] * x[2]);
+    y[5] += x[5] + (d[0] * x[1] - d[1] * x[0]);
+    for (r = 6; r < FRM__COARSE_MODES; r++) y[r] += x[r - 3];
+}
+
+/* z += mask P_i u: (u_t + u_w x d, u_w + u_phi) on frame i's free components. */
+static void frm__coarse_prolong(const frm_model *m, int i, const double *u, frm_real *z)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], o[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    o[0] = u[0] + (u[4] * d[2] - u[5] * d[1]);
+    o[1] = u[1] + (u[5] * d[0] - u[3] * d[2]);
+    o[2] = u[2] + (u[3] * d[1] - u[4] * d[0]);
+    for (r = 3; r < 6; r++) o[r] = u[r] + (FRM__COARSE_MODES > 6 ? u[r + 3] : 0.0);
+    for (r = 0; r < 6; r++)
+        if ((mask >> r) & 1) z[r] += (frm_real)o[r];
+}
+
+/* Sample s's part of P^T K P: for each aggregate among its neighbours and each of its six
+   rigid motions, the sample's K v exactly as the pair-mode product computes it (dF, the
+   law's dP, the rotation stabilisation's stress and torques; not the coupling term), its
+   output per slot projected by P^T. */
+static void frm__coarse_sample(frm_model *m, int s, double a_stiff)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, slots[FRM_MAX_NEIGHBORS], agg_of[FRM_MAX_NEIGHBORS];
+    int na = 0, j, e, k, r, c, D = FRM__COARSE_MODES * m->agg_count, law = m->s_law[s];
+    const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+    frm_real *dqs = m->coarse_dq, vol = m->s_volume[s];
+    for (k = 0; k < n; k++) {
+        int f = m->p_frame[b + k];
+        agg_of[k] = -1;
+        if (!frm__coarse_mask(m, f)) continue;
+        for (j = 0; j < na && slots[j] != m->f_agg[f]; j++) {}
+        if (j == na) slots[na++] = m->f_agg[f];
+        agg_of[k] = j;
+    }
+    for (j = 0; j < na; j++)
+        for (e = 0; e < FRM__COARSE_MODES; e++) {
+            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], stq[3 * FRM_MAX_NEIGHBORS], out[6];
+            const frm_real *dth[FRM_MAX_NEIGHBORS];
+            static const frm_real zero[3] = {0, 0, 0};
+            for (k = 0; k < n; k++) {
+                frm_real *dq = dqs + 6 * k;
+                if (agg_of[k] == j) frm__coarse_mode(m, m->p_frame[b + k], e, dq);
+                else
+                    for (r = 0; r < 6; r++) dq[r] = 0;
+                frm_pair_dF(dq, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), dF);
+                dth[k] = agg_of[k] == j ? dq + 3 : zero;
+            }
+            frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                        m->lin_S + 6 * (size_t)s, dF, dP);
+            if (m->s_stab[s]) {
+                frm_real dPx[9];
+                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
+                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+            }
+            for (k = 0; k < n; k++) {
+                int q = agg_of[k];
+                double y[FRM__COARSE_MODES] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+                if (q < 0) continue;
+                frm_pair_apply(vol, dP, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), out);
+                if (m->s_stab[s])
+                    for (r = 0; r < 3; r++) out[3 + r] += stq[3 * k + r];
+                /* row block slots[q], column 6 slots[j] + e: (mask P_f)^T out */
+                frm__coarse_restrict(m, m->p_frame[b + k], out, y);
+                for (c = 0; c < FRM__COARSE_MODES; c++) m->coarse[(size_t)(FRM__COARSE_MODES * slots[q] + c) * D + FRM__COARSE_MODES * slots[j] + e] += a_stiff * y[c];
+            }
+        }
+}
+
+static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, s, j, k, r, c;
+    double *Ac = m->coarse, *cnt = m->coarse_rhs, *ctr = m->agg_centre;
+    m->coarse_ready = 0;
+    if (!A) return;
+    memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
+    memset(ctr, 0, sizeof(double) * 3 * (size_t)A);
+    for (k = 0; k < A; k++) cnt[k] = 0;
+    for (i = 0; i < m->frame_count; i++)
+        if (frm__coarse_mask(m, i)) {
+            for (r = 0; r < 3; r++) ctr[3 * m->f_agg[i] + r] += (double)m->pos[3 * i + r];
+            cnt[m->f_agg[i]] += 1;
+        }
+    for (k = 0; k < A; k++)
+        for (r = 0; r < 3; r++) ctr[3 * k + r] /= cnt[k] > 0 ? cnt[k] : 1;
+    if (a_stiff != 0)
+        for (s = 0; s < m->sample_count; s++)
+            frm__coarse_sample(m, s, a_stiff);
+    for (i = 0; i < m->frame_count; i++) { /* per frame: frame-own terms, regularisation, mass */
+        double A6[36], PM[6 * FRM__COARSE_MODES], T[6 * FRM__COARSE_MODES], *blk;
+        frm_real col[6];
+        if (!frm__coarse_mask(m, i)) continue;
+        blk = Ac + (size_t)(FRM__COARSE_MODES * m->f_agg[i]) * D + FRM__COARSE_MODES * m->f_agg[i];
+        frm__mass_matrix(m, i, A6);
+        for (k = 0; k < 36; k++) A6[k] *= a_mass;
+        if (a_stiff != 0) {
+            frm_real H[36];
+            for (k = 0; k < 36; k++) H[k] = 0;
+            frm__add_rotational(m->lin_hrot + 6 * (size_t)i, H);
+            for (k = 3; k < 6; k++) H[7 * k] += (frm_real)(m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
+            for (k = 0; k < 36; k++) A6[k] += a_stiff * (double)H[k];
+        }
+        for (c = 0; c < FRM__COARSE_MODES; c++) { /* PM = mask P_i, 6 x modes */
+            frm__coarse_mode(m, i, c, col);
+            for (r = 0; r < 6; r++) PM[FRM__COARSE_MODES * r + c] = (double)col[r];
+        }
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += A6[6 * r + k] * PM[FRM__COARSE_MODES * k + c];
+                T[FRM__COARSE_MODES * r + c] = t;
+            }
+        for (r = 0; r < FRM__COARSE_MODES; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += PM[FRM__COARSE_MODES * k + r] * T[FRM__COARSE_MODES * k + c];
+                blk[(size_t)r * D + c] += t;
+            }
+    }
+    for (r = 0; r < D; r++) /* the symmetric part */
+        for (c = 0; c < r; c++) {
+            double t = 0.5 * (Ac[(size_t)r * D + c] + Ac[(size_t)c * D + r]);
+            Ac[(size_t)r * D + c] = Ac[(size_t)c * D + r] = t;
+        }
+    for (k = 0; k < D; k++) cnt[k] = Ac[(size_t)k * D + k];
+#ifdef FRM_DEBUG_COARSE
+    {
+        double *u = (double*)malloc(sizeof(double)*D), *y=(double*)malloc(sizeof(double)*D), num=0, den=0;
+        int n6 = 6*m->frame_count; frm_real *v = (frm_real*)malloc(sizeof(frm_real)*n6), *o = (frm_real*)malloc(sizeof(frm_real)*n6), col[6];
+        for (k = 0; k < D; k++) u[k] = sin(1.3*k+0.7);
+        for (k = 0; k < n6; k++) v[k] = 0;
+        for (i = 0; i < m->frame_count; i++) { if (!frm__coarse_mask(m,i)) continue;
+            for (c = 0; c < FRM__COARSE_MODES; c++) { frm__coarse_mode(m, i, c, col); for (r = 0; r < 6; r++) v[6*i+r] += (frm_real)(col[r]*u[FRM__COARSE_MODES*m->f_agg[i]+c]); } }
+        frm__system_product(m, a_mass, a_stiff, v, o);
+        for (k = 0; k < D; k++) y[k] = 0;
+        for (i = 0; i < m->frame_count; i++) { if (!frm__coarse_mask(m,i)) continue;
+            for (c = 0; c < FRM__COARSE_MODES; c++) { frm__coarse_mode(m, i, c, col); for (r = 0; r < 6; r++) y[FRM__COARSE_MODES*m->f_agg[i]+c] += col[r]*o[6*i+r]; } }
+        for (r = 0; r < D; r++) { double t = 0; for (c = 0; c < D; c++) t += Ac[(size_t)r*D+c]*u[c]; num += (t-y[r])*(t-y[r]); den += y[r]*y[r]; }
+        fprintf(stderr, "coarse check: |Ac u - P^T A P u| / |.| = %g (a_mass %g a_stiff %g)\n", sqrt(num/den), a_mass, a_stiff);
+        free(u); free(y); free(v); free(o);
+    }
+#endif
+    for (k = 0; k < D; k++) { /* Cholesky, lower triangle, in place */
+        double *Lk = Ac + (size_t)k * D, dk = Lk[k];
+        for (j = 0; j < k; j++) dk -= Lk[j] * Lk[j];
+        if (!(dk > 1e-10 * cnt[k]) || !frm__finite(dk)) {
+            for (i = k; i < D; i++) Ac[(size_t)i * D + k] = 0.0;
+            continue;
+        }
+        dk = sqrt(dk);
+        Lk[k] = dk;
+        for (i = k + 1; i < D; i++) {
+            double *Li = Ac + (size_t)i * D, t = Li[k];
+            for (j = 0; j < k; j++) t -= Li[j] * Lk[j];
+            Li[k] = t / dk;
+        }
+    }
+    m->coarse_ready = 1;
+}
+
+/* z += P A_c^-1 P^T r (P masked by the held components). */
+static void frm__coarse_apply(frm_model *m, const frm_real *rv, frm_real *z)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, j;
+    double *y = m->coarse_rhs, *L = m->coarse;
+    memset(y, 0, sizeof(double) * (size_t)D);
+    for (i = 0; i < m->frame_count; i++) /* y = P^T r */
+        if (frm__coarse_mask(m, i)) frm__coarse_restrict(m, i, rv + 6 * i, y + FRM__COARSE_MODES * m->f_agg[i]);
+    for (i = 0; i < D; i++) { /* L y' = y */
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+    for (i = D - 1; i >= 0; i--) { /* L^T x = y' */
+        double t = y[i], Lii = L[(size_t)i * D + i];
+        if (Lii == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
+        y[i] = t / Lii;
+    }
+    for (i = 0; i < m->frame_count; i++) /* z += P u */
+        if (frm__coarse_mask(m, i)) frm__coarse_prolong(m, i, y + FRM__COARSE_MODES * m->f_agg[i], z + 6 * i);
 }
 
 /* >>solver ----------------------------------------------------------------------------- */
@@ -4721,8 +5073,9 @@ static void frm__system_product(frm_model *m, double a_mass, double a_stiff, con
     frm__mask(m, out);
 }
 
-/* z = P r per frame. */
-static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *z)
+/* z = P r per frame, plus the coarse correction (built here at the first use after
+   frm__build_precond). */
+static void frm__precond_apply(frm_model *m, const frm_real *r, frm_real *z)
 {
     int i, a, b;
     for (i = 0; i < m->frame_count; i++) {
@@ -4732,6 +5085,10 @@ static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *
             for (b = 0; b < 6; b++) t += P[6 * a + b] * x[b];
             z[6 * i + a] = t;
         }
+    }
+    if (m->agg_count) {
+        if (!m->coarse_ready) frm__coarse_build(m, m->precond_mass, m->precond_stiff);
+        frm__coarse_apply(m, r, z);
     }
 }
 
@@ -4805,10 +5162,16 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     if (status == FRM__CG_OK && !frm__finite(rr)) status = FRM__CG_NOT_FINITE;
     if (status == FRM__CG_OK && !(rr <= tol2)) status = FRM__CG_CAP;
     if (status == FRM__CG_NEGATIVE) m->stats.negative_curvature++;
+#ifdef FRM_DEBUG_CG
+    fprintf(stderr, "cg: %d iterations to %g (status %d, a_mass %g a_stiff %g)\n", it, tolerance, status, a_mass, a_stiff);
+#endif
     m->stats.cg_iterations_last = it;
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
     m->lin_iterations = it;
+    /* a short solve (a Newton iteration near convergence) does not predict the next: the
+       probe's or the next increment's solves are long again */
+    m->lin_predict = it > m->lin_predict / 2 ? it : m->lin_predict / 2;
     return status;
 }
 
