@@ -878,7 +878,7 @@ typedef FRM_REAL frm_real;
 
 /* The two-level preconditioner's coarse space (desc.coarse_aggregates, see SOLVERS): the
    default and largest number of aggregates, and the fewest frames an aggregate holds. */
-#define FRM_COARSE_AGGREGATES 64
+#define FRM_COARSE_AGGREGATES 32
 #define FRM_COARSE_MAX_AGGREGATES 256
 #define FRM_COARSE_MIN_FRAMES 8
 
@@ -2291,6 +2291,7 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #ifndef FRM__COARSE_MODES
 #define FRM__COARSE_MODES 9 /* per aggregate: translation, rigid rotation, the frames' own rotation */
 #endif
+#define FRM__COARSE_MIN_ITERATIONS 40 /* solves with mass: block-Jacobi iterations that turn the coarse correction on */
 
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
@@ -2427,6 +2428,8 @@ struct frm_model {
     frm_real *coarse_dq; /* 6 per slot of a sample (scratch): a coarse mode's dq on its frames */
     int coarse_ready;    /* the factor matches the last frm__build_precond */
     double precond_mass, precond_stiff; /* a_mass, a_stiff of the last frm__build_precond */
+    int coarse_use;      /* the coarse correction serves the solves after the last frm__build_precond */
+    int coarse_plain;    /* CG iterations of the last solve without it (-1: none yet) */
 
     int lin_valid, lin_mode, lin_iterations;
     int lin_predict; /* the next linear solve's iterations, predicted: max(last, previous prediction / 2) (-1: none yet) */
@@ -3902,6 +3905,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
     m->lin_predict = -1;
+    m->coarse_plain = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
     return FRM_OK;
@@ -4608,6 +4612,10 @@ static int frm__choose_mode(const frm_model *m)
     pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
+    if (m->coarse_use) { /* the coarse matrix: from the blocks, or a sample pass of 9 products per aggregate */
+        pairs += FRM__COARSE_MODES * 1.5 * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
+        blocks += 3 * FRM__COST_BLOCK_ITER * m->block_count;
+    }
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
 }
 
@@ -4785,6 +4793,10 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
     m->precond_mass = a_mass;
     m->precond_stiff = a_stiff;
     m->coarse_ready = 0;
+    /* static solves always; a solve with mass (implicit steps, shifted modal solves) once
+       block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS: below that the coarse matrix's
+       build (about ten stiffness products) costs more than it saves */
+    m->coarse_use = m->agg_count && (a_mass == 0 || m->coarse_plain >= FRM__COARSE_MIN_ITERATIONS);
     return fixed;
 }
 
@@ -4807,7 +4819,6 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
    symmetrised and Cholesky-factored in double; a pivot at or below 1e-10 of its diagonal
    (an aggregate held by fixed frames, an indefinite linearisation) drops that mode. Cost
    per build: one tangent evaluation per (sample, aggregate) and (6 A)^3 / 3 flops. */
-static void frm__system_product(frm_model *m, double a_mass, double a_stiff, const frm_real *v, frm_real *out);
 
 /* The components of frame i that take part in the coarse space: 0 for fixed and driven
    frames, the free axes of a free one (bit k for component k). */
@@ -4917,6 +4928,50 @@ static void frm__coarse_sample(frm_model *m, int s, double a_stiff)
         }
 }
 
+/* Row i of the assembled blocks' part of P^T K P (block mode): (mask P_i)^T K_ij (mask P_j)
+   for each block, K P_j and then P_i^T by their structure (about 150 multiply-adds a
+   block). The blocks hold the lin_hrot term on the diagonal, which the per-frame loop of
+   frm__coarse_build then does not add again. */
+static void frm__coarse_row(frm_model *m, int i, double a_stiff)
+{
+    const int NM = FRM__COARSE_MODES;
+    int e, r, c, D = NM * m->agg_count;
+    unsigned mi = frm__coarse_mask(m, i);
+    double di[3];
+    if (!mi) return;
+    for (r = 0; r < 3; r++) di[r] = (double)m->pos[3 * i + r] - m->agg_centre[3 * m->f_agg[i] + r];
+    for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+        const frm_real *K = m->blocks + 36 * (size_t)e;
+        int f = m->blk_col[e];
+        unsigned mj = frm__coarse_mask(m, f);
+        double Km[36], X[6 * FRM__COARSE_MODES], Y[FRM__COARSE_MODES * FRM__COARSE_MODES], dj[3], *blk;
+        if (!mj) continue;
+        for (r = 0; r < 3; r++) dj[r] = (double)m->pos[3 * f + r] - m->agg_centre[3 * m->f_agg[f] + r];
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < 6; c++) Km[6 * r + c] = ((mi >> r) & 1) && ((mj >> c) & 1) ? (double)K[6 * r + c] : 0.0;
+        for (r = 0; r < 6; r++) { /* X = Km P_j: (K_t, K_w + K_t (e_k x d), K_w) */
+            const double *k = Km + 6 * r;
+            double *x = X + NM * r;
+            x[0] = k[0], x[1] = k[1], x[2] = k[2];
+            x[3] = k[3] + (k[2] * dj[1] - k[1] * dj[2]); /* K_t (e_k x d) */
+            x[4] = k[4] + (k[0] * dj[2] - k[2] * dj[0]);
+            x[5] = k[5] + (k[1] * dj[0] - k[0] * dj[1]);
+            if (NM > 6) x[6] = k[3], x[7] = k[4], x[8] = k[5];
+        }
+        for (c = 0; c < NM; c++) { /* Y = P_i^T X: (X_t, X_w + d x X_t, X_w) */
+            double t0 = X[c], t1 = X[NM + c], t2 = X[2 * NM + c];
+            Y[c] = t0, Y[NM + c] = t1, Y[2 * NM + c] = t2;
+            Y[3 * NM + c] = X[3 * NM + c] + (di[1] * t2 - di[2] * t1);
+            Y[4 * NM + c] = X[4 * NM + c] + (di[2] * t0 - di[0] * t2);
+            Y[5 * NM + c] = X[5 * NM + c] + (di[0] * t1 - di[1] * t0);
+            if (NM > 6) Y[6 * NM + c] = X[3 * NM + c], Y[7 * NM + c] = X[4 * NM + c], Y[8 * NM + c] = X[5 * NM + c];
+        }
+        blk = m->coarse + (size_t)(NM * m->f_agg[i]) * D + NM * m->f_agg[f];
+        for (r = 0; r < NM; r++)
+            for (c = 0; c < NM; c++) blk[(size_t)r * D + c] += a_stiff * Y[NM * r + c];
+    }
+}
+
 static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
 {
     int A = m->agg_count, D = FRM__COARSE_MODES * A, i, s, j, k, r, c;
@@ -4933,7 +4988,10 @@ static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
         }
     for (k = 0; k < A; k++)
         for (r = 0; r < 3; r++) ctr[3 * k + r] /= cnt[k] > 0 ? cnt[k] : 1;
-    if (a_stiff != 0)
+    if (a_stiff != 0 && m->lin_mode == FRM_STIFFNESS_BLOCKS)
+        for (i = 0; i < m->frame_count; i++)
+            frm__coarse_row(m, i, a_stiff);
+    else if (a_stiff != 0)
         for (s = 0; s < m->sample_count; s++)
             frm__coarse_sample(m, s, a_stiff);
     for (i = 0; i < m->frame_count; i++) { /* per frame: frame-own terms, regularisation, mass */
@@ -4946,7 +5004,7 @@ static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
         if (a_stiff != 0) {
             frm_real H[36];
             for (k = 0; k < 36; k++) H[k] = 0;
-            frm__add_rotational(m->lin_hrot + 6 * (size_t)i, H);
+            if (m->lin_mode != FRM_STIFFNESS_BLOCKS) frm__add_rotational(m->lin_hrot + 6 * (size_t)i, H); /* in the blocks */
             for (k = 3; k < 6; k++) H[7 * k] += (frm_real)(m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
             for (k = 0; k < 36; k++) A6[k] += a_stiff * (double)H[k];
         }
@@ -4973,23 +5031,6 @@ static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
             Ac[(size_t)r * D + c] = Ac[(size_t)c * D + r] = t;
         }
     for (k = 0; k < D; k++) cnt[k] = Ac[(size_t)k * D + k];
-#ifdef FRM_DEBUG_COARSE
-    {
-        double *u = (double*)malloc(sizeof(double)*D), *y=(double*)malloc(sizeof(double)*D), num=0, den=0;
-        int n6 = 6*m->frame_count; frm_real *v = (frm_real*)malloc(sizeof(frm_real)*n6), *o = (frm_real*)malloc(sizeof(frm_real)*n6), col[6];
-        for (k = 0; k < D; k++) u[k] = sin(1.3*k+0.7);
-        for (k = 0; k < n6; k++) v[k] = 0;
-        for (i = 0; i < m->frame_count; i++) { if (!frm__coarse_mask(m,i)) continue;
-            for (c = 0; c < FRM__COARSE_MODES; c++) { frm__coarse_mode(m, i, c, col); for (r = 0; r < 6; r++) v[6*i+r] += (frm_real)(col[r]*u[FRM__COARSE_MODES*m->f_agg[i]+c]); } }
-        frm__system_product(m, a_mass, a_stiff, v, o);
-        for (k = 0; k < D; k++) y[k] = 0;
-        for (i = 0; i < m->frame_count; i++) { if (!frm__coarse_mask(m,i)) continue;
-            for (c = 0; c < FRM__COARSE_MODES; c++) { frm__coarse_mode(m, i, c, col); for (r = 0; r < 6; r++) y[FRM__COARSE_MODES*m->f_agg[i]+c] += col[r]*o[6*i+r]; } }
-        for (r = 0; r < D; r++) { double t = 0; for (c = 0; c < D; c++) t += Ac[(size_t)r*D+c]*u[c]; num += (t-y[r])*(t-y[r]); den += y[r]*y[r]; }
-        fprintf(stderr, "coarse check: |Ac u - P^T A P u| / |.| = %g (a_mass %g a_stiff %g)\n", sqrt(num/den), a_mass, a_stiff);
-        free(u); free(y); free(v); free(o);
-    }
-#endif
     for (k = 0; k < D; k++) { /* Cholesky, lower triangle, in place */
         double *Lk = Ac + (size_t)k * D, dk = Lk[k];
         for (j = 0; j < k; j++) dk -= Lk[j] * Lk[j];
@@ -5086,7 +5127,7 @@ static void frm__precond_apply(frm_model *m, const frm_real *r, frm_real *z)
             z[6 * i + a] = t;
         }
     }
-    if (m->agg_count) {
+    if (m->coarse_use) {
         if (!m->coarse_ready) frm__coarse_build(m, m->precond_mass, m->precond_stiff);
         frm__coarse_apply(m, r, z);
     }
@@ -5162,9 +5203,6 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     if (status == FRM__CG_OK && !frm__finite(rr)) status = FRM__CG_NOT_FINITE;
     if (status == FRM__CG_OK && !(rr <= tol2)) status = FRM__CG_CAP;
     if (status == FRM__CG_NEGATIVE) m->stats.negative_curvature++;
-#ifdef FRM_DEBUG_CG
-    fprintf(stderr, "cg: %d iterations to %g (status %d, a_mass %g a_stiff %g)\n", it, tolerance, status, a_mass, a_stiff);
-#endif
     m->stats.cg_iterations_last = it;
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
@@ -5172,6 +5210,7 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     /* a short solve (a Newton iteration near convergence) does not predict the next: the
        probe's or the next increment's solves are long again */
     m->lin_predict = it > m->lin_predict / 2 ? it : m->lin_predict / 2;
+    if (!m->coarse_use) m->coarse_plain = it;
     return status;
 }
 
