@@ -5224,8 +5224,16 @@ static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double
 {
     switch (m->linear_solver) {
     case FRM_LINEAR_SOLVER_CG:
-    default:
-        return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+    default: {
+        int st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+        if (st == FRM__CG_CAP && !m->coarse_use && m->agg_count) { /* block-Jacobi alone was not enough: */
+            int first = m->stats.cg_iterations_last;                /* on from here, and again from its iterate */
+            m->coarse_use = 1;
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->stats.cg_iterations_last += first;
+        }
+        return st;
+    }
     }
 }
 
