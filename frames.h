@@ -9,8 +9,9 @@
    functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
    compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
    samples, exact forces and stiffness (material and geometric),
-   a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
-   gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
+   a static Newton solver, implicit Euler and BDF2, all with conjugate gradient
+   preconditioned by block-Jacobi plus a coarse space (two levels), matrix-free or by
+   assembled 6x6 blocks, modal analysis (the lowest natural
    frequencies and modes about the current state) and point probes (a material point's
    position, displacement and velocity through the shape functions). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
@@ -341,7 +342,7 @@
 
    SOLVERS
        Static (sec. 3.6): Newton iterations K dq = f on the free frames (f the total
-       force), each by block-Jacobi preconditioned CG stopped at an Eisenstat-Walker
+       force), each by two-level preconditioned CG (below) stopped at an Eisenstat-Walker
        relative residual (1e-3, then as fast as the residual falls, never below
        cg_tolerance, never tighter than the step can use), then a backtracking Armijo line
        search on the total potential (elastic + gravity - f_ext . dq; constant torques have
@@ -467,6 +468,49 @@
        linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
        line search and the step update; their velocity is zero; their forces count as
        reactions in the residual's scale.
+       Preconditioner (issue 21): two levels. The fine level is block-Jacobi (the inverse
+       6x6 diagonal blocks); the coarse level adds P A_c^-1 P^T, with the frames binned
+       into at most desc.coarse_aggregates (default FRM_COARSE_AGGREGATES = 32) cells of
+       their rest bounding box, at least FRM_COARSE_MIN_FRAMES (8) frames each, and 9
+       modes per aggregate: its translation t, its rigid rotation omega (frame i moves by
+       t + omega x (x_i - c), turns by omega) and the frames' own rotation phi (turns by
+       phi, does not move). The last is the one slender and stabilised bodies need: a
+       field of frame rotations that moves no material costs only the stabilisation's
+       h^2 energy, so block-Jacobi resolves it slowest, and rigid modes alone gained only
+       2-3 times (measured on R1). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin
+       product of the linearisation (rotation stabilisation and held axes included, the
+       coupling term left out), from the assembled blocks in block mode (about 150
+       multiply-adds a block) or a per-sample pass in pair mode (9 sample products per
+       aggregate the sample touches), dense and Cholesky-factored in double, a pivot at or
+       below 1e-10 of its diagonal dropping its mode; built at the first CG iteration after
+       each linearisation, serially in a fixed order (bit-identical for any thread count),
+       in the model's block (no allocation: (9 A)^2 doubles, 663 kB for 32 aggregates).
+       Static solves always use it; solves with mass (implicit steps, shifted modal
+       solves) once a solve by block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS (40)
+       or met cg_max_iterations (that solve is then continued with it): below that the
+       build (about ten products) costs more than it saves. coarse_aggregates = 0 gives
+       block-Jacobi alone. Measured (issue 21; one core, gcc -O2 -march=native, CPU time;
+       R1 16 x 0.5 x 0.5 m steel cantilever, 32k x k x k cells, clamped, own weight), CG
+       iterations of the first Newton solve (to 1e-3) with / without the coarse level (64
+       aggregates; the default 32 measured 60 against 57 at k = 4):
+           hexahedral frames, 2^3 samples a cell:
+             k = 1 (132 frames) 35 / 424, k = 2 (585) 36 / 579, k = 3 (1,552) 45 / 829,
+             k = 4 (3,225) 57 / 1,097, k = 6 (9,457) 78 / 1,637
+           tetrahedral frames (6 a cube), one sample each:
+             k = 1 138 / 1,545, k = 2 61 / 2,125, k = 3 67 / 3,094, k = 4 81 / 4,101
+       so within 3x of the smallest mesh's count as the frames grow 72x. The whole static
+       solve (Newton and the minimum check's probe solve): hexahedral k = 3 (1.7 % off
+       R1's 3D solid) 0.92 s against 2.48 s CPU, k = 4 (0.91 %) 2.45 s against 9.9 s,
+       k = 6 (0.39 %) 13.3 s against 59 s; tetrahedral k = 4 0.61 s against 5.6 s. The
+       probe (CG to 1e-7 from a pseudo-random right-hand side) is now most of the hexahedral
+       solve: 1,112 of 1,233 iterations at k = 4 (it excites the stabilised rotation modes of
+       every wavelength, which no coarse mode holds). Implicit Euler on the same beam (k = 2,
+       five steps and creation, CPU, default 32 aggregates): steel at dt = 1 ms, 10 ms,
+       0.1 s 0.40 / 0.48 s, 0.66 / 1.02 s, 0.64 / 1.36 s (with / without; the last step's
+       solves 42 / 355, 66 / 1,282, 68 / 1,968 CG iterations); E = 1 MPa: dt = 1 ms and
+       10 ms need under 40 iterations (it stays off: same time), at dt = 0.1 s it turns on
+       and breaks even (0.72 against 0.70 s; 87 against 233 iterations; 64 aggregates
+       lost 30 %: its Cholesky each Newton iteration), see LIMITS.
        One CG policy: a linear solve stopped at cg_max_iterations above its tolerance fails
        the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
        far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
@@ -597,6 +641,29 @@
          21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
          Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
          test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
+       - Thin parts (issue 14): a plate one cell thick of hexahedral frames solves static and
+         implicit problems and converges under refinement (tests/test_frames.c
+         test_i14_thin_plate: 1 x 1 x 0.05 m cantilever plate under its own weight, 5.85,
+         6.12, 6.20 mm at 4, 8, 16 cells a side, beam theory 5.89 mm); tetrahedral frames
+         one cell thick (one sample each) solve but do not converge in sight (2.87, 5.47,
+         7.54 mm). A thin slab loaded in its plane can buckle: Cook's membrane one element
+         thick (48 x 44..60 x 1, E = 240.565 Pa, nu = 0.3) has no stable flat state beyond
+         F = 2.05 N (hexahedral frames, 16 cells a side; 4.5 N at 4): at the usual F = 32 N
+         the flat state is a saddle and, the load being symmetric about the mid-plane,
+         Newton cannot leave the plane: the static solve refuses (FRM_ERR_UNSTABLE, or
+         FRM_ERR_STALLED when the continuation wanders near the saddle; the stall message's
+         "rotations the samples do not see" is then not the cause). Hold the out-of-plane
+         axes for the plane problem (frm_model_set_frame_axes(m, i, 4, 3): test_i18_cook_membrane)
+         or nudge it out of plane (1e-3 of the load) for the buckled one (corner u_y 7.8,
+         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations). Frames along a
+         curve (meshless Shepard frames on a line, samples in a thin tube) solve but are not
+         consistent: zero-order weights on a line give no convergent bending (tip 0.65,
+         1.6, 3.1, 8.9 mm at 4 to 32 frames against 5.9 mm); a rod model is not done.
+       - The coarse correction of implicit steps turns on after a solve needs 40
+         block-Jacobi iterations; on soft bodies at large steps (E = 1 MPa beam, dt = 0.1 s,
+         40 to 90 iterations a solve) it only breaks even (it is rebuilt every Newton
+         iteration; reusing it across a step's iterations is not done); more aggregates
+         lose there (64: 30 % slower than block-Jacobi alone).
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
@@ -1016,7 +1083,7 @@ typedef enum frm_integrator {
 
 /* Linear solvers of every Newton iteration (static solve and implicit steps). */
 typedef enum frm_linear_solver {
-    FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_CG = 0, /* conjugate gradients, block-Jacobi plus the coarse space (default) */
     FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
 } frm_linear_solver;
 
