@@ -488,7 +488,10 @@
        Static solves always use it; solves with mass (implicit steps, shifted modal
        solves) once a solve by block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS (40)
        or met cg_max_iterations (that solve is then continued with it): below that the
-       build (about ten products) costs more than it saves. coarse_aggregates = 0 gives
+       build (about ten products) costs more than it saves (float builds: only after a
+       solve met the cap; with it, a float implicit step of a tetrahedral plate one cell
+       thick met round-off curvature at 8e-4 relative residual and failed, tests/
+       test_frames.c test_i14_thin_plate). coarse_aggregates = 0 gives
        block-Jacobi alone. Measured (issue 21; one core, gcc -O2 -march=native, CPU time;
        R1 16 x 0.5 x 0.5 m steel cantilever, 32k x k x k cells, clamped, own weight), CG
        iterations of the first Newton solve (to 1e-3) with / without the coarse level (64
@@ -4863,7 +4866,8 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
     /* static solves always; a solve with mass (implicit steps, shifted modal solves) once
        block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS: below that the coarse matrix's
        build (about ten stiffness products) costs more than it saves */
-    m->coarse_use = m->agg_count && (a_mass == 0 || m->coarse_plain >= FRM__COARSE_MIN_ITERATIONS);
+    m->coarse_use = m->agg_count && (a_mass == 0 || m->coarse_plain >= m->cg_max_iterations ||
+                                     (!FRM__IS_FLOAT && m->coarse_plain >= FRM__COARSE_MIN_ITERATIONS));
     return fixed;
 }
 

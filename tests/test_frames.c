@@ -1875,6 +1875,7 @@ static unsigned long long run_hashed(int threads, int workers)
             for (k = 0; k < sizeof(frm_real) * 4 * (size_t)h.node_count; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
         }
         CHECK(frm_model_pair_count(m) >= d.parallel_min_pairs);
+        CHECK(m->agg_count >= 2); /* the coarse correction is in the hashed solves */
         frm_model_destroy(m);
         g[2] = (frm_real)-0.5;
     }
@@ -1929,6 +1930,7 @@ static void test_no_allocation_after_create(void)
         d.stiffness_mode = (frm_stiffness_mode)mode;
         REQUIRE(frm_model_create(&d, &m) == FRM_OK);
         CHECK(frm_model_memory_bytes(m) > 0);
+        CHECK(m->agg_count >= 2); /* the coarse correction's build and solves are in these steps */
         allocs = c.allocs;
         frm_model_fix_frame(m, 0);
         frm_model_fix_frame(m, 4);
@@ -3757,6 +3759,17 @@ static void check_coarse_exact(frm_stiffness_mode mode, double a_mass, double a_
 
 static void test_i21_coarse_galerkin(void)
 {
+    scene sc;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    REQUIRE(scene_hex(&sc, lo, hi, 1, 1, 1, 1, FRM_LAW_SVK, 1e5, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    CHECK_INT(0, sc.m->agg_count); /* 8 frames: too few for two aggregates, block-Jacobi alone */
+    sc.d.coarse_aggregates = -1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&sc.d));
+    sc.d.coarse_aggregates = FRM_COARSE_MAX_AGGREGATES + 1;
+    CHECK_INT(FRM_ERR_SOLVER, try_create(&sc.d));
+    sc.d.coarse_aggregates = 0;
+    CHECK_INT(FRM_OK, try_create(&sc.d));
+    scene_free(&sc);
     check_coarse_exact(FRM_STIFFNESS_BLOCKS, 0, 1, 0);
     check_coarse_exact(FRM_STIFFNESS_PAIRS, 0, 1, 0);
     check_coarse_exact(FRM_STIFFNESS_BLOCKS, 1e3, 1, 1);
@@ -3804,6 +3817,11 @@ static void r1_first_solve(int k, int hex, int aggregates, int *out)
 static void test_i21_coarse_iterations(void)
 {
     int hex, k, top = TEST_IS_QUICK ? 2 : 3;
+    if (IS_FLOAT) { /* a steel beam's tangent (condition about 1e10) puts float's CG at its round-off floor
+                       near the first solve's 1e-3: the counts measure round-off, not the preconditioner */
+        printf("    (double only)\n");
+        return;
+    }
     for (hex = 0; hex < 2; hex++) {
         int first = 0, it = 0, plain = 0;
         for (k = 1; k <= top; k++) {
@@ -3888,6 +3906,10 @@ static void test_i14_thin_plate(void)
             REQUIRE(frm_model_set_gravity(sc.m, zero) == FRM_OK); /* released: it swings back */
             for (s = 0; s < 3; s++) {
                 int e = frm_model_step_ex(sc.m, (frm_real)1e-2);
+                if (e)
+                    printf("    step %d: %s (%d Newton, last CG %d, residual %.3g, CG residual %.3g)\n", s, frm_error_string(e),
+                           frm_model_last_stats(sc.m)->newton_iterations, frm_model_last_stats(sc.m)->cg_iterations_last,
+                           (double)frm_model_last_stats(sc.m)->residual, (double)frm_model_last_stats(sc.m)->cg_residual);
                 CHECK_INT(FRM_OK, e);
             }
             scene_free(&sc);
