@@ -775,7 +775,7 @@
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
    (the symmetric part of K, gravity's and the stresses' geometric terms included; the
    constraints as set) and runs block shift-invert subspace iteration: Y = (K + shift M)^-1
-   M X by the model's linear solver (block-Jacobi CG, warm-started at X / (lambda + shift)
+   M X by the model's linear solver (two-level preconditioned CG, warm-started at X / (lambda + shift)
    once a Ritz value exists), Rayleigh-Ritz on Y (Cholesky of Y^T M Y, Jacobi), X the
    M-orthonormal Ritz vectors, until every wanted residual is below tolerance (or the Ritz
    values stop moving). Chosen over LOBPCG for its simplicity with a matrix-free K and an
@@ -882,6 +882,9 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
+       unreleased (issue 21): CG preconditioned by two levels, block-Jacobi plus a coarse
+             space of 9 modes per aggregate of frames (desc.coarse_aggregates, default 32;
+             0 = block-Jacobi alone): results change within the solve tolerances.
        unreleased (issue 18): the divergence term of the rotation stabilisation
              (desc.rotation_divergence, default 4: removes the tetrahedral frames' spurious
              low modes and the hexahedral frames' zero-energy rotations; changes results
@@ -1665,7 +1668,7 @@ FRMDEF int frm_model_step(frm_model *m);
    state is unchanged. */
 FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
 /* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
-   the total potential energy, each solved by block-Jacobi CG, inside an adaptive load
+   the total potential energy, each solved by two-level preconditioned CG, inside an adaptive load
    continuation (see SOLVERS); velocities are set to zero. Driven frames end at their
    prescribed poses. On failure (see ERRORS) the state is unchanged. */
 FRMDEF int frm_model_solve_static(frm_model *m);
@@ -5150,22 +5153,19 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
 /* >>coarse ------------------------------------------------------------------------------ */
 
 /* The two-level preconditioner (SOLVERS): block-Jacobi plus a coarse correction
-   P A_c^-1 P^T, P the rigid motions of the aggregates (frm__aggregate): a rigid motion
-   (t, omega) of aggregate a moves its frame i by (t + omega x d_i, omega), d_i = x_i - c_a
-   (current positions, c_a the aggregate's mean), so P_i = [I, -[d_i]x; 0, I]. Only free
-   frames without held axes take part. A_c = P^T (a_mass M + a_stiff K) P is the Galerkin
-   projection of the linearisation itself, built per sample without the fine blocks: with
-   dq_i = P_i (t, omega) a sample's dF = sum_i dx_i grad w_i^T + [dtheta_i]x G_i becomes
-   t grad_a^T + [omega]x G_a per aggregate a among its neighbours, grad_a = sum grad w_i,
-   G_a = sum (d_i grad w_i^T + G_i): a virtual pair, so the law's tangent columns and
-   frm_pair_block give its coarse blocks exactly (material and geometric parts); the
-   frame-own rotational terms (lin_hrot), the regularisation and the mass blocks
-   P_i^T M_i P_i add per frame. The rotation stabilisation and the coupling term, zero for
-   a rigid motion of a whole sample's neighbourhood, are left out (a preconditioner need not
-   be exact). Serial, in sample order: deterministic for any thread count. A_c is dense,
-   symmetrised and Cholesky-factored in double; a pivot at or below 1e-10 of its diagonal
-   (an aggregate held by fixed frames, an indefinite linearisation) drops that mode. Cost
-   per build: one tangent evaluation per (sample, aggregate) and (6 A)^3 / 3 flops. */
+   P A_c^-1 P^T over the aggregates of frm__aggregate, 9 modes each: a translation t, a
+   rigid rotation omega (frame i moves by omega x d_i, d_i = x_i - c_a with current
+   positions and c_a the aggregate's mean, and turns by omega) and the frames' own
+   rotation phi (frame i turns by phi and does not move), so per frame
+   P_i = [I, -[d_i]x, 0; 0, I, I], masked by its held components (fixed and driven frames
+   take no part). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin product of the
+   linearisation the solve uses: frm__coarse_row from the assembled blocks (block mode),
+   frm__coarse_sample per sample as the pair-mode product computes it (pair mode; the
+   coupling term left out), plus per frame the mass, the frame-own rotational terms (pair
+   mode) and the regularisation. Serial, in frame or sample order: deterministic for any
+   thread count. Dense, symmetrised and Cholesky-factored in double; a pivot at or below
+   1e-10 of its diagonal (a mode held by fixed frames, an indefinite linearisation) drops
+   that mode. */
 
 /* The components of frame i that take part in the coarse space: 0 for fixed and driven
    frames, the free axes of a free one (bit k for component k). */
