@@ -8929,6 +8929,8 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
     if (md->block > 1024) return FRM_ERR_ARG;
     md->found = 0;
     frm__reset_stats(m);
+    m->coarse_plain = -1; /* a modal solve does not depend on earlier solves (its own bits repeat) */
+    m->lin_predict = -1;
     for (i = 0; i < m->frame_count; i++)
         if (m->state[i] == FRM__FREE)
             for (k = 0; k < 6; k++) free_dof += !((m->axes[i] >> k) & 1);
