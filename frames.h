@@ -8672,12 +8672,12 @@ static double frm__ch_elastic(const frm_chain *c, double *f, double *fsq)
         frm__ch_link_eval(c, i, &L);
         for (k = 0; k < 6; k++) E += 0.5 * L.e[k] * L.g[k];
         if (f) {
-            double kmax = 0, xmax = 1;
+            double kmax = 0, xmax = 0;
             frm__ch_link_force(&L, fl);
             for (k = 0; k < 12; k++) f[6 * i + k] += fl[k], s += fl[k] * fl[k];
             /* and K times one unit of the positions' rounding */
             for (k = 0; k < 6; k++) kmax = L.kc[7 * k] > kmax ? L.kc[7 * k] : kmax;
-            for (k = 0; k < 6; k++) xmax += fabs((double)c->pos[3 * i + k]);
+            for (k = 0; k < 6; k++) xmax = fabs((double)c->pos[3 * i + k]) > xmax ? fabs((double)c->pos[3 * i + k]) : xmax;
             s += kmax * xmax * kmax * xmax;
         }
     }
@@ -8875,7 +8875,7 @@ static double frm__ch_norm(const frm_chain *c, const double *v)
 static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
 {
     int it, i, k, err = FRM_ERR_NO_CONVERGENCE, n6 = 6 * c->n;
-    double h = c->dt, a_m = dyn ? (1 + c->alpha * h) / (h * h) : 0, res = 0, pot = 0;
+    double h = c->dt, a_m = dyn ? (1 + c->alpha * h) / (h * h) : 0, res = 0, pot = 0, previous = HUGE_VAL;
     double *g = c->g, *dq = c->dq, *dl = c->delta, *dl0 = c->delta0;
     frm__ch_store(c, c->save);
     if (iterations) *iterations = 0;
@@ -8915,12 +8915,15 @@ static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
             err = FRM_ERR_NOT_FINITE;
             break;
         }
-        /* converged, or at the round-off floor of the force sums */
-        if (rn <= c->tol * scale || rn <= 64 * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON) * sqrt(c->fsq)) {
+        /* converged, or at the round-off floor of the force sums once an iteration no longer
+           halves the residual */
+        if (rn <= c->tol * scale ||
+            (it > 0 && rn > 0.5 * previous && rn <= 16 * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON) * sqrt(c->fsq))) {
             err = FRM_OK;
             break;
         }
         if (it == c->max_it) break;
+        previous = rn;
         /* Newton direction */
         err = frm__ch_factor(c, a_m);
         if (err) break;
