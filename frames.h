@@ -8205,9 +8205,11 @@ FRMDEF void frm_modal_destroy(frm_modal *md)
 
 /* Block Cholesky of a symmetric block-tridiagonal matrix, blocks of 6 (see the public
    declarations and BLOCK-TRIDIAGONAL SOLVER). Per block i the factor holds
-       L_i (lower triangle, its diagonal stored inverted), S_i = A(i + 1, i) L_i^-T,
-   with L_i L_i^T = A(i, i) - S_{i-1} S_{i-1}^T. Forward y_i = L_i^-1 (b_i - S_{i-1} y_{i-1}),
-   backward x_i = L_i^-T (y_i - S_i^T x_{i+1}). */
+       G_i = L_i^-1 (lower triangular, stored as a full 6x6), S_i = A(i + 1, i) G_i^T,
+   with L_i L_i^T = A(i, i) - S_{i-1} S_{i-1}^T. Forward y_i = G_i (b_i - S_{i-1} y_{i-1}),
+   backward x_i = G_i^T (y_i - S_i^T x_{i+1}). Storing the inverse makes every product a
+   full 6x6 one (fixed trip counts the compiler unrolls and vectorises); the Cholesky and
+   its inversion are the only triangular loops. */
 
 FRMDEF size_t frm_btd_factor_size(int n) { return n < 1 ? 0 : (size_t)72 * (size_t)n; }
 
@@ -8219,21 +8221,24 @@ FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, fr
     if (n < 1 || !diag || !factor || (n > 1 && !lower)) return FRM_ERR_ARG;
     for (i = 0; i < n; i++) {
         const frm_real *A = diag + 36 * (size_t)i;
-        frm_real *L = factor + 72 * (size_t)i, *S = L + 36;
-        double W[36];
-        /* W = A_i - S_{i-1} S_{i-1}^T (lower triangle) */
+        frm_real *Gout = factor + 72 * (size_t)i, *S = Gout + 36;
+        double W[36], G[36];
+        /* W = A_i - S_{i-1} S_{i-1}^T (A's lower triangle mirrored) */
         for (a = 0; a < 6; a++)
-            for (b = 0; b <= a; b++) W[6 * a + b] = (double)A[6 * a + b];
+            for (b = 0; b < 6; b++) W[6 * a + b] = (double)A[a >= b ? 6 * a + b : 6 * b + a];
         if (i > 0) {
             const frm_real *Sp = factor + 72 * (size_t)(i - 1) + 36;
+            double P[36];
+            for (a = 0; a < 36; a++) P[a] = (double)Sp[a];
             for (a = 0; a < 6; a++)
-                for (b = 0; b <= a; b++) {
+                for (b = 0; b < 6; b++) {
                     double s = 0;
-                    for (k = 0; k < 6; k++) s += (double)Sp[6 * a + k] * (double)Sp[6 * b + k];
+                    for (k = 0; k < 6; k++) s += P[6 * a + k] * P[6 * b + k];
                     W[6 * a + b] -= s;
                 }
         }
-        /* Cholesky of W; the pivot is judged against the block's own diagonal entry */
+        /* Cholesky of W (lower, in place); each pivot judged against the block's own
+           diagonal entry */
         for (b = 0; b < 6; b++) {
             double d = W[7 * b], scale = fabs((double)A[7 * b]);
             for (k = 0; k < b; k++) d -= W[6 * b + k] * W[6 * b + k];
@@ -8246,32 +8251,37 @@ FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, fr
                 return d < -tol * scale ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;
             }
             d = sqrt(d);
-            W[7 * b] = 1.0 / d;
+            W[7 * b] = d;
+            G[7 * b] = 1.0 / d; /* one division a column; products elsewhere */
             for (a = b + 1; a < 6; a++) {
                 double s = W[6 * a + b];
                 for (k = 0; k < b; k++) s -= W[6 * a + k] * W[6 * b + k];
-                W[6 * a + b] = s / d;
+                W[6 * a + b] = s * G[7 * b];
             }
         }
-        for (a = 0; a < 36; a++) L[a] = (frm_real)((a % 6) <= (a / 6) ? W[a] : 0.0);
-        /* S_i = B L^-T: each row r of B solves L z = B_r */
+        /* G = L^-1 (lower triangular), column by column */
+        for (b = 0; b < 6; b++) {
+            for (a = 0; a < b; a++) G[6 * a + b] = 0;
+            for (a = b + 1; a < 6; a++) {
+                double s = 0;
+                for (k = b; k < a; k++) s -= W[6 * a + k] * G[6 * k + b];
+                G[6 * a + b] = s * G[7 * a];
+            }
+        }
+        for (a = 0; a < 36; a++) Gout[a] = (frm_real)G[a];
+        /* S_i = B G^T */
         if (i + 1 < n) {
             const frm_real *B = lower + 36 * (size_t)i;
-            for (a = 0; a < 6; a++) {
-                double z[6];
+            for (a = 0; a < 6; a++)
                 for (b = 0; b < 6; b++) {
-                    double s = (double)B[6 * a + b];
-                    for (k = 0; k < b; k++) s -= W[6 * b + k] * z[k];
-                    z[b] = s * W[7 * b];
-                }
-                for (b = 0; b < 6; b++) {
-                    if (!frm__finite(z[b])) {
+                    double s = 0;
+                    for (k = 0; k < 6; k++) s += (double)B[6 * a + k] * G[6 * b + k];
+                    if (!frm__finite(s)) {
                         if (failed_block) *failed_block = i;
                         return FRM_ERR_NOT_FINITE;
                     }
-                    S[6 * a + b] = (frm_real)z[b];
+                    S[6 * a + b] = (frm_real)s;
                 }
-            }
         } else
             memset(S, 0, 36 * sizeof(frm_real));
     }
@@ -8285,37 +8295,37 @@ FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
     if (n < 1 || !factor || !b || nrhs < 0) return FRM_ERR_ARG;
     for (r = 0; r < nrhs; r++) {
         frm_real *x = b + n6 * (size_t)r;
-        for (i = 0; i < n; i++) { /* forward */
-            const frm_real *L = factor + 72 * (size_t)i;
-            double y[6];
-            for (a = 0; a < 6; a++) y[a] = (double)x[6 * i + a];
+        double y[6], t[6];
+        for (a = 0; a < 6; a++) y[a] = 0;
+        for (i = 0; i < n; i++) { /* forward: y_i = G_i (b_i - S_{i-1} y_{i-1}) */
+            const frm_real *G = factor + 72 * (size_t)i;
+            for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
             if (i > 0) {
-                const frm_real *S = factor + 72 * (size_t)(i - 1) + 36, *yp = x + 6 * (i - 1);
+                const frm_real *S = G - 36;
                 for (a = 0; a < 6; a++)
-                    for (k = 0; k < 6; k++) y[a] -= (double)S[6 * a + k] * (double)yp[k];
+                    for (k = 0; k < 6; k++) t[a] -= (double)S[6 * a + k] * y[k];
             }
             for (a = 0; a < 6; a++) {
-                for (k = 0; k < a; k++) y[a] -= (double)L[6 * a + k] * y[k];
-                y[a] *= (double)L[7 * a];
+                double s = 0;
+                for (k = 0; k < 6; k++) s += (double)G[6 * a + k] * t[k];
+                y[a] = s;
             }
             for (a = 0; a < 6; a++) x[6 * i + a] = (frm_real)y[a];
         }
-        for (i = n - 1; i >= 0; i--) { /* backward */
-            const frm_real *L = factor + 72 * (size_t)i;
-            double y[6];
-            for (a = 0; a < 6; a++) y[a] = (double)x[6 * i + a];
+        for (i = n - 1; i >= 0; i--) { /* backward: x_i = G_i^T (y_i - S_i^T x_{i+1}) */
+            const frm_real *G = factor + 72 * (size_t)i;
+            for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
             if (i + 1 < n) {
-                const frm_real *S = L + 36, *xn = x + 6 * (i + 1);
+                const frm_real *S = G + 36;
                 for (k = 0; k < 6; k++)
-                    for (a = 0; a < 6; a++) y[a] -= (double)S[6 * k + a] * (double)xn[k];
+                    for (a = 0; a < 6; a++) t[a] -= (double)S[6 * k + a] * y[k];
             }
-            for (a = 5; a >= 0; a--) {
-                for (k = a + 1; k < 6; k++) y[a] -= (double)L[6 * k + a] * y[k];
-                y[a] *= (double)L[7 * a];
-            }
+            for (a = 0; a < 6; a++) y[a] = 0;
+            for (k = 0; k < 6; k++)
+                for (a = 0; a < 6; a++) y[a] += (double)G[6 * k + a] * t[k];
             for (a = 0; a < 6; a++) {
                 x[6 * i + a] = (frm_real)y[a];
-                bad |= !frm__finite((double)x[6 * i + a]);
+                bad |= !frm__finite(y[a]);
             }
         }
     }
@@ -8881,7 +8891,7 @@ static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
     if (iterations) *iterations = 0;
     memset(dl, 0, sizeof(double) * (size_t)n6);
     for (it = 0; it <= c->max_it; it++) {
-        double scale = 0, rn, slope, alpha = 1, base_pot;
+        double scale = 0, rn, slope, alpha = 1, base_pot, floor;
         /* residual and its scale */
         pot = frm__ch_total(c, g, 1);
         for (k = 0; k < n6; k++) dq[k] = 0;
@@ -8917,8 +8927,8 @@ static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
         }
         /* converged, or at the round-off floor of the force sums once an iteration no longer
            halves the residual */
-        if (rn <= c->tol * scale ||
-            (it > 0 && rn > 0.5 * previous && rn <= 16 * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON) * sqrt(c->fsq))) {
+        floor = 16 * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON) * sqrt(c->fsq);
+        if (rn <= c->tol * scale || (it > 0 && rn > 0.5 * previous && rn <= floor)) {
             err = FRM_OK;
             break;
         }
@@ -8959,9 +8969,10 @@ static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
                 break;
             alpha *= 0.5;
         }
-        if (k == 40) {
+        if (k == 40) { /* no decrease: converged only if already at the round-off floor */
             frm__ch_restore(c, c->trial);
-            err = FRM_ERR_NO_CONVERGENCE;
+            memcpy(dl, dl0, sizeof(double) * (size_t)n6);
+            err = rn <= floor ? FRM_OK : FRM_ERR_NO_CONVERGENCE;
             break;
         }
         if (iterations) (*iterations)++;
