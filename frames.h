@@ -1018,6 +1018,8 @@ typedef enum frm_integrator {
 /* Linear solvers of every Newton iteration (static solve and implicit steps). */
 typedef enum frm_linear_solver {
     FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_BTD = 1, /* block-tridiagonal Cholesky (issue 15): models whose stiffness pattern is a
+                                  chain (frame i coupled to i - 1 and i + 1 only); assembled blocks */
     FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
 } frm_linear_solver;
 
@@ -2563,6 +2565,7 @@ struct frm_model {
     int *rev_start, *rev_pair; /* frame -> pairs (the reverse table) */
     int *blk_start, *blk_col;  /* block pattern (frame adjacency) */
     frm_real *blocks;          /* 36 per block (assembled K, symmetric part) */
+    frm_real *btd;             /* 144 per frame with FRM_LINEAR_SOLVER_BTD: diagonal, sub-diagonal, factor */
     int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
 
     /* samples */
@@ -3235,6 +3238,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
         FRM__CARVE(c, m->sq_start, int, S + 1);
         FRM__CARVE(c, m->pair_blk, int, sq);
     }
+    if (m->linear_solver == FRM_LINEAR_SOLVER_BTD) FRM__CARVE(c, m->btd, frm_real, 144 * n);
     FRM__CARVE(c, m->s_rest, frm_real, 3 * S);
     FRM__CARVE(c, m->s_volume, frm_real, S);
     FRM__CARVE(c, m->s_mu, frm_real, S);
@@ -3802,6 +3806,7 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
     tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
     tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
     tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    tmp->linear_solver = (int)d->linear_solver; /* FRM_LINEAR_SOLVER_BTD carves its blocks */
     if (tmp->has_blocks) {
         long long blocks, sq = 0;
         for (i = 0; i < n; i++) t->marker[i] = -1;
@@ -4020,6 +4025,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     return FRM_OK;
 }
 
+static int frm__btd_model_check(const frm_model *m, const frm_desc *d);
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
 {
     frm_model tmp, *m = NULL;
@@ -4036,6 +4042,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     if (err) return err;
     err = frm__create_layout(d, &tmp, &m);
     if (!err) err = frm__create_precompute(m, d, &tables);
+    if (!err && m->linear_solver == FRM_LINEAR_SOLVER_BTD) err = frm__btd_model_check(m, d);
     frm__create_free_tables(d, &tables);
     if (err) {
         if (m) {
@@ -4714,7 +4721,7 @@ static int frm__choose_mode(const frm_model *m)
 {
     double it, pairs, blocks;
     if (m->stiffness_mode == FRM_STIFFNESS_PAIRS || !m->has_blocks) return FRM_STIFFNESS_PAIRS;
-    if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS) return FRM_STIFFNESS_BLOCKS;
+    if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS || m->linear_solver == FRM_LINEAR_SOLVER_BTD) return FRM_STIFFNESS_BLOCKS;
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
     it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
@@ -5027,11 +5034,14 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
    the free components to |r| <= tolerance |b|, by the model's linear_solver. Returns the
    FRM__CG_* statuses (OK, CAP, NEGATIVE, NOT_FINITE), which the Newton loops map to
    FRM_OK, FRM_ERR_NO_CONVERGENCE (cap; negative curvature when no retry helps) and
-   FRM_ERR_NOT_FINITE. A new solver (e.g. issue 15's block-tridiagonal one) adds a
-   frm_linear_solver value and a case here, with the same statuses. */
+   FRM_ERR_NOT_FINITE. A new solver adds a frm_linear_solver value and a case here, with
+   the same statuses. */
+static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x);
 static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
     switch (m->linear_solver) {
+    case FRM_LINEAR_SOLVER_BTD:
+        return frm__btd_model_solve(m, a_mass, a_stiff, tolerance, b, x);
     case FRM_LINEAR_SOLVER_CG:
     default:
         return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
@@ -8354,6 +8364,92 @@ FRMDEF int frm_btd_compliance(int n, const frm_real *factor, int rows, const frm
             W[rows * a + b] = W[rows * b + a] = (frm_real)(0.5 * (s + t));
         }
     return FRM_OK;
+}
+
+/* FRM_LINEAR_SOLVER_BTD on a frames model (frm__linear_solve's case): the model's assembled
+   blocks, whose pattern creation checked is a chain, as a block-tridiagonal a_mass M +
+   a_stiff K (static_regularization on the rotational diagonal, as CG's product); held
+   components (fixed and driven frames, held axes) become identity rows and columns. A
+   failed factorisation is FRM__CG_NEGATIVE (the Newton loops then retry with K's definite
+   part) or FRM__CG_NOT_FINITE; the answer is checked against the model's own product
+   (|b - A x| <= tolerance |b|, else FRM__CG_CAP). */
+static int frm__btd_model_check(const frm_model *m, const frm_desc *d)
+{
+    int i, e;
+    if (!m->has_blocks) return frm__fail(d, FRM_ERR_SOLVER, "linear_solver FRM_LINEAR_SOLVER_BTD needs block storage (stiffness_mode not PAIRS)");
+    for (i = 0; i < m->frame_count; i++)
+        for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++)
+            if (m->blk_col[e] < i - 1 || m->blk_col[e] > i + 1)
+                return frm__fail(d, FRM_ERR_SOLVER, "linear_solver FRM_LINEAR_SOLVER_BTD needs a chain: frame i coupled to i - 1 and i + 1 only");
+    return FRM_OK;
+}
+
+static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
+{
+    int n = m->frame_count, i, e, a, c, err, k;
+    size_t n6 = 6 * (size_t)n;
+    frm_real *D = m->btd, *Lo = D + 36 * (size_t)n, *F = Lo + 36 * (size_t)n, *r = m->cg_r;
+    double bb, rr;
+    unsigned char held[6];
+    m->stats.cg_iterations_last = 0;
+    m->stats.cg_residual = 0;
+    m->lin_iterations = 0;
+    frm__mask(m, b);
+    bb = frm__dot(m, b, b);
+    if (!frm__finite(bb)) return FRM__CG_NOT_FINITE;
+    memset(D, 0, sizeof(frm_real) * 72 * (size_t)n);
+    for (i = 0; i < n; i++) {
+        double mb[36];
+        for (k = 0; k < 36; k++) mb[k] = 0;
+        if (a_mass != 0)
+            for (c = 0; c < 6; c++) { /* column c of the mass block */
+                frm_real v[6] = {0, 0, 0, 0, 0, 0};
+                double o[6];
+                v[c] = 1;
+                frm__mass_apply(m, i, v, o);
+                for (a = 0; a < 6; a++) mb[6 * a + c] = o[a];
+            }
+        for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+            const frm_real *K = m->blocks + 36 * (size_t)e;
+            int j = m->blk_col[e];
+            if (j == i)
+                for (k = 0; k < 36; k++) D[36 * (size_t)i + k] = (frm_real)(a_stiff * (double)K[k] + a_mass * mb[k]);
+            else if (j == i - 1)
+                for (k = 0; k < 36; k++) Lo[36 * (size_t)j + k] = (frm_real)(a_stiff * (double)K[k]);
+        }
+        if (m->solve_regularization != 0)
+            for (k = 3; k < 6; k++)
+                D[36 * (size_t)i + 7 * k] += (frm_real)(a_stiff * m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
+    }
+    for (i = 0; i < n; i++) { /* held components: identity rows and columns */
+        for (k = 0; k < 6; k++) held[k] = (unsigned char)(m->state[i] != FRM__FREE || ((m->axes[i] >> k) & 1));
+        for (k = 0; k < 6; k++) {
+            if (!held[k]) continue;
+            for (a = 0; a < 6; a++) {
+                D[36 * (size_t)i + 6 * k + a] = D[36 * (size_t)i + 6 * a + k] = 0;
+                if (i > 0) Lo[36 * (size_t)(i - 1) + 6 * k + a] = 0;        /* row k of A(i, i-1) */
+                if (i + 1 < n) Lo[36 * (size_t)i + 6 * a + k] = 0;          /* column k of A(i+1, i) */
+            }
+            D[36 * (size_t)i + 7 * k] = 1;
+        }
+    }
+    err = frm_btd_factor(n, D, Lo, F, NULL);
+    if (err) {
+        if (err == FRM_ERR_NOT_FINITE) return FRM__CG_NOT_FINITE;
+        m->stats.negative_curvature++;
+        memcpy(x, b, sizeof(frm_real) * n6); /* a descent direction for the retry's caller */
+        return FRM__CG_NEGATIVE;
+    }
+    memcpy(x, b, sizeof(frm_real) * n6);
+    if (frm_btd_solve(n, F, 1, x)) return FRM__CG_NOT_FINITE;
+    frm__mask(m, x);
+    if (bb == 0) return FRM__CG_OK;
+    frm__system_product(m, a_mass, a_stiff, x, r);
+    for (k = 0; k < (int)n6; k++) r[k] = b[k] - r[k];
+    rr = frm__dot(m, r, r);
+    m->stats.cg_residual = (frm_real)sqrt(rr / bb);
+    if (!frm__finite(rr)) return FRM__CG_NOT_FINITE;
+    return rr <= tolerance * tolerance * bb || rr <= 1e-20 * bb ? FRM__CG_OK : FRM__CG_CAP;
 }
 
 /* Primal active-set method for min 1/2 x^T H x + c^T x, lo <= x <= hi (the public comment).

@@ -952,6 +952,84 @@ static void test_chain_no_allocation(void)
     frm_chain_destroy(c);
 }
 
+/* ---- FRM_LINEAR_SOLVER_BTD in the frames solvers ------------------------------------------ */
+
+/* A rod of frames whose samples each see two consecutive frames (a chain pattern): the
+   static sag under gravity and ten implicit Euler steps with FRM_LINEAR_SOLVER_BTD equal
+   CG's (both to a Newton tolerance of 1e-10: 1e-6 of the sag; float 1e-4: 1e-3); a model
+   that is not a chain is refused at creation with FRM_ERR_SOLVER. */
+static frm_model *rod_model(frm_linear_solver solver, int chain)
+{
+    enum { NF = 12, PER = 4 };
+    frm_real fp[3 * NF], sp[3 * NF * PER], vol[NF * PER], w[3 * NF * PER], g[9 * NF * PER];
+    int start[NF * PER + 1], fr[3 * NF * PER], s = 0, e = 0, i, q, k;
+    double h = 0.1, r = 0.01;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m = NULL;
+    for (i = 0; i < NF; i++) fp[3 * i] = (frm_real)(h * i), fp[3 * i + 1] = fp[3 * i + 2] = 0;
+    for (i = 0; i + 1 < NF; i++)
+        for (q = 0; q < PER; q++) {
+            double t = (q + 0.5) / PER, y = (q % 2 ? r : -r) * 0.5, z = (q / 2 ? r : -r) * 0.5;
+            sp[3 * s] = (frm_real)(h * (i + t)), sp[3 * s + 1] = (frm_real)y, sp[3 * s + 2] = (frm_real)z;
+            vol[s] = (frm_real)(h * 4 * r * r / PER);
+            start[s] = e;
+            fr[e] = i, w[e] = (frm_real)(1 - t), g[3 * e] = (frm_real)(-1 / h), g[3 * e + 1] = g[3 * e + 2] = 0, e++;
+            fr[e] = i + 1, w[e] = (frm_real)t, g[3 * e] = (frm_real)(1 / h), g[3 * e + 1] = g[3 * e + 2] = 0, e++;
+            if (!chain && i + 2 < NF && q == 0) { /* a third, farther neighbour with zero weight */
+                fr[e] = i + 2, w[e] = 0, g[3 * e] = g[3 * e + 1] = g[3 * e + 2] = 0, e++;
+            }
+            s++;
+        }
+    start[s] = e;
+    (void)k;
+    d.frame_positions = fp;
+    d.frame_count = NF;
+    d.sample_positions = sp;
+    d.sample_volumes = vol;
+    d.sample_count = s;
+    d.neighbor_start = start;
+    d.neighbor_frames = fr;
+    d.neighbor_weights = w;
+    d.neighbor_gradients = g;
+    d.material.young_modulus = (frm_real)1e8;
+    d.material.density = 1000;
+    d.linear_solver = solver;
+    d.newton_tolerance = (frm_real)(IS_FLOAT ? 1e-4 : 1e-10);
+    d.cg_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-12);
+    d.time_step = (frm_real)0.01;
+    CHECK_INT(chain || solver == FRM_LINEAR_SOLVER_CG ? FRM_OK : FRM_ERR_SOLVER, frm_model_create(&d, &m));
+    if (m) frm_model_fix_frame(m, 0);
+    return m;
+}
+
+static void test_frames_btd_solver(void)
+{
+    frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1), *b = rod_model(FRM_LINEAR_SOLVER_BTD, 1);
+    double sag, tol = IS_FLOAT ? 1e-3 : 1e-6;
+    int i, k;
+    if (!a || !b) return;
+    CHECK_INT(FRM_OK, frm_model_solve_static(a));
+    CHECK_INT(FRM_OK, frm_model_solve_static(b));
+    sag = fabs((double)frm_model_displacements(a)[3 * 11 + 2]);
+    CHECK(sag > 1e-4);
+    for (i = 0; i < 12; i++)
+        for (k = 0; k < 3; k++)
+            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    printf("    rod sag %.6e m (CG) and %.6e m (BTD); BTD's last static solve: %d CG iterations\n", sag,
+           fabs((double)frm_model_displacements(b)[3 * 11 + 2]), frm_model_last_stats(b)->cg_iterations);
+    for (i = 0; i < 10; i++) {
+        CHECK_INT(FRM_OK, frm_model_step(a));
+        CHECK_INT(FRM_OK, frm_model_step(b));
+    }
+    for (i = 0; i < 12; i++)
+        for (k = 0; k < 3; k++)
+            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    frm_model_destroy(a);
+    frm_model_destroy(b);
+    a = rod_model(FRM_LINEAR_SOLVER_BTD, 0);
+    CHECK(a == NULL);
+}
+
 static const test_case cases[] = {
     TEST(test_btd_dense),
     TEST(test_btd_refusals),
@@ -969,6 +1047,7 @@ static const test_case cases[] = {
     TEST(test_chain_validation),
     TEST(test_chain_vs_frames_cylinder),
     TEST(test_chain_no_allocation),
+    TEST(test_frames_btd_solver),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
