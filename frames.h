@@ -8372,7 +8372,8 @@ FRMDEF int frm_btd_compliance(int n, const frm_real *factor, int rows, const frm
    components (fixed and driven frames, held axes) become identity rows and columns. A
    failed factorisation is FRM__CG_NEGATIVE (the Newton loops then retry with K's definite
    part) or FRM__CG_NOT_FINITE; the answer is checked against the model's own product
-   (|b - A x| <= tolerance |b|, else FRM__CG_CAP). */
+   (|b - A x| <= tolerance |b|, with up to three steps of iterative refinement, which float
+   needs; else FRM__CG_CAP). */
 static int frm__btd_model_check(const frm_model *m, const frm_desc *d)
 {
     int i, e;
@@ -8444,12 +8445,20 @@ static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, dou
     if (frm_btd_solve(n, F, 1, x)) return FRM__CG_NOT_FINITE;
     frm__mask(m, x);
     if (bb == 0) return FRM__CG_OK;
-    frm__system_product(m, a_mass, a_stiff, x, r);
-    for (k = 0; k < (int)n6; k++) r[k] = b[k] - r[k];
-    rr = frm__dot(m, r, r);
-    m->stats.cg_residual = (frm_real)sqrt(rr / bb);
-    if (!frm__finite(rr)) return FRM__CG_NOT_FINITE;
-    return rr <= tolerance * tolerance * bb || rr <= 1e-20 * bb ? FRM__CG_OK : FRM__CG_CAP;
+    for (k = 0;; k++) { /* the residual by the model's product; iterative refinement (float) */
+        int j;
+        frm__system_product(m, a_mass, a_stiff, x, r);
+        for (j = 0; j < (int)n6; j++) r[j] = b[j] - r[j];
+        frm__mask(m, r);
+        rr = frm__dot(m, r, r);
+        m->stats.cg_residual = (frm_real)sqrt(rr / bb);
+        m->lin_iterations = k;
+        if (!frm__finite(rr)) return FRM__CG_NOT_FINITE;
+        if (rr <= tolerance * tolerance * bb) return FRM__CG_OK;
+        if (k == 3 || frm_btd_solve(n, F, 1, r)) return FRM__CG_CAP;
+        frm__mask(m, r);
+        for (j = 0; j < (int)n6; j++) x[j] += r[j];
+    }
 }
 
 /* Primal active-set method for min 1/2 x^T H x + c^T x, lo <= x <= hi (the public comment).
