@@ -55,6 +55,7 @@ run_case cut_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_cut" --bogus
 run_case hybrid_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" --bogus
 run_case hybrid_two_directories 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" "$tmp" "$tmp"
 run_case soft_arm_bad_option 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" --bogus
+run_case link_compliance_bad_argument 2 '^usage' "$tmp/out" -- "$bin/heml_link_compliance" bogus
 run_case soft_arm_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" "$tmp" "$tmp"
 
 # 2. an output directory that does not exist: exit status 1, a message, no success claim
@@ -97,6 +98,7 @@ case beam_files in *"$filter"*)
         report beam_files 1 "the VTK files are missing or empty"
     fi ;;
 esac
+run_case link_compliance_runs 0 '' "$tmp/out" -- "$bin/heml_link_compliance"
 mkdir -p "$tmp/arm"
 run_case soft_arm_runs 0 '' "$tmp/out" -- "$bin/frames_soft_arm" "$tmp/arm"
 case soft_arm_csv in *"$filter"*)
