@@ -11,8 +11,10 @@
    samples, exact forces and stiffness (material and geometric),
    a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
    gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
-   frequencies and modes about the current state) and point probes (a material point's
-   position, displacement and velocity through the shape functions). The per-sample and per-frame math are
+   frequencies and modes about the current state), point probes (a material point's
+   position, displacement and velocity through the shape functions) that double as mapped
+   points (their Jacobian J and J^T: point forces as frame loads, coupling), and coupling:
+   one model from several parts sharing frames, rigid bodies (see COUPLING). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
    gathers them through a reverse table.
@@ -85,6 +87,8 @@
        1. Frames, samples and the neighbour table: frm_sampling_hexes / _tets (mesh-based),
           frm_sampling_meshless (given points), frm_sampling_box / _surface (Poisson disks);
           or fill the table yourself (any weights that sum to one, gradients to zero).
+          Several parts (own sampling, material, density) sharing frames, and rigid bodies:
+          frm_parts_combine, then frm_assembly_apply instead of frm_sampling_apply (COUPLING).
        2. frm_desc d = frm_model_default_desc(); frm_sampling_apply(&s, &d); set the
           material (or a per-sample table), gravity, time step, solver settings.
        3. frm_model_create(&d, &m) validates everything and allocates all memory once.
@@ -99,7 +103,9 @@
        6. Read frm_model_positions / _orientations / _velocities / _displacements, and
           frm_model_sample_positions / _deformation_gradients, to render or measure; any
           material point through a probe (frm_probe_create once, then frm_probe_positions
-          / _displacements / _velocities; see PROBES); natural frequencies and modes about
+          / _displacements / _velocities; see PROBES: this is how a frames body is rendered,
+          a render mesh's vertices as mapped points; forces at them as loads through
+          frm_probe_add_external, see COUPLING); natural frequencies and modes about
           the current state with frm_modal_create / _solve (see MODAL ANALYSIS).
        7. frm_model_destroy(m); frm_sampling_free(&s) (any time after step 3).
 
@@ -167,7 +173,8 @@
    about 1 kB (BDF2's history included: 25 reals); frm_model_memory_bytes tells. A probe
    makes one allocation at frm_probe_create (through the model's allocator: about 40 bytes
    per (point, frame) pair) plus temporaries freed before it returns. The description's arrays are read during frm_model_create only. The samplings
-   allocate their arrays in one block each (frm_sampling_free) and free their temporaries.
+   allocate their arrays in one block each (frm_sampling_free) and free their temporaries;
+   frm_parts_combine two blocks (the sampling's and its own: frm_assembly_free).
 
    ERRORS: every fallible function returns 0 or a negative FRM_ERR_* code; frm_error_string
    names it, and the optional desc.log callback receives a detailed message for validation
@@ -183,6 +190,13 @@
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
    E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
+   Coupling (issue 14): frm_parts_combine refuses a malformed frame map (FRM_ERR_PART_FRAME:
+   an index out of range or repeated within a part, a model frame nobody gives, shared frames
+   at different rest positions) and a rigid body with mass <= 0 or an inertia not symmetric
+   positive definite (FRM_ERR_RIGID, as creation does for desc.frame_masses / _inertias, and
+   FRM_ERR_SAMPLE_SIZE for desc.sample_sizes); frm_probe_create a point outside the body
+   (FRM_ERR_POINT_OUTSIDE: in no element, or farther from each of its meshless frames than
+   that frame's farthest sample).
    A step or solve never reports success with an unconverged or unchecked result: one that
    meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
    FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
@@ -673,8 +687,18 @@
        - BDF2 treats orientations in the tangent coordinates at the current one and keeps
          the mass at the step's start: second order for translations and small rotations
          per step, first order in the terms of frames spinning fast (see SOLVERS).
-       - At most 16 neighbours per sample. Coupling between objects and the CUDA companion
-         are not in this version.
+       - Coupling (issue 14): the frames' equations of motion neglect the centripetal and
+         gyroscopic terms (omega x (omega x c), omega x J omega), so a body spinning with mass
+         off its frame's origin does not conserve its momentum exactly; each step does
+         conserve sum_i M_i(t_n) v (its start masses): measured on a rigid block turning at 1
+         rad/s with a beam's first cell merged onto it, 1e-2 of sum |m v| over 0.4 s, the same
+         at dt and dt / 2 (tests/test_frames_coupling.c). A rigid body is a frame with its
+         own mass at its origin (its centre of mass); no joints, no contact, no constraints
+         between bodies but shared or attached frames. Mesh-based probes on a combined model
+         need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
+         attached to a rigid body (the attached frames are no longer frames of the model).
+       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes and the
+         CUDA companion are not in this version.
        - Reduced chain (issue 15): each link is linear in its proximal frame's axes (small
          strain, large rotations: the thesis's model), so a link bent by tens of degrees is
          inaccurate (its rotation measure 2 sin(theta/2) saturates); use more vertebrae.
@@ -707,7 +731,8 @@
    default model, more: every frame turning alike moves no material (frame_coupling > 0
    removes them; LIMITS).
 
-   PROBES (issue 19): frm_probe_create(m, &desc, rest_points, count, &p) finds each point
+   PROBES (issue 19; mapped points, issue 14: see COUPLING): frm_probe_create(m, &desc,
+   rest_points, count, &p) finds each point
    once, among the elements whose bounding box (widened by 1e-3 of its size) covers the
    point's cell of a temporary uniform grid of about one cell per element (5,000 points in
    1,600 tetrahedra: 12 ms): FRM_PROBE_TETS the tetrahedron of desc.elements (frame indices) containing it
@@ -716,11 +741,59 @@
    map reaches it (Newton from the centre, parametric coordinates in [-tol, 1 + tol]),
    FRM_PROBE_MESHLESS the frames and weights frm_sampling_meshless would give a sample
    there (desc.shape: Shepard or MLS, nearest or radius support). A point in no element
-   is FRM_ERR_ARG (no nearest-element fallback beyond the tolerance). Then, per point,
+   is FRM_ERR_POINT_OUTSIDE (no nearest-element fallback beyond the tolerance; meshless: a
+   point farther from each of its frames than that frame's farthest sample). Then, per point,
    p = pbar + sum_i w_i (u_i + (Q_i - I) abar_i), abar_i = pbar - xbar_i (eq. 3.34 in the
    kernels' displacement form), and its velocity sum_i w_i (v_i + omega_i x Q_i abar_i):
    exact for rigid motions with any weights, and for affine fields of the frames'
    positions with tetrahedral, hexahedral and MLS weights (tests/test_frames_elem.c).
+
+   COUPLING (issue 14; Bosman, Duriez & Cotin 2013 sec. 4.2 and fig. 5; thesis sec. 4.2)
+       Mapped points. A probe is the mapping p = M(q) of eq. 4.11 from the frames to any
+       points given by their rest positions (eq. 3.34 with the weights found once; see
+       PROBES): a render mesh (frm_probe_positions each frame: this is how a frames body is
+       drawn), contact points, another model's nodes. Its Jacobian at the current state,
+       J dq = sum_i w_i (dx_i + dtheta_i x a_i) with a_i = Q_i abar_i the frame's own lever
+       to the point (frm_probe_jacobian; velocities are J v), and the transpose
+       (frm_probe_jacobian_transpose) give a point force f_n to frame i as the force
+       w_in f_n (eq. 4.12) and the torque w_in a_in x f_n: eq. 4.13 with the frame's own
+       prediction a_in for p_n - x_i. They differ once frames disagree about a point (under
+       strain); ours is the exact transpose of the mapping, so the work f . dp equals the
+       frames' generalized work (tested by finite differences) and a coupling through it
+       neither creates nor loses energy; the total force sum f_n and moment sum p_n x f_n
+       are carried exactly in any state. frm_probe_add_external adds J^T f to the external
+       loads (constant through the following steps and solves: once per step for a
+       staggered coupling). What a stiff coupling needs (J and J^T as products, no
+       allocation) is public; the coupled implicit solve itself is not here (LIMITS).
+       Measured cost: see README (bench kernels part, "frames mapped point").
+       Several parts (frm_parts_combine): each part's samples keep their weights and
+       gradients, their frames are renumbered by the part's frame_map into the model's;
+       frames several parts give are one frame (same rest position required), so a shared
+       frame receives the mass, forces and stiffness of every part whose samples use it
+       (the 2013 paper's sharing of frames between connective tissue and organs: the DoF
+       sharing of thesis fig. 4.5, assembled by the existing solvers as one system). Each
+       part has one material (law, constants, density: desc.materials with a material per
+       part); split a part to give it several. A body split into two parts sharing their
+       interface frames is the same discrete model as the whole, samples reordered:
+       static sag and an implicit step agree to 4e-12 (tests/test_frames_coupling.c).
+       Rigid bodies (frm_rigid_body): a frame with its own mass and inertia (not from
+       samples; desc.frame_masses / frame_inertias, added to the frame's mass block and
+       gravity at its origin). Part frames mapped onto a body's frame are attached: they
+       move rigidly with it (x_j = x_b + Q_b (xbar_j - xbar_b), R_j = Q_b Rbar_j). The
+       thesis couples them by bilateral constraints (fig. 4.7); we eliminate them through
+       the rigid map, exactly: an attached frame predicts a sample at
+       x_j + R_j lbar_j = x_b + Q_b (pbar - xbar_b), the body's own prediction, so in each
+       sample the entries of frames attached to one body merge into one entry of the body's
+       frame with the summed weight and gradient (p and F of eq. 3.34, 3.40 unchanged, and
+       with them the energy, forces, stiffness, mass and gravity); the merged table is an
+       ordinary one, so every solver, the mass and the reaction on the body come for free
+       and nothing changes in the solvers. Only the stabilisation's per-sample length h^2
+       and linear flag depend on levers: they are taken from the parts' own tables
+       (desc.sample_sizes, sample_linear). Tests: a beam on a fixed block sags as the beam
+       with its face frames fixed (1.6e-15 m), a beam on a free block falls with g (the
+       momentum gains M g t to 2e-7) while the beam springs back from its sag, the
+       momentum balance of each step with an internal impulse (7e-10), a weight on a strap
+       reaches the strap's extension within 0.15 % (static solve and damped steps).
 
    BLOCK-TRIDIAGONAL SOLVER (issue 15): frm_btd_factor / frm_btd_solve / frm_btd_compliance,
    usable on their own for any chain of 6-DoF nodes (rods, cables, catheters, trunk robots).
@@ -843,6 +916,13 @@
              reduced chain model with actuators and the inverse model (frm_chain_*,
              frm_actuator), error codes FRM_ERR_BTD_INDEFINITE .. FRM_ERR_QP_INDEFINITE.
              Results of existing models bit-identical.
+       unreleased (issue 14): coupling: mapped points (frm_probe_jacobian,
+             frm_probe_jacobian_transpose, frm_probe_add_external; frm_probe_desc.nodes,
+             node_frames, node_count), several parts (frm_part, frm_parts_combine,
+             frm_assembly_apply / _free), rigid bodies (frm_rigid_body, desc.frame_masses,
+             frame_inertias, sample_sizes, sample_linear); FRM_ERR_POINT_OUTSIDE (was
+             FRM_ERR_ARG for a probe point in no element), FRM_ERR_PART_FRAME, FRM_ERR_RIGID,
+             FRM_ERR_SAMPLE_SIZE. Results of existing models bit-identical.
        unreleased (issue 19): FRM_BDF2 (see SOLVERS), frm_model_set_integrator,
              frm_model_set_damping, frm_model_displacements, frm_model_rest_positions,
              point probes (frm_probe_*), modal analysis (frm_modal_*). Results of existing models bit-identical; the
@@ -938,6 +1018,11 @@ typedef FRM_REAL frm_real;
 #define frm_sampling_free frm_sampling_free_f32
 #define frm_shape_default_desc frm_shape_default_desc_f32
 #define frm_poisson_default_desc frm_poisson_default_desc_f32
+#define frm_part_default frm_part_default_f32
+#define frm_rigid_body_default frm_rigid_body_default_f32
+#define frm_parts_combine frm_parts_combine_f32
+#define frm_assembly_apply frm_assembly_apply_f32
+#define frm_assembly_free frm_assembly_free_f32
 #define frm_model_default_desc frm_model_default_desc_f32
 #define frm_model_create frm_model_create_f32
 #define frm_model_destroy frm_model_destroy_f32
@@ -988,6 +1073,9 @@ typedef FRM_REAL frm_real;
 #define frm_probe_displacements frm_probe_displacements_f32
 #define frm_probe_velocities frm_probe_velocities_f32
 #define frm_probe_count frm_probe_count_f32
+#define frm_probe_jacobian frm_probe_jacobian_f32
+#define frm_probe_jacobian_transpose frm_probe_jacobian_transpose_f32
+#define frm_probe_add_external frm_probe_add_external_f32
 #define frm_probe_destroy frm_probe_destroy_f32
 #define frm_modal_default_desc frm_modal_default_desc_f32
 #define frm_modal_create frm_modal_create_f32
@@ -1056,19 +1144,23 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_STALLED, -34, "static solve stalled: the residual stopped falling (a mechanism: rotations the samples do not see, see LIMITS); the last valid state was kept") \
     X(FRM_ERR_PRECISION, -35, "the state is too far from the rest state for the precision of frm_real to represent the strains (see desc.precision_limit); the last valid state was kept") \
     X(FRM_ERR_UNSTABLE, -36, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
-    X(FRM_ERR_BTD_INDEFINITE, -37, "block-tridiagonal factorisation met a negative pivot: the matrix is not positive definite (the failing block is reported)") \
-    X(FRM_ERR_BTD_SINGULAR, -38, "block-tridiagonal factorisation met a zero pivot: the matrix is singular to working precision (the failing block is reported)") \
-    X(FRM_ERR_COMPLIANCE, -39, "link compliance not finite, not symmetric or not positive definite") \
-    X(FRM_ERR_ACTUATOR, -40, "actuator malformed: unknown kind, too few points, a point on a frame outside the chain, coincident cable points, a triangle index out of range or a cavity enclosing no volume") \
-    X(FRM_ERR_ACTUATOR_BOUNDS, -41, "actuator bounds invalid (not 0 <= min <= max) or an effort outside them") \
-    X(FRM_ERR_UNREACHABLE, -42, "target out of reach: the chain was left at the closest pose found (a valid equilibrium)") \
-    X(FRM_ERR_QP_INDEFINITE, -43, "quadratic program not convex (negative curvature beyond round-off)")
+    X(FRM_ERR_POINT_OUTSIDE, -37, "a mapped point lies outside the body: in no element, or farther from each of its frames than that frame's farthest sample") \
+    X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses") \
+    X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite") \
+    X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0") \
+    X(FRM_ERR_BTD_INDEFINITE, -41, "block-tridiagonal factorisation met a negative pivot: the matrix is not positive definite (the failing block is reported)") \
+    X(FRM_ERR_BTD_SINGULAR, -42, "block-tridiagonal factorisation met a zero pivot: the matrix is singular to working precision (the failing block is reported)") \
+    X(FRM_ERR_COMPLIANCE, -43, "link compliance not finite, not symmetric or not positive definite") \
+    X(FRM_ERR_ACTUATOR, -44, "actuator malformed: unknown kind, too few points, a point on a frame outside the chain, coincident cable points, a triangle index out of range or a cavity enclosing no volume") \
+    X(FRM_ERR_ACTUATOR_BOUNDS, -45, "actuator bounds invalid (not 0 <= min <= max) or an effort outside them") \
+    X(FRM_ERR_UNREACHABLE, -46, "target out of reach: the chain was left at the closest pose found (a valid equilibrium)") \
+    X(FRM_ERR_QP_INDEFINITE, -47, "quadratic program not convex (negative curvature beyond round-off)")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -44
+    FRM_ERR_LAST_ = -48
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1200,12 +1292,33 @@ typedef struct frm_desc {
     const frm_real *frame_orientations; /* 4 * frame_count rest orientations, unit quaternions
                                            (x, y, z, w), or NULL for the identity */
     int frame_count;                    /* >= 1 */
+    const frm_real *frame_masses;   /* rigid bodies (issue 14): frame_count own masses, kg (>= 0; 0 for a
+                                       frame that carries only its samples' mass), or NULL for none;
+                                       added to the mass the samples give the frame (see MASS).
+                                       frm_parts_combine fills it for its rigid bodies */
+    const frm_real *frame_inertias; /* 6 per frame: own inertia about the frame's origin in its rest axes
+                                       (xx, yy, zz, yz, xz, xy), kg m^2, positive definite where the
+                                       own mass is > 0, zero elsewhere; NULL: none. The own mass sits
+                                       at the frame's origin (its centre of mass: gravity acts there) */
 
     /* samples (integration points) */
     const frm_real *sample_positions; /* 3 * sample_count rest positions, m */
     const frm_real *sample_volumes;   /* sample_count volumes, m^3, > 0; they should add up
                                          to the body's volume */
     int sample_count;                 /* >= 1 */
+    const frm_real *sample_sizes;     /* optional sample_count values h^2 (m^2, finite, >= 0): each
+                                         sample's mean squared rest lever sum |w| |lbar|^2 / sum |w|,
+                                         the length scale of the rotation stabilisation's divergence
+                                         term and of the frame coupling (see MODEL); NULL: computed
+                                         from the table. frm_parts_combine gives the values of the
+                                         parts' own tables where frames attached to a rigid body were
+                                         merged (whose levers to the body's origin are not the
+                                         sample's size) */
+    const unsigned char *sample_linear; /* optional sample_count flags: 1 where the sample's weights
+                                           reproduce linear fields (sum_k xbar_k grad w_k^T = I: it
+                                           carries the divergence term), 0 where not; NULL: checked
+                                           from the table (to 1e-3). frm_parts_combine gives the
+                                           parts' own with rigid bodies, as sample_sizes */
 
     /* neighbour table, compressed rows: sample s uses entries neighbor_start[s] to
        neighbor_start[s + 1] - 1 (1 to FRM_MAX_NEIGHBORS of them). Fill it yourself or
@@ -1454,6 +1567,86 @@ FRMDEF void frm_sampling_free(frm_sampling *s);
 FRMDEF frm_shape_desc frm_shape_default_desc(void);
 FRMDEF frm_poisson_desc frm_poisson_default_desc(void);
 
+/* ---- several parts in one model (issue 14; 2013 paper sec. 4.2 and fig. 5): each part
+   has its own sampling (frames, samples, neighbour table, any shape functions), material
+   and density, and says which of the model's frames its frames are, so parts share frames
+   where the caller says (the interface frames of a split body, the surface frames of two
+   organs a connective layer joins). frm_parts_combine makes one sampling of them with a
+   material per part; the model built from it is one mechanical system (one mass, one
+   stiffness, one solve): a shared frame gets the mass, forces and stiffness of every part
+   whose samples use it. ---- */
+
+typedef struct frm_part {
+    const frm_sampling *sampling; /* the part alone: its frames, samples and neighbour table (read
+                                     during frm_parts_combine only) */
+    frm_material material;        /* law, constants and density of every sample of the part
+                                     (default: frm_model_default_desc's material) */
+    const int *frame_map;         /* sampling->frame_count model frame indices: the part's frame j is
+                                     the model's frame frame_map[j] (distinct within the part);
+                                     NULL: frame j is the model's frame j */
+} frm_part;
+
+/* A rigid body (issue 14; 2013 paper sec. 4.2): one model frame with its own mass and
+   inertia (not from samples), its origin at the body's centre of mass. Part frames mapped
+   onto it (frame_map[j] = frame) are attached: they move rigidly with the body ("the frames
+   of the interface have a rigid motion w.r.t. the rigid body") and are eliminated through
+   the rigid map (see RIGID BODIES): the samples that used them use the body's frame, so the
+   deformable part's reaction moves the body. A body no part attaches to is a free rigid
+   body. */
+typedef struct frm_rigid_body {
+    int frame;            /* the model frame that is the body (default -1: set it) */
+    frm_real position[3]; /* m, its rest position: the centre of mass */
+    frm_real mass;        /* kg, > 0 */
+    frm_real inertia[6];  /* kg m^2, the inertia tensor about the centre of mass in world axes at rest
+                             (xx, yy, zz, yz, xz, xy), symmetric positive definite */
+} frm_rigid_body;
+
+/* The combined model description's arrays, owned (frm_assembly_free). */
+typedef struct frm_assembly {
+    frm_sampling sampling;   /* the model's frame_count frames (rest positions from the parts
+                                that give them, a rigid body's from the body), the samples of
+                                part 0, then part 1, ... with their neighbour tables mapped to
+                                the model's frames (entries of frames attached to one rigid
+                                body merged) */
+    frm_material *materials; /* part_count: part k's material */
+    int *sample_materials;   /* sample_count: the part of each sample */
+    int *part_samples;       /* part_count + 1: part k's samples are part_samples[k] ..
+                                part_samples[k + 1] - 1 */
+    frm_real *frame_masses;   /* frame_count: the rigid bodies' masses, 0 elsewhere (kg) */
+    frm_real *frame_inertias; /* 6 per frame: the rigid bodies' inertias, 0 elsewhere (kg m^2) */
+    frm_real *sample_sizes;   /* sample_count: h^2 of each sample from its part's own table (m^2, see
+                                 desc.sample_sizes), given to the model with rigid bodies */
+    unsigned char *sample_linear; /* sample_count: its part's weights reproduce linear fields (see
+                                     desc.sample_linear), given to the model with rigid bodies */
+    int part_count, rigid_count;
+    frm_allocator allocator;  /* the one the arrays came from */
+    size_t bytes;             /* of the block holding the arrays above but the sampling's */
+} frm_assembly;
+
+/* A part with the default material and no frame map. */
+FRMDEF frm_part frm_part_default(void);
+/* A rigid body with every field zero and frame -1 (to be set). */
+FRMDEF frm_rigid_body frm_rigid_body_default(void);
+/* Combines part_count parts and rigid_count rigid bodies (rigids may be NULL for 0) into a
+   model of frame_count frames. Every model frame must be given by a part or be a rigid
+   body's; parts giving the same (non-rigid) frame must give it the same rest position
+   (within 1e-9 of the body's size; float 1e-5); part frames mapped onto a rigid body's
+   frame are attached to it (any rest position). Errors: FRM_ERR_ARG (NULL, part_count < 1,
+   frame_count < 1, a part without frames or samples, a body's position not finite),
+   FRM_ERR_PART_FRAME (a map index out of range, or repeated within a part on a non-rigid
+   frame, a NULL map with more part frames than frame_count, a model frame nobody gives,
+   rest positions that differ, a body's frame out of range or two bodies on one frame),
+   FRM_ERR_RIGID (a body's mass not > 0, its inertia not positive definite),
+   FRM_ERR_NEIGHBOR_TABLE (a part's row malformed), FRM_ERR_ALLOC; *out is then empty.
+   Materials and the merged table are validated by frm_model_create. */
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
+                             int rigid_count, int frame_count, const frm_allocator *allocator);
+/* Points the description's frames, samples, neighbour table, materials, sample_materials
+   and (with rigid bodies) frame_masses and frame_inertias at the assembly (which must outlive frm_model_create, not the model). */
+FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d);
+/* Frees the assembly's arrays and empties it. */
+FRMDEF void frm_assembly_free(frm_assembly *a);
+
 /* ---- model ---- */
 
 /* A description with the documented defaults; always start from it. */
@@ -1616,6 +1809,14 @@ typedef struct frm_probe_desc {
                               samplings put frame i at node i), read during frm_probe_create only */
     int element_count;
     frm_shape_desc shape;  /* MESHLESS: default frm_shape_default_desc() */
+    const frm_real *nodes; /* TETS, HEXES, optional (issue 14): node_count rest positions (3 each, m) of the
+                              mesh's nodes: `elements` then holds node indices and node_frames[node] is
+                              the model frame of each node (frm_parts_combine's frame_map of the part the
+                              mesh sampled; several nodes may share a frame, e.g. frames attached to a
+                              rigid body). NULL: elements hold frame indices, at the frames' rest
+                              positions. Read during frm_probe_create only */
+    const int *node_frames;
+    int node_count;
     frm_real tolerance;    /* dimensionless, default 1e-6: a point at most this far outside an element
                               (barycentric or parametric coordinate down to -tolerance) counts as
                               in it (the element most inside wins); farther: FRM_ERR_ARG */
@@ -1629,9 +1830,11 @@ FRMDEF frm_probe_desc frm_probe_default_desc(void);
 /* Finds each of the `count` rest points (3 each, m) in the description's elements (or its
    meshless neighbours among the model's rest frames) and keeps its frames, weights and rest
    levers pbar - xbar_i. Allocates one block (the model's allocator). Errors: FRM_ERR_DESC
-   (no cookie), FRM_ERR_ARG (NULL, count < 1, non-finite point, a point in no element),
+   (no cookie), FRM_ERR_ARG (NULL, count < 1, non-finite point), FRM_ERR_POINT_OUTSIDE (a
+   point in no element; meshless: no frame within the radius, or farther from each of its
+   frames than that frame's farthest sample in the model, beyond 1e-3 + tolerance of it),
    FRM_ERR_INDEX_RANGE (an element's frame index), FRM_ERR_SAMPLING (shape settings),
-   FRM_ERR_NO_NEIGHBOR / FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
+   FRM_ERR_SHAPE_DEGENERATE (meshless), FRM_ERR_ALLOC; *out NULL then. */
 FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
                             frm_probe **out);
 /* 3 values per point into out (m, m, m/s) for the model's current state: positions
@@ -1642,6 +1845,31 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
 FRMDEF int frm_probe_positions(const frm_probe *p, const frm_model *m, frm_real *out);
 FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_real *out);
 FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out);
+/* Mapped points (issue 14): a probe is the mapping p = M(q) of its points from the frames
+   (thesis eq. 4.11), the way to embed a render mesh, contact points or another model's
+   nodes in a frames body. Its Jacobian at the model's current state, J = dp/dq, with q's
+   variations as everywhere in frames.h (6 per frame: translation, then rotation dtheta
+   about world axes, R -> exp([dtheta]x) R):
+       J dq = sum_i w_i (dx_i + dtheta_i x a_i),   a_i = Q_i abar_i = R_i lbar_i,
+   and its transpose, the generalized forces of point forces f_n (the virtual work
+   dq . J^T f = sum_n f_n . dp_n), per frame i
+       force sum_n w_in f_n (eq. 4.12),   torque sum_n w_in a_in x f_n,
+   the thesis's eq. 4.13 with the frame's own prediction a_in of the point for p_n - x_i
+   (equal for rigid motions; ours is the exact transpose, so work is conserved across an
+   interface). frm_probe_jacobian: dq 6 per frame -> out 3 per point (m for rad and m, or
+   m/s for a velocity). frm_probe_jacobian_transpose: f 3 per point (N) -> out 6 per frame
+   (N, N m about the frame's origin, world axes), overwriting every frame's six values
+   (add = 0) or adding to them (add = 1). No allocation; FRM_ERR_ARG for NULL or a probe
+   made for a model with another frame count. */
+FRMDEF int frm_probe_jacobian(const frm_probe *p, const frm_model *m, const frm_real *dq, frm_real *out);
+FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, const frm_real *f, frm_real *out,
+                                        int add);
+/* Adds J^T f (forces f, 3 per point, N, at the current state) to the model's external
+   loads (frm_model_set_external's force and torque), which stay constant through the next
+   steps and solves until frm_model_clear_external or frm_model_set_external: call it once
+   per step with the points' current forces (a staggered coupling, a render mesh's
+   contact). FRM_ERR_ARG as above, or a non-finite force (nothing added). */
+FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f);
 /* Points of the probe. */
 FRMDEF int frm_probe_count(const frm_probe *p);
 /* Frees the probe. NULL is allowed. */
@@ -3548,6 +3776,27 @@ static int frm__validate_neighbors(const frm_desc *d, int *marker)
     return FRM_OK;
 }
 
+/* A frame's own mass and inertia (J: xx, yy, zz, yz, xz, xy, or NULL): mass 0 with no
+   inertia (NULL or zero), or mass > 0 with a positive definite J (Sylvester's criterion with
+   room for rounding); all finite. */
+static int frm__rigid_valid(double mass, const frm_real *J)
+{
+    double a, b, c, yz, xz, xy, m2, m3;
+    int k, zero = 1;
+    if (!frm__finite(mass) || mass < 0) return 0;
+    if (J)
+        for (k = 0; k < 6; k++) {
+            if (!frm__finite((double)J[k])) return 0;
+            zero &= J[k] == 0;
+        }
+    if (mass == 0) return zero;
+    if (!J) return 0;
+    a = (double)J[0], b = (double)J[1], c = (double)J[2], yz = (double)J[3], xz = (double)J[4], xy = (double)J[5];
+    m2 = a * b - xy * xy;
+    m3 = a * (b * c - yz * yz) - xy * (xy * c - yz * xz) + xz * (xy * yz - b * xz);
+    return a > 0 && m2 > 1e-12 * a * b && m3 > 1e-12 * a * b * c;
+}
+
 /* Everything but the frames' masses (checked once they are computed). marker: frame_count
    ints of scratch. */
 static int frm__validate(const frm_desc *d, int *marker)
@@ -3566,6 +3815,15 @@ static int frm__validate(const frm_desc *d, int *marker)
                 snprintf(msg, sizeof msg, "orientation of frame %d is not a unit quaternion", i);
                 return frm__fail(d, FRM_ERR_QUATERNION, msg);
             }
+    for (i = 0; i < d->frame_count && (d->frame_masses || d->frame_inertias); i++) {
+        double mass = d->frame_masses ? (double)d->frame_masses[i] : 0;
+        const frm_real *J = d->frame_inertias ? d->frame_inertias + 6 * (size_t)i : NULL;
+        if (!frm__rigid_valid(mass, J)) {
+            snprintf(msg, sizeof msg, "frame %d: own mass %g kg, inertia not positive definite or given without mass", i,
+                     mass);
+            return frm__fail(d, FRM_ERR_RIGID, msg);
+        }
+    }
     for (s = 0; s < 3 * d->sample_count; s++)
         if (!frm__finite((double)d->sample_positions[s])) {
             snprintf(msg, sizeof msg, "position of sample %d is not finite", s / 3);
@@ -3575,6 +3833,11 @@ static int frm__validate(const frm_desc *d, int *marker)
         if (!(frm__finite((double)d->sample_volumes[s]) && d->sample_volumes[s] > 0)) {
             snprintf(msg, sizeof msg, "volume %g of sample %d", (double)d->sample_volumes[s], s);
             return frm__fail(d, FRM_ERR_SAMPLE_VOLUME, msg);
+        }
+    for (s = 0; d->sample_sizes && s < d->sample_count; s++)
+        if (!(frm__finite((double)d->sample_sizes[s]) && d->sample_sizes[s] >= 0)) {
+            snprintf(msg, sizeof msg, "size %g of sample %d", (double)d->sample_sizes[s], s);
+            return frm__fail(d, FRM_ERR_SAMPLE_SIZE, msg);
         }
     err = frm__validate_neighbors(d, marker);
     if (err) return err;
@@ -3758,6 +4021,14 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
             ml[9] -= mu * l[0] * l[1];
         }
     }
+    if (d->frame_masses) /* rigid bodies' own mass at the origin and inertia (issue 14) */
+        for (c = 0; c < m->frame_count; c++) {
+            double *ml = m->mass_local + 10 * (size_t)c, own = (double)d->frame_masses[c];
+            ml[0] += own;
+            m->grav_local[4 * (size_t)c] += own;
+            if (d->frame_inertias)
+                for (k = 0; k < 6; k++) ml[4 + k] += (double)d->frame_inertias[6 * (size_t)c + k];
+        }
     for (c = 0; c < m->frame_count; c++)
         if (!(m->mass_local[10 * (size_t)c] > 0)) return c;
     return -1;
@@ -4095,9 +4366,13 @@ static void frm__create_pairs(frm_model *m, const frm_desc *d)
         }
         if (lmax > 0 && sqrt(lmax) < m->h_min) m->h_min = sqrt(lmax); /* the sample's support size */
         h2 = wsum > 0 ? h2 / wsum : 0;
+        if (d->sample_sizes) h2 = (double)d->sample_sizes[s]; /* the parts' own (rigid bodies, issue 14) */
         m->s_couple[s] = (frm_real)(h2 > 0 ? (double)d->frame_coupling * m->s_mu[s] * m->s_volume[s] / h2 : 0.0);
         m->s_hstab[s] = (frm_real)((double)m->stab_gamma * h2);
-        if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
+        if (m->stab_gamma > 0 && d->sample_linear) { /* as the description says (rigid bodies, issue 14) */
+            if (d->sample_linear[s]) m->s_stab[s] = 1;
+            else m->s_hstab[s] = 0;
+        } else if (m->stab_gamma > 0) { /* the divergence term needs weights that reproduce linear fields:
                                     sum_k xbar_k grad w_k^T = I, i.e. sum_k abar_k grad w_k^T = -I */
             double A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, err = 0;
             int q, r;
@@ -7650,6 +7925,237 @@ FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int
     return err;
 }
 
+/* >>parts ------------------------------------------------------------------------------ */
+
+FRMDEF frm_part frm_part_default(void)
+{
+    frm_part p;
+    frm_desc d = frm_model_default_desc();
+    memset(&p, 0, sizeof p);
+    p.material = d.material;
+    return p;
+}
+
+FRMDEF void frm_assembly_free(frm_assembly *a)
+{
+    if (!a) return;
+    if (a->materials) frm__free(&a->allocator, a->materials, a->bytes);
+    frm_sampling_free(&a->sampling);
+    memset(a, 0, sizeof *a);
+}
+
+/* Part k's sample i mapped to the model's frames: its entries with frames on one rigid body
+   merged (their weights and gradients add: the frames predict the same point, see RIGID
+   BODIES). n entries into f, w, g; FRM_ERR_NEIGHBOR_TABLE for a malformed row. */
+static int frm__part_row(const frm_part *pt, int i, const unsigned char *rigid, int *f, double *w, double *g, int *n)
+{
+    const frm_sampling *s = pt->sampling;
+    int a = s->neighbor_start[i], b = s->neighbor_start[i + 1], e, q, r;
+    *n = 0;
+    if (a < 0 || b <= a || b - a > FRM_MAX_NEIGHBORS || b > s->pair_count) return FRM_ERR_NEIGHBOR_TABLE;
+    for (e = a; e < b; e++) {
+        int lf = s->neighbor_frames[e], gf;
+        if (lf < 0 || lf >= s->frame_count) return FRM_ERR_NEIGHBOR_TABLE;
+        gf = pt->frame_map ? pt->frame_map[lf] : lf;
+        q = 0;
+        while (q < *n && !(rigid[gf] && f[q] == gf)) q++;
+        if (q == *n) {
+            f[q] = gf, w[q] = 0;
+            for (r = 0; r < 3; r++) g[3 * q + r] = 0;
+            (*n)++;
+        }
+        w[q] += (double)s->neighbor_weights[e];
+        for (r = 0; r < 3; r++) g[3 * q + r] += (double)s->neighbor_gradients[3 * e + r];
+    }
+    return FRM_OK;
+}
+
+FRMDEF frm_rigid_body frm_rigid_body_default(void)
+{
+    frm_rigid_body b;
+    memset(&b, 0, sizeof b);
+    b.frame = -1;
+    return b;
+}
+
+FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
+                             int rigid_count, int frame_count, const frm_allocator *allocator)
+{
+    long long samples = 0, pairs = 0;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, size = 0, tol;
+    int k, i, j, r, s0 = 0, p0 = 0, err = FRM_OK, first = 1, pass;
+    int *given;
+    unsigned char *rigid;
+    frm_allocator al;
+    frm__carver c;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!parts || part_count < 1 || frame_count < 1 || part_count > 100000000 || frame_count > 100000000 ||
+        rigid_count < 0 || (rigid_count > 0 && !rigids))
+        return FRM_ERR_ARG;
+    memset(&al, 0, sizeof al);
+    if (allocator) al = *allocator;
+    for (k = 0; k < part_count; k++) {
+        const frm_sampling *s = parts[k].sampling;
+        if (!s || s->frame_count < 1 || s->sample_count < 1 || !s->frame_positions || !s->sample_positions ||
+            !s->sample_volumes || !s->neighbor_start || !s->neighbor_frames || !s->neighbor_weights ||
+            !s->neighbor_gradients)
+            return FRM_ERR_ARG;
+        if (!parts[k].frame_map && s->frame_count > frame_count) return FRM_ERR_PART_FRAME;
+        for (j = 0; j < s->frame_count; j++) {
+            int g = parts[k].frame_map ? parts[k].frame_map[j] : j;
+            if (g < 0 || g >= frame_count) return FRM_ERR_PART_FRAME;
+            for (r = 0; r < 3; r++) {
+                double x = (double)s->frame_positions[3 * j + r];
+                if (first || x < lo[r]) lo[r] = x;
+                if (first || x > hi[r]) hi[r] = x;
+            }
+            first = 0;
+        }
+        samples += s->sample_count;
+    }
+    for (k = 0; k < rigid_count; k++) {
+        const frm_rigid_body *rb = rigids + k;
+        if (rb->frame < 0 || rb->frame >= frame_count) return FRM_ERR_PART_FRAME;
+        if (!frm__all_finite(rb->position, 3)) return FRM_ERR_ARG;
+        if (!frm__rigid_valid((double)rb->mass, rb->inertia) || !(rb->mass > 0)) return FRM_ERR_RIGID;
+    }
+    if (samples > 100000000) return FRM_ERR_ARG;
+    for (r = 0; r < 3; r++)
+        if (hi[r] - lo[r] > size) size = hi[r] - lo[r];
+    tol = (sizeof(frm_real) < sizeof(double) ? 1e-5 : 1e-9) * (size > 0 ? size : 1);
+    /* the block of the assembly's own arrays and the scratch marks */
+    c.base = NULL;
+    for (pass = 0; pass < 2; pass++) {
+        c.offset = 0;
+        FRM__CARVE(&c, out->materials, frm_material, part_count);
+        FRM__CARVE(&c, out->sample_materials, int, samples);
+        FRM__CARVE(&c, out->part_samples, int, part_count + 1);
+        FRM__CARVE(&c, out->frame_masses, frm_real, frame_count);
+        FRM__CARVE(&c, out->frame_inertias, frm_real, 6 * (size_t)frame_count);
+        FRM__CARVE(&c, out->sample_sizes, frm_real, samples);
+        FRM__CARVE(&c, out->sample_linear, unsigned char, samples);
+        FRM__CARVE(&c, given, int, frame_count); /* scratch: the last part (+ 1) that gave each model frame */
+        FRM__CARVE(&c, rigid, unsigned char, frame_count); /* scratch: the frame is a rigid body's */
+        if (pass == 0) {
+            out->bytes = c.offset;
+            c.base = (char *)frm__alloc(&al, out->bytes);
+            if (!c.base) {
+                memset(out, 0, sizeof *out);
+                return FRM_ERR_ALLOC;
+            }
+        }
+    }
+    out->part_count = part_count;
+    out->rigid_count = rigid_count;
+    out->allocator = al;
+    memset(given, 0, sizeof(int) * (size_t)frame_count);
+    memset(rigid, 0, (size_t)frame_count);
+    memset(out->frame_masses, 0, sizeof(frm_real) * (size_t)frame_count);
+    memset(out->frame_inertias, 0, sizeof(frm_real) * 6 * (size_t)frame_count);
+    for (k = 0; k < rigid_count; k++) {
+        const frm_rigid_body *rb = rigids + k;
+        if (rigid[rb->frame]) err = FRM_ERR_PART_FRAME; /* two bodies on one frame */
+        rigid[rb->frame] = 1;
+        out->frame_masses[rb->frame] = rb->mass;
+        for (r = 0; r < 6; r++) out->frame_inertias[6 * (size_t)rb->frame + r] = rb->inertia[r];
+    }
+    /* the merged pairs (frames on one rigid body become one entry) */
+    for (k = 0; k < part_count && !err; k++)
+        for (i = 0; i < parts[k].sampling->sample_count && !err; i++) {
+            int f[FRM_MAX_NEIGHBORS], n;
+            double w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS];
+            err = frm__part_row(parts + k, i, rigid, f, w, g, &n);
+            pairs += n;
+        }
+    if (!err && pairs > 1600000000) err = FRM_ERR_ARG;
+    if (!err) err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, &al);
+    if (err) {
+        frm_assembly_free(out);
+        return err;
+    }
+    for (k = 0; k < rigid_count; k++) { /* a body gives its frame */
+        for (r = 0; r < 3; r++) out->sampling.frame_positions[3 * rigids[k].frame + r] = rigids[k].position[r];
+        given[rigids[k].frame] = -1;
+    }
+    out->sampling.neighbor_start[0] = 0;
+    for (k = 0; k < part_count && !err; k++) {
+        const frm_part *pt = parts + k;
+        const frm_sampling *s = pt->sampling;
+        out->materials[k] = pt->material;
+        out->part_samples[k] = s0;
+        for (j = 0; j < s->frame_count && !err; j++) { /* frames: the first giver sets, the others agree */
+            int g = pt->frame_map ? pt->frame_map[j] : j;
+            frm_real *x = out->sampling.frame_positions + 3 * g;
+            if (rigid[g]) continue; /* attached to a body: moves with it rigidly */
+            if (given[g] == k + 1) { /* repeated within this part */
+                err = FRM_ERR_PART_FRAME;
+                break;
+            }
+            if (!given[g])
+                for (r = 0; r < 3; r++) x[r] = s->frame_positions[3 * j + r];
+            else
+                for (r = 0; r < 3; r++)
+                    if (!(fabs((double)x[r] - (double)s->frame_positions[3 * j + r]) <= tol)) err = FRM_ERR_PART_FRAME;
+            given[g] = k + 1;
+        }
+        for (i = 0; i < s->sample_count && !err; i++) {
+            int f[FRM_MAX_NEIGHBORS], n, e;
+            double w[FRM_MAX_NEIGHBORS], g[3 * FRM_MAX_NEIGHBORS];
+            double h2 = 0, wsum = 0, A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, lin = 0;
+            err = frm__part_row(pt, i, rigid, f, w, g, &n);
+            for (e = s->neighbor_start[i]; e < s->neighbor_start[i + 1] && !err; e++) { /* as frm__create_pairs */
+                double l2 = 0, aw = fabs((double)s->neighbor_weights[e]), l[3];
+                int q;
+                for (r = 0; r < 3; r++) {
+                    l[r] = (double)(frm_real)((double)s->sample_positions[3 * i + r] -
+                                              (double)s->frame_positions[3 * s->neighbor_frames[e] + r]);
+                    l2 += l[r] * l[r];
+                }
+                h2 += aw * l2;
+                wsum += aw;
+                for (r = 0; r < 3; r++)
+                    for (q = 0; q < 3; q++) A[3 * r + q] += l[r] * (double)s->neighbor_gradients[3 * e + q];
+            }
+            for (r = 0; r < 9; r++) lin += fabs(A[r]);
+            out->sample_sizes[s0 + i] = (frm_real)(wsum > 0 ? h2 / wsum : 0);
+            out->sample_linear[s0 + i] = lin <= 1e-3;
+            for (r = 0; r < 3; r++) out->sampling.sample_positions[3 * (s0 + i) + r] = s->sample_positions[3 * i + r];
+            out->sampling.sample_volumes[s0 + i] = s->sample_volumes[i];
+            out->sample_materials[s0 + i] = k;
+            for (e = 0; e < n; e++) {
+                out->sampling.neighbor_frames[p0 + e] = f[e];
+                out->sampling.neighbor_weights[p0 + e] = (frm_real)w[e];
+                for (r = 0; r < 3; r++) out->sampling.neighbor_gradients[3 * (p0 + e) + r] = (frm_real)g[3 * e + r];
+            }
+            p0 += n;
+            out->sampling.neighbor_start[s0 + i + 1] = p0;
+        }
+        s0 += s->sample_count;
+    }
+    out->part_samples[part_count] = s0;
+    for (j = 0; j < frame_count && !err; j++)
+        if (!given[j]) err = FRM_ERR_PART_FRAME;
+    if (err) {
+        frm_assembly_free(out);
+        return err;
+    }
+    return FRM_OK;
+}
+
+FRMDEF void frm_assembly_apply(const frm_assembly *a, frm_desc *d)
+{
+    if (!a || !d) return;
+    frm_sampling_apply(&a->sampling, d);
+    d->materials = a->materials;
+    d->material_count = a->part_count;
+    d->sample_materials = a->sample_materials;
+    d->frame_masses = a->rigid_count > 0 ? a->frame_masses : NULL;
+    d->frame_inertias = a->rigid_count > 0 ? a->frame_inertias : NULL;
+    d->sample_sizes = a->rigid_count > 0 ? a->sample_sizes : NULL;
+    d->sample_linear = a->rigid_count > 0 ? a->sample_linear : NULL;
+}
+
 /* >>probes ----------------------------------------------------------------------------- */
 
 struct frm_probe {
@@ -7832,7 +8338,7 @@ static void frm__bins_free(frm__bins *b, const frm_allocator *a)
 
 /* The frames and weights of one point p: n (<= FRM_MAX_NEIGHBORS) into idx, w. */
 static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const frm__grid *grid, const frm__bins *bins,
-                            const double *X, const double p[3], int *idx, double *w, int *n)
+                            const double *X, const double *reach, const double p[3], int *idx, double *w, int *n)
 {
     double tol = (double)d->tolerance, best = -HUGE_VAL;
     int e, a, r, nodes = d->kind == FRM_PROBE_TETS ? 4 : 8, cell, q;
@@ -7844,8 +8350,13 @@ static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const f
             err;
         int c = frm__grid_query(grid, X, p, k, sh->support == FRM_SUPPORT_RADIUS ? (double)sh->radius : 0.0,
                                 FRM_MAX_NEIGHBORS, idx, dist);
-        if (c == 0) return FRM_ERR_NO_NEIGHBOR;
+        if (c == 0) return FRM_ERR_POINT_OUTSIDE;
         if (c > FRM_MAX_NEIGHBORS) return FRM_ERR_TOO_MANY_NEIGHBORS;
+        if (reach) { /* inside the support of at least one of its frames (issue 14) */
+            int in = 0;
+            for (i = 0; i < c && !in; i++) in = dist[i] <= reach[idx[i]] * (1 + 1e-3 + tol);
+            if (!in) return FRM_ERR_POINT_OUTSIDE;
+        }
         for (i = 0; i < c; i++)
             for (r = 0; r < 3; r++) Xn[3 * i + r] = X[3 * idx[i] + r];
         if (sh->shape == FRM_SHAPE_MLS) { /* as frm_sampling_meshless */
@@ -7897,7 +8408,7 @@ static int frm__probe_point(const frm_model *m, const frm_probe_desc *d, const f
             for (a = 0; a < nodes; a++) idx[a] = el[a], w[a] = ww[a];
         }
     }
-    return *n ? FRM_OK : FRM_ERR_ARG;
+    return *n ? FRM_OK : FRM_ERR_POINT_OUTSIDE;
 }
 
 FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const frm_real *rest_points, int count,
@@ -7907,9 +8418,9 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
     frm__grid grid;
     frm__bins bins;
     frm_probe tmp, *p;
-    double *X;
+    double *X, *G;
     size_t xbytes;
-    int err = FRM_OK, i, k, r, pass, pairs = 0, nodes;
+    int err = FRM_OK, i, k, r, pass, pairs = 0, nodes, geo;
     if (out) *out = NULL;
     if (!m || !d || !out) return FRM_ERR_ARG;
     if (d->internal_cookie != FRM__PROBE_COOKIE) return FRM_ERR_DESC;
@@ -7922,21 +8433,37 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
         err = frm__check_shape(&d->shape);
         if (err) return err;
     } else {
+        int range = d->nodes ? d->node_count : m->frame_count;
         if (!d->elements || d->element_count < 1) return FRM_ERR_ARG;
+        if (d->nodes && (d->node_count < 1 || !d->node_frames || !frm__all_finite(d->nodes, 3 * (size_t)d->node_count)))
+            return FRM_ERR_ARG;
         for (i = 0; i < nodes * d->element_count; i++)
-            if (d->elements[i] < 0 || d->elements[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
+            if (d->elements[i] < 0 || d->elements[i] >= range) return FRM_ERR_INDEX_RANGE;
+        for (i = 0; d->nodes && i < d->node_count; i++)
+            if (d->node_frames[i] < 0 || d->node_frames[i] >= m->frame_count) return FRM_ERR_INDEX_RANGE;
     }
-    xbytes = sizeof(double) * 3 * (size_t)m->frame_count;
+    geo = d->kind != FRM_PROBE_MESHLESS && d->nodes ? d->node_count : 0;
+    /* rest positions, each frame's reach, then the elements' own nodes */
+    xbytes = sizeof(double) * (4 * (size_t)m->frame_count + 3 * (size_t)geo);
     X = (double *)frm__alloc(&m->allocator, xbytes);
     if (!X) return FRM_ERR_ALLOC;
     for (i = 0; i < 3 * m->frame_count; i++) X[i] = (double)m->rest_pos[i];
+    G = geo ? X + 4 * (size_t)m->frame_count : X;
+    for (i = 0; i < 3 * geo; i++) G[i] = (double)d->nodes[i];
+    for (i = 0; i < m->frame_count; i++) X[3 * m->frame_count + i] = 0;
+    for (k = 0; k < m->pair_count; k++) { /* reach: the frame's farthest sample (its rest lever) */
+        const frm_real *a = m->p_rlev + 3 * (size_t)k;
+        double len = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+        double *reach = X + 3 * m->frame_count + m->p_frame[k];
+        if (len > *reach) *reach = len;
+    }
     memset(&grid, 0, sizeof grid);
     memset(&bins, 0, sizeof bins);
     if (d->kind == FRM_PROBE_MESHLESS)
         err = frm__grid_build(&grid, X, m->frame_count, d->shape.support == FRM_SUPPORT_RADIUS ? (double)d->shape.radius : 0.0,
                               &m->allocator);
     else
-        err = frm__bins_build(&bins, d, X, m->frame_count, &m->allocator);
+        err = frm__bins_build(&bins, d, G, geo ? geo : m->frame_count, &m->allocator);
     memset(&tmp, 0, sizeof tmp);
     p = NULL;
     /* pass 0 counts the pairs, pass 1 fills the block */
@@ -7973,7 +8500,8 @@ FRMDEF int frm_probe_create(const frm_model *m, const frm_probe_desc *d, const f
             double pt[3], w[FRM_MAX_NEIGHBORS];
             int idx[FRM_MAX_NEIGHBORS + 1], n;
             for (r = 0; r < 3; r++) pt[r] = (double)rest_points[3 * i + r];
-            err = frm__probe_point(m, d, &grid, &bins, X, pt, idx, w, &n);
+            err = frm__probe_point(m, d, &grid, &bins, G, X + 3 * m->frame_count, pt, idx, w, &n);
+            for (k = 0; geo && k < n && !err; k++) idx[k] = d->node_frames[idx[k]]; /* nodes -> frames */
             if (err) break;
             if (pass == 1) {
                 p->start[i] = pairs;
@@ -8035,6 +8563,58 @@ FRMDEF int frm_probe_displacements(const frm_probe *p, const frm_model *m, frm_r
 }
 FRMDEF int frm_probe_velocities(const frm_probe *p, const frm_model *m, frm_real *out) { return frm__probe_eval(p, m, out, 2); }
 FRMDEF int frm_probe_count(const frm_probe *p) { return p ? p->count : 0; }
+
+FRMDEF int frm_probe_jacobian(const frm_probe *p, const frm_model *m, const frm_real *dq, frm_real *out)
+{
+    int i, k, r;
+    if (!p || !m || !dq || !out || p->frame_count != m->frame_count) return FRM_ERR_ARG;
+    for (i = 0; i < p->count; i++) {
+        double acc[3] = {0, 0, 0};
+        for (k = p->start[i]; k < p->start[i + 1]; k++) { /* w (dx + dtheta x Q abar) */
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            const frm_real *Q = m->rel + 9 * p->frame[k], *v = dq + 6 * p->frame[k];
+            double l[3];
+            for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+            acc[0] += w * ((double)v[0] + (double)v[4] * l[2] - (double)v[5] * l[1]);
+            acc[1] += w * ((double)v[1] + (double)v[5] * l[0] - (double)v[3] * l[2]);
+            acc[2] += w * ((double)v[2] + (double)v[3] * l[1] - (double)v[4] * l[0]);
+        }
+        for (r = 0; r < 3; r++) out[3 * i + r] = (frm_real)acc[r];
+    }
+    return FRM_OK;
+}
+
+/* Points in order, each adding to its frames: the sums' order is fixed (deterministic). */
+FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, const frm_real *f, frm_real *out,
+                                        int add)
+{
+    int i, k, r;
+    if (!p || !m || !f || !out || p->frame_count != m->frame_count) return FRM_ERR_ARG;
+    if (!add) memset(out, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+    for (i = 0; i < p->count; i++) {
+        const double fx = (double)f[3 * i], fy = (double)f[3 * i + 1], fz = (double)f[3 * i + 2];
+        for (k = p->start[i]; k < p->start[i + 1]; k++) { /* w (f, Q abar x f) */
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            const frm_real *Q = m->rel + 9 * p->frame[k];
+            frm_real *o = out + 6 * p->frame[k];
+            double l[3];
+            for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+            o[0] = (frm_real)((double)o[0] + w * fx);
+            o[1] = (frm_real)((double)o[1] + w * fy);
+            o[2] = (frm_real)((double)o[2] + w * fz);
+            o[3] = (frm_real)((double)o[3] + w * (l[1] * fz - l[2] * fy));
+            o[4] = (frm_real)((double)o[4] + w * (l[2] * fx - l[0] * fz));
+            o[5] = (frm_real)((double)o[5] + w * (l[0] * fy - l[1] * fx));
+        }
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f)
+{
+    if (!p || !m || !f || p->frame_count != m->frame_count || !frm__all_finite(f, 3 * (size_t)p->count)) return FRM_ERR_ARG;
+    return frm_probe_jacobian_transpose(p, m, f, m->ext, 1);
+}
 
 FRMDEF void frm_probe_destroy(frm_probe *p)
 {

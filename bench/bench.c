@@ -1122,8 +1122,8 @@ static void run_stability(const options *o, const bench_model *const *models, in
    unit cube (2^3 cells) whose bottom face is held and whose top face is
    pushed down 0.5 m (squashed to half its height; St Venant-Kirchhoff, whose equilibrium
    is not unique beyond a stretch of about 0.58, by 0.25 m), both faces held laterally.
-   Grid: E = 1 Pa, 1 kPa, 1 MPa, 200 GPa; nu = 0, 0.45, 0.4999; static, and implicit Euler at
-   dt = 1e-6, 1e-3, 1 s; density 1000 kg/m^3; every model entry, double and float (quick:
+   Grid: E = 1 Pa, 1 kPa, 1 MPa, 200 GPa; nu = 0, 0.45, 0.4999; static, and implicit Euler and
+   BDF2 (issue 19; where the entry has it) at dt = 1e-6, 1e-3, 1 s; density 1000 kg/m^3; every model entry, double and float (quick:
    E = 1 Pa and 200 GPa, nu = 0 and 0.4999, dt = 1e-6 and 1 s, the primary double entries).
    A disagreement between two successes of the same model means one of them is wrong; the
    sweep counts it against the one-call or large-step run.
@@ -1139,12 +1139,17 @@ static void run_stability(const options *o, const bench_model *const *models, in
      brings it within 0.1 % of the increments' answer; the factor 3 is the margin for the
      estimate of w1 and for large deformation (on the code of issue 18's start, 1 instead
      of 3 left 14 of the 960 double runs short of the answer, 5 instead of 3 changed one).
-     Right within 1 %.
+     Right within 1 %. BDF2: the same rule with its own contraction per step, the larger
+     root modulus rho of (3/2 + w dt) z^2 - 2 z + 1/2 = 0 (sweep_bdf2_rho): N = 3 ln(1000) /
+     ln(1 / rho) + 2 (rho = 0.914 against Euler's 0.917 at w dt = 0.09, but sqrt(1 / (3 + 2 w dt))
+     beyond w dt = 1/2, slower than Euler's 1 / (1 + w dt) beyond w dt = sqrt(2): at w dt = 1000,
+     8 steps where Euler needs 5).
    - implicit, "resolved" regime (beam only; n = 8, 4 or 2 steps, the most with
      n dt <= L / (4 c_p), c_p the P-wave speed): the free end has not heard of the clamp
      (the implicit solve's reach per step decays like exp(-x / (c_p dt))), so its mean
-     displacement is implicit Euler's own free fall, v <- (v + dt g) / (1 + c dt),
-     u <- u + dt v. Right within 1 % plus 100 eps(precision) m of position round-off.
+     displacement is the integrator's own free fall: implicit Euler's v <- (v + dt g) / (1 + c dt),
+     u <- u + dt v; BDF2's the same first step, then y <- (4 y - y_prev) / 3 + (2 dt / 3) y' for
+     u and v. Right within 1 % plus 100 eps(precision) m of position round-off.
    - otherwise "unjudged" (8 steps are still run: an error code counts as one, a non-finite
      state as wrong).
    A non-finite state after a success is always wrong. sweep.csv has every run. */
@@ -1313,7 +1318,7 @@ static void sweep_record(const bench_model *m, sweep_run *r, sweep_counts *c, in
 {
     csv_prefix(sweep_csv);
     fprintf(sweep_csv, "%s,%s,%s,%s,%s,%.6g,%.6g,%.6g,%d,%s,%d,%.9g,%.9g,%.6g,%s,%.4g\n", sweep_scene_name[r->scene],
-            m->model, m->variant, m->precision, r->solver == BENCH_STATIC ? "static" : "implicit-euler", r->young,
+            m->model, m->variant, m->precision, integrator_name[r->solver], r->young,
             r->poisson, r->dt, r->steps, r->regime, r->code, r->value, r->reference, r->error, r->outcome, r->seconds);
     if (!strcmp(r->outcome, "right")) c->right++;
     else if (!strcmp(r->outcome, "error")) c->error++;
@@ -1322,7 +1327,7 @@ static void sweep_record(const bench_model *m, sweep_run *r, sweep_counts *c, in
     if (verbose || !strcmp(r->outcome, "WRONG")) {
         char what[48];
         if (r->solver == BENCH_STATIC) snprintf(what, sizeof what, "static");
-        else snprintf(what, sizeof what, "implicit dt=%g x%d %s", r->dt, r->steps, r->regime);
+        else snprintf(what, sizeof what, "%s dt=%g x%d %s", integrator_name[r->solver], r->dt, r->steps, r->regime);
         printf("    %-5s %-5s E=%-7.0e nu=%-6g %-34s %-8s error %9.3g  code %d\n", r->outcome, sweep_scene_name[r->scene],
                r->young, r->poisson, what, r->outcome, r->error, r->code);
     }
@@ -1337,6 +1342,14 @@ static const char *sweep_outcome(int code, int finite, double error, double tole
     return error <= tolerance ? "right" : "WRONG"; /* a NaN error is wrong */
 }
 
+/* BDF2's contraction per step of a critically damped linear mode (w dt = x): the larger root
+   modulus of (3/2 + x) z^2 - 2 z + 1/2 = 0. */
+static double sweep_bdf2_rho(double x)
+{
+    if (x >= 0.5) return sqrt(0.5 / (1.5 + x));
+    return (2 + sqrt(1 - 2 * x)) / (3 + 2 * x);
+}
+
 static void sweep_model(const bench_model *m, const options *o, sweep_counts *total)
 {
     static const double youngs_full[4] = {1, 1e3, 1e6, 2e11}, youngs_quick[2] = {1, 2e11};
@@ -1344,7 +1357,7 @@ static void sweep_model(const bench_model *m, const options *o, sweep_counts *to
     static const double nus_full[3] = {0, 0.45, 0.4999}, nus_quick[2] = {0, 0.4999};
     const double *nus = o->quick ? nus_quick : nus_full, *youngs = o->quick ? youngs_quick : youngs_full,
                  *dts = o->quick ? dts_quick : dts_full;
-    int nnu = o->quick ? 2 : 3, ne = o->quick ? 2 : 4, ndt = o->quick ? 2 : 3, k = 1, scene, e, q, d;
+    int nnu = o->quick ? 2 : 3, ne = o->quick ? 2 : 4, ndt = o->quick ? 2 : 3, k = 1, scene, e, q, d, it;
     double eps = strcmp(m->precision, "float") ? DBL_EPSILON : FLT_EPSILON, t_model = now();
     sweep_counts c;
     memset(&c, 0, sizeof c);
@@ -1380,19 +1393,24 @@ static void sweep_model(const bench_model *m, const options *o, sweep_counts *to
                     r.seconds = now() - t0;
                     sweep_record(m, &r, &c, 0);
                 }
-                /* implicit Euler */
+                /* the implicit integrators: implicit Euler, then BDF2 where the entry has it */
+                for (it = 0; it < 2; it++)
                 for (d = 0; d < ndt; d++) {
+                    int integrator = it ? BENCH_BDF2 : BENCH_IMPLICIT_EULER;
                     double dt = dts[d], wdt = w1 * dt;
                     void *sim = NULL;
                     int s, damped = wdt >= 0.09 && ref,
                            resolved = 0;
+                    if (!(m->integrators & BIT(integrator))) continue;
                     bench_body bd = b;
                     t0 = now();
                     memset(&r, 0, sizeof r);
-                    r.scene = scene, r.solver = BENCH_IMPLICIT_EULER, r.young = youngs[e], r.poisson = nus[q];
+                    r.scene = scene, r.solver = integrator, r.young = youngs[e], r.poisson = nus[q];
                     r.dt = dt;
                     r.value = r.reference = r.error = NAN;
-                    r.steps = damped ? 3 * (int)ceil(log(1000.0) / log(1 + wdt)) + 2 : 8;
+                    r.steps = !damped                       ? 8
+                              : integrator == BENCH_IMPLICIT_EULER ? 3 * (int)ceil(log(1000.0) / log(1 + wdt)) + 2
+                                                                   : 3 * (int)ceil(log(1000.0) / -log(sweep_bdf2_rho(wdt))) + 2;
                     /* resolved: 8, 4 or 2 steps that the clamp's influence cannot cross */
                     while (!damped && scene == SWEEP_BEAM && !resolved && r.steps >= 2) {
                         if (r.steps * dt <= b.size[0] / (4 * cp)) resolved = 1;
@@ -1403,7 +1421,7 @@ static void sweep_model(const bench_model *m, const options *o, sweep_counts *to
                     bd.damping = 2 * w1;
                     r.code = m->create(&bd, &sim);
                     if (!r.code) r.code = sweep_load(m, sim, &bd, scene, 1);
-                    for (s = 0; s < r.steps && !r.code; s++) r.code = m->step(sim, dt, BENCH_IMPLICIT_EULER);
+                    for (s = 0; s < r.steps && !r.code; s++) r.code = m->step(sim, dt, integrator);
                     if (sim) {
                         int finite = all_finite(m, sim);
                         double tolerance = -1;
@@ -1414,10 +1432,18 @@ static void sweep_model(const bench_model *m, const options *o, sweep_counts *to
                             free(x);
                             tolerance = 0.01;
                         } else if (finite && resolved) {
-                            double u[3], v = 0, z = 0, c_damp = bd.damping, dz;
-                            for (s = 0; s < r.steps; s++) { /* implicit Euler's own free fall */
-                                v = (v + dt * bd.gravity[2]) / (1 + c_damp * dt);
-                                z += dt * v;
+                            double u[3], v = 0, z = 0, v_old = 0, z_old = 0, c_damp = bd.damping, dz;
+                            for (s = 0; s < r.steps; s++) { /* the integrator's own free fall */
+                                double v_new, z_new;
+                                if (integrator == BENCH_IMPLICIT_EULER || s == 0) { /* BDF2 starts with Euler */
+                                    v_new = (v + dt * bd.gravity[2]) / (1 + c_damp * dt);
+                                    z_new = z + dt * v_new;
+                                } else { /* y+ = (4 y - y-) / 3 + (2 dt / 3) y+' */
+                                    double h = 2 * dt / 3;
+                                    v_new = ((4 * v - v_old) / 3 + h * bd.gravity[2]) / (1 + c_damp * h);
+                                    z_new = (4 * z - z_old) / 3 + h * v_new;
+                                }
+                                v_old = v, z_old = z, v = v_new, z = z_new;
                             }
                             face_mean(m, sim, &bd, 0, bd.size[0], 1e-6 * bd.size[0], u);
                             dz = sqrt(u[0] * u[0] + u[1] * u[1] + (u[2] - z) * (u[2] - z));
@@ -1450,7 +1476,7 @@ static void run_sweep(const options *o, const bench_model *const *models, int co
     int i;
     memset(&total, 0, sizeof total);
     printf("\nstress sweep: beam and squashed cube, E 1 Pa to 200 GPa, nu 0 to 0.4999, static and implicit Euler at "
-           "dt 1e-6 to 1 s;\n  each run right (against the same model by a more careful path), an error code, WRONG "
+           "dt 1e-6 to 1 s\n  (and BDF2 where the entry has it);\n  each run right (against the same model by a more careful path), an error code, WRONG "
            "(success with a wrong answer) or unjudged (see bench.c >>sweep)\n");
     sweep_csv = open_csv(o, "sweep.csv",
                          "scene,model,variant,precision,solver,young,poisson,time_step,steps,regime,code,value,"
@@ -1795,6 +1821,29 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                     models[i]->variant, models[i]->precision, c + 1, surf, 1e9 * upd[c] / surf, bandwidth[1]);
         }
         printf("\n");
+    }
+    /* mapped points (issue 14): a render mesh's vertices inside the elements, about 30,000
+       (quick: 4,000) */
+    for (i = 0; i < count; i++) {
+        const bench_model *m = models[i];
+        static const char *what[3] = {"mapped-positions", "mapped-velocities", "mapped-JTf"};
+        double ns[3];
+        int n = o->quick ? 8 : 16, points = 0, c;
+        bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
+        void *sim = NULL;
+        if (!m->mapped || !m->primary || m->create(&b, &sim)) continue;
+        set_threads(1);
+        m->step(sim, 1e-5, BENCH_IMPLICIT_EULER); /* a generic deformed state */
+        if (!m->mapped(sim, &points, ns)) {
+            printf("%s %s %s mapped points (%d, 1 thread): positions %.1f ns, velocities %.1f ns, J^T f %.1f ns a point\n",
+                   m->model, m->variant, m->precision, points, ns[0], ns[1], ns[2]);
+            for (c = 0; c < 3; c++) {
+                csv_prefix(f);
+                fprintf(f, "%s,%s,%s,%s,1,%d,point,%.4g,,,,%.4g\n", m->model, m->variant, m->precision, what[c], points,
+                        ns[c], bandwidth[1]);
+            }
+        }
+        m->destroy(sim);
     }
     fclose(f);
 }

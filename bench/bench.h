@@ -95,6 +95,10 @@ typedef struct bench_model {
        (with the offset) is p, through the model's point probe (issue 19); 0 or an error
        (then the caller falls back to node averages) */
     int (*probe)(void *sim, const double p[3], double u[3]);
+    /* optional (NULL): mapped points (issue 14), a render mesh's cost: about `points` points
+       inside the body's elements made once, then the median ns per point of their positions
+       [0], velocities [1] and the forces' transpose J^T f [2]; *points the count made */
+    int (*mapped)(void *sim, int *points, double ns_per_point[3]);
 } bench_model;
 
 /* An adapter's table: *count entries. */

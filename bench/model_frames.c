@@ -2,6 +2,7 @@
    grid (trilinear, 8 sub-cell samples a cell) or of the bench's tetrahedral mesh
    (barycentric, one sample a tet), St Venant-Kirchhoff or Neo-Hookean. The bench's "nodes"
    are the frames. Compiled twice by the Makefile, in double and with -DBENCH_FLOAT. */
+#define _POSIX_C_SOURCE 199309L
 #ifdef BENCH_FLOAT
 #define FRM_REAL float
 #define BENCH_TABLE bench_models_frames_float
@@ -22,6 +23,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 typedef struct fr_sim {
     frm_model *m;
@@ -254,6 +256,73 @@ static int fr_probe(void *v, const double p[3], double u[3])
     return err;
 }
 
+static double fr_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Mapped points: one point between each element's centroid and each of its corners (8 a
+   hexahedron, 4 a tetrahedron), as a render mesh's vertices would sit; then the median
+   time of each evaluation over calls lasting 20 ms at least. */
+static int fr_mapped(void *v, int *points, double ns[3])
+{
+    fr_sim *s = (fr_sim *)v;
+    frm_probe_desc d = frm_probe_default_desc();
+    frm_probe *p = NULL;
+    int per = s->hex ? 8 : 4, count = per * s->element_count, e, a, k, what, err;
+    frm_real *pts = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)count), *out, *q6;
+    if (!pts) return FRM_ERR_ALLOC;
+    for (e = 0; e < s->element_count; e++) {
+        double c[3] = {0, 0, 0};
+        const int *el = s->elements + per * e;
+        for (a = 0; a < per; a++)
+            for (k = 0; k < 3; k++) c[k] += s->rest[3 * el[a] + k] / per;
+        for (a = 0; a < per; a++)
+            for (k = 0; k < 3; k++) pts[3 * (per * e + a) + k] = (frm_real)(0.5 * c[k] + 0.5 * s->rest[3 * el[a] + k]);
+    }
+    d.kind = s->hex ? FRM_PROBE_HEXES : FRM_PROBE_TETS;
+    d.elements = s->elements;
+    d.element_count = s->element_count;
+    err = frm_probe_create(s->m, &d, pts, count, &p);
+    out = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)count);
+    q6 = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)s->frames);
+    if (!err && (!out || !q6)) err = FRM_ERR_ALLOC;
+    for (k = 0; !err && k < 3 * count; k++) pts[k] = (frm_real)(k % 3 == 2 ? -1 : 0); /* the forces: 1 N down */
+    for (what = 0; !err && what < 3; what++) {
+        double t[5];
+        int r, calls = 1, c;
+        for (;;) {
+            double t0 = fr_now();
+            for (c = 0; c < calls; c++)
+                err |= what == 0 ? frm_probe_positions(p, s->m, out)
+                                 : what == 1 ? frm_probe_velocities(p, s->m, out)
+                                             : frm_probe_jacobian_transpose(p, s->m, pts, q6, 0);
+            if (fr_now() - t0 >= 0.02 || calls > (1 << 24)) break;
+            calls *= 2;
+        }
+        for (r = 0; r < 5; r++) {
+            double t0 = fr_now();
+            for (c = 0; c < calls; c++)
+                err |= what == 0 ? frm_probe_positions(p, s->m, out)
+                                 : what == 1 ? frm_probe_velocities(p, s->m, out)
+                                             : frm_probe_jacobian_transpose(p, s->m, pts, q6, 0);
+            t[r] = (fr_now() - t0) / calls;
+        }
+        for (r = 1; r < 5; r++) /* the median of five */
+            for (c = r; c > 0 && t[c] < t[c - 1]; c--) {
+                double x = t[c];
+                t[c] = t[c - 1], t[c - 1] = x;
+            }
+        ns[what] = 1e9 * t[2] / count;
+    }
+    *points = count;
+    frm_probe_destroy(p);
+    free(pts), free(out), free(q6);
+    return err;
+}
+
 static double fr_elements(void *v) { return (double)frm_model_pair_count(((fr_sim *)v)->m); }
 
 static double fr_kernel_bytes(void *v, int kernel)
@@ -288,7 +357,7 @@ static int fr_kernel(void *v, int kernel)
 #define FR_ALL ((1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_BDF2) | (1u << BENCH_STATIC))
 #define FR_FUNCTIONS                                                                                          \
     fr_destroy, fr_dof, fr_node_count, fr_rest, fr_position, fr_pin, fr_release, fr_set_gravity, fr_solve_static, \
-        fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL, fr_probe
+        fr_step, fr_forces, NULL, fr_elements, fr_kernel_bytes, fr_kernel, NULL, fr_probe, fr_mapped
 
 static const bench_model fr_models[] = {
     {"frames", "svk hex8", "svk", BENCH_PRECISION, FR_ALL, 1, 1, "pair", fr_create_svk_hex, FR_FUNCTIONS},

@@ -229,7 +229,7 @@ static int hm_kernel(void *v, int kernel)
 #define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC) | (1u << BENCH_BDF2))
 #define HM_FUNCTIONS                                                                                          \
     hm_destroy, hm_dof, hm_node_count, hm_rest, hm_position, hm_pin, hm_release, hm_set_gravity, hm_solve_static, \
-        hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL, hm_probe
+        hm_step, hm_forces, NULL, hm_elements, hm_kernel_bytes, hm_kernel, NULL, hm_probe, NULL
 
 static const bench_model hm_models[] = {
     {"heml", "svk", "svk", BENCH_PRECISION, HM_ALL, 1, 1, "tet", hm_create_svk, HM_FUNCTIONS},

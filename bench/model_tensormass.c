@@ -295,10 +295,10 @@ static int tm_haptic(int quick, double update_seconds[3], int *surface_nodes, do
 static const bench_model tm_models[] = {
     {"tensormass", "linear", "linear", BENCH_PRECISION, TM_ALL, 0, 1, "tet", tm_create_tensor, tm_destroy, tm_dof,
      tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
-     tm_cut, tm_elements, tm_bytes_tensor, tm_kernel_tensor, tm_haptic, tm_probe},
+     tm_cut, tm_elements, tm_bytes_tensor, tm_kernel_tensor, tm_haptic, tm_probe, NULL},
     {"tensormass", "springs", "springs", BENCH_PRECISION, TM_ALL, 1, 1, "tet", tm_create_springs, tm_destroy, tm_dof,
      tm_node_count, tm_rest, tm_position, tm_pin, tm_release, tm_set_gravity, tm_solve_static, tm_step, tm_forces,
-     tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL, tm_probe},
+     tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL, tm_probe, NULL},
 };
 
 const bench_model *BENCH_TABLE(int *count);

@@ -92,7 +92,8 @@ esac
 mkdir -p "$tmp/beam" "$tmp/hybrid"
 run_case beam_runs 0 '' "$tmp/out" -- "$bin/frames_beam" "$tmp/beam"
 case beam_files in *"$filter"*)
-    if [ -s "$tmp/beam/frames_beam_samples.vtk" ] && [ -s "$tmp/beam/frames_beam_frames.vtk" ]; then
+    if [ -s "$tmp/beam/frames_beam_samples.vtk" ] && [ -s "$tmp/beam/frames_beam_frames.vtk" ] &&
+        [ -s "$tmp/beam/frames_beam_render.vtk" ]; then
         report beam_files 0 ""
     else
         report beam_files 1 "the VTK files are missing or empty"

@@ -87,8 +87,10 @@ static void test_float_renames(void)
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
         NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions),
+        NAME(frm_part_default), NAME(frm_rigid_body_default), NAME(frm_parts_combine), NAME(frm_assembly_apply), NAME(frm_assembly_free),
         NAME(frm_probe_default_desc), NAME(frm_probe_create), NAME(frm_probe_positions), NAME(frm_probe_displacements),
-        NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
+        NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_jacobian), NAME(frm_probe_jacobian_transpose),
+        NAME(frm_probe_add_external), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
         NAME(frm_modal_create), NAME(frm_modal_solve), NAME(frm_modal_count), NAME(frm_modal_frequency),
         NAME(frm_modal_shape), NAME(frm_modal_destroy), NAME(frm_btd_factor_size), NAME(frm_btd_factor),
         NAME(frm_btd_solve), NAME(frm_btd_compliance), NAME(frm_qp_box), NAME(frm_chain_default_desc),
@@ -1525,7 +1527,7 @@ static void test_probe_kinds(void)
         CHECK(worst_v < 10 * tol);
         frm_probe_destroy(p);
         p = NULL;
-        if (kind < 2) CHECK_INT(FRM_ERR_ARG, frm_probe_create(m, &pd, outside, 1, &p));
+        if (kind < 2) CHECK_INT(FRM_ERR_POINT_OUTSIDE, frm_probe_create(m, &pd, outside, 1, &p));
         CHECK(p == NULL);
         free(pos), free(quat), free(vel), free(out), free(elements);
         frm_model_destroy(m);
