@@ -757,6 +757,55 @@ static void test_inverse_unreachable(void)
     frm_chain_destroy(c);
 }
 
+/* An orientation target too (effector_orientation = 1, 6 rows for 6 cables): a pose made
+   by the direct simulation with known efforts is reached in position (1e-4 of L) and
+   orientation (1e-3 rad) by frm_chain_inverse_solve from the rest pose. */
+static void test_inverse_orientation(void)
+{
+    frm_actuator act[6];
+    int pf[200], k;
+    frm_real pp[600], lam[6] = {10, 0, 4, 0, 6, 2}, target[6], tip[3], q[4], pos[3 * ARM_N], comp[36 * ARM_N];
+    double L = 0.5, th;
+    frm_inverse_stats st;
+    frm_chain_desc d = frm_chain_default_desc();
+    frm_chain *c = make_arm(L, 0, act, pf, pp), *c2 = NULL;
+    if (!c) return;
+    CHECK_INT(FRM_OK, frm_chain_set_efforts(c, lam));
+    CHECK_INT(FRM_OK, frm_chain_solve_static(c));
+    CHECK_INT(FRM_OK, frm_chain_effector(c, tip, q));
+    /* the rest orientation is the identity: the target rotation vector is log(q) */
+    th = 2 * atan2(sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2]), (double)q[3]);
+    for (k = 0; k < 3; k++) {
+        double s = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2]);
+        target[k] = tip[k];
+        target[3 + k] = (frm_real)(s > 0 ? th * (double)q[k] / s : 0);
+    }
+    frm_chain_destroy(c);
+    /* the same arm with the orientation rows */
+    for (k = 0; k < ARM_N; k++) {
+        double rm = 0.03 - 0.015 * (k + 0.5) / (ARM_N - 1.0);
+        pos[3 * k] = (frm_real)(L * k / (ARM_N - 1)), pos[3 * k + 1] = pos[3 * k + 2] = 0;
+        if (k + 1 < ARM_N)
+            beam_compliance(L / (ARM_N - 1), 3e6, 3e6 / 2.8, PI * rm * rm, PI * rm * rm * rm * rm / 4, PI * rm * rm * rm * rm / 2,
+                            comp + 36 * k);
+    }
+    d.frame_count = ARM_N;
+    d.positions = pos;
+    d.compliances = comp;
+    d.gravity[2] = 0;
+    d.actuators = act;
+    d.actuator_count = 6;
+    d.effector_orientation = 1;
+    CHECK_INT(FRM_OK, frm_chain_create(&d, &c2));
+    if (!c2) return;
+    CHECK_INT(FRM_OK, frm_chain_inverse_solve(c2, target, 1e-4 * L, 10, &st));
+    frm_chain_effector(c2, tip, q);
+    printf("    position and orientation reached in %d linearisations: error %.2e\n", st.linearizations, st.error);
+    for (k = 0; k < 3; k++) CHECK_NEAR((double)target[k], (double)tip[k], 1e-4 * L);
+    CHECK(st.error <= 1e-4 * L);
+    frm_chain_destroy(c2);
+}
+
 /* ---- validation --------------------------------------------------------------------------- */
 
 static void test_chain_validation(void)
@@ -1044,6 +1093,7 @@ static const test_case cases[] = {
     TEST(test_cavity_push),
     TEST(test_inverse_reach),
     TEST(test_inverse_unreachable),
+    TEST(test_inverse_orientation),
     TEST(test_chain_validation),
     TEST(test_chain_vs_frames_cylinder),
     TEST(test_chain_no_allocation),
