@@ -2113,8 +2113,10 @@ FRMDEF int frm_chain_step(frm_chain *c);
 FRMDEF int frm_chain_inverse_step(frm_chain *c, const frm_real *target, double tolerance, frm_inverse_stats *stats);
 /* Inverse steps until the effector is within tolerance, at most max_linearizations (>= 1).
    FRM_ERR_UNREACHABLE: the target is out of reach; the chain is left at the closest pose
-   found (a valid equilibrium). FRM_ERR_NO_CONVERGENCE: not reached although predicted
-   reachable; the start state is restored. */
+   found (a valid equilibrium). FRM_ERR_NO_CONVERGENCE: not reached in max_linearizations
+   although the last linearisation predicted it reachable; the chain is likewise left at
+   the closest pose found (at worst the start state). A direct simulation's failure returns
+   its code with the state of the step before it. */
 FRMDEF int frm_chain_inverse_solve(frm_chain *c, const frm_real *target, double tolerance, int max_linearizations,
                                    frm_inverse_stats *stats);
 /* The compliance of an intervertebra sub-model of frames with rigid ends (eqs. 5.1-5.11):
