@@ -303,6 +303,80 @@
        limit dt -> infinity (A_i = alpha_i, B_i = 0: the fully relaxed equilibrium) and
        leaves the state relaxed there.
 
+   NEAR-INCOMPRESSIBLE BODIES (desc.nodal_pressure = 1; off by default, and then every
+       result is bit-identical to 0.3.0): average nodal pressure tetrahedra (Bonet and
+       Burton 1998's ANP element, the volumetric part moved from the tetrahedra to the
+       nodes), for every law but mass-spring, user laws included. P1 tetrahedra lock near
+       nu = 0.5 because every tetrahedron must keep its own volume (one constraint per
+       tetrahedron, about 5 per node against 3 degrees of freedom per node); here the
+       volume is constrained per node (one per node). Our formulation, in energy form so
+       that forces and differential follow exactly:
+           W = sum_e Vol_e (w(F_e) - U(J_e)) + sum_a sum_mat W_a,mat U_mat(J_a),
+       U(J) = w(J^(1/3) I) the law's energy on a pure dilation (I1 = 3 J^(2/3), I2 =
+       3 J^(4/3)), continued below J0 by its quadratic Taylor polynomial (J^(2/3) has no
+       second derivative at 0); W_a,mat = sum Vol_e / 4 over node a's tetrahedra of that
+       material, V_a = sum_mat W_a,mat, and the nodal volume ratio J_a = sum_e Vol_e J_e /
+       (4 V_a) (current over rest nodal volume). So each tetrahedron keeps its law minus
+       the law's own dilation energy, w - U, which has no bulk stiffness at small strain
+       (Neo-Hookean: w - U = mu/2 (I1 - 3 J^(2/3)), the isochoric part exactly; split
+       Mooney-Rivlin: U = kappa/2 (J - 1)^2, its volumetric term exactly; St Venant-
+       Kirchhoff: w - U is O(strain^3)), and the nodes carry the volumetric energy. A
+       homogeneous deformation gives every J_a = J_e = J, the two U terms cancel, and the
+       stress is the law's P(F) (the patch test) for any law; rigid motions give J = 1 and
+       zero force. Our choice where the papers offer several: U from the law itself (no
+       separate volumetric law to specify, user laws work unchanged) rather than Bonet and
+       Burton's assumed split, and the nodal energy weighted per material (a node on a
+       material interface carries each material's U on its own volume share).
+       Forces: dW/dx = sum_e Vol_e (dw - U'(J_e) dJ_e) + sum_a V_a P_a dJ_a with the nodal
+       pressure P_a = sum_mat W_a,mat U'_mat(J_a) / V_a and dJ_a = sum_e Vol_e dJ_e / (4 V_a),
+       so regrouped per tetrahedron:
+           w_J  ->  w_J - U'(J_e) + p_e,   p_e = (P_a + P_b + P_c + P_d) / 4
+       (and s0 the same), its four nodes' mean pressure: the P1 force kernel unchanged.
+       Differential: dp_e = sum_{a in e} dP_a / 4, dP_a = (sum_mat W_a,mat U''_mat(J_a) /
+       V_a) dJ_a, so in the element's differential w_JJ -> w_JJ - U''(J_e) and dw_J gains
+       dp_e: the exact tangent, which couples a node to its neighbours' neighbours
+       (through J_a), matrix-free. Each pass (force, energy, differential, stresses) is
+       three: the tetrahedra scatter Vol (J - 1) / 4 (the differential also Vol dJ / 4 =
+       Vol cof F : dH / 4) into two scalars per node (coloured as the force pass); a node
+       pass (chunks of 1024 nodes) evaluates U', U'' (and U) at J_a in blocks of 16
+       through the law's own row of heml__laws (one evaluation per material present); the
+       usual pass then gathers the four P_a (and dP_a) and evaluates the element's U at
+       J_e besides the law. U', U'' are formed from the law's s0 and second derivatives at
+       the dilation point: U' = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1), s = J^(1/3), s - 1 =
+       (J - 1) / (s^2 + s + 1), without cancellation at rest. It runs the general path
+       (not the vectorised Neo-Hookean kernels). Prony: the nodal pressure enters w_J
+       before the filter, so it relaxes with the rest of the stress. Inversion: the
+       continued U is restoring below J0 at the nodes; a single tetrahedron's own
+       resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
+       the bulk part. Memory: 6 reals per node plus one per node and material.
+       Measured (tests/test_heml_solve.c, Cook's membrane R10, nu = 0.4999, corner u_y in
+       mm at N x N x 1 cells, N = 4, 8, 16, 32; converged about 6.9):
+           six tetrahedra per cell   plain 2.15 2.17 2.22 2.38   nodal 2.65 4.38 5.99 6.61
+           five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
+       so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
+       it and converge (as O(h)) towards the published value. What it does not fix
+       (LIMITS): the static solve's Krylov iterations (Cook, N = 16: about 430 at nu = 0.3,
+       17,000 at nu = 0.4999, with or without nodal pressure: the conditioning is the
+       bulk-to-shear ratio, which the Jacobi and rigid-body coarse preconditioner does
+       not address; scaling the Jacobi diagonal's bulk share by 0.2 or 0.02 gave 14,300
+       to 21,600: the diagonal is not the cause, a volumetric (divergence-free) coarse
+       space or a block preconditioner would be), and the nodal pressure field oscillates between neighbouring nodes
+       near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
+       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
+       smoothed, e.g. as the element means p_e, not node by node. The bench's Poisson beam
+       (1 x 0.1 x 0.1 m, 30 x 3 x 3 cells of five tetrahedra, tip against Timoshenko): 14.4,
+       18.9, 22.5, 25.9 % off at nu = 0.3, 0.45, 0.49, 0.499 (plain 18.5, 22.4, 26.6,
+       30.2 %); of six tetrahedra per cell at nu = 0.499 the tip is 0.0071 m instead of
+       plain P1's 0.0004 m. The growth with nu that remains halves with h (13 % between
+       nu = 0.3 and 0.499 at 3 cells across, 6 % at 6): P1 bending error, not locking.
+       Cost (callgrind, 2,592 tetrahedra, Neo-Hookean, gcc -O3 -mavx2 -mfma, instructions
+       per tetrahedron and pass): force 643 against 229 on the vectorised kernel (284 on
+       the general path it runs instead), differential 979 against 310 (431): the sums
+       pass (a second gather) about 130, the element's U with its cube root (Halley, 4
+       steps, vectorised; libm's cbrt made it twice as slow) about 100, the node pass
+       about 25. The issue's target, 1.3 times the plain force, would need a fused
+       Neo-Hookean kernel for it; not done.
+
    INTEGRATORS (the desc picks a default, heml_step_ex picks per call)
        HEML_SEMI_EXPLICIT_EULER  eq. 32: v1 = v + dt a(u, v), u1 = u + dt v1, lumped masses
                              m_i = sum rho Vol / 4 (sec. 3.3). One force evaluation per
@@ -623,7 +697,16 @@
 
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
-         to 0.5 or a stiff penalty): refine the mesh across thin parts.
+         to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
+         desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
+         BODIES), which removes the volumetric locking, not the bending one.
+       - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
+         shear ratio (about 40 times more at nu = 0.4999 than at nu = 0.3 on Cook's
+         membrane: no preconditioner for the volumetric part yet); the nodal pressure
+         oscillates between neighbouring nodes near nu = 0.5 (smooth the pressure before
+         reading it); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
+         laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
          (HEML_ERR_DIVERGED) catches growth of more than twice the energy the body was
          given, so slower growth below that still passes: respect the time-step estimate.
@@ -870,13 +953,14 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept") \
     X(HEML_ERR_DIVERGED, -29, "explicit step failed its divergence check (energy grew beyond the work done on the body); the last valid state was kept") \
     X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept") \
-    X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept")
+    X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept") \
+    X(HEML_ERR_NODAL_PRESSURE, -32, "nodal_pressure not 0 or 1, or set with a law it cannot average (mass-spring, a user law without second derivatives)")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
     HEML_ERROR_LIST(HEML__ENUM)
 #undef HEML__ENUM
-    HEML_ERR_LAST_ = -32
+    HEML_ERR_LAST_ = -33
 };
 
 typedef enum heml_law {
@@ -992,6 +1076,10 @@ typedef struct heml_desc {
     int material_count;
     const int *tet_material;         /* tet_count indices into materials, or NULL (all 0) */
     heml_real inversion_threshold;   /* J0 of sec. 4.4, in (0, 1), default 0.4 */
+    int nodal_pressure;              /* 0 (default): plain P1 tetrahedra; 1: average nodal
+                                        pressure tetrahedra for nearly incompressible bodies
+                                        (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
+                                        user laws with second derivatives */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1348,6 +1436,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
+#define HEML__NODE_CHUNK 1024 /* nodes per work item of the nodal pressure's node pass */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
 #define HEML__MAX_NODES 200000000
@@ -1369,6 +1458,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__STRESS 3
 #define HEML__FORCE_ENERGY 4 /* forces and the elastic energy (static line search) */
 #define HEML__ABS 5          /* sum of |tetrahedron force| per dof (the round-off floor) */
+#define HEML__NODAL_SUMS 6   /* the nodal pressure's sums of Vol (J - 1) / 4 (and Vol dJ / 4) */
 
 /* A material in kernel form. */
 typedef struct heml__mat {
@@ -1418,6 +1508,7 @@ struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     int agg_count;                         /* aggregates of the coarse space (0: none) */
+    int nodal;                             /* desc.nodal_pressure (NEAR-INCOMPRESSIBLE BODIES) */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
     heml_linear_solver linear_solver;
@@ -1500,6 +1591,15 @@ struct heml_model {
     double *agg_centre; /* 3 per aggregate */
     double *coarse;     /* (6 A)^2: A_c, then its Cholesky factor */
     double *coarse_rhs; /* 6 A */
+
+    /* average nodal pressure (heml__nodal_prepare): per node the rest volume weights of
+       each material, W[mat n + a] = sum Vol_e / 4 over the node's tetrahedra of that
+       material, 1 / V_a (V_a their sum over materials), the sums sum Vol_e (J_e - 1) / 4
+       and sum Vol_e dJ_e / 4 of the current pass, the nodal pressure P_a and its
+       differential dP_a; per node chunk its energy */
+    heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
+    double *nod_energy;
+    int nod_chunks;
 
     heml_stats stats;
 };
@@ -1653,6 +1753,8 @@ struct heml__blk {
     heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
     heml_real de[9][HEML__W]; /* differential: the links of dx */
     heml_real len[6][HEML__W]; /* springs: clamped link lengths */
+    heml_real dp[HEML__W];    /* differential: the nodal pressure's dp (0 without it), see
+                                 NEAR-INCOMPRESSIBLE BODIES */
 };
 typedef struct heml__blk heml__blk;
 
@@ -1910,6 +2012,62 @@ static void heml__law_at_rest(const heml__mat *mt, heml_real jm1_0, heml__blk *b
     for (k = 0; k < HEML__W; k++) b->I1m3[k] = b->I2m3[k] = b->tr2[k] = b->q1[k] = b->jm1[k] = 0;
     heml__clamp_J(jm1_0, b);
     heml__law(mt, b, 1, HEML__WANT_SECOND);
+}
+
+/* The volumetric function of a law (NEAR-INCOMPRESSIBLE BODIES): U(J) = w at the pure
+   dilation F = J^(1/3) I (I1 = 3 s^2, I2 = 3 s^4, s = J^(1/3)) for J >= J0, continued
+   below J0 by its quadratic Taylor polynomial; U, U' and U'' at the `W` lanes' J - 1 (jm1)
+   into U (when want has HEML__WANT_ENERGY), U1, U2. s is a workspace. With the law's
+   derivatives at the dilation point,
+       U'  = 2 w_1 / s + 4 w_2 s + w_J = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1),
+       U'' = -2/3 w_1 / s^4 + 4/3 w_2 / s^2 + 4 w_11 / s^2 + 16 w_12 + 16 s^2 w_22
+             + 4 w_1J / s + 8 s w_2J + w_JJ
+   (dI1/dJ = 2 / s, dI2/dJ = 4 s); s - 1 = (J - 1) / (s^2 + s + 1) and the invariants'
+   offsets I1 - 3 = 3 (s^2 - 1), q1 = I1 - 3 - 2 (J - 1) = -(s - 1)^2 (2 s + 1) are formed
+   without cancellation, so U' keeps the law's precision at small strains. */
+static void heml__dilation(const heml__mat *mt, heml_real jm1_0, const heml_real *jm1, int valid, int want,
+                           heml__blk *s, heml_real *U, heml_real *U1, heml_real *U2)
+{
+    heml_real dd[HEML__W], sv[HEML__W], sm[HEML__W];
+    int k;
+    for (k = 0; k < HEML__W; k++) { /* s = J^(1/3): Halley from the tangent 1 + (J - 1) / 3,
+                                       to round-off in 4 steps for J in [1/8, 8] (vectorised;
+                                       libm's cbrt is a call) */
+        heml_real jc = heml__max(jm1[k], jm1_0), x = 1 + jc, t = 1 + jc / 3;
+        int r;
+        for (r = 0; r < 4; r++) {
+            heml_real t3 = t * t * t;
+            t = t * (t3 + 2 * x) / (2 * t3 + x);
+        }
+        sv[k] = t;
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real jc = heml__max(jm1[k], jm1_0);
+        if (jc < (heml_real)-0.875 || jc > 7) sv[k] = (heml_real)cbrt(1.0 + (double)jc);
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real j = jm1[k], jc = heml__max(j, jm1_0), t = sv[k];
+        heml_real t1 = jc / (t * t + t + 1), t2 = t1 * (t + 1);
+        dd[k] = j - jc;
+        sm[k] = t1;
+        s->jm1[k] = jc;
+        s->I1m3[k] = 3 * t2;
+        s->I2m3[k] = 3 * t2 * (t * t + 1);
+        s->tr2[k] = 3 * t2 * t2;
+        s->q1[k] = -t1 * t1 * (2 * t + 1);
+    }
+    heml__clamp_J(jm1_0, s);
+    heml__law(mt, s, valid, (want & HEML__WANT_ENERGY) | HEML__WANT_SECOND);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real t = sv[k], it = 1 / t, d = dd[k], w1 = s->w1[k], w2 = s->w2[k];
+        heml_real u1 = s->s0[k] - 2 * w1 * sm[k] * it + 4 * w2 * sm[k];
+        heml_real u2 = (heml_real)(-2.0 / 3.0) * w1 * it * it * it * it + (heml_real)(4.0 / 3.0) * w2 * it * it +
+                       4 * s->h[0][k] * it * it + 16 * s->h[1][k] + 16 * t * t * s->h[3][k] + 4 * s->h[2][k] * it +
+                       8 * t * s->h[4][k] + s->h[5][k];
+        if (want & HEML__WANT_ENERGY) U[k] = s->w[k] + d * (u1 + d / 2 * u2);
+        U1[k] = u1 + u2 * d;
+        U2[k] = u2;
+    }
 }
 
 /* >>forces ---------------------------------------------------------------------------- */
@@ -2342,6 +2500,30 @@ static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real 
     heml__p_times_grad(R, b);
 }
 
+/* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
+   INCOMPRESSIBLE BODIES): the element's own volumetric function U(J_e) comes off (w -= U,
+   w_J -= U', w_JJ -= U'') and the mean of its four nodes' pressures p_e = sum P_a / 4 goes
+   on (w_J += p_e; s0 the same, as s0 = 2 w_1 + 4 w_2 + w_J); with second derivatives also
+   dp (the mean of the nodes' dP_a, read by heml__diff_general). */
+static void heml__nodal_element(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want)
+{
+    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+    const heml_real *p = m->nod_p, *dp = m->nod_dp;
+    heml_real U[HEML__W], U1[HEML__W], U2[HEML__W];
+    heml__blk s;
+    int k;
+    heml__dilation(mt, m->jm1_0, b->jm1, m->blk_valid[blk], want, &s, U, U1, U2);
+    for (k = 0; k < HEML__W; k++) {
+        int i0 = idx[k], i1 = idx[HEML__W + k], i2 = idx[2 * HEML__W + k], i3 = idx[3 * HEML__W + k];
+        heml_real pe = ((p[i0] + p[i1]) + (p[i2] + p[i3])) / 4 - U1[k];
+        b->wJ[k] += pe;
+        b->s0[k] += pe;
+        b->h[5][k] -= U2[k];
+        if (want & HEML__WANT_ENERGY) b->w[k] -= U[k];
+        if (want & HEML__WANT_SECOND) b->dp[k] = ((dp[i0] + dp[i1]) + (dp[i2] + dp[i3])) / 4;
+    }
+}
+
 /* Kinematics, law and stress coefficients of one general block (not springs), Prony
    applied (written to the next state when prony_write). */
 static void heml__block_stress(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want,
@@ -2351,6 +2533,7 @@ static void heml__block_stress(const heml_model *m, const heml__mat *mt, int blk
     heml__kinematics(R, b);
     heml__clamp_J(m->jm1_0, b);
     heml__law(mt, b, m->blk_valid[blk], want);
+    if (m->nodal) heml__nodal_element(m, mt, blk, b, want);
     heml__coefficients(b, mt->uses_i2);
     if (mt->prony_count) heml__prony(m, mt, blk, b, mt->uses_i2 ? 9 : 3, prony_write);
 }
@@ -2433,7 +2616,7 @@ static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, 
                        C21 * D21 + C22 * D22;
         heml_real dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
         heml_real dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
-        heml_real dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
+        heml_real dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ + b->dp[k];
         heml_real da2 = 2 * sp * vol * (dw1 + (2 + t) * dw2 + w2 * dI1), dwj = sp * vol * dwJ;
         heml_real a2 = 2 * vol * b->co[1][k], wj = vol * b->co[2][k];
         /* M~ (filtered) and s dM = 2 s (dw2 E2 + w2 dE2), both times Vol */
@@ -2533,6 +2716,8 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     }
     /* (fast-path laws reach here only with Prony: the general path covers them, with
        zero I-derivatives) */
+    if (!m->nodal)
+        for (k = 0; k < HEML__W; k++) b->dp[k] = 0;
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
 }
@@ -2581,6 +2766,58 @@ static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__bl
             out[3 * r + s] = (heml_real)(J > 0.0 ? acc / J : NAN);
         }
     return !(J > 0.0);
+}
+
+/* The nodal pressure's first pass on a block: Vol (J - 1) / 4 into b->jm1 and, with_d,
+   Vol dJ / 4 = Vol cof F : dH / 4 into b->dp (J - 1 formed as in heml__kinematics). */
+static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b, int with_d)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real q = R[9 * HEML__W + k] / 4;
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+        b->jm1[k] = q * (tr + i2 + det);
+        if (with_d) { /* cof F = (tr H + 1) I - H^T + cof H */
+            heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
+            heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
+            heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
+            heml_real D00 = x0 * g10 + y0 * g20 + z0 * g30, D01 = x0 * g11 + y0 * g21 + z0 * g31;
+            heml_real D02 = x0 * g12 + y0 * g22 + z0 * g32, D10 = x1 * g10 + y1 * g20 + z1 * g30;
+            heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
+            heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
+            heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32, t1 = 1 + tr;
+            b->dp[k] = q * ((t1 - H00 + c00) * D00 + (c01 - H10) * D01 + (c02 - H20) * D02 + (c10 - H01) * D10 +
+                            (t1 - H11 + c11) * D11 + (c12 - H21) * D12 + (c20 - H02) * D20 + (c21 - H12) * D21 +
+                            (t1 - H22 + c22) * D22);
+        }
+    }
+}
+
+/* Adds the block's scalar v of each lane into out at its four nodes (lanes in order). */
+static void heml__scatter_scalar(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT v,
+                                 heml_real *HEML__RESTRICT out)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        out[idx[k]] += v[k];
+        out[idx[HEML__W + k]] += v[k];
+        out[idx[2 * HEML__W + k]] += v[k];
+        out[idx[3 * HEML__W + k]] += v[k];
+    }
 }
 
 /* >>parallel -------------------------------------------------------------------------- */
@@ -2653,6 +2890,13 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 heml__scatter_abs(idx, b.f, p->out);
                 break;
+            case HEML__NODAL_SUMS:
+                heml__gather(idx, p->x, b.e);
+                if (p->dx) heml__gather(idx, p->dx, b.de);
+                heml__nodal_sums(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b, p->dx != NULL);
+                heml__scatter_scalar(idx, b.jm1, m->nod_j);
+                if (p->dx) heml__scatter_scalar(idx, b.dp, m->nod_dj);
+                break;
             case HEML__ENERGY:
                 heml__gather(idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
@@ -2662,6 +2906,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                     heml__kinematics(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__clamp_J(m->jm1_0, &b);
                     heml__law(mt, &b, valid, HEML__WANT_ENERGY);
+                    if (m->nodal) heml__nodal_element(m, mt, blk, &b, HEML__WANT_ENERGY);
                 }
                 energy += heml__lanes_energy(m, mt, blk, &b);
                 break;
@@ -2679,6 +2924,80 @@ static void heml__chunks(void *vctx, int begin, int end)
     }
 }
 
+/* The node pass of the nodal pressure on node chunks [begin, end): J_a - 1 = inv_a sum Vol
+   (J - 1) / 4, the pressure P_a = inv_a sum_mat W U'_mat(J_a), with `diff` its differential
+   dP_a = inv_a^2 (sum_mat W U''_mat(J_a)) sum Vol dJ / 4, with `energy` sum_mat W U_mat(J_a)
+   (times the material's Prony factor when `relaxed`) into the chunk's energy. */
+typedef struct heml__nodal_ctx {
+    heml_model *m;
+    int diff, energy, relaxed;
+} heml__nodal_ctx;
+
+static void heml__nodal_chunks(void *vctx, int begin, int end)
+{
+    const heml__nodal_ctx *cx = (const heml__nodal_ctx *)vctx;
+    heml_model *m = cx->m;
+    const int n = m->node_count, want = cx->energy ? HEML__WANT_ENERGY : 0;
+    heml__blk s;
+    int c, a, k, i;
+    for (c = begin; c < end; c++) {
+        int a1 = (c + 1) * HEML__NODE_CHUNK < n ? (c + 1) * HEML__NODE_CHUNK : n;
+        double energy = 0.0;
+        for (a = c * HEML__NODE_CHUNK; a < a1; a += HEML__W) {
+            int valid = a1 - a < HEML__W ? a1 - a : HEML__W;
+            heml_real jm1[HEML__W], P[HEML__W], Q[HEML__W], U[HEML__W], U1[HEML__W], U2[HEML__W];
+            for (k = 0; k < HEML__W; k++) {
+                jm1[k] = k < valid ? m->nod_j[a + k] * m->nod_inv[a + k] : 0;
+                P[k] = Q[k] = 0;
+            }
+            for (i = 0; i < m->material_count; i++) {
+                const heml_real *w = m->nod_w + (size_t)i * (size_t)n + (size_t)a;
+                const heml__mat *mt = m->mats + i;
+                double sp = cx->relaxed && mt->prony_count ? (double)m->prony_s[i] : 1.0;
+                int any = 0;
+                for (k = 0; k < valid; k++) any |= w[k] != 0;
+                if (!any) continue;
+                heml__dilation(mt, m->jm1_0, jm1, valid, want, &s, U, U1, U2);
+                for (k = 0; k < valid; k++) {
+                    P[k] += w[k] * U1[k];
+                    Q[k] += w[k] * U2[k];
+                    if (cx->energy) energy += sp * (double)w[k] * (double)U[k];
+                }
+            }
+            for (k = 0; k < valid; k++) {
+                heml_real inv = m->nod_inv[a + k];
+                m->nod_p[a + k] = P[k] * inv;
+                if (cx->diff) m->nod_dp[a + k] = Q[k] * inv * inv * m->nod_dj[a + k];
+            }
+        }
+        m->nod_energy[c] = energy;
+    }
+}
+
+static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
+                             heml_real *out, int prony_write, heml_stress_kind kind);
+
+/* The nodal pressure's first two passes before a pass of `mode` at x (and dx): the sums
+   over the tetrahedra (coloured like the force pass), then the node pass. Returns the
+   nodal energy (ENERGY, FORCE_ENERGY; 0 otherwise). */
+static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, const heml_real *dx)
+{
+    heml__nodal_ctx cx;
+    double energy = 0.0;
+    int c, diff = mode == HEML__DIFF;
+    memset(m->nod_j, 0, sizeof(heml_real) * (size_t)m->node_count);
+    if (diff) memset(m->nod_dj, 0, sizeof(heml_real) * (size_t)m->node_count);
+    heml__pass_run(m, HEML__NODAL_SUMS, x, diff ? dx : NULL, NULL, 0, HEML_STRESS_PK1);
+    cx.m = m;
+    cx.diff = diff;
+    cx.energy = mode == HEML__ENERGY || mode == HEML__FORCE_ENERGY;
+    cx.relaxed = mode == HEML__FORCE_ENERGY;
+    heml__run(m, m->nod_chunks, heml__nodal_chunks, &cx);
+    if (cx.energy)
+        for (c = 0; c < m->nod_chunks; c++) energy += m->nod_energy[c];
+    return energy;
+}
+
 /* Runs a pass; FORCE and DIFF overwrite out (3n). Returns the energy (ENERGY) or 0, and
    leaves the per-chunk counts in the model. */
 static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
@@ -2687,6 +3006,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     heml__pass p;
     double energy = 0.0;
     int c, below = 0, inverted = 0;
+    if (m->nodal && mode != HEML__NODAL_SUMS) energy = heml__nodal_prepare(m, mode, x, dx);
     p.m = m;
     p.mode = mode;
     p.prony_write = prony_write && m->has_prony;
@@ -2876,6 +3196,16 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse_rhs, double, 6 * (size_t)m->agg_count);
+    {
+        size_t nn = m->nodal ? n : 0;
+        HEML__CARVE(c, m->nod_w, heml_real, nn * M);
+        HEML__CARVE(c, m->nod_inv, heml_real, nn);
+        HEML__CARVE(c, m->nod_j, heml_real, nn);
+        HEML__CARVE(c, m->nod_dj, heml_real, nn);
+        HEML__CARVE(c, m->nod_p, heml_real, nn);
+        HEML__CARVE(c, m->nod_dp, heml_real, nn);
+        HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
+    }
     if (!m->has_springs) m->blk_spring = NULL;
 }
 
@@ -3137,6 +3467,8 @@ static int heml__create_validate(const heml_desc *d)
                                               "min_increment, precision_limit, allow_inversion or leave_saddles");
     for (i = 0; i < 3; i++)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
+    if (d->nodal_pressure != 0 && d->nodal_pressure != 1)
+        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0 or 1");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return heml__fail(d, HEML_ERR_ARG, "allocator needs both alloc and free");
     M = d->materials ? d->material_count : 1;
@@ -3147,6 +3479,15 @@ static int heml__create_validate(const heml_desc *d)
         err = heml__validate_material(d->materials ? d->materials + i : &d->material,
                                       (heml_real)((double)d->inversion_threshold - 1.0), i, msg, sizeof msg);
         if (err) return heml__fail(d, err, msg);
+        if (d->nodal_pressure) {
+            const heml_material *mi = d->materials ? d->materials + i : &d->material;
+            if (heml__laws[mi->law].kind == HEML__K_SPRING ||
+                (heml__laws[mi->law].kind == HEML__K_USER && !mi->user.second)) {
+                snprintf(msg, sizeof msg, "nodal_pressure: material %d is mass-spring or a user law without "
+                                          "second derivatives", i);
+                return heml__fail(d, HEML_ERR_NODAL_PRESSURE, msg);
+            }
+        }
     }
     for (i = 0; i < 3 * d->node_count; i++)
         if (!heml__finite((double)d->rest_positions[i])) {
@@ -3365,6 +3706,33 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
         m->inv_mass[s] = mass_acc[s] > 0 ? (heml_real)(1.0 / mass_acc[s]) : (heml_real)0;
         for (r = 0; r < 3; r++) m->diag[3 * s + r] = (heml_real)diag_acc[3 * s + r];
     }
+}
+
+/* The nodal pressure's rest weights (NEAR-INCOMPRESSIBLE BODIES): W[mat n + a] = sum of
+   Vol_e / 4 over the tetrahedra e of material mat at node a (the stored Vol, so that a
+   homogeneous J gives each node exactly that J), and 1 / V_a, V_a = sum_mat W (0 for a node
+   of no tetrahedron). acc: n doubles of scratch. */
+static void heml__nodal_weights(heml_model *m, const heml_desc *d, double *acc)
+{
+    size_t n = (size_t)m->node_count;
+    int s, j;
+    memset(acc, 0, sizeof(double) * n);
+    memset(m->nod_w, 0, sizeof(heml_real) * n * (size_t)m->material_count);
+    for (s = 0; s < m->slot_count; s++) {
+        int t = m->slot_tet[s], blk = s / HEML__W, k = s % HEML__W;
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        heml_real q;
+        size_t base;
+        if (t < 0) continue;
+        q = m->blk_rest[((size_t)blk * HEML__NR + 9) * HEML__W + k] / 4;
+        base = (size_t)(d->tet_material ? d->tet_material[t] : 0) * n;
+        for (j = 0; j < 4; j++) {
+            int a = idx[j * HEML__W + k];
+            acc[a] += (double)q;
+            m->nod_w[base + (size_t)a] += q;
+        }
+    }
+    for (s = 0; s < m->node_count; s++) m->nod_inv[s] = acc[s] > 0 ? (heml_real)(1.0 / acc[s]) : (heml_real)0;
 }
 
 /* >>coarse ---------------------------------------------------------------------------- */
@@ -3715,6 +4083,8 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
             tmp->has_user_without_second = 1;
     }
     tmp->slot_count = tmp->block_count * HEML__W;
+    tmp->nodal = d->nodal_pressure;
+    tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     {
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
@@ -3782,6 +4152,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
+        if (m->nodal) mt->fast = 0; /* the general path carries the nodal pressure */
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
@@ -3826,6 +4197,7 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
         m->tet_slot[t] = slot;
     }
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
+    if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
     heml__create_chunks(m, src, w);
     if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);

@@ -1093,7 +1093,8 @@ static void stability_twist(const bench_model *m, const options *o)
     stability_out(&r);
 }
 
-static void run_stability(const options *o, const bench_model *const *models, int count)
+static void run_stability(const options *o, const bench_model *const *models, int count,
+                          const bench_model *const *variants, int variant_count)
 {
     int i;
     printf("\n== 2. stability at the extremes ==\n");
@@ -1107,6 +1108,7 @@ static void run_stability(const options *o, const bench_model *const *models, in
         stability_twist(models[i], o);
         stability_far(models[i]);
     }
+    for (i = 0; i < variant_count; i++) stability_poisson(variants[i], o); /* the primary = -1 entries */
     fclose(stability_csv);
 }
 
@@ -1765,7 +1767,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                 m->destroy(probe);
             }
         }
-        for (s = 0; s < (m->primary || o->quick ? sizes : 2); s++) {
+        for (s = 0; s < (m->primary > 0 || o->quick ? sizes : 2); s++) {
             /* a cube of n^3 cells; adapters report the elements they built */
             int n = (int)ceil(cbrt(targets[s] / per_cell)), code;
             bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
@@ -1860,8 +1862,8 @@ static void usage(void)
 int main(int argc, char **argv)
 {
     options o;
-    static const bench_model *models[256];
-    int i, count = 0;
+    static const bench_model *models[256], *variants[64];
+    int i, count = 0, variant_count = 0;
     double t0 = now();
     memset(&o, 0, sizeof o);
     o.repeats = 3;
@@ -1889,7 +1891,10 @@ int main(int argc, char **argv)
         int n, j;
         const bench_model *table = registry[i](&n);
         for (j = 0; j < n && count < 256; j++)
-            if (selected(&o, table + j)) models[count++] = table + j;
+            if (selected(&o, table + j)) {
+                if (table[j].primary >= 0) models[count++] = table + j;
+                else if (variant_count < 64) variants[variant_count++] = table + j;
+            }
     }
     {
         const char *wait = getenv("OMP_WAIT_POLICY");
@@ -1905,12 +1910,18 @@ int main(int argc, char **argv)
     set_threads(1);
     if (o.parts & 1) run_trade(&o, models, count);
     set_threads(1);
-    if (o.parts & 2) run_stability(&o, models, count);
+    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
     set_threads(1);
     if (o.parts & 8) run_sweep(&o, models, count);
     set_threads(1);
     if (o.parts & 16) run_time(&o, models, count);
-    if (o.parts & 4) run_kernels(&o, models, count);
+    if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */
+        static const bench_model *all[256];
+        int n = 0;
+        for (i = 0; i < count && n < 256; i++) all[n++] = models[i];
+        for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
+        run_kernels(&o, all, n);
+    }
     if (o.parts & 4) run_chain(&o);
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;

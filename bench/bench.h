@@ -61,7 +61,10 @@ typedef struct bench_model {
     int nonlinear;         /* 1: geometrically exact (large deformation) */
     int primary;           /* 1: every scene; 0: a variant of a primary entry (another law)
                               that runs only the static scenes and the smallest kernels,
-                              to keep `make bench` within its time */
+                              to keep `make bench` within its time; -1: an opt-in option of
+                              a primary entry (e.g. a volumetric treatment against locking)
+                              that runs only the stability part's Poisson rows and the
+                              kernels' two smallest sizes */
     const char *element;   /* unit of the kernel counts: "tet", "pair" */
     /* 0 or the library's error code; *sim NULL on failure */
     int (*create)(const bench_body *b, void **sim);

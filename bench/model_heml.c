@@ -30,7 +30,7 @@ typedef struct hm_sim {
     double probe_at[3];
 } hm_sim;
 
-static int hm_create(const bench_body *b, heml_law law, void **out)
+static int hm_create(const bench_body *b, heml_law law, int nodal, void **out)
 {
     tetmesh mesh;
     heml_desc d = heml_default_desc();
@@ -63,6 +63,7 @@ static int hm_create(const bench_body *b, heml_law law, void **out)
     d.mass_damping = (heml_real)b->damping;
     for (i = 0; i < 3; i++) d.gravity[i] = (heml_real)b->gravity[i];
     d.cg_max_iterations = 20000; /* stiff slender beams need many CG iterations */
+    d.nodal_pressure = nodal;
     err = heml_create(&d, &s->m);
     free(x);
     if (err) {
@@ -81,10 +82,12 @@ static int hm_create(const bench_body *b, heml_law law, void **out)
     return 0;
 }
 
-static int hm_create_svk(const bench_body *b, void **out) { return hm_create(b, HEML_STVK, out); }
-static int hm_create_nh(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, out); }
-static int hm_create_mr(const bench_body *b, void **out) { return hm_create(b, HEML_MOONEY_RIVLIN, out); }
-static int hm_create_springs(const bench_body *b, void **out) { return hm_create(b, HEML_MASS_SPRING, out); }
+static int hm_create_svk(const bench_body *b, void **out) { return hm_create(b, HEML_STVK, 0, out); }
+static int hm_create_nh(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, 0, out); }
+static int hm_create_mr(const bench_body *b, void **out) { return hm_create(b, HEML_MOONEY_RIVLIN, 0, out); }
+static int hm_create_springs(const bench_body *b, void **out) { return hm_create(b, HEML_MASS_SPRING, 0, out); }
+/* Neo-Hookean with desc.nodal_pressure = 1 (average nodal pressure tetrahedra) */
+static int hm_create_nh_nodal(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, 1, out); }
 
 static void hm_destroy(void *v)
 {
@@ -236,6 +239,7 @@ static const bench_model hm_models[] = {
     {"heml", "neo-hookean", "neo-hookean", BENCH_PRECISION, HM_ALL, 1, 1, "tet", hm_create_nh, HM_FUNCTIONS},
     {"heml", "mooney-rivlin", "mooney-rivlin", BENCH_PRECISION, HM_ALL, 1, 0, "tet", hm_create_mr, HM_FUNCTIONS},
     {"heml", "springs", "springs", BENCH_PRECISION, HM_ALL, 1, 0, "tet", hm_create_springs, HM_FUNCTIONS},
+    {"heml", "neo-hookean nodal-p", "neo-hookean", BENCH_PRECISION, HM_ALL, 1, -1, "tet", hm_create_nh_nodal, HM_FUNCTIONS},
 };
 
 const bench_model *BENCH_TABLE(int *count);
