@@ -2251,8 +2251,10 @@ FRMDEF int frm_chain_inverse_solve(frm_chain *c, const frm_real *target, double 
    at origin_b; C (36, row-major) is that frame's compliance in the model's world axes (build
    the sub-model in the proximal vertebra's rest axes), the Schur complement of the model's
    linear stiffness at its current (rest) state through its own linear solver, by six imposed
-   unit rigid motions and their reactions. The model's fixed / driven frames are restored;
-   its state is untouched. Errors: FRM_ERR_ARG, FRM_ERR_FRAME_RANGE, the linear solver's
+   unit rigid motions and their reactions (ends' frame rotations free: see REDUCED CHAIN).
+   Give the sub-model no gravity (its stiffness terms would enter). The model's fixed /
+   driven frames and held axes are restored; its state is untouched. One temporary
+   allocation (3 vectors) through the model's allocator. Errors: FRM_ERR_ARG, FRM_ERR_FRAME_RANGE, the linear solver's
    FRM_ERR_NO_CONVERGENCE / FRM_ERR_NOT_FINITE, FRM_ERR_COMPLIANCE (the reduced stiffness
    is not positive definite: end B not held by the material). */
 FRMDEF int frm_chain_link_compliance(frm_model *m, const int *end_a, int na, const int *end_b, int nb,
