@@ -906,9 +906,10 @@
    W = J A^-1 J^T for a few constraint rows (eqs. 5.24-5.25) by rows solves, without A^-1.
    Tested against dense Cholesky for 1 to 60 blocks and by residuals at 1,000, with
    symmetric scalings that put the condition number near 1e10 (tests/test_frames_chain.c).
-   Measured (one core of the development machine, gcc -O3 -march=native, double): factor
-   about 170-210 us and solve 27 us for 1,000 blocks (the bench's btd rows); the goal of 50
-   us was not met: the factorisation is a sequential chain of 6x6 Cholesky steps whose
+   Measured (one core of the development machine, gcc -O3 -march=native, double, 1,000
+   blocks): factor 170 us and solve 28 us at best of 50 runs; the bench's btd rows (median
+   of 5 batches, the machine loaded to 5-7 on 2 cores) 420-520 us and 33 us, linear from 10
+   to 10,000 blocks. The issue's goal of 50 us was not met: the factorisation is a sequential chain of 6x6 Cholesky steps whose
    square roots and divisions (6 each a block) are latency-bound, about 0.2 us a block.
    In the frames solvers: desc.linear_solver = FRM_LINEAR_SOLVER_BTD for a model whose block
    pattern is a chain (frame i coupled to i - 1 and i + 1 only; checked at creation,
