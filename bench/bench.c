@@ -62,6 +62,8 @@ const bench_model *bench_models_heml_double(int *count);
 const bench_model *bench_models_heml_float(int *count);
 const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
+int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 static const bench_models_fn registry[] = {
     bench_models_tensormass_double, bench_models_tensormass_float, bench_models_heml_double,
     bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
@@ -1718,6 +1720,32 @@ static void print_kernel_spans(const kernel_span *spans, int count, const char *
     }
 }
 
+/* The reduced chain of frames.h (issue 15), in the kernels part: block-tridiagonal factor
+   and solve against the block count, one inverse control step of the 16-vertebra arm
+   (examples/frames_soft_arm.c). One thread. chain.csv; --filter chain or btd selects it. */
+static void run_chain(const options *o)
+{
+    const char *names[16];
+    double sizes[16], seconds[16];
+    int p, i, rows;
+    FILE *f;
+    if (o->filter && !strstr("frames chain btd", o->filter)) return;
+    printf("\n== frames.h reduced chain (issue 15), 1 thread ==\n");
+    f = open_csv(o, "chain.csv", "precision,kernel,blocks,us,ns_per_block");
+    for (p = 0; p < 2; p++) {
+        rows = (p ? bench_chain_rows_float : bench_chain_rows_double)(o->quick, now, names, sizes, seconds);
+        for (i = 0; i < rows; i++) {
+            printf("  %-6s %-17s %6.0f blocks: %10.2f us (%.1f ns a block)\n", p ? "float" : "double", names[i],
+                   sizes[i], 1e6 * seconds[i], 1e9 * seconds[i] / sizes[i]);
+            if (f) csv_prefix(f);
+            if (f)
+                fprintf(f, "%s,%s,%.0f,%.3f,%.2f\n", p ? "float" : "double", names[i], sizes[i], 1e6 * seconds[i],
+                        1e9 * seconds[i] / sizes[i]);
+        }
+    }
+    if (f) fclose(f);
+}
+
 /* single-thread results of this run, for the peer ratios */
 typedef struct kernel_result {
     const bench_model *m;
@@ -1977,6 +2005,7 @@ int main(int argc, char **argv)
         for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
         run_kernels(&o, all, n);
     }
+    if (o.parts & 4) run_chain(&o);
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;
 }
