@@ -6473,6 +6473,19 @@ static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double
             m->coarse_use = 1;
             st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
             m->stats.cg_iterations_last += first;
+        } else if ((st == FRM__CG_NEGATIVE || st == FRM__CG_CAP) && m->coarse_use) {
+            /* The coarse correction failed: once more from zero with block-Jacobi alone.
+               Near-singular systems (free rotations, no regularisation) make the coarse
+               matrix's solve amplify float's round-off until p.Kp or r.z turns non-positive
+               (float: frm_chain_link_compliance's cylinder, at 70 iterations); a genuinely
+               indefinite system stays NEGATIVE without it, so the minimum checks see the
+               same answer at twice the cost. */
+            int first = m->stats.cg_iterations_last;
+            m->coarse_use = 0;
+            memset(x, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->coarse_use = 1;
+            m->stats.cg_iterations_last += first;
         }
         return st;
     }
