@@ -1,8 +1,14 @@
 /* Tests of frames.h's coupling (issue 14): mapped points (probes as a mapping of the frames:
    positions, velocities, the Jacobian J and J^T), several parts in one model, and their
-   refusals. frames.h only: glue tests with the other headers go here later. */
+   refusals; and the glue to heml.h meshes (anchors in both headers, a staggered and a
+   stiff coupling of a heml.h half beam to a frames half beam). The headers never include
+   each other: this file includes all three. */
 #define FRAMES_IMPLEMENTATION
 #include "../frames.h"
+#define HEML_IMPLEMENTATION
+#include "../heml.h"
+#define TETMESH_IMPLEMENTATION
+#include "../examples/tetmesh.h"
 #include "test.h"
 #include "fixtures.h"
 
@@ -1142,11 +1148,212 @@ static void test_coupling_no_allocation(void)
     frm_sampling_free(&s);
 }
 
+/* ---- glue to heml.h meshes (issue 14) -------------------------------------------------- */
+
+/* A heml.h model of the box mesh [x0, x0 + sx] x [0, sy] x [0, sz] (nx x ny x nz cells, six
+   tetrahedra a cell, node (i, j, k) = i + (nx + 1) (j + (ny + 1) k)). */
+static int heml_box(int nx, int ny, int nz, double x0, double sx, double sy, double sz, double E, double nu, double rho,
+                    heml_law law, heml_model **m)
+{
+    tetmesh tm;
+    heml_desc d = heml_default_desc();
+    heml_real *x;
+    int i, err;
+    box_mesh(&tm, nx, ny, nz, sx, sy, sz, TETMESH_SPLIT6);
+    x = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)tm.node_count);
+    for (i = 0; i < 3 * tm.node_count; i++) x[i] = (heml_real)(tm.nodes[i] + (i % 3 == 0 ? x0 : 0));
+    d.rest_positions = x;
+    d.node_count = tm.node_count;
+    d.tets = tm.tets;
+    d.tet_count = tm.tet_count;
+    d.material = heml_material_from_young(law, E, nu);
+    d.material.density = (heml_real)rho;
+    d.integrator = HEML_IMPLICIT_EULER;
+    err = heml_create(&d, m);
+    free(x);
+    tetmesh_free(&tm);
+    return err;
+}
+
+/* Anchors of heml.h: energy, force and differential of the springs (the model with anchors
+   less the model without, same state) against central differences, on a Neo-Hookean box
+   in a random state, stiff springs (k = 10 E h) to random targets. Tolerance: central
+   differences of a quadratic are exact but for round-off (1e-9 relative in double; float
+   1e-3). */
+static void test_glue_anchor_fd_heml(void)
+{
+    heml_model *m = NULL;
+    unsigned seed = 7u;
+    int n, i, a, nodes[5] = {0, 3, 7, 11, 3}, trial;
+    heml_real k[5], t[15], *u, *w, *fa, *f0, *Ka, *K0;
+    double eps = IS_FLOAT ? 1e-3 : 1e-6, tol = IS_FLOAT ? 2e-3 : 1e-8, worst_f = 0, worst_k = 0;
+    REQUIRE(heml_box(2, 1, 1, 0, 2, 1, 1, 1e5, 0.3, 1000, HEML_NEO_HOOKEAN, &m) == HEML_OK);
+    n = heml_node_count(m);
+    u = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    w = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    fa = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    f0 = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    Ka = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    K0 = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+    for (a = 0; a < 5; a++) {
+        k[a] = (heml_real)(1e6 * (1.5 + rnd(&seed)));
+        for (i = 0; i < 3; i++) t[3 * a + i] = (heml_real)(heml_rest_positions(m)[3 * nodes[a] + i] + 0.1 * rnd(&seed));
+    }
+    for (i = 0; i < 3 * n; i++) u[i] = (heml_real)(0.05 * rnd(&seed));
+    for (trial = 0; trial < 3; trial++) {
+        double Ep, Em, fw = 0, scale = 0;
+        heml_energies e;
+        for (i = 0; i < 3 * n; i++) w[i] = (heml_real)rnd(&seed);
+        REQUIRE(heml_set_displacements(m, u) == HEML_OK);
+        REQUIRE(heml_set_anchors(m, 0, NULL, NULL, NULL) == HEML_OK);
+        memcpy(f0, heml_compute_forces(m), sizeof(heml_real) * 3 * (size_t)n);
+        REQUIRE(heml_apply_stiffness(m, w, K0) == HEML_OK);
+        REQUIRE(heml_set_anchors(m, 5, nodes, k, t) == HEML_OK);
+        memcpy(fa, heml_compute_forces(m), sizeof(heml_real) * 3 * (size_t)n);
+        REQUIRE(heml_apply_stiffness(m, w, Ka) == HEML_OK);
+        for (i = 0; i < 3 * n; i++) {
+            fw += ((double)fa[i] - (double)f0[i]) * (double)w[i];
+            scale += fabs(((double)fa[i] - (double)f0[i]) * (double)w[i]);
+        }
+        /* the springs' energy and force at u +- eps w: with anchors less without */
+        for (i = 0; i < 3 * n; i++) u[i] = (heml_real)((double)u[i] + eps * (double)w[i]);
+        REQUIRE(heml_set_displacements(m, u) == HEML_OK);
+        REQUIRE(heml_energy(m, &e) == HEML_OK);
+        Ep = e.elastic;
+        memcpy(Ka + 0, Ka, 0); /* (keeps the differential) */
+        {
+            heml_real *fp = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n), *fm = (heml_real *)malloc(sizeof(heml_real) * 3 * (size_t)n);
+            double kd = 0, ks = 0;
+            memcpy(fp, heml_compute_forces(m), sizeof(heml_real) * 3 * (size_t)n);
+            REQUIRE(heml_set_anchors(m, 0, NULL, NULL, NULL) == HEML_OK);
+            REQUIRE(heml_energy(m, &e) == HEML_OK);
+            Ep -= e.elastic;
+            for (i = 0; i < 3 * n; i++) fp[i] = (heml_real)((double)fp[i] - (double)heml_compute_forces(m)[i]);
+            for (i = 0; i < 3 * n; i++) u[i] = (heml_real)((double)u[i] - 2 * eps * (double)w[i]);
+            REQUIRE(heml_set_displacements(m, u) == HEML_OK);
+            REQUIRE(heml_energy(m, &e) == HEML_OK);
+            Em = -e.elastic;
+            memcpy(fm, heml_compute_forces(m), sizeof(heml_real) * 3 * (size_t)n);
+            REQUIRE(heml_set_anchors(m, 5, nodes, k, t) == HEML_OK);
+            REQUIRE(heml_energy(m, &e) == HEML_OK);
+            Em += e.elastic;
+            for (i = 0; i < 3 * n; i++) fm[i] = (heml_real)((double)heml_compute_forces(m)[i] - (double)fm[i]);
+            for (i = 0; i < 3 * n; i++) u[i] = (heml_real)((double)u[i] + eps * (double)w[i]);
+            for (i = 0; i < 3 * n; i++) { /* (f(u + eps w) - f(u - eps w)) / 2 eps = df w */
+                double fd = ((double)fp[i] - (double)fm[i]) / (2 * eps), an = (double)Ka[i] - (double)K0[i];
+                if (fabs(fd - an) > kd) kd = fabs(fd - an);
+                if (fabs(an) > ks) ks = fabs(an);
+            }
+            if (kd / ks > worst_k) worst_k = kd / ks;
+            free(fp), free(fm);
+        }
+        if (fabs(-(Ep - Em) / (2 * eps) - fw) / scale > worst_f) worst_f = fabs(-(Ep - Em) / (2 * eps) - fw) / scale;
+    }
+    printf("    heml anchors: force against -dE/dx %.1e, differential against df/dx %.1e (relative)\n", worst_f, worst_k);
+    CHECK(worst_f < tol);
+    CHECK(worst_k < tol);
+    /* refusals */
+    k[1] = -1;
+    CHECK_INT(HEML_ERR_ARG, heml_set_anchors(m, 5, nodes, k, t));
+    k[1] = 1;
+    nodes[2] = n;
+    CHECK_INT(HEML_ERR_NODE_RANGE, heml_set_anchors(m, 5, nodes, k, t));
+    CHECK_INT(HEML_ERR_ARG, heml_set_anchors(m, 5, NULL, k, t));
+    CHECK_INT(HEML_ERR_ARG, heml_set_anchors(m, -1, NULL, NULL, NULL));
+    free(u), free(w), free(fa), free(f0), free(Ka), free(K0);
+    heml_destroy(m);
+}
+
+/* Anchors of frames.h on mapped points (hexahedral, Shepard and MLS probes): energy, force
+   and the exact stiffness product of the springs (with anchors less without, same state)
+   against central differences in a random deformed state (frames turned up to 0.4 rad).
+   Tolerance: central differences with eps 1e-5 (float 1e-2) on fields of curvature of
+   order 1: 1e-7 relative (float 2e-2). */
+static void test_glue_anchor_fd_frames(void)
+{
+    double eps = IS_FLOAT ? 1e-2 : 1e-5, tol = IS_FLOAT ? 2e-2 : 1e-7, worst_f = 0, worst_k = 0;
+    int kind, i, trial;
+    for (kind = 0; kind < 3; kind++) {
+        frm_model *m = NULL;
+        frm_sampling s;
+        frm_probe_desc pd;
+        frm_probe *p = NULL;
+        int *hexes, n, np = 12;
+        unsigned seed = 31u + (unsigned)kind;
+        frm_real pts[3 * 12], k[12], t[3 * 12], *v, *Ka, *K0, *fa;
+        double *pos, *quat, *dq;
+        REQUIRE(small_scene(kind, &m, &s, &pd, &hexes) == FRM_OK);
+        n = frm_model_frame_count(m);
+        box_points(pts, np, 5u + (unsigned)kind);
+        REQUIRE(frm_probe_create(m, &pd, pts, np, &p) == FRM_OK);
+        for (i = 0; i < np; i++) k[i] = (frm_real)(1e8 * (1.5 + rnd(&seed)));
+        for (i = 0; i < 3 * np; i++) t[i] = (frm_real)((double)pts[i] + 0.1 * rnd(&seed));
+        pos = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+        quat = (double *)malloc(sizeof(double) * 4 * (size_t)n);
+        dq = (double *)malloc(sizeof(double) * 6 * (size_t)n);
+        v = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        Ka = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        K0 = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        fa = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        REQUIRE(random_state(m, 0.05, 0.4, seed, pos, quat) == FRM_OK);
+        for (trial = 0; trial < 2; trial++) {
+            double E[2], F[2][2], fw = 0, scale = 0, kd = 0, ks = 0;
+            frm_real *fs[2];
+            int sgn, with;
+            const frm_real *f;
+            frm_energies e;
+            for (i = 0; i < 6 * n; i++) dq[i] = rnd(&seed), v[i] = (frm_real)dq[i];
+            REQUIRE(perturbed_poses(m, pos, quat, dq, 0) == FRM_OK);
+            for (with = 0; with < 2; with++) { /* K v and f at the state, without then with */
+                REQUIRE(frm_model_set_anchors(m, with ? p : NULL, k, t) == FRM_OK);
+                REQUIRE(frm_model_prepare_stiffness(m) == FRM_OK);
+                REQUIRE(frm_model_apply_stiffness(m, v, with ? Ka : K0, 0) == FRM_OK);
+                REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+                for (i = 0; i < 6 * n; i++) fa[i] = (frm_real)(with ? (double)f[i] - (double)fa[i] : (double)f[i]);
+            }
+            for (i = 0; i < 6 * n; i++) fw += (double)fa[i] * dq[i], scale += fabs((double)fa[i] * dq[i]);
+            fs[0] = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+            fs[1] = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+            for (sgn = 0; sgn < 2; sgn++) {
+                REQUIRE(perturbed_poses(m, pos, quat, dq, sgn ? -eps : eps) == FRM_OK);
+                for (with = 0; with < 2; with++) {
+                    REQUIRE(frm_model_set_anchors(m, with ? p : NULL, k, t) == FRM_OK);
+                    REQUIRE(frm_model_energy(m, &e) == FRM_OK);
+                    REQUIRE(frm_model_forces(m, &f) == FRM_OK);
+                    F[sgn][with] = e.elastic;
+                    for (i = 0; i < 6 * n; i++) fs[sgn][i] = (frm_real)(with ? (double)f[i] - (double)fs[sgn][i] : (double)f[i]);
+                }
+                E[sgn] = F[sgn][1] - F[sgn][0];
+            }
+            for (i = 0; i < 6 * n; i++) { /* K = -df/dq: -(f+ - f-) / 2 eps against K_anchor v */
+                double fd = -((double)fs[0][i] - (double)fs[1][i]) / (2 * eps), an = (double)Ka[i] - (double)K0[i];
+                if (fabs(fd - an) > kd) kd = fabs(fd - an);
+                if (fabs(an) > ks) ks = fabs(an);
+            }
+            if (kd / ks > worst_k) worst_k = kd / ks;
+            if (fabs(-(E[0] - E[1]) / (2 * eps) - fw) / scale > worst_f) worst_f = fabs(-(E[0] - E[1]) / (2 * eps) - fw) / scale;
+            free(fs[0]), free(fs[1]);
+        }
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_anchors(m, p, NULL, t));
+        k[3] = (frm_real)-1;
+        CHECK_INT(FRM_ERR_ARG, frm_model_set_anchors(m, p, k, t));
+        REQUIRE(frm_model_set_anchors(m, NULL, NULL, NULL) == FRM_OK);
+        free(pos), free(quat), free(dq), free(v), free(Ka), free(K0), free(fa), free(hexes);
+        frm_probe_destroy(p);
+        frm_model_destroy(m);
+        frm_sampling_free(&s);
+    }
+    printf("    frames anchors: force against -dE/dq %.1e, K v against -df/dq %.1e (relative)\n", worst_f, worst_k);
+    CHECK(worst_f < tol);
+    CHECK(worst_k < tol);
+}
+
 static const test_case cases[] = {
     TEST(test_mapped_rigid_motion),      TEST(test_mapped_virtual_work), TEST(test_mapped_point_at_frame),
     TEST(test_mapped_external_loads),    TEST(test_mapped_point_outside), TEST(test_parts_split_equals_whole),
     TEST(test_parts_mixed_kinds),        TEST(test_parts_refusals),      TEST(test_rigid_fixed_equals_clamped), TEST(test_rigid_falling_beam),  TEST(test_rigid_momentum),
     TEST(test_mapped_points_on_parts),   TEST(test_rigid_hanging_weight),     TEST(test_rigid_refusals),      TEST(test_coupling_no_allocation),
+    TEST(test_glue_anchor_fd_heml), TEST(test_glue_anchor_fd_frames),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
