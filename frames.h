@@ -697,9 +697,14 @@
          between bodies but shared or attached frames. Mesh-based probes on a combined model
          need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
          attached to a rigid body (the attached frames are no longer frames of the model).
-       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes, the
-         block-tridiagonal chain solver, inverse actuation and the CUDA companion are not in
-         this version.
+       - At most 16 neighbours per sample. The block-tridiagonal chain solver, inverse
+         actuation and the CUDA companion are not in this version.
+       - Coupling to heml.h and tensormass.h meshes is by iteration between the models
+         (COUPLING), not one monolithic solve: each coupled step costs several steps of
+         each model (7 to 9 measured), the staggered exchange has a small time-step limit,
+         and the glue is a penalty (its compliance is a modelling error, about 1 / k per
+         glued node). Assembled blocks (frm_model_stiffness_blocks) hold the anchors' own
+         rotational term on the diagonal but not J^T k J (the products add it).
 
    MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
@@ -758,9 +763,48 @@
        neither creates nor loses energy; the total force sum f_n and moment sum p_n x f_n
        are carried exactly in any state. frm_probe_add_external adds J^T f to the external
        loads (constant through the following steps and solves: once per step for a
-       staggered coupling). What a stiff coupling needs (J and J^T as products, no
-       allocation) is public; the coupled implicit solve itself is not here (LIMITS).
-       Measured cost: see README (bench kernels part, "frames mapped point").
+       staggered coupling). Measured cost: see README (bench kernels part, "frames mapped
+       point").
+       Anchors (frm_model_set_anchors; heml_set_anchors and tmass_set_anchors are the same
+       hook for nodes): zero-length springs from a probe's mapped points to targets, energy
+       sum_n k_n / 2 |p_n(q) - t_n|^2, part of the model (forces J^T (-k d), d = p - t; the
+       stiffness J^T k J plus the levers' own term k w (a d^T - (a . d) I) per pair, whose
+       antisymmetric half is the 1/2 [tau]x of every torque; energies; the block-Jacobi
+       blocks; every solve). Tested against central differences of the energy and force
+       (tests/test_frames_coupling.c, with heml's).
+       Coupling a heml.h or tensormass.h mesh (no header includes another; the user's code
+       holds both models; examples/glue.h is one, used by the tests and
+       examples/frames_connective.c). Glued nodes x_n of the mesh and the mapped points
+       p_n(q) of a probe at their rest positions:
+       (a) Staggered, once a step: the frames step under J^T of the mesh's last forces on
+       the glued nodes (elastic force plus weight; their inertia left out), then the glued
+       nodes are prescribed at the new mapped points (heml_set_displacement) and the mesh
+       steps. Explicit in the exchange: measured on R3's soft beam (1 x 0.1 x 0.1 m,
+       E = 1 MPa, 1000 kg/m^3, half frames 0.1 m hexahedra, half heml.h, glued at mid-span),
+       stable up to 1.5 ms and diverging from 2 ms with the mesh's 0.05 m cells, 0.95 /
+       1.19 ms with 0.1 m cells (T/1300 of the beam's first period; heavier glued nodes,
+       whose inertia the exchange leaves out, lower it). Above it the frames' Newton fails
+       within a few steps (FRM_ERR_NO_CONVERGENCE, state kept), never a silent blow-up in
+       the tests; use it only for light meshes and small steps.
+       (b) Stiff: springs of stiffness k between x_n and p_n, as anchors in one model
+       (targets the other's interface points) and as loads in the other (heml: the
+       springs' force on the nodes; frames: J^T of it). One coupled step minimises both
+       models' incremental potentials plus the springs' energy; a Robin-Neumann iteration
+       reaches it (the side with the anchors solves with the other held, the other under
+       the springs' forces, each from the step's start; J at the latest iterate, so the
+       transfer is exact at convergence), accelerated by Anderson mixing of the interface
+       points (depth 6), until they move less than a tolerance. Put the anchors on the side
+       that is less held (the outer part of a beam; a Neumann side must be held, or its
+       static solve has rigid modes). Measured: plain block Gauss-Seidel with springs in
+       both models stalls (a side held by stiff springs moves 1e-6 m an iteration on R1
+       with 0.055 m to go); plain Robin-Neumann diverges on R1's interface modes; with
+       Anderson mixing R1 (half frames 16 x 2 x 2 hexahedra clamped, half heml.h 16 x 2 x 2
+       cells of P1 tetrahedra) converges in 7 iterations to +0.13 % of Timoshenko (frames
+       alone +3.49 %, heml alone -64.9 %: P1 locking, which the outer half feels 1/16 of),
+       and the soft beam above steps at dt = 10 ms with at most 9 iterations a step. k
+       trades the glue's compliance against the iteration: k = 0.1, 0.3, 1, 3 E h (h the
+       mesh's cell size across) gave +1.41, +0.13, -0.40, -0.57 % on R1 (the last not
+       converged in 30 iterations); 0.3 E h is the tests' choice.
        Several parts (frm_parts_combine): each part's samples keep their weights and
        gradients, their frames are renumbered by the part's frame_map into the model's;
        frames several parts give are one frame (same rest position required), so a shared

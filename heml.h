@@ -72,7 +72,8 @@
        3. Boundary conditions: heml_fix_node (pinned where it is), heml_set_displacement
           (pinned at rest + u, e.g. driven by a tool), heml_set_displacement_axes (only some
           axes pinned: rollers, symmetry planes), heml_release_node, gravity,
-          heml_set_external_force.
+          heml_set_external_force, heml_set_anchors (springs to targets: gluing to another
+          model, see ANCHORS).
        4. heml_step(m) (desc integrator and time step) or heml_step_ex(m, dt, integrator);
           heml_solve_static(m) for the equilibrium.
        5. Read heml_positions / heml_velocities to render (heml_displacements for the
@@ -411,6 +412,21 @@
                              T/50 or less for the modes that matter) and it needs a
                              constant dt (a change restarts it with one implicit Euler
                              step).
+   ANCHORS (heml_set_anchors, issue 14; the same hook as tmass_set_anchors and
+       frm_model_set_anchors): zero-length springs from chosen nodes to target points,
+       energy sum_a k_a / 2 |x_a - t_a|^2, part of the model's energy W from the call on:
+       forces (-k (x - t)), the differential (-k dx, so heml_apply_stiffness is the public
+       stiffness product of the model with its anchors), the Jacobi preconditioner (k on the
+       anchored diagonal), every integrator, the static solve, its saddle check and modal
+       analysis; heml_energy's elastic part includes them. They are the hook for gluing a
+       mesh to another model without either header including the other: the targets are
+       the other model's points (frames.h: mapped points of a probe), updated between
+       solves; the springs' stiffness is then inside each implicit and static solve, so a
+       coupling iteration stays stable at the time steps the models run alone (frames.h
+       COUPLING: a steel beam half heml.h, half frames, static; a soft one at dt = 10 ms).
+       The arrays are the caller's (kept by pointer). Off by default: without the call every
+       result is bit-identical. One loop over the anchors per pass (after the tetrahedra),
+       allocation-free.
    STATIC SOLVE (heml_solve_static): the minimum of the potential W(u) - (f_ext + M g) . u
        over the free axes (the fully relaxed Prony response), by continuation and Newton.
        Continuation: the loads and the pinned axes' moves to their targets are applied with
