@@ -189,7 +189,11 @@
    than FRM_MAX_NEIGHBORS (16), frame indices out of range or repeated in a sample,
    weights that do not sum to one (1e-9; float 1e-5) or gradients that do not sum to zero
    (relative to sum |grad w|), frames no sample gives a weight (no mass), unknown laws,
-   E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings.
+   E <= 0, nu outside (-1, 0.5), density <= 0, bad time step, damping or solver settings,
+   an unknown desc.volumetric, FRM_VOLUMETRIC_CELLS without sample_cells or with a negative
+   index, a negative or non-finite volumetric_stabilization, or a frame whose averaging
+   volume sum_s v_s w_s is not > 0 (FRM_ERR_VOLUMETRIC), FRM_STIFFNESS_BLOCKS with the
+   volumetric option (FRM_ERR_STIFFNESS_MODE).
    Coupling (issue 14): frm_parts_combine refuses a malformed frame map (FRM_ERR_PART_FRAME:
    an index out of range or repeated within a part, a model frame nobody gives, shared frames
    at different rest positions) and a rigid body with mass <= 0 or an inertia not symmetric
@@ -336,6 +340,82 @@
        Both terms: the stabilisation's stress joins the sample's P, the frame-own torques
        apart; the unseen-rotations term's stiffness is exact too (Gauss-Newton part and
        second-order part).
+
+   VOLUMETRIC AVERAGING (issue 13; desc.volumetric, default FRM_VOLUMETRIC_NONE, which
+   leaves every result bit-identical). Near incompressibility (nu -> 0.5) a sample's own J
+   is a constraint the frames cannot all meet: the bench's Poisson beam (1 m, 3 cells
+   across) with hexahedral frames is 19 % too stiff at nu = 0.49 and 41 % at 0.499. The
+   option evaluates every sample's law (any row of the law table, user laws included) at
+   the F-bar of de Souza Neto et al. (1996),
+       F_bar_s = alpha_s F_s,   alpha_s = (J_bar_s / J_s)^(1/3),   J_bar = A J,
+   A a fixed averaging of the samples' J with A 1 = 1 (a homogeneous J is kept) and
+   v^T A = v^T (volume is conserved), and adds a stabilisation of the fluctuation:
+       E = sum_s v_s [ W(F_bar_s) + eta mu_s / 2 ln^2(J_bar_s / J_s) ]
+   (eta = desc.volumetric_stabilization, default 2; mu_s the law's small-strain shear
+   modulus). At small strain W(F_bar) is W's deviatoric part at the sample plus the bulk
+   term of the average, kappa / 2 (tr eps_bar)^2 (the B-bar element), so the bulk modulus
+   acts on one constraint per cell or frame instead of one per sample; the fluctuation
+   J_s - J_bar_s, which the average does not see, costs eta mu: a shear-like stiffness,
+   which does not lock, and without which coarse meshes have soft modes (the bench's beam
+   with hexahedral frames 2 cells across: +14.3 % at nu = 0.3 with eta = 0, +7.5 % with
+   1, +3.1 % with 2, the plain model +2.4 %; one-sample tetrahedral frames one cell across
+   with 5-tetrahedra cells: +830 % with eta = 0). The averages (choices of this library):
+       FRM_VOLUMETRIC_CELLS: mean dilatation, J_bar_s = sum_{t in c(s)} v_t J_t / V_c over
+           the sample's cell (desc.sample_cells; frm_sampling_hexes / _tets fill
+           frm_sampling.sample_cells and frm_sampling_apply sets it). For hexahedral frames
+           with several samples a cell, or any grouping of samples the user gives (e.g. the 5
+           tetrahedra of a hexahedral cell split).
+       FRM_VOLUMETRIC_FRAMES: nodal averaging through the frames, J_i = sum_t v_t w_ti J_t /
+           m_i at frame i (m_i = sum_t v_t w_ti > 0, else FRM_ERR_VOLUMETRIC), J_bar_s =
+           sum_i w_si J_i (Bonet & Burton 1998's average nodal pressure tetrahedron, in
+           F-bar form): any neighbour table with weights >= 0, e.g. one-sample tetrahedra.
+   Both are A = B N over entries e (the pairs, or one a sample): y_g = sum_{e of g} to_e
+   x_{sample e}, (A x)_s = sum_{e of s} back_e y_{group e}, and A^T the same with back and
+   to swapped, run serially in entry order (deterministic; O(entries)).
+   Forces (minus the gradient, exact): with dJ/J = e = F^-T : dF, dJ_bar / J_bar = e_bar,
+   dF_bar = alpha (dF + (e_bar - e) / 3 F) and pi~_s = P(F_bar_s) : F_bar_s / 3 + eta mu_s
+   ln(J_bar_s / J_s),
+       dE = sum_s v_s [alpha_s P_bar_s : dF_s + pi~_s (e_bar_s - e_s)],
+   and since sum_s v_s pi~_s e_bar_s = sum_t J_t e_t Q_t with Q = A^T (v pi~ / J_bar), every
+   sample's stress is
+       P_s = alpha_s P(F_bar_s) + beta_s F_s^-T,   beta_s = Q_s J_s / v_s - pi~_s,
+   which then enters the force (eq. 3.52) and the rest of the model as P did: the force pass
+   runs F and J per sample, the average, the law at F_bar, the transposed average, then
+   the pairs. Differential, exact (the averaging couples the samples of a cell, or through
+   the frames the samples two frames apart):
+       dP = alpha dP_bar + (dQ J / v - dpi~) F^-T
+            + alpha (e_bar - e) / 3 P_bar + (beta + pi~) e F^-T - beta F^-T dF^T F^-T,
+       dP_bar = the law's dP at F_bar for dF_bar,  dpi~ = (dP_bar : F_bar + P_bar : dF_bar) / 3
+            + eta mu (e_bar - e),  dQ = A^T (v (dpi~ - pi~ e_bar) / J_bar),
+   so K v is also five passes (dF and e, the average, dP_bar, the transposed average, dP
+   and the pairs). K's positive-definite part (SOLVERS) keeps the Gauss-Newton part
+   L^T (C_bar+ + eta mu) L of the map L: dF -> (dF_bar, dphi) (the law's definite
+   tangent at F_bar, the positive part of S_bar), i.e. it drops P_bar : dF_bar, pi~ e_bar,
+   the (e_bar - e) P_bar, (beta + pi~) e and beta dF^-T terms. Tested against finite
+   differences of an energy the test computes itself, for every law and both averages,
+   rotations and the stabilisation included (tests/test_frames_elem.c test_vol_*).
+   Patch test: a homogeneous deformation (the frames' interpolation reproduces it) gives
+   every sample J_bar = J, F_bar = F and the forces of the plain model to 1e-15; rigid
+   motions far from the origin give zero force. The model is matrix-free with the option
+   (AUTO takes pairs, FRM_STIFFNESS_BLOCKS is refused: the averaging couples frames beyond
+   the block pattern); the block-Jacobi preconditioner keeps the plain law's rest
+   diagonal. Memory: about 70 reals per sample and 3 per pair (entry) more. Cost, one run
+   on a loaded machine, the bench's beam 3 cells across: force pass 1.4-1.7x (hexahedra),
+   1.35x (tetrahedra), K v 1.45x and 1.5x.
+   Measured (the bench's Poisson beam: 1 m, 0.1 m square, E = 1 MPa, Timoshenko; static
+   Newton, CG iterations summed, the minimum check's probe solve included):
+       hexahedral frames, CELLS, 3 cells across (2,976 DoF): +0.70, -0.38, -0.50 % at nu =
+           0.3, 0.49, 0.499, Newton 3, 6, 9, CG 1,512, 6,221, 17,404 (plain: +0.42, -18.9,
+           -40.6 %, CG 1,553, 2,907, 14,156); 2 cells across (1,134 DoF): +3.06, +3.10,
+           +2.99 %, Newton 3, 6, 10, CG 1,016, 4,092, 10,672 (plain +2.44, -21.2, -47.5 %);
+       one-sample tetrahedral frames (the 5-tetrahedra split), 3 cells across: FRAMES +8.7,
+           -4.2, -7.1 % (plain +0.64, -9.5, -13 %: the nodal average about halves the locking,
+           it does not remove it, see LIMITS), CELLS over each grid cell's 5 tetrahedra
+           +0.82, -2.49, -2.76 %; 2 cells across FRAMES +20.5, -2.5, -7.5 %, CELLS(5) +3.9,
+           -0.02, -0.42 %.
+   nu = 0.499 no longer stalls or locks with hexahedral frames; its CG iterations grow
+   with the bulk-to-shear ratio (block Jacobi does not precondition the averaged
+   constraint): 17,404 against 1,512 at nu = 0.3 above.
 
    MASS (the thesis leaves it open; our derivation). Each sample's mass m_s = rho v_s is
    split among its frames in the fractions mu_is = |w_is| / sum_k |w_ks|, and each frame
@@ -645,7 +725,23 @@
          trilinear elements (R1: -1.7 % at nu = 0.3, -7.8 % at nu = 0.45 on 4 cells
          across); sub-cell samples lock less (-16 % at nu = 0.49 on the bench's 40 x 4 x 4
          beam, and no convergence at 0.499). Tetrahedral frames with one sample each lock
-         less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2).
+         less (-8 % at 0.49, -11 % at 0.499) but converge slowly (R2). The volumetric
+         option (VOLUMETRIC AVERAGING) removes the volumetric locking of hexahedral frames
+         (FRM_VOLUMETRIC_CELLS: within 1.2 points of nu = 0.3's error at 0.49 and 0.499 on
+         the bench's beam 3 cells across). What it leaves:
+         one-sample tetrahedral frames with FRM_VOLUMETRIC_FRAMES (nodal averaging) are
+         still 7 % stiff at nu = 0.499 and 9-20 % soft at nu = 0.3 on the bench's beam at 3
+         and 2 cells across: the average over frames smooths the J field over two rings of
+         samples, and the frames' rotations give J fluctuations the average does not see
+         (held by eta mu only); mean dilatation over each grid cell's 5 tetrahedra does
+         better there (-2.8 % at 0.499, +0.8 % at 0.3) where the mesh has such cells. One
+         cell across, the option is soft (hexahedra +38 % at 0.49 against +20 % at 0.3,
+         tetrahedra with 5-tetrahedra cells +50 %): the one-cell rotation modes that the
+         volumetric stiffness was holding. The CG iterations of static solves grow with
+         kappa / mu (17,404 at nu = 0.499 against 1,512 at 0.3, hexahedra 3 cells across:
+         block Jacobi with the plain law's rest diagonal); the option is matrix-free (no
+         assembled blocks); its force pass costs 1.35-1.7x. Not validated on Cook's
+         membrane (issue 13 asks it of heml.h).
        - St Venant-Kirchhoff softens and can collapse under strong compression, and its
          energy has a minimum of zero at every mirror image of the rest state (F =
          diag(1, 1, -1)): a solve once settled a compressed cube's top layer there, with
@@ -1067,13 +1163,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_POINT_OUTSIDE, -37, "a mapped point lies outside the body: in no element, or farther from each of its frames than that frame's farthest sample") \
     X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses") \
     X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite") \
-    X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0")
+    X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0") \
+    X(FRM_ERR_VOLUMETRIC, -41, "volumetric averaging settings invalid (unknown mode, sample_cells missing or out of range, or a frame's averaging volume not > 0)")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -41
+    FRM_ERR_LAST_ = -42
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1127,6 +1224,19 @@ typedef struct frm_user_law {
 } frm_user_law;
 
 /* How K * v is evaluated inside CG (see PERFORMANCE). */
+/* Volumetric treatment against volumetric locking near incompressibility (desc.volumetric;
+   see MODEL, volumetric averaging). Every sample's law is evaluated at the F-bar
+   F_bar = (J_bar / J)^(1/3) F, J_bar a volume-weighted average of the samples' J. */
+typedef enum frm_volumetric {
+    FRM_VOLUMETRIC_NONE = 0, /* default: every sample at its own F (the thesis's model) */
+    FRM_VOLUMETRIC_CELLS,    /* mean dilatation: J_bar the volume-weighted mean J of the sample's cell
+                                (desc.sample_cells; frm_sampling_hexes / _tets fill it): hexahedral
+                                frames with several samples a cell */
+    FRM_VOLUMETRIC_FRAMES,   /* nodal averaging: J averaged at the frames, then interpolated back to
+                                the samples: one-sample tetrahedral frames (any weights >= 0) */
+    FRM_VOLUMETRIC_COUNT
+} frm_volumetric;
+
 typedef enum frm_stiffness_mode {
     FRM_STIFFNESS_AUTO = 0,  /* choose per linearisation from the cost model (default) */
     FRM_STIFFNESS_PAIRS = 1, /* matrix-free: per-pair data computed once per linearisation */
@@ -1259,6 +1369,17 @@ typedef struct frm_desc {
                                      rotations that move no material (tetrahedral frames'
                                      spurious low modes, hexahedral frames' layers turning about
                                      their normal); of order h^2 for smooth fields (see MODEL) */
+    frm_volumetric volumetric; /* default FRM_VOLUMETRIC_NONE; _CELLS or _FRAMES remove volumetric
+                                  locking near nu = 0.5 (see MODEL, volumetric averaging). The
+                                  model is then matrix-free (FRM_STIFFNESS_PAIRS: AUTO picks it,
+                                  BLOCKS is refused with FRM_ERR_STIFFNESS_MODE) */
+    frm_real volumetric_stabilization; /* dimensionless eta >= 0, default 2: with volumetric averaging,
+                                          adds eta mu v / 2 ln^2(J_bar / J) per sample (mu the small-strain
+                                          shear modulus): holds the J fluctuations the average does not
+                                          see at a shear-like stiffness, which does not lock (see MODEL) */
+    const int *sample_cells;   /* FRM_VOLUMETRIC_CELLS: sample_count cell indices >= 0 (the samples
+                                  of a cell average their J); frm_sampling_apply sets it from
+                                  frm_sampling_hexes / _tets, NULL for meshless samplings */
     frm_real frame_coupling; /* dimensionless, default 0 (the thesis's model exactly): weight
                                 of the coupling term that ties each frame's own prediction
                                 of a sample to the blended position (see MODEL); 1e-2
@@ -1389,6 +1510,8 @@ typedef struct frm_sampling {
     int *neighbor_frames;         /* pair_count */
     frm_real *neighbor_weights;   /* pair_count */
     frm_real *neighbor_gradients; /* 3 * pair_count, 1/m */
+    int cell_count;               /* mesh samplings: the elements; 0 for meshless ones */
+    int *sample_cells;            /* sample_count element indices (NULL when cell_count is 0) */
     frm_allocator allocator;      /* the one the arrays came from */
 } frm_sampling;
 
@@ -1469,8 +1592,9 @@ FRMDEF int frm_sampling_box(frm_sampling *out, const frm_real lo[3], const frm_r
 FRMDEF int frm_sampling_surface(frm_sampling *out, const frm_real *vertices, int vertex_count,
                                 const int *triangles, int triangle_count, const frm_poisson_desc *p,
                                 const frm_shape_desc *shape, const frm_allocator *allocator);
-/* Points the description's frame, sample and neighbour fields at the sampling's arrays
-   (which must outlive frm_model_create, not the model). */
+/* Points the description's frame, sample and neighbour fields and sample_cells (NULL for
+   meshless samplings) at the sampling's arrays (which must outlive frm_model_create, not
+   the model); it does not set desc.volumetric. */
 FRMDEF void frm_sampling_apply(const frm_sampling *s, frm_desc *d);
 /* Frees the arrays and empties the struct. */
 FRMDEF void frm_sampling_free(frm_sampling *s);
@@ -1549,7 +1673,10 @@ FRMDEF frm_rigid_body frm_rigid_body_default(void);
    rest positions that differ, a body's frame out of range or two bodies on one frame),
    FRM_ERR_RIGID (a body's mass not > 0, its inertia not positive definite),
    FRM_ERR_NEIGHBOR_TABLE (a part's row malformed), FRM_ERR_ALLOC; *out is then empty.
-   Materials and the merged table are validated by frm_model_create. */
+   Materials and the merged table are validated by frm_model_create. Cells (issue 13's
+   FRM_VOLUMETRIC_CELLS): when every part's sampling has them (mesh samplings), the
+   combination numbers each part's cells after the previous parts' (no averaging across
+   parts); otherwise it has none and a model asking for cell averaging is refused. */
 FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
                              int rigid_count, int frame_count, const frm_allocator *allocator);
 /* Points the description's frames, samples, neighbour table, materials, sample_materials
@@ -2670,6 +2797,22 @@ struct frm_model {
                                               unseen rotations m_k = N omega_k + g D grad w_k, the others
                                               t_k = sum_j f_j x z_j (F, Z_k); NULL without stabilisation */
 
+    /* volumetric averaging (desc.volumetric, see MODEL): J_bar = A J with A = B N, entries e
+       per sample (the pairs for FRAMES, one a sample for CELLS) of group (frame or cell)
+       ve_group[e]: (A x)_s = sum_{e of s} ve_back[e] y_g, y_g = sum_{e of g} ve_to[e] x_{sample e};
+       NULL arrays when off */
+    int vol_mode, vol_groups, vol_entries;
+    frm_real vol_eta; /* volumetric_stabilization */
+    int *ve_start, *ve_group, *ve_sample, *vg_start, *vg_entry; /* S + 1, E, E, G + 1, E */
+    frm_real *ve_back, *ve_to;                                  /* E, E */
+    double *vg_y;                                               /* G: scratch of the averages */
+    frm_real *v_H, *v_Pbar;                     /* 9, 9 per sample: H = F - I, P(F_bar) of the last pass */
+    frm_real *v_jm1, *v_jbm1, *v_am1, *v_pi, *v_beta, *v_x, *v_y; /* 1 each: J - 1, J_bar - 1, alpha - 1, pi,
+                                                                   beta of the last pass; scratch x, y */
+    frm_real *vl_Finv, *vl_Fbar, *vl_Pbar;      /* 9 each at the linearisation: F^-1, F_bar, P(F_bar) */
+    frm_real *vl_J, *vl_Jbar, *vl_alpha, *vl_pi, *vl_beta; /* 1 each at the linearisation */
+    frm_real *vk_dF, *vk_dPbar, *vk_e, *vk_ebar, *vk_dpi;  /* K v scratch: 9, 9, 1, 1, 1 per sample */
+
     /* per sample chunk: energy partial sums and errors of the last pass */
     double *chunk_energy;
     int *chunk_err;
@@ -3348,6 +3491,39 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->p_C, frm_real, 3 * P);
     FRM__CARVE(c, m->p_out, frm_real, 6 * P);
     if (m->stab_on) FRM__CARVE(c, m->p_stab, frm_real, 3 * P);
+    if (m->vol_mode) {
+        size_t E = (size_t)m->vol_entries, G = (size_t)m->vol_groups;
+        FRM__CARVE(c, m->ve_start, int, S + 1);
+        FRM__CARVE(c, m->ve_group, int, E);
+        FRM__CARVE(c, m->ve_sample, int, E);
+        FRM__CARVE(c, m->vg_start, int, G + 1);
+        FRM__CARVE(c, m->vg_entry, int, E);
+        FRM__CARVE(c, m->ve_back, frm_real, E);
+        FRM__CARVE(c, m->ve_to, frm_real, E);
+        FRM__CARVE(c, m->vg_y, double, G);
+        FRM__CARVE(c, m->v_H, frm_real, 9 * S);
+        FRM__CARVE(c, m->v_Pbar, frm_real, 9 * S);
+        FRM__CARVE(c, m->v_jm1, frm_real, S);
+        FRM__CARVE(c, m->v_jbm1, frm_real, S);
+        FRM__CARVE(c, m->v_am1, frm_real, S);
+        FRM__CARVE(c, m->v_pi, frm_real, S);
+        FRM__CARVE(c, m->v_beta, frm_real, S);
+        FRM__CARVE(c, m->v_x, frm_real, S);
+        FRM__CARVE(c, m->v_y, frm_real, S);
+        FRM__CARVE(c, m->vl_Finv, frm_real, 9 * S);
+        FRM__CARVE(c, m->vl_Fbar, frm_real, 9 * S);
+        FRM__CARVE(c, m->vl_Pbar, frm_real, 9 * S);
+        FRM__CARVE(c, m->vl_J, frm_real, S);
+        FRM__CARVE(c, m->vl_Jbar, frm_real, S);
+        FRM__CARVE(c, m->vl_alpha, frm_real, S);
+        FRM__CARVE(c, m->vl_pi, frm_real, S);
+        FRM__CARVE(c, m->vl_beta, frm_real, S);
+        FRM__CARVE(c, m->vk_dF, frm_real, 9 * S);
+        FRM__CARVE(c, m->vk_dPbar, frm_real, 9 * S);
+        FRM__CARVE(c, m->vk_e, frm_real, S);
+        FRM__CARVE(c, m->vk_ebar, frm_real, S);
+        FRM__CARVE(c, m->vk_dpi, frm_real, S);
+    }
     FRM__CARVE(c, m->chunk_energy, double, m->sample_chunks);
     FRM__CARVE(c, m->chunk_err, int, m->sample_chunks);
     FRM__CARVE(c, m->cg_r, frm_real, 6 * n);
@@ -3439,6 +3615,11 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
+    if ((unsigned)d->volumetric >= FRM_VOLUMETRIC_COUNT) return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric");
+    if (!(frm__finite((double)d->volumetric_stabilization) && d->volumetric_stabilization >= 0))
+        return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric_stabilization must be finite and >= 0");
+    if (d->volumetric != FRM_VOLUMETRIC_NONE && d->stiffness_mode == FRM_STIFFNESS_BLOCKS)
+        return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "volumetric averaging is matrix-free: no assembled blocks");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return frm__fail(d, FRM_ERR_ARG, "allocator needs both alloc and free");
     return FRM_OK;
@@ -3563,6 +3744,14 @@ static int frm__validate(const frm_desc *d, int *marker)
         }
     err = frm__validate_neighbors(d, marker);
     if (err) return err;
+    if (d->volumetric == FRM_VOLUMETRIC_CELLS) {
+        if (!d->sample_cells) return frm__fail(d, FRM_ERR_VOLUMETRIC, "FRM_VOLUMETRIC_CELLS needs sample_cells");
+        for (s = 0; s < d->sample_count; s++)
+            if (d->sample_cells[s] < 0 || d->sample_cells[s] >= 100000000) {
+                snprintf(msg, sizeof msg, "sample %d: cell index %d", s, d->sample_cells[s]);
+                return frm__fail(d, FRM_ERR_VOLUMETRIC, msg);
+            }
+    }
     if (!d->materials) {
         err = frm__validate_material(&d->material, 0, msg, sizeof msg);
         if (err) return frm__fail(d, err, msg);
@@ -3635,6 +3824,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.frame_coupling = 0;
     d.rotation_stabilization = (frm_real)0.5;
     d.rotation_divergence = (frm_real)4;
+    d.volumetric_stabilization = 2;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
@@ -3924,7 +4114,16 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
     tmp->pair_count = P;
     tmp->sample_chunks = (S + FRM__SAMPLE_CHUNK - 1) / FRM__SAMPLE_CHUNK;
     tmp->frame_chunks = (n + FRM__FRAME_CHUNK - 1) / FRM__FRAME_CHUNK;
-    tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS;
+    tmp->vol_mode = (int)d->volumetric;
+    tmp->has_blocks = d->stiffness_mode != FRM_STIFFNESS_PAIRS && !tmp->vol_mode;
+    if (tmp->vol_mode == FRM_VOLUMETRIC_FRAMES) {
+        tmp->vol_groups = n;
+        tmp->vol_entries = P;
+    } else if (tmp->vol_mode == FRM_VOLUMETRIC_CELLS) {
+        tmp->vol_entries = S;
+        for (s = 0; s < S; s++)
+            if (d->sample_cells[s] + 1 > tmp->vol_groups) tmp->vol_groups = d->sample_cells[s] + 1;
+    }
     if (tmp->has_blocks) {
         long long blocks, sq = 0;
         for (i = 0; i < n; i++) t->marker[i] = -1;
@@ -4004,6 +4203,7 @@ static void frm__create_settings(frm_model *m, const frm_desc *d)
     m->load_scale = 1;
     m->stiffness_mode = d->stiffness_mode;
     m->regularization = (double)d->static_regularization;
+    m->vol_eta = d->volumetric_stabilization;
 }
 
 /* Stage 4b: frames' rest poses, the reverse table, the frames with unseen rotations. */
@@ -4126,6 +4326,53 @@ static void frm__create_blocks(frm_model *m, int *marker)
     }
 }
 
+/* Stage 4f: the averaging operator A = B N of the volumetric treatment (see MODEL):
+   FRAMES: entries the pairs, groups the frames, back w_si, to v_s w_si / m_i with
+   m_i = sum_s v_s w_si; CELLS: one entry a sample, groups the cells, back 1, to v_s / V_c.
+   Both give A 1 = 1 and v^T A = v^T (the patch test). Returns -1, or a frame with
+   m_i <= 0 (FRAMES). */
+static int frm__create_volumetric(frm_model *m, const frm_desc *d)
+{
+    int S = m->sample_count, E = m->vol_entries, G = m->vol_groups, s, e, g;
+    if (!m->vol_mode) return -1;
+    for (g = 0; g <= G; g++) m->vg_start[g] = 0;
+    if (m->vol_mode == FRM_VOLUMETRIC_FRAMES) {
+        memcpy(m->ve_start, m->s_start, sizeof(int) * ((size_t)S + 1));
+        memcpy(m->ve_group, m->p_frame, sizeof(int) * (size_t)E);
+        memcpy(m->ve_sample, m->p_sample, sizeof(int) * (size_t)E);
+        memcpy(m->ve_back, m->p_weight, sizeof(frm_real) * (size_t)E);
+    } else {
+        for (s = 0; s <= S; s++) m->ve_start[s] = s;
+        for (s = 0; s < S; s++) {
+            m->ve_group[s] = d->sample_cells[s];
+            m->ve_sample[s] = s;
+            m->ve_back[s] = 1;
+        }
+    }
+    /* the reverse table (group -> entries in entry order) and the group volumes */
+    for (e = 0; e < E; e++) m->vg_start[m->ve_group[e] + 1]++;
+    for (g = 0; g < G; g++) m->vg_start[g + 1] += m->vg_start[g];
+    for (g = 0; g < G; g++) m->vg_y[g] = 0;
+    for (e = 0; e < E; e++) {
+        g = m->ve_group[e];
+        m->vg_entry[m->vg_start[g] + (int)m->vg_y[g]] = e;
+        m->vg_y[g] += 1;
+    }
+    for (g = 0; g < G; g++) {
+        double vol = 0;
+        for (e = m->vg_start[g]; e < m->vg_start[g + 1]; e++) {
+            int q = m->vg_entry[e];
+            vol += (double)m->s_volume[m->ve_sample[q]] * (double)m->ve_back[q];
+        }
+        if (m->vg_start[g + 1] > m->vg_start[g] && !(vol > 0)) return g;
+        for (e = m->vg_start[g]; e < m->vg_start[g + 1]; e++) {
+            int q = m->vg_entry[e];
+            m->ve_to[q] = (frm_real)((double)m->s_volume[m->ve_sample[q]] * (double)m->ve_back[q] / vol);
+        }
+    }
+    return -1;
+}
+
 /* Stage 4: everything the rest state determines; fails only on a frame without mass. */
 static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_tables *t)
 {
@@ -4139,6 +4386,11 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     if (i >= 0) {
         snprintf(msg, sizeof msg, "frame %d carries no mass", i);
         return frm__fail(d, FRM_ERR_FRAME_UNUSED, msg);
+    }
+    i = frm__create_volumetric(m, d);
+    if (i >= 0) {
+        snprintf(msg, sizeof msg, "frame %d: averaging volume sum_s v_s w_s not > 0", i);
+        return frm__fail(d, FRM_ERR_VOLUMETRIC, msg);
     }
     frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
@@ -4320,6 +4572,162 @@ static void frm__stab_sample_apply(const frm_model *m, int s, const frm_real dF[
     }
 }
 
+
+/* >>volumetric ------------------------------------------------------------------------- */
+
+/* out = A x (transpose 0) or A^T x (transpose 1) over the samples, A the averaging
+   operator of frm__create_volumetric: serial, sums in double in entry order (the same
+   result for any thread count; O(entries), small beside the force pass). */
+static void frm__vol_average(const frm_model *m, const frm_real *x, frm_real *out, int transpose)
+{
+    const frm_real *wg = transpose ? m->ve_back : m->ve_to, *ws = transpose ? m->ve_to : m->ve_back;
+    int g, e, s;
+    for (g = 0; g < m->vol_groups; g++) {
+        double y = 0;
+        for (e = m->vg_start[g]; e < m->vg_start[g + 1]; e++) {
+            int q = m->vg_entry[e];
+            y += (double)wg[q] * (double)x[m->ve_sample[q]];
+        }
+        m->vg_y[g] = y;
+    }
+    for (s = 0; s < m->sample_count; s++) {
+        double o = 0;
+        for (e = m->ve_start[s]; e < m->ve_start[s + 1]; e++) o += (double)ws[e] * m->vg_y[m->ve_group[e]];
+        out[s] = (frm_real)o;
+    }
+}
+
+/* F^-1 of F = I + H with J = det F (adjugate / J). */
+static void frm__vol_inverse(const frm_real F[9], frm_real J, frm_real Fi[9])
+{
+    frm_real r = 1 / J;
+    Fi[0] = (F[4] * F[8] - F[5] * F[7]) * r;
+    Fi[1] = (F[2] * F[7] - F[1] * F[8]) * r;
+    Fi[2] = (F[1] * F[5] - F[2] * F[4]) * r;
+    Fi[3] = (F[5] * F[6] - F[3] * F[8]) * r;
+    Fi[4] = (F[0] * F[8] - F[2] * F[6]) * r;
+    Fi[5] = (F[2] * F[3] - F[0] * F[5]) * r;
+    Fi[6] = (F[3] * F[7] - F[4] * F[6]) * r;
+    Fi[7] = (F[1] * F[6] - F[0] * F[7]) * r;
+    Fi[8] = (F[0] * F[4] - F[1] * F[3]) * r;
+}
+
+typedef struct frm__vol_ctx {
+    frm_model *m;
+    int linearize, outputs;
+    const frm_real *v; /* K v: the direction */
+} frm__vol_ctx;
+
+/* Force stage 1 over sample chunks: H = F - I and J - 1 of every sample (and the outputs). */
+static void frm__vol_deform_chunks(void *vctx, int begin, int end)
+{
+    frm__vol_ctx *ctx = (frm__vol_ctx *)vctx;
+    frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            int b = m->s_start[s], n = m->s_start[s + 1] - b;
+            frm_real *H = m->v_H + 9 * (size_t)s;
+            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
+                                   m->s_rest + 3 * s, m->disp, m->relm, H, NULL, NULL,
+                                   ctx->outputs ? m->s_pos + 3 * s : NULL);
+            m->v_jm1[s] = frm_det_minus_one(H);
+            if (ctx->outputs) {
+                int r;
+                for (r = 0; r < 9; r++) m->s_F[9 * s + r] = H[r] + (r % 4 == 0 ? 1 : 0);
+            }
+            if (!(1 + m->v_jm1[s] > 0)) err = FRM_ERR_INVERTED;
+        }
+        m->chunk_err[c] = err;
+    }
+}
+
+/* Force stage 3 over sample chunks: the law at F_bar = alpha F (H_bar = alpha H +
+   (alpha - 1) I), P_bar = F_bar S_bar, pi = P_bar : F_bar / 3, the energy; with linearize
+   the law's data at F_bar (lin_S, lin_cache; made definite for linearize = 2). */
+static void frm__vol_stress_chunks(void *vctx, int begin, int end)
+{
+    frm__vol_ctx *ctx = (frm__vol_ctx *)vctx;
+    frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
+        double energy = 0;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            const frm_real *H = m->v_H + 9 * (size_t)s, *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+            frm_real Hb[9], Fb[9], S[6], psi, cache[FRM__LAW_CACHE_MAX], *P = m->v_Pbar + 9 * (size_t)s, am1 = m->v_am1[s];
+            int r, e;
+            for (r = 0; r < 9; r++) Hb[r] = H[r] + am1 * H[r] + (r % 4 == 0 ? am1 : 0);
+            e = frm__law_stress(m->s_law[s], prm, m->s_user[s], Hb, S, &psi, cache);
+            if (e) {
+                err = e;
+                continue;
+            }
+            for (r = 0; r < 9; r++) Fb[r] = Hb[r] + (r % 4 == 0 ? 1 : 0);
+            frm_first_piola(Fb, S, P);
+            {
+                /* pi~ = P_bar : F_bar / 3 + c phi, the stabilisation c phi^2 / 2 with phi = ln(J_bar / J) */
+                frm_real cst = m->vol_eta * m->s_mu[s], phi = 3 * (frm_real)log1p((double)am1);
+                m->v_pi[s] = (P[0] * Fb[0] + P[1] * Fb[1] + P[2] * Fb[2] + P[3] * Fb[3] + P[4] * Fb[4] + P[5] * Fb[5] +
+                              P[6] * Fb[6] + P[7] * Fb[7] + P[8] * Fb[8]) / 3 + cst * phi;
+                energy += (double)m->s_volume[s] * ((double)psi + 0.5 * (double)cst * (double)phi * (double)phi);
+            }
+            if (ctx->linearize) {
+                memcpy(m->vl_Fbar + 9 * (size_t)s, Fb, sizeof Fb);
+                if (ctx->linearize == 2) {
+                    double Sd[6];
+                    for (r = 0; r < 6; r++) Sd[r] = (double)S[r];
+                    frm__positive_part3(Sd);
+                    for (r = 0; r < 6; r++) S[r] = (frm_real)Sd[r];
+                    if (frm__laws[m->s_law[s]].definite) frm__laws[m->s_law[s]].definite(prm, cache);
+                }
+                memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
+                memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
+            }
+        }
+        m->chunk_energy[c] = energy;
+        m->chunk_err[c] = err;
+    }
+}
+
+static void frm__force_chunks(void *vctx, int begin, int end);
+
+/* The volumetric force pass, stages 1 to 4 (stage 5 is frm__force_chunks with vol on):
+   J per sample, J_bar = A J, alpha = (J_bar / J)^(1/3), the law at F_bar, and
+   beta_t = (A^T (v pi / J_bar))_t J_t / v_t - pi_t, so that stage 5's stress is
+   P_t = alpha_t P_bar_t + beta_t F_t^-T (see MODEL). Returns 0 or the first error. */
+static int frm__vol_force_stages(frm_model *m, int linearize, int outputs)
+{
+    frm__vol_ctx ctx;
+    int c, s;
+    ctx.m = m;
+    ctx.linearize = linearize;
+    ctx.outputs = outputs;
+    ctx.v = NULL;
+    frm__run(m, m->sample_chunks, frm__vol_deform_chunks, &ctx);
+    for (c = 0; c < m->sample_chunks; c++)
+        if (m->chunk_err[c]) return m->chunk_err[c];
+    frm__vol_average(m, m->v_jm1, m->v_jbm1, 0); /* A 1 = 1: A (J - 1) = J_bar - 1 */
+    for (s = 0; s < m->sample_count; s++) {
+        double x = ((double)m->v_jbm1[s] - (double)m->v_jm1[s]) / (1.0 + (double)m->v_jm1[s]); /* J_bar / J - 1 */
+        if (!(1.0 + (double)m->v_jbm1[s] > 0) || !(x > -1)) return FRM_ERR_INVERTED;
+        m->v_am1[s] = (frm_real)expm1(log1p(x) / 3.0);
+    }
+    frm__run(m, m->sample_chunks, frm__vol_stress_chunks, &ctx);
+    for (c = 0; c < m->sample_chunks; c++)
+        if (m->chunk_err[c]) return m->chunk_err[c];
+    for (s = 0; s < m->sample_count; s++)
+        m->v_x[s] = (frm_real)((double)m->s_volume[s] * (double)m->v_pi[s] / (1.0 + (double)m->v_jbm1[s]));
+    frm__vol_average(m, m->v_x, m->v_y, 1);
+    for (s = 0; s < m->sample_count; s++)
+        m->v_beta[s] = (frm_real)((double)m->v_y[s] * (1.0 + (double)m->v_jm1[s]) / (double)m->s_volume[s] -
+                                  (double)m->v_pi[s]);
+    return FRM_OK;
+}
+
 typedef struct frm__force_ctx {
     frm_model *m;
     int linearize, outputs;
@@ -4336,7 +4744,7 @@ static void frm__force_chunks(void *vctx, int begin, int end)
     int c;
     for (c = begin; c < end; c++) {
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
-        double energy = 0;
+        double energy = m->vol_mode ? m->chunk_energy[c] : 0; /* volumetric: the law's energy of stage 3 */
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
@@ -4346,19 +4754,38 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                                    m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
                                    ctx->outputs ? m->s_pos + 3 * s : NULL);
             const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
-            e = frm__law_stress(m->s_law[s], prm, m->s_user[s], H, S, &psi, cache);
             memcpy(F, H, sizeof F);
             F[0] += 1; /* F = I + H */
             F[4] += 1;
             F[8] += 1;
-            if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
+            if (m->vol_mode) { /* P = alpha P_bar + beta F^-T (the law ran in stage 3) */
+                frm_real Fi[9], J = 1 + m->v_jm1[s], al = 1 + m->v_am1[s], be = m->v_beta[s];
+                const frm_real *Pb = m->v_Pbar + 9 * (size_t)s;
+                frm__vol_inverse(F, J, Fi);
+                for (r = 0; r < 3; r++)
+                    for (k = 0; k < 3; k++) P[3 * r + k] = al * Pb[3 * r + k] + be * Fi[3 * k + r];
+                if (ctx->linearize) {
+                    memcpy(m->vl_Finv + 9 * (size_t)s, Fi, sizeof Fi);
+                    memcpy(m->vl_Pbar + 9 * (size_t)s, Pb, sizeof Fi);
+                    m->vl_J[s] = J;
+                    m->vl_Jbar[s] = 1 + m->v_jbm1[s];
+                    m->vl_alpha[s] = al;
+                    m->vl_pi[s] = m->v_pi[s];
+                    m->vl_beta[s] = be;
+                }
+                e = 0;
+                psi = 0;
+            } else {
+                e = frm__law_stress(m->s_law[s], prm, m->s_user[s], H, S, &psi, cache);
+                if (ctx->outputs) memcpy(m->s_F + 9 * s, F, sizeof F);
+                if (!e) frm_first_piola(F, S, P);
+            }
             if (e) {
                 err = e;
                 memset(m->p_out + 6 * (size_t)b, 0, sizeof(frm_real) * 6 * (size_t)n);
                 continue;
             }
-            energy += (double)v * (double)psi;
-            frm_first_piola(F, S, P);
+            energy += (double)v * (double)psi; /* volumetric: 0 here, the law's energy came from stage 3 */
             if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
                 energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
             for (k = 0; k < n; k++)
@@ -4374,7 +4801,8 @@ static void frm__force_chunks(void *vctx, int begin, int end)
             if (ctx->linearize) {
                 memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
-                if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
+                if (m->vol_mode) { /* the law's data at F_bar were stored in stage 3 */
+                } else if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
                                               law's tangent data made definite where it has a rule */
                     double Sd[6];
                     for (r = 0; r < 6; r++) Sd[r] = (double)S[r];
@@ -4382,8 +4810,10 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                     for (r = 0; r < 6; r++) S[r] = (frm_real)Sd[r];
                     if (frm__laws[m->s_law[s]].definite) frm__laws[m->s_law[s]].definite(prm, cache);
                 }
-                memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
-                memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
+                if (!m->vol_mode) {
+                    memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
+                    memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
+                }
                 for (k = 0; k < n; k++) {
                     frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
                     frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
@@ -4461,6 +4891,15 @@ static int frm__force_pass(frm_model *m, int linearize, int outputs, double *ene
     ctx.linearize = linearize;
     ctx.outputs = outputs;
     if (linearize) m->lin_valid = 0;
+    if (m->vol_mode) {
+        err = frm__vol_force_stages(m, linearize, outputs);
+        if (err) {
+            m->stats.force_evaluations++;
+            if (energy) *energy = 0;
+            return err;
+        }
+        ctx.outputs = 0; /* stage 1 wrote them */
+    }
     frm__run(m, m->sample_chunks, frm__force_chunks, &ctx);
     m->stats.force_evaluations++;
     for (c = 0; c < m->sample_chunks; c++) {
@@ -4568,6 +5007,104 @@ typedef struct frm__apply_ctx {
     const frm_real *v;
 } frm__apply_ctx;
 
+
+/* K v stage 1 over sample chunks (volumetric): dF of every sample, e = tr(F^-1 dF) (dJ = J e),
+   x = J e for the average. */
+static void frm__vol_dF_chunks(void *vctx, int begin, int end)
+{
+    frm__vol_ctx *ctx = (frm__vol_ctx *)vctx;
+    frm_model *m = ctx->m;
+    int c;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k;
+            frm_real *dF = m->vk_dF + 9 * (size_t)s, e;
+            const frm_real *Fi = m->vl_Finv + 9 * (size_t)s;
+            for (k = 0; k < 9; k++) dF[k] = 0;
+            for (k = b; k < b + n; k++) frm_pair_dF(ctx->v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
+            e = Fi[0] * dF[0] + Fi[1] * dF[3] + Fi[2] * dF[6] + Fi[3] * dF[1] + Fi[4] * dF[4] + Fi[5] * dF[7] +
+                Fi[6] * dF[2] + Fi[7] * dF[5] + Fi[8] * dF[8];
+            m->vk_e[s] = e;
+            m->v_x[s] = m->vl_J[s] * e;
+        }
+    }
+}
+
+/* K v stage 3 over sample chunks: dF_bar = alpha (dF + (ebar - e) / 3 F), dP_bar by the law
+   at F_bar, dpi = (dP_bar : F_bar + P_bar : dF_bar) / 3 and y = v (dpi - pi ebar) / J_bar
+   (definite: the Gauss-Newton part only, dpi = dP_bar : F_bar / 3 and y = v dpi / J_bar). */
+static void frm__vol_dstress_chunks(void *vctx, int begin, int end)
+{
+    frm__vol_ctx *ctx = (frm__vol_ctx *)vctx;
+    frm_model *m = ctx->m;
+    int c, full = !m->lin_definite;
+    for (c = begin; c < end; c++) {
+        int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
+        if (s1 > m->sample_count) s1 = m->sample_count;
+        for (s = s0; s < s1; s++) {
+            const frm_real *dF = m->vk_dF + 9 * (size_t)s, *F = m->lin_F + 9 * (size_t)s;
+            const frm_real *Fb = m->vl_Fbar + 9 * (size_t)s, *Pb = m->vl_Pbar + 9 * (size_t)s;
+            const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s, *cache = m->lin_cache + (size_t)m->law_cache * s;
+            frm_real dFb[9], *dP = m->vk_dPbar + 9 * (size_t)s, al = m->vl_alpha[s], t, dpi = 0;
+            int law = m->s_law[s], r;
+            t = (m->vk_ebar[s] - m->vk_e[s]) / 3;
+            for (r = 0; r < 9; r++) dFb[r] = al * (dF[r] + t * F[r]);
+            if (frm__laws[law].fast_path)
+                frm_sample_dP(law, prm[0], prm[1], cache, Fb, m->lin_S + 6 * (size_t)s, dFb, dP);
+            else
+                frm__law_dP(law, prm, m->s_user[s], cache, Fb, m->lin_S + 6 * (size_t)s, dFb, dP);
+            for (r = 0; r < 9; r++) dpi += dP[r] * Fb[r] + (full ? Pb[r] * dFb[r] : 0);
+            dpi = dpi / 3 + m->vol_eta * m->s_mu[s] * 3 * t; /* + c dphi, dphi = ebar - e */
+            m->vk_dpi[s] = dpi;
+            m->v_x[s] = m->s_volume[s] * (dpi - (full ? m->vl_pi[s] * m->vk_ebar[s] : 0)) / m->vl_Jbar[s];
+        }
+    }
+}
+
+/* K v stages 1 to 4 (volumetric): stage 5 in frm__apply_chunks forms, per sample,
+       dP = alpha dP_bar + (dQ J / v - dpi) F^-T
+            + [alpha (ebar - e) / 3 P_bar + (beta + pi) e F^-T - beta F^-T dF^T F^-T]  (not definite)
+   with dQ = A^T y (the derivative of P = alpha P_bar + beta F^-T, see MODEL). */
+static void frm__vol_apply_stages(frm_model *m, const frm_real *v)
+{
+    frm__vol_ctx ctx;
+    int s;
+    ctx.m = m;
+    ctx.linearize = 0;
+    ctx.outputs = 0;
+    ctx.v = v;
+    frm__run(m, m->sample_chunks, frm__vol_dF_chunks, &ctx);
+    frm__vol_average(m, m->v_x, m->vk_ebar, 0);
+    for (s = 0; s < m->sample_count; s++) m->vk_ebar[s] /= m->vl_Jbar[s];
+    frm__run(m, m->sample_chunks, frm__vol_dstress_chunks, &ctx);
+    frm__vol_average(m, m->v_x, m->v_y, 1);
+}
+
+/* K v stage 5 for sample s (volumetric): dP as in frm__vol_apply_stages; dF its dF. */
+static void frm__vol_sample_dP(const frm_model *m, int s, frm_real dF[9], frm_real dP[9])
+{
+    const frm_real *Fi = m->vl_Finv + 9 * (size_t)s, *dPb = m->vk_dPbar + 9 * (size_t)s, *Pb = m->vl_Pbar + 9 * (size_t)s;
+    frm_real al = m->vl_alpha[s], J = m->vl_J[s], be = m->vl_beta[s], e = m->vk_e[s], c;
+    int r, k;
+    memcpy(dF, m->vk_dF + 9 * (size_t)s, sizeof(frm_real) * 9);
+    c = m->v_y[s] * J / m->s_volume[s] - m->vk_dpi[s];
+    if (!m->lin_definite) c += (be + m->vl_pi[s]) * e;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) dP[3 * r + k] = al * dPb[3 * r + k] + c * Fi[3 * k + r];
+    if (!m->lin_definite) {
+        frm_real a = al * (m->vk_ebar[s] - e) / 3, X[9], Y[9];
+        for (r = 0; r < 9; r++) dP[r] += a * Pb[r];
+        /* - beta F^-T dF^T F^-T: X = dF^T F^-T, Y = F^-T X */
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) X[3 * r + k] = dF[r] * Fi[3 * k] + dF[3 + r] * Fi[3 * k + 1] + dF[6 + r] * Fi[3 * k + 2];
+        for (r = 0; r < 3; r++)
+            for (k = 0; k < 3; k++) Y[3 * r + k] = Fi[r] * X[k] + Fi[3 + r] * X[3 + k] + Fi[6 + r] * X[6 + k];
+        for (r = 0; r < 9; r++) dP[r] -= be * Y[r];
+    }
+}
+
 /* Pass 1 of K v in pair mode over sample chunks: dF from the neighbours' dq, dP, then
    each pair's contribution into p_out. Reads per pair 1 int and 3 + 9 + 6 reals (grad,
    G, Hs), writes 6; per sample 9 + 6 (+ FRM_LAW_CACHE for Neo-Hookean) reals; gathers 6
@@ -4584,7 +5121,9 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
         for (s = s0; s < s1; s++) {
             int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
             frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
-            for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
+            if (m->vol_mode) frm__vol_sample_dP(m, s, dF, dP);
+            else {
+                for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
             {
                 int law = m->s_law[s];
                 const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
@@ -4594,6 +5133,7 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
                 else
                     frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
                                 m->lin_S + 6 * (size_t)s, dF, dP);
+            }
             }
             if (m->s_stab[s]) {
                 frm_real dPx[9];
@@ -4677,6 +5217,7 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         frm__apply_ctx a;
         a.m = m;
         a.v = v;
+        if (m->vol_mode) frm__vol_apply_stages(m, v);
         frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
         frm__gather(m, m->p_out, out, NULL);
         for (i = 0; i < m->frame_count; i++) { /* the frame-own rotational term (pairs' Hs + gravity) */
@@ -6785,6 +7326,7 @@ static void frm__sampling_layout(frm_sampling *s, frm__carver *c)
     FRM__CARVE(c, s->neighbor_frames, int, P);
     FRM__CARVE(c, s->neighbor_weights, frm_real, P);
     FRM__CARVE(c, s->neighbor_gradients, frm_real, 3 * P);
+    if (s->cell_count > 0) FRM__CARVE(c, s->sample_cells, int, S);
 }
 
 static size_t frm__sampling_bytes(const frm_sampling *s)
@@ -6798,7 +7340,7 @@ static size_t frm__sampling_bytes(const frm_sampling *s)
 }
 
 /* One block for every array of the sampling (the first array is the block's start). */
-static int frm__sampling_alloc(frm_sampling *s, int frames, int samples, int pairs, const frm_allocator *a)
+static int frm__sampling_alloc(frm_sampling *s, int frames, int samples, int pairs, int cells, const frm_allocator *a)
 {
     frm__carver c;
     void *block;
@@ -6807,6 +7349,7 @@ static int frm__sampling_alloc(frm_sampling *s, int frames, int samples, int pai
     s->frame_count = frames;
     s->sample_count = samples;
     s->pair_count = pairs;
+    s->cell_count = cells;
     block = frm__alloc(&s->allocator, frm__sampling_bytes(s));
     if (!block) {
         memset(s, 0, sizeof *s);
@@ -6841,6 +7384,7 @@ FRMDEF void frm_sampling_apply(const frm_sampling *s, frm_desc *d)
     d->neighbor_frames = s->neighbor_frames;
     d->neighbor_weights = s->neighbor_weights;
     d->neighbor_gradients = s->neighbor_gradients;
+    d->sample_cells = s->sample_cells;
 }
 
 static int frm__check_mesh(const frm_real *nodes, int node_count, const int *cells, int cell_count, int per_cell)
@@ -6889,7 +7433,7 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
         for (a = 0; a < 8; a++)
             for (b = 0; b < a; b++)
                 if (hexes[8 * h + a] == hexes[8 * h + b]) return FRM_ERR_SHAPE_DEGENERATE;
-    err = frm__sampling_alloc(out, node_count, hex_count * g3, hex_count * g3 * 8, allocator);
+    err = frm__sampling_alloc(out, node_count, hex_count * g3, hex_count * g3 * 8, hex_count, allocator);
     if (err) return err;
     memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
     if (rule == FRM_QUADRATURE_GAUSS) frm__gauss(points, gx, gw);
@@ -6915,6 +7459,7 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
                         return FRM_ERR_SHAPE_DEGENERATE;
                     }
                     out->neighbor_start[s] = 8 * s;
+                    out->sample_cells[s] = h;
                     for (r = 0; r < 3; r++) out->sample_positions[3 * s + r] = (frm_real)p[r];
                     out->sample_volumes[s] = (frm_real)(det * gw[i] * gw[j] * gw[k]);
                     for (a = 0; a < 8; a++) {
@@ -6962,7 +7507,7 @@ FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_
         for (a = 0; a < 4; a++)
             for (k = 0; k < a; k++)
                 if (tets[4 * t + a] == tets[4 * t + k]) return FRM_ERR_SHAPE_DEGENERATE;
-    err = frm__sampling_alloc(out, node_count, tet_count * points, tet_count * points * 4, allocator);
+    err = frm__sampling_alloc(out, node_count, tet_count * points, tet_count * points * 4, tet_count, allocator);
     if (err) return err;
     memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
     for (t = 0; t < tet_count; t++) {
@@ -6979,6 +7524,7 @@ FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_
         vol = fabs(frm__dot3d(e[0], c)) / 6.0;
         for (k = 0; k < points; k++, s++) {
             out->neighbor_start[s] = 4 * s;
+            out->sample_cells[s] = t;
             for (r = 0; r < 3; r++) {
                 double p = 0;
                 for (a = 0; a < 4; a++) p += bary[4 * k + a] * X[a][r];
@@ -7174,7 +7720,7 @@ FRMDEF int frm_sampling_meshless(frm_sampling *out, const frm_real *frames, int 
     /* pass 0 counts the neighbours, pass 1 fills the table */
     for (pass = 0; pass < 2 && !err; pass++) {
         if (pass == 1) {
-            err = frm__sampling_alloc(out, frame_count, sample_count, pairs, &alloc);
+            err = frm__sampling_alloc(out, frame_count, sample_count, pairs, 0, &alloc);
             if (err) break;
             memcpy(out->frame_positions, frames, sizeof(frm_real) * 3 * (size_t)frame_count);
             memcpy(out->sample_positions, samples, sizeof(frm_real) * 3 * (size_t)sample_count);
@@ -7708,9 +8254,9 @@ FRMDEF frm_rigid_body frm_rigid_body_default(void)
 FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_count, const frm_rigid_body *rigids,
                              int rigid_count, int frame_count, const frm_allocator *allocator)
 {
-    long long samples = 0, pairs = 0;
+    long long samples = 0, pairs = 0, cells = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, size = 0, tol;
-    int k, i, j, r, s0 = 0, p0 = 0, err = FRM_OK, first = 1, pass;
+    int k, i, j, r, s0 = 0, p0 = 0, c0 = 0, err = FRM_OK, first = 1, pass, all_cells = 1;
     int *given;
     unsigned char *rigid;
     frm_allocator al;
@@ -7740,7 +8286,12 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             first = 0;
         }
         samples += s->sample_count;
+        /* cells (volumetric averaging): each part's own, numbered after the previous
+           parts'; a combination keeps them only when every part has them */
+        if (s->cell_count > 0 && s->sample_cells) cells += s->cell_count;
+        else all_cells = 0;
     }
+    if (!all_cells || cells > 100000000) cells = 0;
     for (k = 0; k < rigid_count; k++) {
         const frm_rigid_body *rb = rigids + k;
         if (rb->frame < 0 || rb->frame >= frame_count) return FRM_ERR_PART_FRAME;
@@ -7796,7 +8347,7 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             pairs += n;
         }
     if (!err && pairs > 1600000000) err = FRM_ERR_ARG;
-    if (!err) err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, &al);
+    if (!err) err = frm__sampling_alloc(&out->sampling, frame_count, (int)samples, (int)pairs, (int)cells, &al);
     if (err) {
         frm_assembly_free(out);
         return err;
@@ -7849,6 +8400,7 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             out->sample_linear[s0 + i] = lin <= 1e-3;
             for (r = 0; r < 3; r++) out->sampling.sample_positions[3 * (s0 + i) + r] = s->sample_positions[3 * i + r];
             out->sampling.sample_volumes[s0 + i] = s->sample_volumes[i];
+            if (cells) out->sampling.sample_cells[s0 + i] = c0 + s->sample_cells[i];
             out->sample_materials[s0 + i] = k;
             for (e = 0; e < n; e++) {
                 out->sampling.neighbor_frames[p0 + e] = f[e];
@@ -7859,6 +8411,7 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
             out->sampling.neighbor_start[s0 + i + 1] = p0;
         }
         s0 += s->sample_count;
+        if (cells) c0 += s->cell_count;
     }
     out->part_samples[part_count] = s0;
     for (j = 0; j < frame_count && !err; j++)

@@ -64,6 +64,8 @@
        HEML_STATIC     make every function static (private to the including file).
        HEML_PARALLEL_MIN_TETS
                        meshes with fewer tetrahedra run serially (default 16384).
+       HEML_NO_SIMD    no intrinsics: the portable scalar gather, scatter and square
+                       roots even where the target has AVX (results are the same bits).
 
    STEP BY STEP
        1. heml_desc d = heml_default_desc(); fill the mesh, the material (or a table of
@@ -304,6 +306,80 @@
        limit dt -> infinity (A_i = alpha_i, B_i = 0: the fully relaxed equilibrium) and
        leaves the state relaxed there.
 
+   NEAR-INCOMPRESSIBLE BODIES (desc.nodal_pressure = 1; off by default, and then every
+       result is bit-identical to 0.3.0): average nodal pressure tetrahedra (Bonet and
+       Burton 1998's ANP element, the volumetric part moved from the tetrahedra to the
+       nodes), for every law but mass-spring, user laws included. P1 tetrahedra lock near
+       nu = 0.5 because every tetrahedron must keep its own volume (one constraint per
+       tetrahedron, about 5 per node against 3 degrees of freedom per node); here the
+       volume is constrained per node (one per node). Our formulation, in energy form so
+       that forces and differential follow exactly:
+           W = sum_e Vol_e (w(F_e) - U(J_e)) + sum_a sum_mat W_a,mat U_mat(J_a),
+       U(J) = w(J^(1/3) I) the law's energy on a pure dilation (I1 = 3 J^(2/3), I2 =
+       3 J^(4/3)), continued below J0 by its quadratic Taylor polynomial (J^(2/3) has no
+       second derivative at 0); W_a,mat = sum Vol_e / 4 over node a's tetrahedra of that
+       material, V_a = sum_mat W_a,mat, and the nodal volume ratio J_a = sum_e Vol_e J_e /
+       (4 V_a) (current over rest nodal volume). So each tetrahedron keeps its law minus
+       the law's own dilation energy, w - U, which has no bulk stiffness at small strain
+       (Neo-Hookean: w - U = mu/2 (I1 - 3 J^(2/3)), the isochoric part exactly; split
+       Mooney-Rivlin: U = kappa/2 (J - 1)^2, its volumetric term exactly; St Venant-
+       Kirchhoff: w - U is O(strain^3)), and the nodes carry the volumetric energy. A
+       homogeneous deformation gives every J_a = J_e = J, the two U terms cancel, and the
+       stress is the law's P(F) (the patch test) for any law; rigid motions give J = 1 and
+       zero force. Our choice where the papers offer several: U from the law itself (no
+       separate volumetric law to specify, user laws work unchanged) rather than Bonet and
+       Burton's assumed split, and the nodal energy weighted per material (a node on a
+       material interface carries each material's U on its own volume share).
+       Forces: dW/dx = sum_e Vol_e (dw - U'(J_e) dJ_e) + sum_a V_a P_a dJ_a with the nodal
+       pressure P_a = sum_mat W_a,mat U'_mat(J_a) / V_a and dJ_a = sum_e Vol_e dJ_e / (4 V_a),
+       so regrouped per tetrahedron:
+           w_J  ->  w_J - U'(J_e) + p_e,   p_e = (P_a + P_b + P_c + P_d) / 4
+       (and s0 the same), its four nodes' mean pressure: the P1 force kernel unchanged.
+       Differential: dp_e = sum_{a in e} dP_a / 4, dP_a = (sum_mat W_a,mat U''_mat(J_a) /
+       V_a) dJ_a, so in the element's differential w_JJ -> w_JJ - U''(J_e) and dw_J gains
+       dp_e: the exact tangent, which couples a node to its neighbours' neighbours
+       (through J_a), matrix-free. Each pass (force, energy, differential, stresses) is
+       three: the tetrahedra scatter Vol (J - 1) / 4 (the differential also Vol dJ / 4 =
+       Vol cof F : dH / 4) into two scalars per node (coloured as the force pass); a node
+       pass (chunks of 1024 nodes) evaluates U', U'' (and U) at J_a in blocks of 16
+       through the law's own row of heml__laws (one evaluation per material present); the
+       usual pass then gathers the four P_a (and dP_a) and evaluates the element's U at
+       J_e besides the law. U', U'' are formed from the law's s0 and second derivatives at
+       the dilation point: U' = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1), s = J^(1/3), s - 1 =
+       (J - 1) / (s^2 + s + 1), without cancellation at rest. It runs the general path
+       (not the vectorised Neo-Hookean kernels). Prony: the nodal pressure enters w_J
+       before the filter, so it relaxes with the rest of the stress. Inversion: the
+       continued U is restoring below J0 at the nodes; a single tetrahedron's own
+       resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
+       the bulk part. Memory: 6 reals per node plus one per node and material.
+       Measured (tests/test_heml_solve.c, Cook's membrane R10, nu = 0.4999, corner u_y in
+       mm at N x N x 1 cells, N = 4, 8, 16, 32; converged about 6.9):
+           six tetrahedra per cell   plain 2.15 2.17 2.22 2.38   nodal 2.65 4.38 5.99 6.61
+           five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
+       so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
+       it and converge (as O(h)) towards the published value. What it does not fix
+       (LIMITS): the static solve's Krylov iterations (Cook, N = 16: about 430 at nu = 0.3,
+       17,000 at nu = 0.4999, with or without nodal pressure: the conditioning is the
+       bulk-to-shear ratio, which the Jacobi and rigid-body coarse preconditioner does
+       not address; scaling the Jacobi diagonal's bulk share by 0.2 or 0.02 gave 14,300
+       to 21,600: the diagonal is not the cause, a volumetric (divergence-free) coarse
+       space or a block preconditioner would be), and the nodal pressure field oscillates between neighbouring nodes
+       near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
+       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
+       smoothed, e.g. as the element means p_e, not node by node. The bench's Poisson beam
+       (1 x 0.1 x 0.1 m, 30 x 3 x 3 cells of five tetrahedra, tip against Timoshenko): 14.4,
+       18.9, 22.5, 25.9 % off at nu = 0.3, 0.45, 0.49, 0.499 (plain 18.5, 22.4, 26.6,
+       30.2 %); of six tetrahedra per cell at nu = 0.499 the tip is 0.0071 m instead of
+       plain P1's 0.0004 m. The growth with nu that remains halves with h (13 % between
+       nu = 0.3 and 0.499 at 3 cells across, 6 % at 6): P1 bending error, not locking.
+       Cost (callgrind, 2,592 tetrahedra, Neo-Hookean, gcc -O3 -mavx2 -mfma, instructions
+       per tetrahedron and pass): force 643 against 229 on the vectorised kernel (284 on
+       the general path it runs instead), differential 979 against 310 (431): the sums
+       pass (a second gather) about 130, the element's U with its cube root (Halley, 4
+       steps, vectorised; libm's cbrt made it twice as slow) about 100, the node pass
+       about 25. The issue's target, 1.3 times the plain force, would need a fused
+       Neo-Hookean kernel for it; not done.
+
    INTEGRATORS (the desc picks a default, heml_step_ex picks per call)
        HEML_SEMI_EXPLICIT_EULER  eq. 32: v1 = v + dt a(u, v), u1 = u + dt v1, lumped masses
                              m_i = sum rho Vol / 4 (sec. 3.3). One force evaluation per
@@ -535,7 +611,8 @@
    least a pass must move from memory: the stream plus each node's displacement read once
    and force written once (105 bytes per tetrahedron on the beam below). Tetrahedra sit in
    blocks of 16 (structure of arrays inside a block); a block's arithmetic is vectorised
-   loops over its lanes; gather and scatter are scalar loops (AVX2 has no scatter). The
+   loops over its lanes; gather and scatter are vector code where the target has AVX
+   (issue 21, below), scalar loops elsewhere. The
    Neo-Hookean force: 9 subtractions (the link displacements), H = du V^-1 (27
    multiply-adds), cof H (18), J - 1, one logarithm with its log1p correction (a
    branch-free fdlibm polynomial, which vectorises where libm's log is a call), two
@@ -632,6 +709,60 @@
    was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); the
    kernel figures above come from the Zen 3 named earlier. There the clock alone would bring
    20 ns near 15, and the bound halves with the bandwidth; neither is measured.
+   Issue 21 (this machine is not the Zen 3 above any more: /proc/cpuinfo says AMD EPYC
+   family 26 (Zen 5) with AVX-512, gcc 12 takes -march=native as znver3 plus AVX-512;
+   shared by several jobs, load 4 to 7 on 2 vCPUs, so timings move by 2x: figures are the
+   minimum of 5 to 15 interleaved runs, ns per tetrahedron, 8,640-tetrahedron beam, force /
+   differential, and instruction counts by callgrind of -march=x86-64-v3 builds, which
+   valgrind can run):
+                                    before           after         instructions (v3)
+       Neo-Hookean, -march=native   12.5 / 15.9      10.1 / 12.4
+       Neo-Hookean, x86-64-v3       13.5 / 21.1      11.4 / 17.7   213 / 278 -> 160 / 198
+       St Venant-Kirchhoff          14.6             (unchanged)   259 / 376 -> 207 / 296
+       Mooney-Rivlin (split)        39 / 45          17 / 22       490 / 606 -> 230 / 320
+       springs                      284 / 34         17            451 / 509 -> 248 / 270
+   So every law's force is within 1.5 times the Neo-Hookean force (SVK 1.17, Mooney-Rivlin
+   1.35, springs 1.34, all measured in one interleaved run before the gather change; the
+   gather and scatter serve every law alike). What changed, all bit-identical to the scalar
+   path except the cube root:
+   - the spring force: heml__spring_forces took the differential's terms under a branch on
+     dt, which gcc if-converted, so the force pass multiplied the unset workspace de, whose
+     stack garbage held subnormals (microcode assists: 15x). The differential is now
+     heml__spring_dforces. Its six square roots per tetrahedron go through
+     heml__sqrt_lanes (AVX _mm256_sqrt, correctly rounded like sqrt; libm's sqrt keeps
+     errno, so gcc does not vectorise it, and optimize("no-math-errno") on the function
+     had no effect).
+   - Mooney-Rivlin: J^-1/3 by heml__inv_cbrt (a float bit-trick guess and Newton steps,
+     3.6 ulp in double, 2 in float, where libm's cbrt is a call), its energy terms
+     (log1p, expm1 calls) in a loop of their own: the law's loop vectorises. Forces move
+     by round-off against 0.3.0's.
+   - the gather (heml__gather_vec): per lane and node one masked 3-component load
+     (AVX-512 VL masks, or AVX's vmaskmov: never reads past an array's end), differences in
+     AoS, a 4 x 4 transpose per link into the lanes' rows. The scatter (heml__scatter_vec):
+     per lane and node a 16-byte (x, y) and a scalar z read-modify-write, lanes in order;
+     masked 3-component stores were tried and lost (force 12.7 -> 20.4 ns: a masked store
+     does not forward to the next lane's load of a shared node), as did unmasked 32-byte
+     stores (they would write a neighbour node's x, a race with another colour group).
+     AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
+     conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
+     (tests compare both, bit for bit, every law).
+   - tried and not kept: software prefetch of the next block's nodes and the rest constants
+     of the block after (large meshes): no difference measurable above this machine's
+     noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns in the
+     same interleaved series: noise).
+   The bench's ratio lines (bench/bench.c, kernels part, `--filter heml`; one loaded run of
+   git ea15902 plus these kernels, double, 1 thread) put the Neo-Hookean force at 20 to 23 %
+   of its bandwidth bound at 1e3 to 1e4 tetrahedra and 13 to 14 % at 1e5 to 1e6 (goal 40 %:
+   not met), at 2.3 to 2.6 times its arithmetic floor in cache (the `arith` rows: the same
+   pass without gather and scatter; goal 2: not met, the gather/scatter still costs more than
+   the arithmetic), and the differential at 0.85 to 0.89 times a CSR product of the same
+   assembled tangent at 1e3 tetrahedra but 1.2 to 2.1 times at 1e4 to 1e6 in double; in float
+   0.46 to 0.98 times at every size (a float CSR still reads a 4-byte column index per value,
+   so halving the real size saves it less than it saves the kernel).
+   What the remaining gap needs (not done): more independent chains per block in double
+   (HEML__W = 32: a change of the chunk structure, so of every sum's order), and a
+   differential that caches F, cof F and the volumetric scalars per tetrahedron at the
+   linearisation point (88 more bytes per tetrahedron: still below the CSR's about 300).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -639,7 +770,16 @@
 
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
-         to 0.5 or a stiff penalty): refine the mesh across thin parts.
+         to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
+         desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
+         BODIES), which removes the volumetric locking, not the bending one.
+       - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
+         shear ratio (about 40 times more at nu = 0.4999 than at nu = 0.3 on Cook's
+         membrane: no preconditioner for the volumetric part yet); the nodal pressure
+         oscillates between neighbouring nodes near nu = 0.5 (smooth the pressure before
+         reading it); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
+         laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
          (HEML_ERR_DIVERGED) catches growth of more than twice the energy the body was
          given, so slower growth below that still passes: respect the time-step estimate.
@@ -715,6 +855,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
+             masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
+             spring force 15x faster (no differential terms on an unset workspace) and its
+             square roots vectorised; Mooney-Rivlin's J^-1/3 by a branch-free Newton cube
+             root (forces change by round-off). See PERFORMANCE, issue 21.
        unreleased (issue 19) HEML_BDF2 (second order, the same Newton minimisation as
              implicit Euler; the model keeps its history, 2 more 3n vectors, and 2 3n
              scratch vectors); point probes (heml_probe_*); modal analysis (heml_modal_*).
@@ -887,13 +1032,14 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_ROUND_OFF, -28, "static solve stalled at the round-off level of the forces above static_tolerance; the last valid state was kept") \
     X(HEML_ERR_DIVERGED, -29, "explicit step failed its divergence check (energy grew beyond the work done on the body); the last valid state was kept") \
     X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept") \
-    X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept")
+    X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept") \
+    X(HEML_ERR_NODAL_PRESSURE, -32, "nodal_pressure not 0 or 1, or set with a law it cannot average (mass-spring, a user law without second derivatives)")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
     HEML_ERROR_LIST(HEML__ENUM)
 #undef HEML__ENUM
-    HEML_ERR_LAST_ = -32
+    HEML_ERR_LAST_ = -33
 };
 
 typedef enum heml_law {
@@ -1009,6 +1155,10 @@ typedef struct heml_desc {
     int material_count;
     const int *tet_material;         /* tet_count indices into materials, or NULL (all 0) */
     heml_real inversion_threshold;   /* J0 of sec. 4.4, in (0, 1), default 0.4 */
+    int nodal_pressure;              /* 0 (default): plain P1 tetrahedra; 1: average nodal
+                                        pressure tetrahedra for nearly incompressible bodies
+                                        (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
+                                        user laws with second derivatives */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1355,6 +1505,18 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #else
 #define HEML__SCALAR_FN
 #endif
+/* Vector intrinsics, only where the target has them (compile-time checks; never required):
+   the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
+   do not vectorise it; _mm*_sqrt_* round the same, correctly, so results are
+   bit-identical to the scalar path), and the node gather and scatter (heml__gather_vec).
+   HEML_NO_SIMD forces the portable scalar code. */
+#if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
+#include <immintrin.h>
+#define HEML__AVX 1
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#define HEML__AVX512 1 /* the gather's masked node loads with AVX-512 masks (else AVX's vmaskmov) */
+#endif
+#endif
 #if defined(__clang__)
 #define HEML__SCALAR_LOOP _Pragma("clang loop vectorize(disable)")
 #else
@@ -1381,6 +1543,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
+#define HEML__NODE_CHUNK 1024 /* nodes per work item of the nodal pressure's node pass */
 #define HEML__MAX_TETS 100000000
 #define HEML__SIXTH ((heml_real)(1.0 / 6.0))
 #define HEML__MAX_NODES 200000000
@@ -1402,6 +1565,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__STRESS 3
 #define HEML__FORCE_ENERGY 4 /* forces and the elastic energy (static line search) */
 #define HEML__ABS 5          /* sum of |tetrahedron force| per dof (the round-off floor) */
+#define HEML__NODAL_SUMS 6   /* the nodal pressure's sums of Vol (J - 1) / 4 (and Vol dJ / 4) */
 
 /* A material in kernel form. */
 typedef struct heml__mat {
@@ -1451,6 +1615,9 @@ struct heml_model {
     int node_count, tet_count, block_count, slot_count, chunk_count, group_count, colour_count;
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     int agg_count;                         /* aggregates of the coarse space (0: none) */
+    int nodal;                             /* desc.nodal_pressure (NEAR-INCOMPRESSIBLE BODIES) */
+    int simd;                              /* 1: the vector gather and scatter where compiled in
+                                              (HEML__AVX); tests set 0 to compare with the scalar path */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
     heml_linear_solver linear_solver;
@@ -1537,6 +1704,15 @@ struct heml_model {
     double *agg_centre; /* 3 per aggregate */
     double *coarse;     /* (6 A)^2: A_c, then its Cholesky factor */
     double *coarse_rhs; /* 6 A */
+
+    /* average nodal pressure (heml__nodal_prepare): per node the rest volume weights of
+       each material, W[mat n + a] = sum Vol_e / 4 over the node's tetrahedra of that
+       material, 1 / V_a (V_a their sum over materials), the sums sum Vol_e (J_e - 1) / 4
+       and sum Vol_e dJ_e / 4 of the current pass, the nodal pressure P_a and its
+       differential dP_a; per node chunk its energy */
+    heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
+    double *nod_energy;
+    int nod_chunks;
 
     heml_stats stats;
 };
@@ -1690,6 +1866,8 @@ struct heml__blk {
     heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
     heml_real de[9][HEML__W]; /* differential: the links of dx */
     heml_real len[6][HEML__W]; /* springs: clamped link lengths */
+    heml_real dp[HEML__W];    /* differential: the nodal pressure's dp (0 without it), see
+                                 NEAR-INCOMPRESSIBLE BODIES */
 };
 typedef struct heml__blk heml__blk;
 
@@ -1813,6 +1991,28 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int valid, int want
         }
 }
 
+/* Jc^(-1/3) for Jc > 0, branch-free so that the law's loop vectorises (libm's cbrt is a
+   call): a first guess from the bits of the float (the exponent divided by 3, error below
+   4 %), then Newton steps r <- r (4 - Jc r^3) / 3, whose relative error e becomes about
+   2 e^2: 4 steps in double, 3 in float, to within a few ulps (libm's cbrt, correctly
+   rounded to 1 ulp, gave the same forces to round-off in the all-law tests). Valid for
+   Jc in [2^-60, 2^60]; heml__law_split sends other lanes to libm. */
+HEML__INLINE heml_real heml__inv_cbrt(heml_real Jc)
+{
+    float xf = (float)Jc, gf;
+    int i;
+    heml_real r, x3 = Jc / 3;
+    memcpy(&i, &xf, sizeof i);
+    i = 0x54a21d2a - (int)((float)i * (1.0f / 3.0f));
+    memcpy(&gf, &i, sizeof gf);
+    r = (heml_real)gf;
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    if (sizeof(heml_real) > sizeof(float)) r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    return r;
+}
+
 /* heml__law_split, the compressible Mooney-Rivlin (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
    (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
@@ -1822,12 +2022,22 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
 {
     (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
-    int k;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real Jc = b->Jc[k];
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside) /* (NaN lanes stay NaN either way) */
+        for (k = 0; k < HEML__W; k++)
+            if (b->Jc[k] < lo || b->Jc[k] > hi) rc[k] = (heml_real)(1 / cbrt((double)b->Jc[k]));
     for (k = 0; k < HEML__W; k++) {
         heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
         heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], I1 = 3 + I1m3, I2 = 3 + I2m3;
-        heml_real t = (heml_real)cbrt((double)Jc), iJ = 1 / Jc;
-        heml_real a = 1 / (t * t), bq = a * a;
+        heml_real r = rc[k], iJ = 1 / Jc;
+        heml_real a = r * r, bq = a * a;
         heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
         heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
         heml_real at = a + d * (a1 + d / 2 * a2), at1 = a1 + d * a2;
@@ -1842,14 +2052,21 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
         b->h[2][k] = c1 * at1;
         b->h[4][k] = c2 * bt1;
         b->h[5][k] = c1 * I1 * a2 + c2 * I2 * b2 + kappa;
-        if (want & HEML__WANT_ENERGY) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+    }
+    /* the energy in a loop of its own (library calls), so that the one above vectorises */
+    if (want & HEML__WANT_ENERGY)
+        for (k = 0; k < HEML__W; k++) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+            heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
+            heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], r = rc[k], iJ = 1 / Jc;
+            heml_real a = r * r, bq = a * a;
+            heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
+            heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
             double L = log1p((double)jc1), dd = (double)d;
             double am1 = expm1(-2.0 / 3.0 * L) + dd * ((double)a1 + dd / 2 * (double)a2);
             double bm1 = expm1(-4.0 / 3.0 * L) + dd * ((double)b1 + dd / 2 * (double)b2);
             b->w[k] = (heml_real)((double)c1 * (3 * am1 + (double)I1m3 * (1 + am1)) +
                                   (double)c2 * (3 * bm1 + (double)I2m3 * (1 + bm1)) + (double)kappa / 2 * jm1 * jm1);
         }
-    }
 }
 
 /* heml__law_svk (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
@@ -1949,11 +2166,67 @@ static void heml__law_at_rest(const heml__mat *mt, heml_real jm1_0, heml__blk *b
     heml__law(mt, b, 1, HEML__WANT_SECOND);
 }
 
+/* The volumetric function of a law (NEAR-INCOMPRESSIBLE BODIES): U(J) = w at the pure
+   dilation F = J^(1/3) I (I1 = 3 s^2, I2 = 3 s^4, s = J^(1/3)) for J >= J0, continued
+   below J0 by its quadratic Taylor polynomial; U, U' and U'' at the `W` lanes' J - 1 (jm1)
+   into U (when want has HEML__WANT_ENERGY), U1, U2. s is a workspace. With the law's
+   derivatives at the dilation point,
+       U'  = 2 w_1 / s + 4 w_2 s + w_J = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1),
+       U'' = -2/3 w_1 / s^4 + 4/3 w_2 / s^2 + 4 w_11 / s^2 + 16 w_12 + 16 s^2 w_22
+             + 4 w_1J / s + 8 s w_2J + w_JJ
+   (dI1/dJ = 2 / s, dI2/dJ = 4 s); s - 1 = (J - 1) / (s^2 + s + 1) and the invariants'
+   offsets I1 - 3 = 3 (s^2 - 1), q1 = I1 - 3 - 2 (J - 1) = -(s - 1)^2 (2 s + 1) are formed
+   without cancellation, so U' keeps the law's precision at small strains. */
+static void heml__dilation(const heml__mat *mt, heml_real jm1_0, const heml_real *jm1, int valid, int want,
+                           heml__blk *s, heml_real *U, heml_real *U1, heml_real *U2)
+{
+    heml_real dd[HEML__W], sv[HEML__W], sm[HEML__W];
+    int k;
+    for (k = 0; k < HEML__W; k++) { /* s = J^(1/3): Halley from the tangent 1 + (J - 1) / 3,
+                                       to round-off in 4 steps for J in [1/8, 8] (vectorised;
+                                       libm's cbrt is a call) */
+        heml_real jc = heml__max(jm1[k], jm1_0), x = 1 + jc, t = 1 + jc / 3;
+        int r;
+        for (r = 0; r < 4; r++) {
+            heml_real t3 = t * t * t;
+            t = t * (t3 + 2 * x) / (2 * t3 + x);
+        }
+        sv[k] = t;
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real jc = heml__max(jm1[k], jm1_0);
+        if (jc < (heml_real)-0.875 || jc > 7) sv[k] = (heml_real)cbrt(1.0 + (double)jc);
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real j = jm1[k], jc = heml__max(j, jm1_0), t = sv[k];
+        heml_real t1 = jc / (t * t + t + 1), t2 = t1 * (t + 1);
+        dd[k] = j - jc;
+        sm[k] = t1;
+        s->jm1[k] = jc;
+        s->I1m3[k] = 3 * t2;
+        s->I2m3[k] = 3 * t2 * (t * t + 1);
+        s->tr2[k] = 3 * t2 * t2;
+        s->q1[k] = -t1 * t1 * (2 * t + 1);
+    }
+    heml__clamp_J(jm1_0, s);
+    heml__law(mt, s, valid, (want & HEML__WANT_ENERGY) | HEML__WANT_SECOND);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real t = sv[k], it = 1 / t, d = dd[k], w1 = s->w1[k], w2 = s->w2[k];
+        heml_real u1 = s->s0[k] - 2 * w1 * sm[k] * it + 4 * w2 * sm[k];
+        heml_real u2 = (heml_real)(-2.0 / 3.0) * w1 * it * it * it * it + (heml_real)(4.0 / 3.0) * w2 * it * it +
+                       4 * s->h[0][k] * it * it + 16 * s->h[1][k] + 16 * t * t * s->h[3][k] + 4 * s->h[2][k] * it +
+                       8 * t * s->h[4][k] + s->h[5][k];
+        if (want & HEML__WANT_ENERGY) U[k] = s->w[k] + d * (u1 + d / 2 * u2);
+        U1[k] = u1 + u2 * d;
+        U2[k] = u2;
+    }
+}
+
 /* >>forces ---------------------------------------------------------------------------- */
 
 /* Links du_1, du_2, du_3 of the block's lanes from a 3n field (displacements or dx). */
-HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
-                                         heml_real (*HEML__RESTRICT e)[HEML__W])
+HEML__SCALAR_FN static void heml__gather_scalar(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                                                heml_real (*HEML__RESTRICT e)[HEML__W])
 {
     int k, r;
     HEML__SCALAR_LOOP
@@ -1971,8 +2244,8 @@ HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const he
 /* Adds the block's node forces (f on nodes 1..3, minus their sum on node 0) into out. The
    lanes go in order, so a node shared by two lanes of a block is updated twice in a
    fixed order. */
-static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
-                          heml_real *HEML__RESTRICT out)
+static void heml__scatter_scalar(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                                 heml_real *HEML__RESTRICT out)
 {
     int k, r;
     for (k = 0; k < HEML__W; k++) {
@@ -1986,6 +2259,172 @@ static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTR
             o0[r] -= (a + b) + c;
         }
     }
+}
+
+#if defined(HEML__AVX)
+/* The vector gather and scatter (AVX; AVX-512 VL masks where present), 4 lanes at a time.
+   Gather: one masked load moves a node's 3 components (the mask never faults past the
+   array's end), 4 x 4 transposes turn them into the lanes' rows. Scatter: per node a
+   16-byte (x, y) and a scalar z read-modify-write (masked stores were tried: 1.6 times
+   slower, their store-to-load forwarding fails where the next lane updates the same node).
+   The same operations in the same order as the scalar loops (the links are differences of
+   the same pairs; a node shared by lanes receives the lanes' terms in lane order, node 0
+   the same (a + b) + c), so the forces are bit-identical to the scalar path. */
+#if defined(HEML__AVX512)
+#define HEML__LOAD3D(p) _mm256_maskz_loadu_pd((__mmask8)7, (p))
+#define HEML__LOAD3F(p) _mm_maskz_loadu_ps((__mmask8)7, (p))
+#else
+#define HEML__LOAD3D(p) _mm256_maskload_pd((p), _mm256_set_epi64x(0, -1, -1, -1))
+#define HEML__LOAD3F(p) _mm_maskload_ps((p), _mm_set_epi32(0, -1, -1, -1))
+#endif
+static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                             heml_real (*HEML__RESTRICT e)[HEML__W])
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            const double *xd = (const double *)(const void *)x;
+            __m256d p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3D(xd + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m256d d[4], t0, t1, t2, t3;
+                double *row = (double *)(void *)e[3 * (j - 1)];
+                for (l = 0; l < 4; l++)
+                    d[l] = _mm256_sub_pd(HEML__LOAD3D(xd + 3 * (size_t)idx[j * HEML__W + k + l]),
+                                         p0[l]);
+                t0 = _mm256_unpacklo_pd(d[0], d[1]); /* x0 x1 z0 z1 */
+                t1 = _mm256_unpackhi_pd(d[0], d[1]); /* y0 y1 .. */
+                t2 = _mm256_unpacklo_pd(d[2], d[3]);
+                t3 = _mm256_unpackhi_pd(d[2], d[3]);
+                _mm256_storeu_pd(row + k, _mm256_permute2f128_pd(t0, t2, 0x20));
+                _mm256_storeu_pd(row + HEML__W + k, _mm256_permute2f128_pd(t1, t3, 0x20));
+                _mm256_storeu_pd(row + 2 * HEML__W + k, _mm256_permute2f128_pd(t0, t2, 0x31));
+            }
+        } else {
+            const float *xf = (const float *)(const void *)x;
+            __m128 p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3F(xf + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m128 d0, d1, d2, d3;
+                float *row = (float *)(void *)e[3 * (j - 1)];
+                d0 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k]), p0[0]);
+                d1 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 1]), p0[1]);
+                d2 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 2]), p0[2]);
+                d3 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 3]), p0[3]);
+                _MM_TRANSPOSE4_PS(d0, d1, d2, d3);
+                _mm_storeu_ps(row + k, d0);
+                _mm_storeu_ps(row + HEML__W + k, d1);
+                _mm_storeu_ps(row + 2 * HEML__W + k, d2);
+            }
+        }
+    }
+}
+
+static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                              heml_real *HEML__RESTRICT out)
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            double *od = (double *)(void *)out;
+            __m128d xy[4][4]; /* [node][lane] */
+            double zz[4][4];
+            for (j = 0; j < 4; j++) {
+                __m256d X, Y, Z, t0, t1;
+                if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                    const double *f0 = (const double *)(const void *)f[0] + k;
+                    X = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0), _mm256_loadu_pd(f0 + 3 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 6 * HEML__W));
+                    Y = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + HEML__W), _mm256_loadu_pd(f0 + 4 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 7 * HEML__W));
+                    Z = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + 2 * HEML__W), _mm256_loadu_pd(f0 + 5 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 8 * HEML__W));
+                } else {
+                    const double *fj = (const double *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm256_loadu_pd(fj);
+                    Y = _mm256_loadu_pd(fj + HEML__W);
+                    Z = _mm256_loadu_pd(fj + 2 * HEML__W);
+                }
+                t0 = _mm256_unpacklo_pd(X, Y); /* x0 y0 x2 y2 */
+                t1 = _mm256_unpackhi_pd(X, Y); /* x1 y1 x3 y3 */
+                xy[j][0] = _mm256_castpd256_pd128(t0);
+                xy[j][1] = _mm256_castpd256_pd128(t1);
+                xy[j][2] = _mm256_extractf128_pd(t0, 1);
+                xy[j][3] = _mm256_extractf128_pd(t1, 1);
+                _mm256_storeu_pd(zz[j], Z);
+            }
+            for (l = 0; l < 4; l++) { /* lanes in order: shared nodes see the scalar order */
+                for (j = 1; j < 4; j++) {
+                    double *o = od + 3 * (size_t)idx[j * HEML__W + k + l];
+                    _mm_storeu_pd(o, _mm_add_pd(_mm_loadu_pd(o), xy[j][l]));
+                    o[2] += zz[j][l];
+                }
+                {
+                    double *o = od + 3 * (size_t)idx[k + l];
+                    _mm_storeu_pd(o, _mm_sub_pd(_mm_loadu_pd(o), xy[0][l]));
+                    o[2] -= zz[0][l];
+                }
+            }
+        } else {
+            float *of = (float *)(void *)out;
+            __m128 v[4][4];
+            for (j = 0; j < 4; j++) {
+                __m128 X, Y, Z, W = _mm_setzero_ps();
+                if (j == 0) {
+                    const float *f0 = (const float *)(const void *)f[0] + k;
+                    X = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0), _mm_loadu_ps(f0 + 3 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 6 * HEML__W));
+                    Y = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + HEML__W), _mm_loadu_ps(f0 + 4 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 7 * HEML__W));
+                    Z = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + 2 * HEML__W), _mm_loadu_ps(f0 + 5 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 8 * HEML__W));
+                } else {
+                    const float *fj = (const float *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm_loadu_ps(fj);
+                    Y = _mm_loadu_ps(fj + HEML__W);
+                    Z = _mm_loadu_ps(fj + 2 * HEML__W);
+                }
+                _MM_TRANSPOSE4_PS(X, Y, Z, W);
+                v[j][0] = X, v[j][1] = Y, v[j][2] = Z, v[j][3] = W;
+            }
+            for (l = 0; l < 4; l++) {
+                for (j = 0; j < 4; j++) {
+                    float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
+                    __m128 xyo = _mm_castpd_ps(_mm_load_sd((const double *)(const void *)o)), r;
+                    r = j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]);
+                    _mm_store_sd((double *)(void *)o, _mm_castps_pd(r));
+                    o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
+                             : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
+                }
+            }
+        }
+    }
+}
+#endif
+
+/* The gather and scatter of a model: vector where compiled in and m->simd, else scalar. */
+static void heml__gather(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__gather_vec(idx, x, e);
+        return;
+    }
+#endif
+    (void)m;
+    heml__gather_scalar(idx, x, e);
+}
+
+static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HEML__W], heml_real *out)
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__scatter_vec(idx, f, out);
+        return;
+    }
+#endif
+    (void)m;
+    heml__scatter_scalar(idx, f, out);
 }
 
 /* The same with absolute values (the size of the terms each node's force sums). */
@@ -2112,6 +2551,24 @@ static void heml__spring_rest_links(const heml_real *HEML__RESTRICT R, heml__blk
     }
 }
 
+/* x[i] = sqrt(x[i]) for n non-negative values: vector
+   square roots where the target has them (HEML__AVX), the same correctly rounded values. */
+static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
+{
+    int i = 0;
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(double)) {
+        double *d = (double *)(void *)x;
+        for (; i + 4 <= n; i += 4) _mm256_storeu_pd(d + i, _mm256_sqrt_pd(_mm256_loadu_pd(d + i)));
+    } else {
+        float *f = (float *)(void *)x;
+        for (; i + 8 <= n; i += 8) _mm256_storeu_ps(f + i, _mm256_sqrt_ps(_mm256_loadu_ps(f + i)));
+    }
+#endif
+    HEML__SCALAR_LOOP
+    for (; i < n; i++) x[i] = (heml_real)sqrt((double)x[i]);
+}
+
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
@@ -2134,15 +2591,16 @@ static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *
             }
             dl2[l][k] = acc;
         }
-    for (l = 0; l < 6; l++) /* the square roots (library calls) */
+    for (l = 0; l < 6; l++) /* l^2 (clamped at 0) */
         for (k = 0; k < HEML__W; k++) {
-            heml_real L = S[l * HEML__W + k];
-            b->len[l][k] = (heml_real)sqrt((double)heml__max(L * L + dl2[l][k], 0));
+            heml_real L = S[l * HEML__W + k], q = L * L + dl2[l][k];
+            b->len[l][k] = q > 0 ? q : 0;
         }
+    heml__sqrt_lanes(b->len[0], 6 * HEML__W);
     for (l = 0; l < 6; l++)
         for (k = 0; k < HEML__W; k++) {
             heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k], len = b->len[l][k];
-            heml_real lc = heml__max(len, (heml_real)1e-12 * L);
+            heml_real lo = (heml_real)1e-12 * L, lc = len > lo ? len : lo;
             b->len[l][k] = lc;
             b->co[l][k] = kk * dl2[l][k] / ((lc + L) * lc); /* k (l - L) / l */
         }
@@ -2172,10 +2630,8 @@ static void heml__spring_links(const heml__blk *b, int k, heml_real v[6][3])
 }
 
 /* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
-   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). With dt (differential) each term
-   t v becomes t dv + dt v, dv the links of de. */
-static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
-                                heml_real (*HEML__RESTRICT t)[HEML__W], heml_real (*HEML__RESTRICT dt)[HEML__W])
+   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). */
+static void heml__spring_forces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W])
 {
     int k, r;
     for (r = 0; r < 3; r++)
@@ -2184,15 +2640,32 @@ static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
             heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
             heml_real p1 = t[0][k] * v1, p2 = t[1][k] * v2, p3 = t[2][k] * v3;
             heml_real p4 = t[3][k] * (v2 - v1), p5 = t[4][k] * (v3 - v2), p6 = t[5][k] * (v1 - v3);
-            if (dt) {
-                heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
-                p1 = t[0][k] * d1 + dt[0][k] * v1;
-                p2 = t[1][k] * d2 + dt[1][k] * v2;
-                p3 = t[2][k] * d3 + dt[2][k] * v3;
-                p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
-                p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
-                p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
-            }
+            b->f[r][k] = -p1 + p4 - p6;
+            b->f[3 + r][k] = -p2 - p4 + p5;
+            b->f[6 + r][k] = -p3 - p5 + p6;
+        }
+}
+
+/* The differential of heml__spring_forces: each term t v becomes t dv + dt v, dv the links
+   of de. A function of its own: one loop with a branch on dt was if-converted by gcc, so
+   the force pass computed (and discarded) the differential's products from the unset
+   workspace de, whose garbage included subnormals: 15 times the Neo-Hookean force on Zen
+   (measured, issue 21). */
+static void heml__spring_dforces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W],
+                                 heml_real (*HEML__RESTRICT dt)[HEML__W])
+{
+    int k, r;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real v1 = b->H[r][k] + b->e[r][k], v2 = b->H[3 + r][k] + b->e[3 + r][k];
+            heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
+            heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
+            heml_real p1 = t[0][k] * d1 + dt[0][k] * v1;
+            heml_real p2 = t[1][k] * d2 + dt[1][k] * v2;
+            heml_real p3 = t[2][k] * d3 + dt[2][k] * v3;
+            heml_real p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
+            heml_real p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
+            heml_real p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
             b->f[r][k] = -p1 + p4 - p6;
             b->f[3 + r][k] = -p2 - p4 + p5;
             b->f[6 + r][k] = -p3 - p5 + p6;
@@ -2379,6 +2852,30 @@ static void heml__diff_nh(const heml__mat *mt, heml_real jm1_0, const heml_real 
     heml__p_times_grad(R, b);
 }
 
+/* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
+   INCOMPRESSIBLE BODIES): the element's own volumetric function U(J_e) comes off (w -= U,
+   w_J -= U', w_JJ -= U'') and the mean of its four nodes' pressures p_e = sum P_a / 4 goes
+   on (w_J += p_e; s0 the same, as s0 = 2 w_1 + 4 w_2 + w_J); with second derivatives also
+   dp (the mean of the nodes' dP_a, read by heml__diff_general). */
+static void heml__nodal_element(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want)
+{
+    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+    const heml_real *p = m->nod_p, *dp = m->nod_dp;
+    heml_real U[HEML__W], U1[HEML__W], U2[HEML__W];
+    heml__blk s;
+    int k;
+    heml__dilation(mt, m->jm1_0, b->jm1, m->blk_valid[blk], want, &s, U, U1, U2);
+    for (k = 0; k < HEML__W; k++) {
+        int i0 = idx[k], i1 = idx[HEML__W + k], i2 = idx[2 * HEML__W + k], i3 = idx[3 * HEML__W + k];
+        heml_real pe = ((p[i0] + p[i1]) + (p[i2] + p[i3])) / 4 - U1[k];
+        b->wJ[k] += pe;
+        b->s0[k] += pe;
+        b->h[5][k] -= U2[k];
+        if (want & HEML__WANT_ENERGY) b->w[k] -= U[k];
+        if (want & HEML__WANT_SECOND) b->dp[k] = ((dp[i0] + dp[i1]) + (dp[i2] + dp[i3])) / 4;
+    }
+}
+
 /* Kinematics, law and stress coefficients of one general block (not springs), Prony
    applied (written to the next state when prony_write). */
 static void heml__block_stress(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want,
@@ -2388,6 +2885,7 @@ static void heml__block_stress(const heml_model *m, const heml__mat *mt, int blk
     heml__kinematics(R, b);
     heml__clamp_J(m->jm1_0, b);
     heml__law(mt, b, m->blk_valid[blk], want);
+    if (m->nodal) heml__nodal_element(m, mt, blk, b, want);
     heml__coefficients(b, mt->uses_i2);
     if (mt->prony_count) heml__prony(m, mt, blk, b, mt->uses_i2 ? 9 : 3, prony_write);
 }
@@ -2410,14 +2908,14 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    heml__gather(idx, u, b->e);
+    heml__gather(m, idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml__spring_rest_links(R, b);
         heml__spring_J(R, b);
         heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
-        heml__spring_forces(b, b->co, NULL);
+        heml__spring_forces(b, b->co);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
@@ -2470,7 +2968,7 @@ static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, 
                        C21 * D21 + C22 * D22;
         heml_real dw1 = b->h[0][k] * dI1 + b->h[1][k] * dI2 + b->h[2][k] * dJ;
         heml_real dw2 = b->h[1][k] * dI1 + b->h[3][k] * dI2 + b->h[4][k] * dJ;
-        heml_real dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ;
+        heml_real dwJ = b->h[2][k] * dI1 + b->h[4][k] * dI2 + b->h[5][k] * dJ + b->dp[k];
         heml_real da2 = 2 * sp * vol * (dw1 + (2 + t) * dw2 + w2 * dI1), dwj = sp * vol * dwJ;
         heml_real a2 = 2 * vol * b->co[1][k], wj = vol * b->co[2][k];
         /* M~ (filtered) and s dM = 2 s (dw2 E2 + w2 dE2), both times Vol */
@@ -2534,8 +3032,8 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml_real sp;
     int k;
-    heml__gather(idx, u, b->e);
-    heml__gather(idx, dx, b->de);
+    heml__gather(m, idx, u, b->e);
+    heml__gather(m, idx, dx, b->de);
     if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
@@ -2565,11 +3063,13 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
                 dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
             }
         }
-        heml__spring_forces(b, b->co, dsig);
+        heml__spring_dforces(b, b->co, dsig);
         return;
     }
     /* (fast-path laws reach here only with Prony: the general path covers them, with
        zero I-derivatives) */
+    if (!m->nodal)
+        for (k = 0; k < HEML__W; k++) b->dp[k] = 0;
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
 }
@@ -2618,6 +3118,58 @@ static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__bl
             out[3 * r + s] = (heml_real)(J > 0.0 ? acc / J : NAN);
         }
     return !(J > 0.0);
+}
+
+/* The nodal pressure's first pass on a block: Vol (J - 1) / 4 into b->jm1 and, with_d,
+   Vol dJ / 4 = Vol cof F : dH / 4 into b->dp (J - 1 formed as in heml__kinematics). */
+static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b, int with_d)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real q = R[9 * HEML__W + k] / 4;
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+        b->jm1[k] = q * (tr + i2 + det);
+        if (with_d) { /* cof F = (tr H + 1) I - H^T + cof H */
+            heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
+            heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
+            heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
+            heml_real D00 = x0 * g10 + y0 * g20 + z0 * g30, D01 = x0 * g11 + y0 * g21 + z0 * g31;
+            heml_real D02 = x0 * g12 + y0 * g22 + z0 * g32, D10 = x1 * g10 + y1 * g20 + z1 * g30;
+            heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
+            heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
+            heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32, t1 = 1 + tr;
+            b->dp[k] = q * ((t1 - H00 + c00) * D00 + (c01 - H10) * D01 + (c02 - H20) * D02 + (c10 - H01) * D10 +
+                            (t1 - H11 + c11) * D11 + (c12 - H21) * D12 + (c20 - H02) * D20 + (c21 - H12) * D21 +
+                            (t1 - H22 + c22) * D22);
+        }
+    }
+}
+
+/* Adds the block's scalar v of each lane into out at its four nodes (lanes in order). */
+static void heml__scatter_lane_values(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT v,
+                                      heml_real *HEML__RESTRICT out)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        out[idx[k]] += v[k];
+        out[idx[HEML__W + k]] += v[k];
+        out[idx[2 * HEML__W + k]] += v[k];
+        out[idx[3 * HEML__W + k]] += v[k];
+    }
 }
 
 /* >>parallel -------------------------------------------------------------------------- */
@@ -2676,7 +3228,7 @@ static void heml__chunks(void *vctx, int begin, int end)
             case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
                     below += b.jm1[k] < jm1_0;
                     inverted += b.jm1[k] <= -1;
@@ -2684,14 +3236,21 @@ static void heml__chunks(void *vctx, int begin, int end)
                 break;
             case HEML__DIFF:
                 heml__block_diff(m, mt, blk, p->x, p->dx, &b);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 break;
             case HEML__ABS:
                 heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 heml__scatter_abs(idx, b.f, p->out);
                 break;
+            case HEML__NODAL_SUMS:
+                heml__gather(m, idx, p->x, b.e);
+                if (p->dx) heml__gather(m, idx, p->dx, b.de);
+                heml__nodal_sums(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b, p->dx != NULL);
+                heml__scatter_lane_values(idx, b.jm1, m->nod_j);
+                if (p->dx) heml__scatter_lane_values(idx, b.dp, m->nod_dj);
+                break;
             case HEML__ENERGY:
-                heml__gather(idx, p->x, b.e);
+                heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
                     heml__spring_rest_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
@@ -2699,6 +3258,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                     heml__kinematics(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__clamp_J(m->jm1_0, &b);
                     heml__law(mt, &b, valid, HEML__WANT_ENERGY);
+                    if (m->nodal) heml__nodal_element(m, mt, blk, &b, HEML__WANT_ENERGY);
                 }
                 energy += heml__lanes_energy(m, mt, blk, &b);
                 break;
@@ -2714,6 +3274,80 @@ static void heml__chunks(void *vctx, int begin, int end)
         m->chunk_below[ci] = below;
         m->chunk_inverted[ci] = inverted;
     }
+}
+
+/* The node pass of the nodal pressure on node chunks [begin, end): J_a - 1 = inv_a sum Vol
+   (J - 1) / 4, the pressure P_a = inv_a sum_mat W U'_mat(J_a), with `diff` its differential
+   dP_a = inv_a^2 (sum_mat W U''_mat(J_a)) sum Vol dJ / 4, with `energy` sum_mat W U_mat(J_a)
+   (times the material's Prony factor when `relaxed`) into the chunk's energy. */
+typedef struct heml__nodal_ctx {
+    heml_model *m;
+    int diff, energy, relaxed;
+} heml__nodal_ctx;
+
+static void heml__nodal_chunks(void *vctx, int begin, int end)
+{
+    const heml__nodal_ctx *cx = (const heml__nodal_ctx *)vctx;
+    heml_model *m = cx->m;
+    const int n = m->node_count, want = cx->energy ? HEML__WANT_ENERGY : 0;
+    heml__blk s;
+    int c, a, k, i;
+    for (c = begin; c < end; c++) {
+        int a1 = (c + 1) * HEML__NODE_CHUNK < n ? (c + 1) * HEML__NODE_CHUNK : n;
+        double energy = 0.0;
+        for (a = c * HEML__NODE_CHUNK; a < a1; a += HEML__W) {
+            int valid = a1 - a < HEML__W ? a1 - a : HEML__W;
+            heml_real jm1[HEML__W], P[HEML__W], Q[HEML__W], U[HEML__W], U1[HEML__W], U2[HEML__W];
+            for (k = 0; k < HEML__W; k++) {
+                jm1[k] = k < valid ? m->nod_j[a + k] * m->nod_inv[a + k] : 0;
+                P[k] = Q[k] = 0;
+            }
+            for (i = 0; i < m->material_count; i++) {
+                const heml_real *w = m->nod_w + (size_t)i * (size_t)n + (size_t)a;
+                const heml__mat *mt = m->mats + i;
+                double sp = cx->relaxed && mt->prony_count ? (double)m->prony_s[i] : 1.0;
+                int any = 0;
+                for (k = 0; k < valid; k++) any |= w[k] != 0;
+                if (!any) continue;
+                heml__dilation(mt, m->jm1_0, jm1, valid, want, &s, U, U1, U2);
+                for (k = 0; k < valid; k++) {
+                    P[k] += w[k] * U1[k];
+                    Q[k] += w[k] * U2[k];
+                    if (cx->energy) energy += sp * (double)w[k] * (double)U[k];
+                }
+            }
+            for (k = 0; k < valid; k++) {
+                heml_real inv = m->nod_inv[a + k];
+                m->nod_p[a + k] = P[k] * inv;
+                if (cx->diff) m->nod_dp[a + k] = Q[k] * inv * inv * m->nod_dj[a + k];
+            }
+        }
+        m->nod_energy[c] = energy;
+    }
+}
+
+static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
+                             heml_real *out, int prony_write, heml_stress_kind kind);
+
+/* The nodal pressure's first two passes before a pass of `mode` at x (and dx): the sums
+   over the tetrahedra (coloured like the force pass), then the node pass. Returns the
+   nodal energy (ENERGY, FORCE_ENERGY; 0 otherwise). */
+static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, const heml_real *dx)
+{
+    heml__nodal_ctx cx;
+    double energy = 0.0;
+    int c, diff = mode == HEML__DIFF;
+    memset(m->nod_j, 0, sizeof(heml_real) * (size_t)m->node_count);
+    if (diff) memset(m->nod_dj, 0, sizeof(heml_real) * (size_t)m->node_count);
+    heml__pass_run(m, HEML__NODAL_SUMS, x, diff ? dx : NULL, NULL, 0, HEML_STRESS_PK1);
+    cx.m = m;
+    cx.diff = diff;
+    cx.energy = mode == HEML__ENERGY || mode == HEML__FORCE_ENERGY;
+    cx.relaxed = mode == HEML__FORCE_ENERGY;
+    heml__run(m, m->nod_chunks, heml__nodal_chunks, &cx);
+    if (cx.energy)
+        for (c = 0; c < m->nod_chunks; c++) energy += m->nod_energy[c];
+    return energy;
 }
 
 /* Runs a pass; FORCE and DIFF overwrite out (3n). Returns the energy (ENERGY) or 0, and
@@ -2746,6 +3380,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     heml__pass p;
     double energy = 0.0;
     int c, below = 0, inverted = 0;
+    if (m->nodal && mode != HEML__NODAL_SUMS) energy = heml__nodal_prepare(m, mode, x, dx);
     p.m = m;
     p.mode = mode;
     p.prony_write = prony_write && m->has_prony;
@@ -2936,6 +3571,16 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse_rhs, double, 6 * (size_t)m->agg_count);
+    {
+        size_t nn = m->nodal ? n : 0;
+        HEML__CARVE(c, m->nod_w, heml_real, nn * M);
+        HEML__CARVE(c, m->nod_inv, heml_real, nn);
+        HEML__CARVE(c, m->nod_j, heml_real, nn);
+        HEML__CARVE(c, m->nod_dj, heml_real, nn);
+        HEML__CARVE(c, m->nod_p, heml_real, nn);
+        HEML__CARVE(c, m->nod_dp, heml_real, nn);
+        HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
+    }
     if (!m->has_springs) m->blk_spring = NULL;
 }
 
@@ -3197,6 +3842,8 @@ static int heml__create_validate(const heml_desc *d)
                                               "min_increment, precision_limit, allow_inversion or leave_saddles");
     for (i = 0; i < 3; i++)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
+    if (d->nodal_pressure != 0 && d->nodal_pressure != 1)
+        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0 or 1");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return heml__fail(d, HEML_ERR_ARG, "allocator needs both alloc and free");
     M = d->materials ? d->material_count : 1;
@@ -3207,6 +3854,15 @@ static int heml__create_validate(const heml_desc *d)
         err = heml__validate_material(d->materials ? d->materials + i : &d->material,
                                       (heml_real)((double)d->inversion_threshold - 1.0), i, msg, sizeof msg);
         if (err) return heml__fail(d, err, msg);
+        if (d->nodal_pressure) {
+            const heml_material *mi = d->materials ? d->materials + i : &d->material;
+            if (heml__laws[mi->law].kind == HEML__K_SPRING ||
+                (heml__laws[mi->law].kind == HEML__K_USER && !mi->user.second)) {
+                snprintf(msg, sizeof msg, "nodal_pressure: material %d is mass-spring or a user law without "
+                                          "second derivatives", i);
+                return heml__fail(d, HEML_ERR_NODAL_PRESSURE, msg);
+            }
+        }
     }
     for (i = 0; i < 3 * d->node_count; i++)
         if (!heml__finite((double)d->rest_positions[i])) {
@@ -3425,6 +4081,33 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
         m->inv_mass[s] = mass_acc[s] > 0 ? (heml_real)(1.0 / mass_acc[s]) : (heml_real)0;
         for (r = 0; r < 3; r++) m->diag[3 * s + r] = (heml_real)diag_acc[3 * s + r];
     }
+}
+
+/* The nodal pressure's rest weights (NEAR-INCOMPRESSIBLE BODIES): W[mat n + a] = sum of
+   Vol_e / 4 over the tetrahedra e of material mat at node a (the stored Vol, so that a
+   homogeneous J gives each node exactly that J), and 1 / V_a, V_a = sum_mat W (0 for a node
+   of no tetrahedron). acc: n doubles of scratch. */
+static void heml__nodal_weights(heml_model *m, const heml_desc *d, double *acc)
+{
+    size_t n = (size_t)m->node_count;
+    int s, j;
+    memset(acc, 0, sizeof(double) * n);
+    memset(m->nod_w, 0, sizeof(heml_real) * n * (size_t)m->material_count);
+    for (s = 0; s < m->slot_count; s++) {
+        int t = m->slot_tet[s], blk = s / HEML__W, k = s % HEML__W;
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        heml_real q;
+        size_t base;
+        if (t < 0) continue;
+        q = m->blk_rest[((size_t)blk * HEML__NR + 9) * HEML__W + k] / 4;
+        base = (size_t)(d->tet_material ? d->tet_material[t] : 0) * n;
+        for (j = 0; j < 4; j++) {
+            int a = idx[j * HEML__W + k];
+            acc[a] += (double)q;
+            m->nod_w[base + (size_t)a] += q;
+        }
+    }
+    for (s = 0; s < m->node_count; s++) m->nod_inv[s] = acc[s] > 0 ? (heml_real)(1.0 / acc[s]) : (heml_real)0;
 }
 
 /* >>coarse ---------------------------------------------------------------------------- */
@@ -3775,6 +4458,8 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
             tmp->has_user_without_second = 1;
     }
     tmp->slot_count = tmp->block_count * HEML__W;
+    tmp->nodal = d->nodal_pressure;
+    tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     {
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
@@ -3824,6 +4509,7 @@ static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
     m->parallel = d->tet_count >= HEML_PARALLEL_MIN_TETS;
+    m->simd = 1;
     memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     *out = m;
@@ -3842,6 +4528,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
+        if (m->nodal) mt->fast = 0; /* the general path carries the nodal pressure */
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
@@ -3886,6 +4573,7 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
         m->tet_slot[t] = slot;
     }
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
+    if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
     heml__create_chunks(m, src, w);
     if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);

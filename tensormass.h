@@ -424,7 +424,25 @@
          rotation (a 90 degree turn yields forces of the order of E times the element size
          squared). Use heml.h or frames.h for large rotations.
        - Linear tetrahedra lock in bending and near incompressibility (nu -> 0.5): refine
-         the mesh across thin parts; a bending beam needs several tets across.
+         the mesh across thin parts; a bending beam needs several tets across. Volumetric
+         locking is not refinement-friendly: at nu = 0.499 a beam 3 cells across split
+         into six tetrahedra per cell comes out 95 % too stiff (heml's P1 tetrahedra, the
+         same stiffness at small strain), and Cook's membrane (REFERENCES R10) converges
+         to the wrong value. For nearly incompressible tissue use heml.h with
+         desc.nodal_pressure = 1 (average nodal pressure tetrahedra: the same mesh within
+         1 % for both splits on Cook's membrane; see its NEAR-INCOMPRESSIBLE BODIES).
+         Why tensormass.h has no such option: the linear form of the average nodal
+         pressure replaces each tetrahedron's bulk term by sum_a V_a K (div u)_a^2 with
+         (div u)_a the volume-weighted mean of the divergence over node a's tetrahedra, a
+         row that reaches every node of every tetrahedron at a. Its stiffness couples
+         nodes two edges apart (through the shared node a), which the tensor-mass form
+         (one 3x3 tensor per vertex and per mesh edge, updated locally by a cut) cannot
+         hold: it would need a second, matrix-free pass (a scalar gather and scatter per
+         node, as heml.h does) besides the edge pass, in the dynamic, static,
+         quasi-static and hybrid solvers alike, and the precomputed quasi-static inverse
+         would lose its locality. Cutting itself would survive (a removed tetrahedron
+         subtracts its volume from its four nodes' V_a), so the obstacle is the edge
+         structure and the precomputation, not topology changes; not done.
        - The explicit integrators are conditionally stable (semi-implicit Euler for
          dt < 2 / w_max, RK4 about 2.8 / w_max; explicit Euler grows every undamped mode
          at any dt). A blow-up is stopped by the divergence check (TMASS_ERR_DIVERGED,

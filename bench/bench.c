@@ -67,6 +67,15 @@ static const bench_models_fn registry[] = {
     bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
 };
 
+/* peers (issue 21): other libraries, timed by the kernels part only (bench/peer_*.cpp,
+   built when their packages are installed: see the Makefile) */
+#ifdef BENCH_HAVE_BULLET
+#ifdef __cplusplus
+extern "C"
+#endif
+const bench_model *bench_models_bullet(int *count);
+#endif
+
 #define BIT(i) (1u << (i))
 #define PI 3.14159265358979323846
 static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", "semi-implicit-euler", "rk4",
@@ -1091,7 +1100,8 @@ static void stability_twist(const bench_model *m, const options *o)
     stability_out(&r);
 }
 
-static void run_stability(const options *o, const bench_model *const *models, int count)
+static void run_stability(const options *o, const bench_model *const *models, int count,
+                          const bench_model *const *variants, int variant_count)
 {
     int i;
     printf("\n== 2. stability at the extremes ==\n");
@@ -1105,6 +1115,7 @@ static void run_stability(const options *o, const bench_model *const *models, in
         stability_twist(models[i], o);
         stability_far(models[i]);
     }
+    for (i = 0; i < variant_count; i++) stability_poisson(variants[i], o); /* the primary = -1 entries */
     fclose(stability_csv);
 }
 
@@ -1705,16 +1716,65 @@ static void print_kernel_spans(const kernel_span *spans, int count, const char *
     }
 }
 
-static void run_kernels(const options *o, const bench_model *const *models, int count)
+/* single-thread results of this run, for the peer ratios */
+typedef struct kernel_result {
+    const bench_model *m;
+    int kernel;
+    double elems, ns;
+} kernel_result;
+static kernel_result kernel_results[4096];
+static int kernel_result_count;
+
+/* The kernels part's model list: the selected entries, then the peers (when built, and the
+   filter is empty or names them or heml, their comparison). */
+static int kernel_models(const options *o, const bench_model *const *models, int count, const bench_model **out)
 {
+    int i, n = 0;
+    for (i = 0; i < count && n < 250; i++) out[n++] = models[i];
+#ifdef BENCH_HAVE_BULLET
+    {
+        int pc = 0;
+        const bench_model *peers = bench_models_bullet(&pc);
+        if (!o->filter || strstr("bullet heml neo-hookean corotated", o->filter))
+            for (i = 0; i < pc && n < 256; i++) out[n++] = peers + i;
+    }
+#else
+    printf("Bullet rows skipped: install Debian's libbullet-dev (apt-get install libbullet-dev) and rebuild the "
+           "bench (make build/bench/bench) to time Bullet's Neo-Hookean and corotated forces and implicit step\n");
+#endif
+    return n;
+}
+
+static void print_peer_ratios(const char *const *kernel_name)
+{
+    int i, j;
+    for (i = 0; i < kernel_result_count; i++) {
+        const kernel_result *p = kernel_results + i;
+        if (strcmp(p->m->model, "bullet")) continue;
+        for (j = 0; j < kernel_result_count; j++) {
+            const kernel_result *h = kernel_results + j;
+            if (strcmp(h->m->model, "heml") || strcmp(h->m->variant, "neo-hookean") || h->kernel != p->kernel ||
+                h->elems != p->elems)
+                continue;
+            printf("  peer: bullet %-11s %-5s %7.0f tets: %8.1f ns = %6.1f x heml neo-hookean %s (%.1f ns)\n",
+                   p->m->variant, kernel_name[p->kernel], p->elems, p->ns, p->ns / h->ns, h->m->precision, h->ns);
+        }
+    }
+}
+
+static void run_kernels(const options *o, const bench_model *const *models_in, int count_in)
+{
+    static const bench_model *models[256];
+    int count;
     static kernel_span spans[256 * BENCH_KERNEL_COUNT]; /* 256 model entries at most (main) */
     int span_count = 0;
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
-    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move"};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move", "K*v-csr", "arith", "step"};
     double bandwidth[3];
     int i, s, th, kern, sizes = o->quick ? 1 : 4, max_threads = o->threads;
     FILE *f;
     printf("\n== 3. kernel throughput ==\n");
+    count = kernel_models(o, models_in, count_in, models);
     for (th = 1; th <= max_threads; th++) {
         bandwidth[th] = stream_triad(o->quick ? (size_t)1 << 22 : (size_t)1 << 25, th);
         printf("STREAM triad, %d thread%s: %.1f GB/s\n", th, th > 1 ? "s" : "", bandwidth[th]);
@@ -1737,18 +1797,21 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                 m->destroy(probe);
             }
         }
-        for (s = 0; s < (m->primary || o->quick ? sizes : 2); s++) {
+        for (s = 0; s < (m->primary > 0 || o->quick ? sizes : 2); s++) {
             /* a cube of n^3 cells; adapters report the elements they built */
             int n = (int)ceil(cbrt(targets[s] / per_cell)), code;
             bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
             void *sim = NULL;
             if (m->create(&b, &sim)) continue;
+            double ns1[BENCH_KERNEL_COUNT], bound1 = NAN;
+            for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++) ns1[kern] = NAN;
             /* one step under gravity, so the kernels see a generic deformed state */
             m->step(sim, 1e-5, (m->integrators & BIT(BENCH_SEMI_IMPLICIT_EULER)) ? BENCH_SEMI_IMPLICIT_EULER
                                                                                  : BENCH_IMPLICIT_EULER);
             for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++)
                 for (th = 1; th <= max_threads; th++) {
                     double sec, elems = m->elements(sim), bytes = m->kernel_bytes(sim, kern), bound, ns;
+                    if (kern == BENCH_KERNEL_STEP && (th > 1 || elems > 2e5)) break; /* (seconds per step) */
                     set_threads(th);
                     sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.02, &code);
                     if (code) break;
@@ -1764,7 +1827,15 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                         }
                         k->large_elems = elems, k->large_ns = ns;
                     }
-                    bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
+                    bound = bytes > 0 ? bytes / (bandwidth[th] * 1e9) * 1e9 / elems : NAN;
+                    if (th == 1 && kernel_result_count < (int)(sizeof kernel_results / sizeof kernel_results[0])) {
+                        kernel_result *r = kernel_results + kernel_result_count++;
+                        r->m = m, r->kernel = kern, r->elems = elems, r->ns = ns;
+                    }
+                    if (th == 1) {
+                        ns1[kern] = ns;
+                        if (kern == BENCH_KERNEL_FORCE) bound1 = bound;
+                    }
                     printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
                            m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
                     fflush(stdout);
@@ -1773,10 +1844,21 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                             m->precision, kernel_name[kern], th, elems, m->element, ns, bytes / elems, bound,
                             ns / bound, bandwidth[th]);
                 }
+            /* the issue-21 ratios, measured in this run (1 thread) */
+            if (ns1[BENCH_KERNEL_FORCE] > 0 && (ns1[BENCH_KERNEL_ARITH] > 0 || ns1[BENCH_KERNEL_CSR] > 0)) {
+                printf("  ratios %s %s %s, %.0f elements, 1 thread: force at %.0f %% of its bandwidth bound", m->model,
+                       m->variant, m->precision, m->elements(sim), 100 * bound1 / ns1[BENCH_KERNEL_FORCE]);
+                if (ns1[BENCH_KERNEL_ARITH] > 0)
+                    printf(", %.2f x its arithmetic floor", ns1[BENCH_KERNEL_FORCE] / ns1[BENCH_KERNEL_ARITH]);
+                if (ns1[BENCH_KERNEL_CSR] > 0)
+                    printf(", K*v %.2f x the CSR product's time", ns1[BENCH_KERNEL_KV] / ns1[BENCH_KERNEL_CSR]);
+                printf("\n");
+            }
             m->destroy(sim);
         }
     }
     print_kernel_spans(spans, span_count, kernel_name);
+    print_peer_ratios(kernel_name);
     /* haptic scenes: precomputed contact models */
     for (i = 0; i < count; i++) {
         double upd[3], pre = 0, mem = 0;
@@ -1832,8 +1914,8 @@ static void usage(void)
 int main(int argc, char **argv)
 {
     options o;
-    static const bench_model *models[256];
-    int i, count = 0;
+    static const bench_model *models[256], *variants[64];
+    int i, count = 0, variant_count = 0;
     double t0 = now();
     memset(&o, 0, sizeof o);
     o.repeats = 3;
@@ -1861,7 +1943,10 @@ int main(int argc, char **argv)
         int n, j;
         const bench_model *table = registry[i](&n);
         for (j = 0; j < n && count < 256; j++)
-            if (selected(&o, table + j)) models[count++] = table + j;
+            if (selected(&o, table + j)) {
+                if (table[j].primary >= 0) models[count++] = table + j;
+                else if (variant_count < 64) variants[variant_count++] = table + j;
+            }
     }
     {
         const char *wait = getenv("OMP_WAIT_POLICY");
@@ -1877,12 +1962,18 @@ int main(int argc, char **argv)
     set_threads(1);
     if (o.parts & 1) run_trade(&o, models, count);
     set_threads(1);
-    if (o.parts & 2) run_stability(&o, models, count);
+    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
     set_threads(1);
     if (o.parts & 8) run_sweep(&o, models, count);
     set_threads(1);
     if (o.parts & 16) run_time(&o, models, count);
-    if (o.parts & 4) run_kernels(&o, models, count);
+    if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */
+        static const bench_model *all[256];
+        int n = 0;
+        for (i = 0; i < count && n < 256; i++) all[n++] = models[i];
+        for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
+        run_kernels(&o, all, n);
+    }
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;
 }

@@ -32,7 +32,15 @@ enum {
     BENCH_KERNEL_MOVE = 3,      /* the force pass with its arithmetic taken out (gather the
                                    nodes, stream the per-element data, scatter): the floor
                                    under the force, where a model can time it */
-    BENCH_KERNEL_COUNT = 4
+    BENCH_KERNEL_CSR = 4,       /* K * v by a CSR matrix (scalar rows, 4-byte column
+                                   indices, the model's real type) of the same tangent
+                                   stiffness, assembled by the adapter at the first call
+                                   (issue 21: the differential against an assembled matrix) */
+    BENCH_KERNEL_ARITH = 5,     /* the force pass's arithmetic alone (no gather or scatter:
+                                   one gathered block reused), the arithmetic floor */
+    BENCH_KERNEL_STEP = 6,      /* one implicit step of 1 ms under gravity (per element), where
+                                   an adapter times it: the peer comparison (issue 21) */
+    BENCH_KERNEL_COUNT = 7
 };
 
 typedef struct bench_body {
@@ -61,7 +69,10 @@ typedef struct bench_model {
     int nonlinear;         /* 1: geometrically exact (large deformation) */
     int primary;           /* 1: every scene; 0: a variant of a primary entry (another law)
                               that runs only the static scenes and the smallest kernels,
-                              to keep `make bench` within its time */
+                              to keep `make bench` within its time; -1: an opt-in option of
+                              a primary entry (e.g. a volumetric treatment against locking)
+                              that runs only the stability part's Poisson rows and the
+                              kernels' two smallest sizes */
     const char *element;   /* unit of the kernel counts: "tet", "pair" */
     /* 0 or the library's error code; *sim NULL on failure */
     int (*create)(const bench_body *b, void **sim);

@@ -1896,6 +1896,128 @@ static void test_threads_bit_identical(void)
     CHECK(h1 == h4);
 }
 
+/* A beam of 4 x 2 x 2 cells (0.5 x 0.25 x 0.25 m; 128 hexahedral sub-cell samples, or 80
+   tetrahedra: two sample chunks) with the option on at nu = 0.49, clamped at x = 0: two
+   Newton iterations of a static solve under gravity (CG to 1e-3), then two implicit Euler
+   steps, a Newton step, forces and K v; the hash of the poses and K v.
+   With `a` given, counts the allocations after creation instead (into *allocs_after). */
+static unsigned long long vol_run(int mode, int threads, int workers, frm_allocator *a, int *allocs_after)
+{
+    frm_sampling s;
+    frm_desc d = frm_model_default_desc();
+    frm_model *m;
+    frm_real *x, g[3] = {0, 0, (frm_real)-9.81}, *v, *out, res;
+    const frm_real *f;
+    frm_energies en;
+    unsigned long long hash = 1469598103934665603ull;
+    int i, n, err;
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#else
+    (void)threads;
+#endif
+    if (mode == FRM_VOLUMETRIC_CELLS) {
+        hexmesh h;
+        double lo[3] = {0, 0, 0}, hi[3] = {0.5, 0.25, 0.25};
+        if (hexmesh_grid(&h, lo, hi, 4, 2, 2) != TETMESH_OK) return 0;
+        n = h.node_count;
+        x = alloc_reals(3 * n);
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)h.nodes[i];
+        err = frm_sampling_hexes(&s, x, n, h.hexes, h.hex_count, 2, FRM_QUADRATURE_SUBCELL, NULL);
+        hexmesh_free(&h);
+    } else {
+        tetmesh t;
+        if (tetmesh_beam(&t, 0.5, 0.25, 0.25, 4, 2, 2, TETMESH_SPLIT5) != TETMESH_OK) return 0;
+        n = t.node_count;
+        x = alloc_reals(3 * n);
+        for (i = 0; i < 3 * n; i++) x[i] = (frm_real)t.nodes[i];
+        for (i = 0; i < n; i++)
+            if (fabs(t.nodes[3 * i]) < 1e-12) x[3 * i] = 0;
+        err = frm_sampling_tets(&s, x, n, t.tets, t.tet_count, 1, NULL, NULL);
+        tetmesh_free(&t);
+    }
+    if (err) return free(x), 0;
+    frm_sampling_apply(&s, &d);
+    d.material.law = FRM_LAW_NEO_HOOKEAN;
+    d.material.young_modulus = 1e5;
+    d.material.poisson_ratio = (frm_real)0.49;
+    d.volumetric = (frm_volumetric)mode;
+    d.parallel_for = workers ? reversed_parallel_for : NULL;
+    d.parallel_user = &workers;
+    d.parallel_min_pairs = 64;
+    if (a) d.allocator = *a;
+    if (frm_model_create(&d, &m) != FRM_OK) return frm_sampling_free(&s), free(x), 0;
+    CHECK(s.sample_count > 64); /* several sample chunks */
+    for (i = 0; i < n; i++)
+        if (x[3 * i] == 0) frm_model_fix_frame(m, i);
+    v = alloc_reals(6 * n);
+    out = alloc_reals(6 * n);
+    for (i = 0; i < 6 * n; i++) v[i] = (frm_real)(0.01 * (i % 7));
+    if (a) *allocs_after = ((counting_allocator *)a->user)->allocs;
+    frm_model_set_gravity(m, g);
+    frm_model_set_solver(m, (frm_real)1e-3, 1000, (frm_real)1e-6, 2);
+    frm_model_solve_static(m); /* two Newton iterations, converged or not */
+    for (i = 0; i < 2; i++) frm_model_step_ex(m, (frm_real)0.01);
+    frm_model_newton_step(m, &res);
+    frm_model_forces(m, &f);
+    frm_model_energy(m, &en);
+    frm_model_prepare_stiffness(m);
+    frm_model_apply_stiffness(m, v, out, 0);
+    frm_model_apply_stiffness(m, v, out, 1);
+    if (a) *allocs_after = ((counting_allocator *)a->user)->allocs - *allocs_after;
+    {
+        const unsigned char *bytes = (const unsigned char *)frm_model_positions(m);
+        size_t k;
+        for (k = 0; k < sizeof(frm_real) * 3 * (size_t)n; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
+        bytes = (const unsigned char *)frm_model_orientations(m);
+        for (k = 0; k < sizeof(frm_real) * 4 * (size_t)n; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
+        bytes = (const unsigned char *)out;
+        for (k = 0; k < sizeof(frm_real) * 6 * (size_t)n; k++) hash = (hash ^ bytes[k]) * 1099511628211ull;
+    }
+    frm_model_destroy(m);
+    frm_sampling_free(&s);
+    free(x), free(v), free(out);
+    return hash;
+}
+
+/* Issue 13, the volumetric averaging (tests/test_frames_elem.c test_vol_* test its math).
+   With the option on: bit-identical results for 1 and 2 OpenMP threads and job systems
+   splitting in 2 and 3 parts run in reverse (the averages run serially in entry order, the
+   sample passes in fixed chunks), and nothing allocates after creation (static solve,
+   steps, Newton step, forces, energy, stiffness products). */
+static void test_vol_threads_allocation(void)
+{
+    int mode;
+#ifdef TEST_QUICK /* one mode in the quick builds (the OpenMP build runs both) */
+    const int last = FRM_VOLUMETRIC_CELLS;
+#else
+    const int last = FRM_VOLUMETRIC_FRAMES;
+#endif
+    for (mode = FRM_VOLUMETRIC_CELLS; mode <= last; mode++) {
+        counting_allocator c = {0, 0, 0, 0};
+        frm_allocator a;
+        unsigned long long h1 = vol_run(mode, 1, 0, NULL, NULL), h2 = vol_run(mode, 2, 0, NULL, NULL), h3 = h1, h4 = h1, h5;
+        int after = -1;
+#ifndef TEST_QUICK /* the job systems: full builds */
+        h3 = vol_run(mode, 1, 2, NULL, NULL);
+        h4 = vol_run(mode, 1, 3, NULL, NULL);
+#endif
+        a.alloc = count_alloc;
+        a.free = count_free;
+        a.user = &c;
+        h5 = vol_run(mode, 1, 0, &a, &after);
+        printf("    %s: hashes 1 thread %016llx, 2 threads %016llx, 2 tasks %016llx, 3 tasks %016llx; %d allocations "
+               "after creation\n", mode == FRM_VOLUMETRIC_CELLS ? "cells" : "frames", h1, h2, h3, h4, after);
+        CHECK(h1 != 0);
+        CHECK(h1 == h2);
+        CHECK(h1 == h3);
+        CHECK(h1 == h4);
+        CHECK(h1 == h5);
+        CHECK_INT(0, after);
+        CHECK_INT(0, c.live);
+    }
+}
+
 /* Nothing allocates after creation: steps, static solves, Newton steps, forces, energies,
    stiffness products and assembly; the sampling helpers free their temporaries; the
    model and the sampling free everything. */
@@ -3716,6 +3838,7 @@ static const test_case cases[] = {
     TEST(test_failed_step_keeps_state),
     TEST(test_stiffness_blocks),
     TEST(test_threads_bit_identical),
+    TEST(test_vol_threads_allocation),
     TEST(test_no_allocation_after_create),
     TEST(test_validation_errors),
     TEST(test_error_strings),

@@ -774,7 +774,7 @@ static void odd_parallel_for(int count, heml_task_fn task, void *ctx, void *user
 
 /* Explicit and implicit steps and a static solve on a two-material mesh with Prony
    viscosity, positions hashed. */
-static unsigned long long run_hashed(int threads, int job_system)
+static unsigned long long run_hashed(int threads, int job_system, int nodal)
 {
     tetmesh mesh;
     heml_model *m;
@@ -808,6 +808,7 @@ static unsigned long long run_hashed(int threads, int job_system)
     d.material_count = 2;
     d.tet_material = tm;
     if (job_system) d.parallel_for = odd_parallel_for;
+    d.nodal_pressure = nodal; /* (its node pass runs in chunks of 1024 nodes: one here) */
     if (heml_create(&d, &m) != HEML_OK) return 0;
     clamp_x0(m, &mesh);
     for (s = 0; s < (TEST_IS_QUICK ? 3 : 10); s++) {
@@ -830,11 +831,16 @@ static unsigned long long run_hashed(int threads, int job_system)
 
 static void test_threads_bit_identical(void)
 {
-    unsigned long long h1 = run_hashed(1, 0), h2 = run_hashed(2, 0), hj = run_hashed(2, 1);
+    unsigned long long h1 = run_hashed(1, 0, 0), h2 = run_hashed(2, 0, 0), hj = run_hashed(2, 1, 0);
+    unsigned long long n1 = run_hashed(1, 0, 1), n2 = run_hashed(2, 0, 1), nj = run_hashed(2, 1, 1);
     printf("    hash with 1 thread %016llx, 2 threads %016llx, job system %016llx\n", h1, h2, hj);
+    printf("    nodal_pressure: %016llx, %016llx, %016llx\n", n1, n2, nj);
     CHECK(h1 == h2);
     CHECK(h1 == hj);
     CHECK(h1 != 0);
+    CHECK(n1 == n2);
+    CHECK(n1 == nj);
+    CHECK(n1 != 0 && n1 != h1);
 }
 
 /* No allocation during steps, solves, force and stiffness passes or diagnostics, with
@@ -902,6 +908,64 @@ static void test_no_allocation_after_create(void)
     free(out);
     free(stress);
     free(J);
+    free(tm);
+    tetmesh_free(&mesh);
+}
+
+/* The same with nodal_pressure = 1 (its sums, node pass and nodal arrays): two materials,
+   one with a Prony term, every integrator, a static solve and the diagnostics. */
+static void test_no_allocation_nodal_pressure(void)
+{
+    tetmesh mesh;
+    heml_material mats[2];
+    heml_prony_term term;
+    counting_allocator c = {0, 0, 0, 0};
+    heml_desc d;
+    heml_model *m;
+    heml_real *X, *dx, *out, *stress;
+    heml_energies e;
+    int *tm, i, allocs;
+    box_mesh(&mesh, 3, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    X = to_real(mesh.nodes, 3 * mesh.node_count);
+    dx = alloc_reals(3 * mesh.node_count);
+    out = alloc_reals(3 * mesh.node_count);
+    stress = alloc_reals(9 * mesh.tet_count);
+    tm = (int *)malloc(sizeof(int) * mesh.tet_count);
+    term.alpha = (heml_real)0.2;
+    term.tau = (heml_real)0.1;
+    mats[0] = heml_material_from_young(HEML_NEO_HOOKEAN, 1e4, 0.45);
+    mats[1] = heml_material_from_young(HEML_MOONEY_RIVLIN, 1e4, 0.4);
+    mats[1].prony = &term;
+    mats[1].prony_count = 1;
+    for (i = 0; i < mesh.tet_count; i++) tm[i] = i % 2;
+    d = mesh_desc(&mesh, X);
+    d.materials = mats;
+    d.material_count = 2;
+    d.tet_material = tm;
+    d.nodal_pressure = 1;
+    d.allocator.alloc = count_alloc;
+    d.allocator.free = count_free;
+    d.allocator.user = &c;
+    REQUIRE(heml_create(&d, &m) == HEML_OK);
+    allocs = c.allocs;
+    clamp_x0(m, &mesh);
+    CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)1e-4, HEML_SEMI_EXPLICIT_EULER));
+    CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)1e-2, HEML_IMPLICIT_EULER));
+    CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)1e-2, HEML_BDF2));
+    CHECK_INT(HEML_OK, heml_step_ex(m, (heml_real)1e-2, HEML_BDF2));
+    CHECK_INT(HEML_OK, heml_solve_static(m));
+    heml_compute_forces(m);
+    for (i = 0; i < 3 * mesh.node_count; i++) dx[i] = (heml_real)(i % 5);
+    heml_apply_stiffness(m, dx, out);
+    heml_energy(m, &e);
+    heml_tet_stresses(m, HEML_STRESS_PK1, stress);
+    CHECK_INT(allocs, c.allocs);
+    heml_destroy(m);
+    CHECK_INT(c.allocs, c.frees);
+    free(X);
+    free(dx);
+    free(out);
+    free(stress);
     free(tm);
     tetmesh_free(&mesh);
 }
@@ -1063,6 +1127,9 @@ static void test_validation_errors(void)
     d = base; d.inversion_threshold = (heml_real)NAN; CHECK_INT(HEML_ERR_THRESHOLD, try_create(&d));
     d = base; d.time_step = 0;                       CHECK_INT(HEML_ERR_TIME_STEP, try_create(&d));
     d = base; d.time_step = (heml_real)-1e-3;        CHECK_INT(HEML_ERR_TIME_STEP, try_create(&d));
+    d = base; d.nodal_pressure = 2;                  CHECK_INT(HEML_ERR_NODAL_PRESSURE, try_create(&d));
+    d = base; d.nodal_pressure = 1; d.material = heml_material_from_young(HEML_MASS_SPRING, 1e4, 0.3);
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, try_create(&d));
     d = base; d.mass_damping = -1;                   CHECK_INT(HEML_ERR_DAMPING, try_create(&d));
     d = base; d.mass_damping = (heml_real)NAN;       CHECK_INT(HEML_ERR_DAMPING, try_create(&d));
     d = base; d.integrator = (heml_integrator)9;     CHECK_INT(HEML_ERR_INTEGRATOR, try_create(&d));
@@ -1330,6 +1397,7 @@ static const test_case cases[] = {
     TEST(test_user_law_without_second),
     TEST(test_threads_bit_identical),
     TEST(test_no_allocation_after_create),
+    TEST(test_no_allocation_nodal_pressure),
     TEST(test_kernel_bytes),
     TEST(test_validation_errors),
     TEST(test_error_strings),

@@ -1148,6 +1148,172 @@ static void test_stress_sweep(void)
     tetmesh_free(&cube);
 }
 
+/* ---- average nodal pressure (NEAR-INCOMPRESSIBLE BODIES) --------------------------- */
+
+/* Cook's membrane (REFERENCES R10) on an N x N x 1 hexahedral mesh of the tapered panel,
+   1 mm thick, each hexahedron cut by `split` (TETMESH_SPLIT5 or TETMESH_SPLIT6): left edge
+   clamped, u_z = 0 everywhere (plane strain), 100 N per mm of thickness in y on the right
+   edge (trapezoid-rule node shares), mm, N, MPa. Returns the static solve's code; the
+   corner (48, 60)'s vertical displacement, the Krylov iterations and the largest jump of
+   the nodal pressure between neighbouring nodes of the midplane relative to the pressure's
+   range go to the outputs. */
+static int cook(int N, int split, int nodal, double bulk, double *uy, int *krylov, double *jump)
+{
+    tetmesh mesh;
+    heml_desc d = heml_default_desc();
+    heml_material mt = heml_material_from_young(HEML_NEO_HOOKEAN, 1, 0.3);
+    heml_model *m;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, mu = 80.194;
+    int i, err, corner = -1;
+    tetmesh_box(&mesh, lo, hi, N, N, 1, split);
+    for (i = 0; i < mesh.node_count; i++) {
+        double *X = mesh.nodes + 3 * i, xi = X[0], eta = X[1];
+        X[0] = 48 * xi;
+        X[1] = 44 * xi + eta * (44 - 28 * xi);
+    }
+    mt.mu = (heml_real)mu;
+    mt.lambda = (heml_real)(bulk - 2.0 / 3.0 * mu);
+    mt.density = 1e-9;
+    d.material = mt;
+    d.nodal_pressure = nodal;
+    d.gravity[2] = 0;
+    d.cg_max_iterations = 100000;
+    m = make_model_ex(&mesh, mt, 0, &d);
+    if (!m) {
+        tetmesh_free(&mesh);
+        return HEML_ERR_ARG;
+    }
+    for (i = 0; i < mesh.node_count; i++) {
+        const double *X = mesh.nodes + 3 * i;
+        heml_real zero[3] = {0, 0, 0};
+        if (X[0] < 1e-9) heml_fix_node(m, i);
+        else heml_set_displacement_axes(m, i, 4u, zero);
+        if (X[0] > 48 - 1e-9) {
+            double share = 100.0 / N / 2 * (X[1] < 44 + 1e-9 || X[1] > 60 - 1e-9 ? 0.5 : 1.0);
+            heml_real f[3] = {0, 0, 0};
+            f[1] = (heml_real)share;
+            heml_set_external_force(m, i, f);
+            if (X[1] > 60 - 1e-9 && X[2] < 1e-9) corner = i;
+        }
+    }
+    err = heml_solve_static(m);
+    *uy = (double)heml_displacements(m)[3 * corner + 1];
+    *krylov = heml_last_stats(m)->cg_iterations;
+    *jump = 0;
+    if (nodal && m->nod_p) { /* the nodal pressures the last force pass left (internal), on
+                                the nodes 8 mm or more from the clamped edge (its corners are
+                                singular) */
+        double pmin = 1e300, pmax = -1e300, worst = 0;
+        int t, a, b;
+        for (i = 0; i < mesh.node_count; i++) {
+            if (mesh.nodes[3 * i] < 8) continue;
+            pmin = (double)m->nod_p[i] < pmin ? (double)m->nod_p[i] : pmin;
+            pmax = (double)m->nod_p[i] > pmax ? (double)m->nod_p[i] : pmax;
+        }
+        for (t = 0; t < mesh.tet_count; t++)
+            for (a = 0; a < 4; a++)
+                for (b = 0; b < 4; b++) {
+                    int na = mesh.tets[4 * t + a], nb = mesh.tets[4 * t + b];
+                    double dp = fabs((double)m->nod_p[na] - (double)m->nod_p[nb]);
+                    if (mesh.nodes[3 * na] < 8 || mesh.nodes[3 * nb] < 8) continue;
+                    worst = dp > worst ? dp : worst;
+                }
+        *jump = worst / (pmax - pmin);
+    }
+    heml_destroy(m);
+    tetmesh_free(&mesh);
+    return err;
+}
+
+/* Cook's membrane at nu = 0.4999 on 8 x 8 cells (R10's value needs a refinement series:
+   measured with this function, corner u_y at N = 4, 8, 16, 32: split into six
+   tetrahedra 2.65, 4.38, 5.99, 6.61 mm with nodal_pressure, 2.15, 2.17, 2.22, 2.38 mm
+   without; into five 2.46, 4.23, 6.13, 6.68 mm with, 2.26, 3.19, 5.20, 6.33 mm without;
+   approaching about 6.9 mm as O(h)). Here: both splits agree within 5 % with nodal
+   pressure (they differ by a factor 1.5 without), the locked six-tetrahedron split moves
+   at least 1.8 times further with it, and no answer exceeds the converged 6.9 mm by more
+   than 2 % (P1 displacements converge from below). The nodal pressure is not free of
+   oscillation: its largest jump between neighbouring nodes away from the clamped edge
+   is 0.8 to 1.0 of its range there (printed, not asserted; see LIMITS). */
+static void test_nodal_pressure_cook(void)
+{
+    double u5, u6, u6p, jump;
+    int it5, it6, it6p;
+    const int N = TEST_IS_QUICK ? 6 : 8; /* (6: u_y 3.54 mm with, 2.16 without) */
+    if (TEST_IS_QUICK) { /* (the reduced builds: the six-tetrahedron split only, 6 x 6) */
+        u5 = 0;
+    } else {
+        CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump));
+        printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u5, it5, jump);
+    }
+    CHECK_INT(HEML_OK, cook(N, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump));
+    printf("    split 6, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u6, it6, jump);
+    CHECK_INT(HEML_OK, cook(N, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump));
+    printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov\n", u6p, it6p);
+    if (!TEST_IS_QUICK) CHECK(fabs(u5 - u6) <= 0.05 * u6);
+    CHECK(u6 >= (TEST_IS_QUICK ? 1.5 : 1.8) * u6p);
+    CHECK(u5 <= 6.9 * 1.02 && u6 <= 6.9 * 1.02);
+}
+
+/* A nearly incompressible cube (1 m, 2 x 2 x 2 cells of five tetrahedra, Neo-Hookean
+   E = 1e4 Pa, nu = 0.499, nodal_pressure = 1, mass damping 20 / s, no gravity) squashed
+   through zero volume (z -> -0.2 z: every tetrahedron inverted, J = -0.2) and released:
+   semi-explicit steps of 1/16 of the estimated stable step (the inverted tetrahedra's
+   continuation is stiffer than the rest state the estimate is for: at 1/4 the divergence
+   check stops the run, HEML_ERR_DIVERGED, state kept) and implicit Euler / BDF2 steps of
+   0.02 s stay finite and, after 2 s, are back near rest: every tetrahedron upright within
+   5 % of its rest volume and the kinetic energy below 1e-5 of the elastic energy released
+   (measured: semi-explicit 6e-6 and J in [0.986, 1.020], the slowest overdamped modes
+   still creeping; implicit 1.4e-10, J within 1e-4 of 1). */
+static void test_nodal_pressure_squash_release(void)
+{
+    static const heml_integrator integ[3] = {HEML_SEMI_EXPLICIT_EULER, HEML_IMPLICIT_EULER, HEML_BDF2};
+    tetmesh mesh;
+    int k;
+    cube_mesh(&mesh, 2);
+    for (k = 0; k < 3; k++) {
+        heml_desc d = heml_default_desc();
+        heml_material mt = heml_material_from_young(HEML_NEO_HOOKEAN, 1e4, 0.499);
+        heml_model *m;
+        heml_real *u = alloc_reals(3 * mesh.node_count), *J = alloc_reals(mesh.tet_count);
+        heml_energies e0, e1;
+        double dt, jmin = 1e9, jmax = -1e9;
+        int i, steps, err = HEML_OK;
+        d.nodal_pressure = 1;
+        d.mass_damping = 20;
+        d.allow_inversion = 1;
+        d.newton_iterations = 200;
+        m = make_model_ex(&mesh, mt, 0, &d);
+        REQUIRE(m != NULL);
+        for (i = 0; i < mesh.node_count; i++) u[3 * i + 2] = (heml_real)(-1.2 * mesh.nodes[3 * i + 2]);
+        CHECK_INT(HEML_OK, heml_set_displacements(m, u));
+        heml_energy(m, &e0);
+        dt = integ[k] == HEML_SEMI_EXPLICIT_EULER ? heml_stable_time_step(m) / 16 : 0.02;
+        steps = (int)(2.0 / dt);
+        for (i = 0; i < steps && !err; i++) err = heml_step_ex(m, (heml_real)dt, integ[k]);
+        if (err) printf("    step %d: %s\n", i, heml_error_string(err));
+        /* float: near rest (after about 60 implicit steps) Newton's residual stalls at the
+           forces' round-off above the step's tolerance, HEML_ERR_ROUND_OFF with the state
+           kept: the body is at rest to float's resolution, which the checks below read */
+        if (IS_FLOAT && err == HEML_ERR_ROUND_OFF && integ[k] != HEML_SEMI_EXPLICIT_EULER && i > 30) err = HEML_OK;
+        CHECK_INT(HEML_OK, err);
+        heml_energy(m, &e1);
+        heml_tet_volume_ratios(m, J);
+        for (i = 0; i < mesh.tet_count; i++) {
+            jmin = (double)J[i] < jmin ? (double)J[i] : jmin;
+            jmax = (double)J[i] > jmax ? (double)J[i] : jmax;
+        }
+        printf("    integrator %d: %d steps of %.3g s, J in [%.4f, %.4f], kinetic %.3g J of %.3g J released\n", (int)integ[k],
+               steps, dt, jmin, jmax, e1.kinetic, e0.elastic);
+        CHECK(jmin > 0.95 && jmax < 1.05);
+        CHECK(e1.kinetic <= 1e-5 * e0.elastic);
+        free(u);
+        free(J);
+        heml_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_static_large_imposed_displacement),
     TEST(test_static_inversion_refused),
@@ -1167,6 +1333,8 @@ static const test_case cases[] = {
     TEST(test_integrator_order),
     TEST(test_implicit_damped_recurrence),
     TEST(test_stress_sweep),
+    TEST(test_nodal_pressure_cook),
+    TEST(test_nodal_pressure_squash_release),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
