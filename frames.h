@@ -800,7 +800,10 @@
          each model (7 to 9 measured), the staggered exchange has a small time-step limit,
          and the glue is a penalty (its compliance is a modelling error, about 1 / k per
          glued node). Assembled blocks (frm_model_stiffness_blocks) hold the anchors' own
-         rotational term on the diagonal but not J^T k J (the products add it).
+         rotational term on the diagonal but not J^T k J (the products add it). In float
+         builds the coupled beams of tests/test_frames_coupling.c fail (a model's solve
+         stops at its round-off before the interface settles; skipped there, not yet
+         investigated); the anchors' own finite-difference tests pass in float.
 
    MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
