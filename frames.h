@@ -864,8 +864,8 @@
        loads (constant through the following steps and solves: once per step for a
        staggered coupling). Measured cost: see README (bench kernels part, "frames mapped
        point").
-       Anchors (frm_model_set_anchors; heml_set_anchors and tmass_set_anchors are the same
-       hook for nodes): zero-length springs from a probe's mapped points to targets, energy
+       Anchors (frm_model_set_anchors; heml_set_anchors is the same hook for nodes,
+       tensormass.h's is not written yet): zero-length springs from a probe's mapped points to targets, energy
        sum_n k_n / 2 |p_n(q) - t_n|^2, part of the model (forces J^T (-k d), d = p - t; the
        stiffness J^T k J plus the levers' own term k w (a d^T - (a . d) I) per pair, whose
        antisymmetric half is the 1/2 [tau]x of every torque; energies; the block-Jacobi
@@ -1911,7 +1911,7 @@ FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, 
    per step with the points' current forces (a staggered coupling, a render mesh's
    contact). FRM_ERR_ARG as above, or a non-finite force (nothing added). */
 FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f);
-/* Anchors (issue 14; the same hook as heml_set_anchors and tmass_set_anchors): zero-length
+/* Anchors (issue 14; the same hook as heml_set_anchors; tensormass.h's is planned): zero-length
    springs from each mapped point p_n of the probe to targets[3n..3n+2] (m) with stiffness
    stiffness[n] (N/m, >= 0), energy sum_n k_n / 2 |p_n(q) - t_n|^2. They are part of the
    model from then on: internal forces (frm_model_forces; J^T of -k (p - t)), energies,

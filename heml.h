@@ -488,8 +488,8 @@
                              T/50 or less for the modes that matter) and it needs a
                              constant dt (a change restarts it with one implicit Euler
                              step).
-   ANCHORS (heml_set_anchors, issue 14; the same hook as tmass_set_anchors and
-       frm_model_set_anchors): zero-length springs from chosen nodes to target points,
+   ANCHORS (heml_set_anchors, issue 14; the same hook as frm_model_set_anchors, and
+       tensormass.h's planned tmass_set_anchors): zero-length springs from chosen nodes to target points,
        energy sum_a k_a / 2 |x_a - t_a|^2, part of the model's energy W from the call on:
        forces (-k (x - t)), the differential (-k dx, so heml_apply_stiffness is the public
        stiffness product of the model with its anchors), the Jacobi preconditioner (k on the
@@ -1279,7 +1279,7 @@ HEMLDEF int heml_node_pinned(const heml_model *m, int i);
 HEMLDEF int heml_set_external_force(heml_model *m, int i, const heml_real f[3]);
 /* Sets every external force to zero. */
 HEMLDEF void heml_clear_external_forces(heml_model *m);
-/* Anchors (issue 14; the same hook as tmass_set_anchors and frm_model_set_anchors): zero-
+/* Anchors (issue 14; the same hook as frm_model_set_anchors; tensormass.h's is planned): zero-
    length springs from nodes[a] to the point targets[3a..3a+2] (m) with stiffness
    stiffness[a] (N/m, >= 0), energy sum_a k_a / 2 |x_nodes[a] - t_a|^2. They are part of the
    model from then on: every force, energy, stiffness product (heml_apply_stiffness, the
