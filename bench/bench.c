@@ -4,7 +4,7 @@
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
    build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels]
-                     [--filter TEXT] [--repeats N] [--threads N] [--budget SECONDS]
+                     [--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
    (default 2 s; law variants get a quarter). Raise it to see finer levels.
@@ -62,6 +62,8 @@ const bench_model *bench_models_heml_double(int *count);
 const bench_model *bench_models_heml_float(int *count);
 const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
+int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 /* the coupled scenes (issue 14): bench/model_glue.c, not a bench_model (two models glued) */
 int bench_glue_rows_double(int quick, double *v);
 int bench_glue_rows_float(int quick, double *v);
@@ -89,6 +91,7 @@ static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", 
 typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
+    const char *scenes; /* --scenes: trade scenes to run (comma list of names; NULL: all) */
     int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time */
     double budget; /* s: a configuration slower than this stops its refinement */
 } options;
@@ -793,6 +796,7 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     printf("== 1. speed/accuracy trade ==\n");
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) {
         double t0 = now();
+        if (o->scenes && !strstr(o->scenes, scenes[s].name)) continue;
         printf("%s\n", scenes[s].title);
         if (!strcmp(scenes[s].name, "R3"))
             printf("  (frequency from the tip's zero crossings, corrected for the integrator's phase error: Euler "
@@ -1720,6 +1724,32 @@ static void print_kernel_spans(const kernel_span *spans, int count, const char *
     }
 }
 
+/* The reduced chain of frames.h (issue 15), in the kernels part: block-tridiagonal factor
+   and solve against the block count, one inverse control step of the 16-vertebra arm
+   (examples/frames_soft_arm.c). One thread. chain.csv; --filter chain or btd selects it. */
+static void run_chain(const options *o)
+{
+    const char *names[16];
+    double sizes[16], seconds[16];
+    int p, i, rows;
+    FILE *f;
+    if (o->filter && !strstr("frames chain btd", o->filter)) return;
+    printf("\n== frames.h reduced chain (issue 15), 1 thread ==\n");
+    f = open_csv(o, "chain.csv", "precision,kernel,blocks,us,ns_per_block");
+    for (p = 0; p < 2; p++) {
+        rows = (p ? bench_chain_rows_float : bench_chain_rows_double)(o->quick, now, names, sizes, seconds);
+        for (i = 0; i < rows; i++) {
+            printf("  %-6s %-17s %6.0f blocks: %10.2f us (%.1f ns a block)\n", p ? "float" : "double", names[i],
+                   sizes[i], 1e6 * seconds[i], 1e9 * seconds[i] / sizes[i]);
+            if (f) csv_prefix(f);
+            if (f)
+                fprintf(f, "%s,%s,%.0f,%.3f,%.2f\n", p ? "float" : "double", names[i], sizes[i], 1e6 * seconds[i],
+                        1e9 * seconds[i] / sizes[i]);
+        }
+    }
+    if (f) fclose(f);
+}
+
 /* single-thread results of this run, for the peer ratios */
 typedef struct kernel_result {
     const bench_model *m;
@@ -1935,7 +1965,7 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
 static void usage(void)
 {
     fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels] [--filter TEXT] "
-                    "[--repeats N] [--threads N] [--budget SECONDS]\n");
+                    "[--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
 
@@ -1955,6 +1985,7 @@ int main(int argc, char **argv)
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else if (!strcmp(argv[i], "--filter") && i + 1 < argc) o.filter = argv[++i];
+        else if (!strcmp(argv[i], "--scenes") && i + 1 < argc) o.scenes = argv[++i];
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--budget") && i + 1 < argc) o.budget = atof(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
@@ -2002,6 +2033,7 @@ int main(int argc, char **argv)
         for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
         run_kernels(&o, all, n);
     }
+    if (o.parts & 4) run_chain(&o);
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;
 }
