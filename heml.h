@@ -74,7 +74,8 @@
        3. Boundary conditions: heml_fix_node (pinned where it is), heml_set_displacement
           (pinned at rest + u, e.g. driven by a tool), heml_set_displacement_axes (only some
           axes pinned: rollers, symmetry planes), heml_release_node, gravity,
-          heml_set_external_force.
+          heml_set_external_force, heml_set_anchors (springs to targets: gluing to another
+          model, see ANCHORS).
        4. heml_step(m) (desc integrator and time step) or heml_step_ex(m, dt, integrator);
           heml_solve_static(m) for the equilibrium.
        5. Read heml_positions / heml_velocities to render (heml_displacements for the
@@ -493,6 +494,21 @@
                              T/50 or less for the modes that matter) and it needs a
                              constant dt (a change restarts it with one implicit Euler
                              step).
+   ANCHORS (heml_set_anchors, issue 14; the same hook as frm_model_set_anchors, and
+       tensormass.h's planned tmass_set_anchors): zero-length springs from chosen nodes to target points,
+       energy sum_a k_a / 2 |x_a - t_a|^2, part of the model's energy W from the call on:
+       forces (-k (x - t)), the differential (-k dx, so heml_apply_stiffness is the public
+       stiffness product of the model with its anchors), the Jacobi preconditioner (k on the
+       anchored diagonal), every integrator, the static solve, its saddle check and modal
+       analysis; heml_energy's elastic part includes them. They are the hook for gluing a
+       mesh to another model without either header including the other: the targets are
+       the other model's points (frames.h: mapped points of a probe), updated between
+       solves; the springs' stiffness is then inside each implicit and static solve, so a
+       coupling iteration stays stable at the time steps the models run alone (frames.h
+       COUPLING: a steel beam half heml.h, half frames, static; a soft one at dt = 10 ms).
+       The arrays are the caller's (kept by pointer). Off by default: without the call every
+       result is bit-identical. One loop over the anchors per pass (after the tetrahedra),
+       allocation-free.
    STATIC SOLVE (heml_solve_static): the minimum of the potential W(u) - (f_ext + M g) . u
        over the free axes (the fully relaxed Prony response), by continuation and Newton.
        Continuation: the loads and the pinned axes' moves to their targets are applied with
@@ -967,6 +983,7 @@ typedef HEML_REAL heml_real;
 #define heml_node_pinned heml_node_pinned_f32
 #define heml_set_external_force heml_set_external_force_f32
 #define heml_clear_external_forces heml_clear_external_forces_f32
+#define heml_set_anchors heml_set_anchors_f32
 #define heml_set_gravity heml_set_gravity_f32
 #define heml_set_mass_damping heml_set_mass_damping_f32
 #define heml_set_solver heml_set_solver_f32
@@ -1305,6 +1322,22 @@ HEMLDEF int heml_node_pinned(const heml_model *m, int i);
 HEMLDEF int heml_set_external_force(heml_model *m, int i, const heml_real f[3]);
 /* Sets every external force to zero. */
 HEMLDEF void heml_clear_external_forces(heml_model *m);
+/* Anchors (issue 14; the same hook as frm_model_set_anchors; tensormass.h's is planned): zero-
+   length springs from nodes[a] to the point targets[3a..3a+2] (m) with stiffness
+   stiffness[a] (N/m, >= 0), energy sum_a k_a / 2 |x_nodes[a] - t_a|^2. They are part of the
+   model from then on: every force, energy, stiffness product (heml_apply_stiffness, the
+   solvers' Krylov products and Jacobi preconditioner), static solve, step and modal
+   analysis includes them, exactly (force -k (x - t), differential -k dx). This is how a
+   mesh is glued to another model (frames.h COUPLING: the targets are the other model's
+   mapped points, updated between solves). The three arrays are the caller's: kept by
+   pointer and read at every evaluation until the next call, so they must outlive the
+   model's use of them (update targets in place or call again). count = 0 removes every
+   anchor (the arrays may then be NULL); default none (results bit-identical to a model
+   without the call). A node may carry several anchors (they add). Errors (nothing kept):
+   HEML_ERR_ARG (NULL model or array, count < 0, a stiffness negative or not finite, a target
+   not finite), HEML_ERR_NODE_RANGE (a node index). */
+HEMLDEF int heml_set_anchors(heml_model *m, int count, const int *nodes, const heml_real *stiffness,
+                             const heml_real *targets);
 /* Gravity, m/s^2. */
 HEMLDEF int heml_set_gravity(heml_model *m, const heml_real g[3]);
 /* Mass damping coefficient (1/s, >= 0): damping force -alpha m v. */
@@ -1663,6 +1696,10 @@ struct heml_model {
     heml_real *diag;                 /* per degree of freedom: small-strain stiffness diagonal */
     double energy_noise;             /* J: round-off of the energy of user laws (static line search) */
     unsigned char *axes;             /* pinned axes per node; target: their displacements */
+    /* anchors (heml_set_anchors, issue 14): the caller's arrays, read at every evaluation */
+    int anchor_count;
+    const int *anchor_nodes;
+    const heml_real *anchor_k, *anchor_target;
 
     /* tetrahedra, in blocks of HEML__W slots (structure of arrays inside a block) */
     int *blk_idx;         /* 4 W per block: node j of lane k at [4 W b + W j + k] */
@@ -3438,6 +3475,28 @@ static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, c
 
 /* Runs a pass; FORCE and DIFF overwrite out (3n). Returns the energy (ENERGY) or 0, and
    leaves the per-chunk counts in the model. */
+/* The anchors' part of a pass (heml_set_anchors): per anchor a on node n, d = x_n - t_a
+   (rest + u - t, formed as (rest - t) + u), energy k |d|^2 / 2, force -k d, differential
+   -k dx, round-off size |k d|. Anchors in order: deterministic. */
+static double heml__anchor_pass(heml_model *m, int mode, const heml_real *x, const heml_real *dx, heml_real *out)
+{
+    double energy = 0.0;
+    int a, r;
+    for (a = 0; a < m->anchor_count; a++) {
+        int n = m->anchor_nodes[a];
+        double k = (double)m->anchor_k[a];
+        for (r = 0; r < 3; r++) {
+            int j = 3 * n + r;
+            double d = ((double)m->rest[j] - (double)m->anchor_target[3 * a + r]) + (double)x[j];
+            energy += 0.5 * k * d * d;
+            if (mode == HEML__FORCE || mode == HEML__FORCE_ENERGY) out[j] = (heml_real)((double)out[j] - k * d);
+            else if (mode == HEML__DIFF) out[j] = (heml_real)((double)out[j] - k * (double)dx[j]);
+            else if (mode == HEML__ABS) out[j] = (heml_real)((double)out[j] + fabs(k * d));
+        }
+    }
+    return mode == HEML__DIFF || mode == HEML__ABS ? 0.0 : energy;
+}
+
 static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
                              heml_real *out, int prony_write, heml_stress_kind kind)
 {
@@ -3461,6 +3520,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
         below += m->chunk_below[c];
         inverted += m->chunk_inverted[c];
     }
+    if (m->anchor_count && mode != HEML__STRESS) energy += heml__anchor_pass(m, mode, x, dx, out);
     if (mode == HEML__FORCE || mode == HEML__FORCE_ENERGY) {
         m->stats.below_threshold = below;
         m->stats.inverted = inverted;
@@ -4747,6 +4807,26 @@ static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, h
         double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)m->diag[i];
         pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
     }
+    if (m->anchor_count) { /* the anchors' k joins the diagonal of the nodes they hold */
+        int a, r, j;
+        for (a = 0; a < m->anchor_count; a++) /* pinv holds each anchored entry's sum of k first */
+            for (r = 0; r < 3; r++) pinv[3 * m->anchor_nodes[a] + r] = 0;
+        for (a = 0; a < m->anchor_count; a++)
+            for (r = 0; r < 3; r++) pinv[3 * m->anchor_nodes[a] + r] += m->anchor_k[a];
+        for (a = 0; a < m->anchor_count; a++) /* then its inverse, stored negated: each entry once */
+            for (r = 0; r < 3; r++) {
+                double dgl;
+                j = 3 * m->anchor_nodes[a] + r;
+                if (pinv[j] < 0) continue;
+                dgl = (diag ? (double)diag[j] : 0.0) + c * ((double)m->diag[j] + (double)pinv[j]);
+                pinv[j] = (heml_real)(m->free_mask[j] > 0 && dgl > 0 ? -1.0 / dgl : -0.0);
+            }
+        for (a = 0; a < m->anchor_count; a++)
+            for (r = 0; r < 3; r++) {
+                j = 3 * m->anchor_nodes[a] + r;
+                pinv[j] = pinv[j] < 0 ? -pinv[j] : 0;
+            }
+    }
 }
 
 /* z = pinv r, plus the coarse correction when `coarse` (static solves). */
@@ -5763,6 +5843,23 @@ HEMLDEF int heml_set_external_force(heml_model *m, int i, const heml_real f[3])
     if (err) return err;
     if (!heml__vec3_finite(f)) return HEML_ERR_ARG;
     for (r = 0; r < 3; r++) m->ext[3 * i + r] = f[r];
+    return HEML_OK;
+}
+
+HEMLDEF int heml_set_anchors(heml_model *m, int count, const int *nodes, const heml_real *stiffness,
+                             const heml_real *targets)
+{
+    int a;
+    if (!m || count < 0 || (count > 0 && (!nodes || !stiffness || !targets))) return HEML_ERR_ARG;
+    for (a = 0; a < count; a++) {
+        if (nodes[a] < 0 || nodes[a] >= m->node_count) return HEML_ERR_NODE_RANGE;
+        if (!(heml__finite((double)stiffness[a]) && stiffness[a] >= 0) || !heml__vec3_finite(targets + 3 * a))
+            return HEML_ERR_ARG;
+    }
+    m->anchor_count = count;
+    m->anchor_nodes = count ? nodes : NULL;
+    m->anchor_k = count ? stiffness : NULL;
+    m->anchor_target = count ? targets : NULL;
     return HEML_OK;
 }
 

@@ -64,6 +64,10 @@ const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
 int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+/* the coupled scenes (issue 14): bench/model_glue.c, not a bench_model (two models glued) */
+int bench_glue_rows_double(int quick, double *v);
+int bench_glue_rows_float(int quick, double *v);
+
 static const bench_models_fn registry[] = {
     bench_models_tensormass_double, bench_models_tensormass_float, bench_models_heml_double,
     bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
@@ -1936,6 +1940,30 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
             }
         }
         m->destroy(sim);
+    }
+    /* the glue (issue 14): a heml.h half beam glued to a frames half beam, stiff coupling
+       (bench/model_glue.c); --filter glue runs these rows alone */
+    if (!o->filter || strstr(o->filter, "glue")) {
+        double v[8];
+        set_threads(1);
+        if (!bench_glue_rows_double(o->quick, v)) {
+            static const char *what[4] = {"glue-step", "glue-step-frames", "glue-step-heml", "glue-R1-error-glued"};
+            printf("glue heml+frames double: soft beam at dt 10 ms %.1f ms a step (frames %.1f, heml %.1f, %.1f "
+                   "iterations); R1 tip against Timoshenko: glued %+.2f %%, frames alone %+.2f %%, heml alone %+.2f "
+                   "%% (%g iterations)\n", v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]);
+            for (i = 0; i < 3; i++) {
+                csv_prefix(f);
+                fprintf(f, "glue,heml+frames,double,%s,1,1,step,%.4g,,,,\n", what[i], 1e6 * v[i]); /* ns a step */
+            }
+            csv_prefix(f);
+            fprintf(f, "glue,heml+frames,double,%s,1,1,percent,%.4g,,,,\n", what[3], v[4]);
+            csv_prefix(f);
+            fprintf(f, "glue,frames-alone,double,glue-R1-error-frames,1,1,percent,%.4g,,,,\n", v[5]);
+            csv_prefix(f);
+            fprintf(f, "glue,heml-alone,double,glue-R1-error-heml,1,1,percent,%.4g,,,,\n", v[6]);
+        } else
+            printf("glue heml+frames: a coupled solve failed\n");
+        (void)bench_glue_rows_float;
     }
     fclose(f);
 }
