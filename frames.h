@@ -9,8 +9,9 @@
    functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
    compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
    samples, exact forces and stiffness (material and geometric),
-   a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
-   gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
+   a static Newton solver, implicit Euler and BDF2, all with conjugate gradient
+   preconditioned by block-Jacobi plus a coarse space (two levels), matrix-free or by
+   assembled 6x6 blocks, modal analysis (the lowest natural
    frequencies and modes about the current state), point probes (a material point's
    position, displacement and velocity through the shape functions) that double as mapped
    points (their Jacobian J and J^T: point forces as frame loads, coupling), and coupling:
@@ -435,7 +436,7 @@
 
    SOLVERS
        Static (sec. 3.6): Newton iterations K dq = f on the free frames (f the total
-       force), each by block-Jacobi preconditioned CG stopped at an Eisenstat-Walker
+       force), each by two-level preconditioned CG (below) stopped at an Eisenstat-Walker
        relative residual (1e-3, then as fast as the residual falls, never below
        cg_tolerance, never tighter than the step can use), then a backtracking Armijo line
        search on the total potential (elastic + gravity - f_ext . dq; constant torques have
@@ -561,6 +562,52 @@
        linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
        line search and the step update; their velocity is zero; their forces count as
        reactions in the residual's scale.
+       Preconditioner (issue 21): two levels. The fine level is block-Jacobi (the inverse
+       6x6 diagonal blocks); the coarse level adds P A_c^-1 P^T, with the frames binned
+       into at most desc.coarse_aggregates (default FRM_COARSE_AGGREGATES = 32) cells of
+       their rest bounding box, at least FRM_COARSE_MIN_FRAMES (8) frames each, and 9
+       modes per aggregate: its translation t, its rigid rotation omega (frame i moves by
+       t + omega x (x_i - c), turns by omega) and the frames' own rotation phi (turns by
+       phi, does not move). The last is the one slender and stabilised bodies need: a
+       field of frame rotations that moves no material costs only the stabilisation's
+       h^2 energy, so block-Jacobi resolves it slowest, and rigid modes alone gained only
+       2-3 times (measured on R1). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin
+       product of the linearisation (rotation stabilisation and held axes included, the
+       coupling term left out), from the assembled blocks in block mode (about 150
+       multiply-adds a block) or a per-sample pass in pair mode (9 sample products per
+       aggregate the sample touches), dense and Cholesky-factored in double, a pivot at or
+       below 1e-10 of its diagonal dropping its mode; built at the first CG iteration after
+       each linearisation, serially in a fixed order (bit-identical for any thread count),
+       in the model's block (no allocation: (9 A)^2 doubles, 663 kB for 32 aggregates).
+       Static solves always use it; solves with mass (implicit steps, shifted modal
+       solves) once a solve by block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS (40)
+       or met cg_max_iterations (that solve is then continued with it): below that the
+       build (about ten products) costs more than it saves (float builds: only after a
+       solve met the cap; with it, a float implicit step of a tetrahedral plate one cell
+       thick met round-off curvature at 8e-4 relative residual and failed, tests/
+       test_frames.c test_i14_thin_plate). coarse_aggregates = 0 gives
+       block-Jacobi alone. Measured (issue 21; one core, gcc -O2 -march=native, CPU time;
+       R1 16 x 0.5 x 0.5 m steel cantilever, 32k x k x k cells, clamped, own weight), CG
+       iterations of the first Newton solve (to 1e-3) with / without the coarse level (64
+       aggregates; the default 32 measured 60 against 57 at k = 4):
+           hexahedral frames, 2^3 samples a cell:
+             k = 1 (132 frames) 35 / 424, k = 2 (585) 36 / 579, k = 3 (1,552) 45 / 829,
+             k = 4 (3,225) 57 / 1,097, k = 6 (9,457) 78 / 1,637
+           tetrahedral frames (6 a cube), one sample each:
+             k = 1 138 / 1,545, k = 2 61 / 2,125, k = 3 67 / 3,094, k = 4 81 / 4,101
+       so within 3x of the smallest mesh's count as the frames grow 72x. The whole static
+       solve (Newton and the minimum check's probe solve): hexahedral k = 3 (1.7 % off
+       R1's 3D solid) 0.92 s against 2.48 s CPU, k = 4 (0.91 %) 2.45 s against 9.9 s,
+       k = 6 (0.39 %) 13.3 s against 59 s; tetrahedral k = 4 0.61 s against 5.6 s. The
+       probe (CG to 1e-7 from a pseudo-random right-hand side) is now most of the hexahedral
+       solve: 1,112 of 1,233 iterations at k = 4 (it excites the stabilised rotation modes of
+       every wavelength, which no coarse mode holds). Implicit Euler on the same beam (k = 2,
+       five steps and creation, CPU, default 32 aggregates): steel at dt = 1 ms, 10 ms,
+       0.1 s 0.40 / 0.48 s, 0.66 / 1.02 s, 0.64 / 1.36 s (with / without; the last step's
+       solves 42 / 355, 66 / 1,282, 68 / 1,968 CG iterations); E = 1 MPa: dt = 1 ms and
+       10 ms need under 40 iterations (it stays off: same time), at dt = 0.1 s it turns on
+       and breaks even (0.72 against 0.70 s; 87 against 233 iterations; 64 aggregates
+       lost 30 %: its Cholesky each Newton iteration), see LIMITS.
        One CG policy: a linear solve stopped at cg_max_iterations above its tolerance fails
        the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
        far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
@@ -691,6 +738,32 @@
          21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
          Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
          test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
+       - Thin parts (issue 14): a plate one cell thick of hexahedral frames solves static and
+         implicit problems and converges under refinement (tests/test_frames.c
+         test_i14_thin_plate: 1 x 1 x 0.05 m cantilever plate under its own weight, 5.85,
+         6.12, 6.20 mm at 4, 8, 16 cells a side, beam theory 5.89 mm); tetrahedral frames
+         one cell thick (one sample each) solve but do not converge in sight (2.87, 5.47,
+         7.54 mm). A thin slab loaded in its plane can buckle: Cook's membrane one element
+         thick (48 x 44..60 x 1, E = 240.565 Pa, nu = 0.3) has no stable flat state beyond
+         F = 2.05 N (hexahedral frames, 16 cells a side; 4.5 N at 4): at the usual F = 32 N
+         the flat state is a saddle and, the load being symmetric about the mid-plane,
+         Newton cannot leave the plane: the static solve refuses (FRM_ERR_UNSTABLE, or
+         FRM_ERR_STALLED when the continuation wanders near the saddle; the stall message's
+         "rotations the samples do not see" is then not the cause). Hold the out-of-plane
+         axes for the plane problem (frm_model_set_frame_axes(m, i, 4, 3): test_i18_cook_membrane)
+         or nudge it out of plane (1e-3 of the load) for the buckled one (corner u_y 7.8,
+         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations). Frames along a
+         curve (meshless Shepard frames on a line, samples in a thin tube) solve but are not
+         consistent: zero-order weights on a line give no convergent bending (tip 0.65,
+         1.6, 3.1, 8.9 mm at 4 to 32 frames against 5.9 mm); a rod model is not done.
+       - Models with volumetric averaging (desc.volumetric, issue 13) solve with
+         block-Jacobi alone: the coarse matrix's per-sample pass does not know the cell
+         averages (not measured; to do).
+       - The coarse correction of implicit steps turns on after a solve needs 40
+         block-Jacobi iterations; on soft bodies at large steps (E = 1 MPa beam, dt = 0.1 s,
+         40 to 90 iterations a solve) it only breaks even (it is rebuilt every Newton
+         iteration; reusing it across a step's iterations is not done); more aggregates
+         lose there (64: 30 % slower than block-Jacobi alone).
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
@@ -806,7 +879,7 @@
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
    (the symmetric part of K, gravity's and the stresses' geometric terms included; the
    constraints as set) and runs block shift-invert subspace iteration: Y = (K + shift M)^-1
-   M X by the model's linear solver (block-Jacobi CG, warm-started at X / (lambda + shift)
+   M X by the model's linear solver (two-level preconditioned CG, warm-started at X / (lambda + shift)
    once a Ritz value exists), Rayleigh-Ritz on Y (Cholesky of Y^T M Y, Jacobi), X the
    M-orthonormal Ritz vectors, until every wanted residual is below tolerance (or the Ritz
    values stop moving). Chosen over LOBPCG for its simplicity with a matrix-free K and an
@@ -1046,6 +1119,9 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
+       unreleased (issue 21): CG preconditioned by two levels, block-Jacobi plus a coarse
+             space of 9 modes per aggregate of frames (desc.coarse_aggregates, default 32;
+             0 = block-Jacobi alone): results change within the solve tolerances.
        unreleased (issue 18): the divergence term of the rotation stabilisation
              (desc.rotation_divergence, default 4: removes the tetrahedral frames' spurious
              low modes and the hexahedral frames' zero-energy rotations; changes results
@@ -1198,6 +1274,12 @@ typedef FRM_REAL frm_real;
 /* Most frames one sample may depend on (the GPU pass keeps a sample's slots in fast
    memory, thesis sec. 4.4). */
 #define FRM_MAX_NEIGHBORS 16
+
+/* The two-level preconditioner's coarse space (desc.coarse_aggregates, see SOLVERS): the
+   default and largest number of aggregates, and the fewest frames an aggregate holds. */
+#define FRM_COARSE_AGGREGATES 32
+#define FRM_COARSE_MAX_AGGREGATES 256
+#define FRM_COARSE_MIN_FRAMES 8
 
 /* The least bytes each kernel streams per (sample, neighbour) pair (see PERFORMANCE), for
    bandwidth bounds: the force pass (pass 1 reads index, weight, gradient and rest lever,
@@ -1358,7 +1440,7 @@ typedef enum frm_integrator {
 
 /* Linear solvers of every Newton iteration (static solve and implicit steps). */
 typedef enum frm_linear_solver {
-    FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_CG = 0, /* conjugate gradients, block-Jacobi plus the coarse space (default) */
     FRM_LINEAR_SOLVER_BTD = 1, /* block-tridiagonal Cholesky (issue 15): models whose stiffness pattern is a
                                   chain (frame i coupled to i - 1 and i + 1 only); assembled blocks */
     FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
@@ -1529,6 +1611,12 @@ typedef struct frm_desc {
                                        sit near 1e-7 of the diagonal; 0 gives the plain
                                        Newton step */
     frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
+    int coarse_aggregates;     /* two-level preconditioner (see SOLVERS, >>coarse): at most this
+                                  many aggregates of frames (cells of the rest bounding box, at
+                                  least FRM_COARSE_MIN_FRAMES frames each), whose rigid motions
+                                  form a coarse space solved exactly on top of block-Jacobi in
+                                  every CG solve; 0 = block-Jacobi only. Default
+                                  FRM_COARSE_AGGREGATES (0 to FRM_COARSE_MAX_AGGREGATES) */
 
     /* environment */
     frm_allocator allocator;          /* all NULL: FRM_MALLOC / FRM_FREE */
@@ -1857,7 +1945,7 @@ FRMDEF int frm_model_step(frm_model *m);
    state is unchanged. */
 FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
 /* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
-   the total potential energy, each solved by block-Jacobi CG, inside an adaptive load
+   the total potential energy, each solved by two-level preconditioned CG, inside an adaptive load
    continuation (see SOLVERS); velocities are set to zero. Driven frames end at their
    prescribed poses. On failure (see ERRORS) the state is unchanged. */
 FRMDEF int frm_model_solve_static(frm_model *m);
@@ -2987,6 +3075,11 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
 #endif
 
 #define FRM__COOKIE 0x46524D53u         /* "FRMS" */
+#ifndef FRM__COARSE_MODES
+#define FRM__COARSE_MODES 9 /* per aggregate: translation, rigid rotation, the frames' own rotation */
+#endif
+#define FRM__COARSE_MIN_ITERATIONS 40 /* solves with mass: block-Jacobi iterations that turn the coarse correction on */
+
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__PROBE_COOKIE 0x46524D51u   /* "FRMQ" */
@@ -3130,7 +3223,20 @@ struct frm_model {
                                 discontinuity or a change of dt) */
     double history_dt;       /* the step length the history was made with */
 
+    /* coarse space (>>coarse): rigid motions of aggregates of frames */
+    int agg_count;       /* aggregates (0: block-Jacobi only) */
+    int *f_agg;          /* 1 per frame: its aggregate */
+    double *coarse;      /* (6 A)^2: A_c = P^T (a_mass M + a_stiff K) P, then its Cholesky factor */
+    double *coarse_rhs;  /* 6 A: the coarse right-hand side and solution */
+    double *agg_centre;  /* 3 A: the aggregates' mean position at the coarse matrix's build */
+    frm_real *coarse_dq; /* 6 per slot of a sample (scratch): a coarse mode's dq on its frames */
+    int coarse_ready;    /* the factor matches the last frm__build_precond */
+    double precond_mass, precond_stiff; /* a_mass, a_stiff of the last frm__build_precond */
+    int coarse_use;      /* the coarse correction serves the solves after the last frm__build_precond */
+    int coarse_plain;    /* CG iterations of the last solve without it (-1: none yet) */
+
     int lin_valid, lin_mode, lin_iterations;
+    int lin_predict; /* the next linear solve's iterations, predicted: max(last, previous prediction / 2) (-1: none yet) */
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
 };
@@ -3836,6 +3942,71 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->history, frm_real, 13 * n);
     FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
     FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
+    if (m->agg_count) {
+        size_t D = FRM__COARSE_MODES * (size_t)m->agg_count;
+        FRM__CARVE(c, m->f_agg, int, n);
+        FRM__CARVE(c, m->coarse, double, D * D);
+        FRM__CARVE(c, m->coarse_rhs, double, D);
+        FRM__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
+        FRM__CARVE(c, m->coarse_dq, frm_real, 6 * FRM_MAX_NEIGHBORS);
+    }
+}
+
+/* >>coarse (aggregation) ---------------------------------------------------------------- */
+
+/* Bins the frames' rest positions into roughly cubic cells of their bounding box, at most
+   min(max_agg, n / FRM_COARSE_MIN_FRAMES) cells; returns the number of non-empty cells (0:
+   no coarse space, fewer than 2 aggregates) and, when agg is not NULL, each frame's cell
+   renumbered 0.. in cell order. Deterministic: a function of the rest positions only. */
+static int frm__aggregate(const frm_real *x, int n, int max_agg, int *agg)
+{
+    double lo[3], hi[3], ext[3], size, vol = 1.0, big = 0.0;
+    int dims[3], i, r, target = n / FRM_COARSE_MIN_FRAMES, cells, count = 0;
+    int used[FRM_COARSE_MAX_AGGREGATES];
+    if (target > max_agg) target = max_agg;
+    if (target < 2) return 0;
+    for (r = 0; r < 3; r++) lo[r] = hi[r] = (double)x[r];
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            double v = (double)x[3 * i + r];
+            if (v < lo[r]) lo[r] = v;
+            if (v > hi[r]) hi[r] = v;
+        }
+    for (r = 0; r < 3; r++) big = hi[r] - lo[r] > big ? hi[r] - lo[r] : big;
+    if (!(big > 0)) return 0;
+    for (r = 0; r < 3; r++) { /* a flat or thin body: its thin axes count as 1e-6 of the largest */
+        ext[r] = hi[r] - lo[r] > 1e-6 * big ? hi[r] - lo[r] : 1e-6 * big;
+        vol *= ext[r];
+    }
+    size = cbrt(vol / target);
+    for (;;) {
+        cells = 1;
+        for (r = 0; r < 3; r++) {
+            dims[r] = (int)(ext[r] / size + 0.5);
+            if (dims[r] < 1) dims[r] = 1;
+            cells *= dims[r];
+        }
+        if (cells <= target) break;
+        size *= 1.05;
+    }
+    for (i = 0; i < cells; i++) used[i] = -1;
+    for (i = 0; i < n; i++) {
+        int c = 0;
+        for (r = 2; r >= 0; r--) {
+            int k = (int)(((double)x[3 * i + r] - lo[r]) / ext[r] * dims[r]);
+            if (k >= dims[r]) k = dims[r] - 1;
+            if (k < 0) k = 0;
+            c = c * dims[r] + k;
+        }
+        if (agg) agg[i] = c;
+        used[c] = 0;
+    }
+    for (i = 0; i < cells; i++)
+        if (used[i] == 0) used[i] = count++;
+    if (count < 2) return 0;
+    if (agg)
+        for (i = 0; i < n; i++) agg[i] = used[agg[i]];
+    return count;
 }
 
 /* >>validation ------------------------------------------------------------------------- */
@@ -3910,6 +4081,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
+    if (d->coarse_aggregates < 0 || d->coarse_aggregates > FRM_COARSE_MAX_AGGREGATES)
+        return frm__fail(d, FRM_ERR_SOLVER, "coarse_aggregates must be 0 to FRM_COARSE_MAX_AGGREGATES");
     if ((unsigned)d->volumetric >= FRM_VOLUMETRIC_COUNT) return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric");
     if (!(frm__finite((double)d->volumetric_stabilization) && d->volumetric_stabilization >= 0))
         return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric_stabilization must be finite and >= 0");
@@ -4121,6 +4294,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.rotation_divergence = (frm_real)4;
     d.volumetric_stabilization = 2;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    d.coarse_aggregates = FRM_COARSE_AGGREGATES;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
     return d;
@@ -4436,6 +4610,7 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
         tmp->block_count = (int)blocks;
         tmp->sq_total = (int)sq;
     }
+    tmp->agg_count = frm__aggregate(d->frame_positions, n, d->coarse_aggregates, NULL);
     tmp->stab_beta = d->rotation_stabilization;
     tmp->stab_gamma = d->rotation_divergence;
     if (tmp->stab_beta > 0)
@@ -4676,6 +4851,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     int i;
     frm__create_settings(m, d);
     frm__create_frames(m, d, t);
+    if (m->agg_count) frm__aggregate(d->frame_positions, m->frame_count, d->coarse_aggregates, m->f_agg);
     frm__create_samples(m, d);
     frm__create_pairs(m, d);
     i = frm__compute_masses(m, d);
@@ -4690,6 +4866,8 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     }
     frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
+    m->lin_predict = -1;
+    m->coarse_plain = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
     return FRM_OK;
@@ -5682,11 +5860,15 @@ static int frm__choose_mode(const frm_model *m)
     if (m->stiffness_mode == FRM_STIFFNESS_PAIRS || !m->has_blocks) return FRM_STIFFNESS_PAIRS;
     if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS || m->linear_solver == FRM_LINEAR_SOLVER_BTD) return FRM_STIFFNESS_BLOCKS;
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
-    it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
+    it = m->lin_predict >= 0 ? (double)m->lin_predict + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
     pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
+    if (m->coarse_use) { /* the coarse matrix: from the blocks, or a sample pass of 9 products per aggregate */
+        pairs += FRM__COARSE_MODES * 1.5 * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
+        blocks += 3 * FRM__COST_BLOCK_ITER * m->block_count;
+    }
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
 }
 
@@ -5861,7 +6043,292 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
                 if (((m->axes[i] >> (k / 6)) & 1) || ((m->axes[i] >> (k % 6)) & 1)) inv[k] = 0;
         for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
     }
+    m->precond_mass = a_mass;
+    m->precond_stiff = a_stiff;
+    m->coarse_ready = 0;
+    /* static solves always; a solve with mass (implicit steps, shifted modal solves) once
+       block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS: below that the coarse matrix's
+       build (about ten stiffness products) costs more than it saves */
+    m->coarse_use = m->agg_count && !m->vol_mode && (a_mass == 0 || m->coarse_plain >= m->cg_max_iterations ||
+                                     (!FRM__IS_FLOAT && m->coarse_plain >= FRM__COARSE_MIN_ITERATIONS));
     return fixed;
+}
+
+/* >>coarse ------------------------------------------------------------------------------ */
+
+/* The two-level preconditioner (SOLVERS): block-Jacobi plus a coarse correction
+   P A_c^-1 P^T over the aggregates of frm__aggregate, 9 modes each: a translation t, a
+   rigid rotation omega (frame i moves by omega x d_i, d_i = x_i - c_a with current
+   positions and c_a the aggregate's mean, and turns by omega) and the frames' own
+   rotation phi (frame i turns by phi and does not move), so per frame
+   P_i = [I, -[d_i]x, 0; 0, I, I], masked by its held components (fixed and driven frames
+   take no part). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin product of the
+   linearisation the solve uses: frm__coarse_row from the assembled blocks (block mode),
+   frm__coarse_sample per sample as the pair-mode product computes it (pair mode; the
+   coupling term left out), plus per frame the mass, the frame-own rotational terms (pair
+   mode) and the regularisation. Serial, in frame or sample order: deterministic for any
+   thread count. Dense, symmetrised and Cholesky-factored in double; a pivot at or below
+   1e-10 of its diagonal (a mode held by fixed frames, an indefinite linearisation) drops
+   that mode. */
+
+/* The components of frame i that take part in the coarse space: 0 for fixed and driven
+   frames, the free axes of a free one (bit k for component k). */
+static unsigned frm__coarse_mask(const frm_model *m, int i) { return m->state[i] == FRM__FREE ? 63u & ~(unsigned)m->axes[i] : 0u; }
+
+/* dq = mask (P_i e) for the coarse direction e of frame i's aggregate (0-2: translation
+   t, 3-5: rigid rotation omega, 6-8: the frames' own rotation phi). */
+static void frm__coarse_mode(const frm_model *m, int i, int e, frm_real dq[6])
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    double d[3], v[6] = {0, 0, 0, 0, 0, 0};
+    unsigned mask = frm__coarse_mask(m, i);
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    if (e >= 6) e -= 3; /* phi: the rotation alone */
+    else if (e >= 3) { /* omega: and omega x d */
+        v[e] = 1;
+        v[0] = v[4] * d[2] - v[5] * d[1];
+        v[1] = v[5] * d[0] - v[3] * d[2];
+        v[2] = v[3] * d[1] - v[4] * d[0];
+    }
+    v[e] = 1;
+    for (r = 0; r < 6; r++) dq[r] = (mask >> r) & 1 ? (frm_real)v[r] : 0;
+}
+
+/* y += (mask P_i)^T r for frame i's 6 values r: (r_t, r_w + d x r_t, r_w) of the masked r. */
+static void frm__coarse_restrict(const frm_model *m, int i, const frm_real *rv, double *y)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], x[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    for (r = 0; r < 6; r++) x[r] = (mask >> r) & 1 ? (double)rv[r] : 0.0;
+    for (r = 0; r < 3; r++) y[r] += x[r];
+    y[3] += x[3] + (d[1] * x[2] - d[2] * x[1]);
+    y[4] += x[4] + (d[2] * x[0] - d[0] * x[2]);
+    y[5] += x[5] + (d[0] * x[1] - d[1] * x[0]);
+    for (r = 6; r < FRM__COARSE_MODES; r++) y[r] += x[r - 3];
+}
+
+/* z += mask P_i u: (u_t + u_w x d, u_w + u_phi) on frame i's free components. */
+static void frm__coarse_prolong(const frm_model *m, int i, const double *u, frm_real *z)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], o[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    o[0] = u[0] + (u[4] * d[2] - u[5] * d[1]);
+    o[1] = u[1] + (u[5] * d[0] - u[3] * d[2]);
+    o[2] = u[2] + (u[3] * d[1] - u[4] * d[0]);
+    for (r = 3; r < 6; r++) o[r] = u[r] + (FRM__COARSE_MODES > 6 ? u[r + 3] : 0.0);
+    for (r = 0; r < 6; r++)
+        if ((mask >> r) & 1) z[r] += (frm_real)o[r];
+}
+
+/* Sample s's part of P^T K P: for each aggregate among its neighbours and each of its six
+   rigid motions, the sample's K v exactly as the pair-mode product computes it (dF, the
+   law's dP, the rotation stabilisation's stress and torques; not the coupling term), its
+   output per slot projected by P^T. */
+static void frm__coarse_sample(frm_model *m, int s, double a_stiff)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, slots[FRM_MAX_NEIGHBORS], agg_of[FRM_MAX_NEIGHBORS];
+    int na = 0, j, e, k, r, c, D = FRM__COARSE_MODES * m->agg_count, law = m->s_law[s];
+    const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+    frm_real *dqs = m->coarse_dq, vol = m->s_volume[s];
+    for (k = 0; k < n; k++) {
+        int f = m->p_frame[b + k];
+        agg_of[k] = -1;
+        if (!frm__coarse_mask(m, f)) continue;
+        for (j = 0; j < na && slots[j] != m->f_agg[f]; j++) {}
+        if (j == na) slots[na++] = m->f_agg[f];
+        agg_of[k] = j;
+    }
+    for (j = 0; j < na; j++)
+        for (e = 0; e < FRM__COARSE_MODES; e++) {
+            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], stq[3 * FRM_MAX_NEIGHBORS], out[6];
+            const frm_real *dth[FRM_MAX_NEIGHBORS];
+            static const frm_real zero[3] = {0, 0, 0};
+            for (k = 0; k < n; k++) {
+                frm_real *dq = dqs + 6 * k;
+                if (agg_of[k] == j) frm__coarse_mode(m, m->p_frame[b + k], e, dq);
+                else
+                    for (r = 0; r < 6; r++) dq[r] = 0;
+                frm_pair_dF(dq, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), dF);
+                dth[k] = agg_of[k] == j ? dq + 3 : zero;
+            }
+            frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                        m->lin_S + 6 * (size_t)s, dF, dP);
+            if (m->s_stab[s]) {
+                frm_real dPx[9];
+                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
+                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+            }
+            for (k = 0; k < n; k++) {
+                int q = agg_of[k];
+                double y[FRM__COARSE_MODES] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+                if (q < 0) continue;
+                frm_pair_apply(vol, dP, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), out);
+                if (m->s_stab[s])
+                    for (r = 0; r < 3; r++) out[3 + r] += stq[3 * k + r];
+                /* row block slots[q], column 6 slots[j] + e: (mask P_f)^T out */
+                frm__coarse_restrict(m, m->p_frame[b + k], out, y);
+                for (c = 0; c < FRM__COARSE_MODES; c++) m->coarse[(size_t)(FRM__COARSE_MODES * slots[q] + c) * D + FRM__COARSE_MODES * slots[j] + e] += a_stiff * y[c];
+            }
+        }
+}
+
+/* Row i of the assembled blocks' part of P^T K P (block mode): (mask P_i)^T K_ij (mask P_j)
+   for each block, K P_j and then P_i^T by their structure (about 150 multiply-adds a
+   block). The blocks hold the lin_hrot term on the diagonal, which the per-frame loop of
+   frm__coarse_build then does not add again. */
+static void frm__coarse_row(frm_model *m, int i, double a_stiff)
+{
+    const int NM = FRM__COARSE_MODES;
+    int e, r, c, D = NM * m->agg_count;
+    unsigned mi = frm__coarse_mask(m, i);
+    double di[3];
+    if (!mi) return;
+    for (r = 0; r < 3; r++) di[r] = (double)m->pos[3 * i + r] - m->agg_centre[3 * m->f_agg[i] + r];
+    for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+        const frm_real *K = m->blocks + 36 * (size_t)e;
+        int f = m->blk_col[e];
+        unsigned mj = frm__coarse_mask(m, f);
+        double Km[36], X[6 * FRM__COARSE_MODES], Y[FRM__COARSE_MODES * FRM__COARSE_MODES], dj[3], *blk;
+        if (!mj) continue;
+        for (r = 0; r < 3; r++) dj[r] = (double)m->pos[3 * f + r] - m->agg_centre[3 * m->f_agg[f] + r];
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < 6; c++) Km[6 * r + c] = ((mi >> r) & 1) && ((mj >> c) & 1) ? (double)K[6 * r + c] : 0.0;
+        for (r = 0; r < 6; r++) { /* X = Km P_j: (K_t, K_w + K_t (e_k x d), K_w) */
+            const double *k = Km + 6 * r;
+            double *x = X + NM * r;
+            x[0] = k[0], x[1] = k[1], x[2] = k[2];
+            x[3] = k[3] + (k[2] * dj[1] - k[1] * dj[2]); /* K_t (e_k x d) */
+            x[4] = k[4] + (k[0] * dj[2] - k[2] * dj[0]);
+            x[5] = k[5] + (k[1] * dj[0] - k[0] * dj[1]);
+            if (NM > 6) x[6] = k[3], x[7] = k[4], x[8] = k[5];
+        }
+        for (c = 0; c < NM; c++) { /* Y = P_i^T X: (X_t, X_w + d x X_t, X_w) */
+            double t0 = X[c], t1 = X[NM + c], t2 = X[2 * NM + c];
+            Y[c] = t0, Y[NM + c] = t1, Y[2 * NM + c] = t2;
+            Y[3 * NM + c] = X[3 * NM + c] + (di[1] * t2 - di[2] * t1);
+            Y[4 * NM + c] = X[4 * NM + c] + (di[2] * t0 - di[0] * t2);
+            Y[5 * NM + c] = X[5 * NM + c] + (di[0] * t1 - di[1] * t0);
+            if (NM > 6) Y[6 * NM + c] = X[3 * NM + c], Y[7 * NM + c] = X[4 * NM + c], Y[8 * NM + c] = X[5 * NM + c];
+        }
+        blk = m->coarse + (size_t)(NM * m->f_agg[i]) * D + NM * m->f_agg[f];
+        for (r = 0; r < NM; r++)
+            for (c = 0; c < NM; c++) blk[(size_t)r * D + c] += a_stiff * Y[NM * r + c];
+    }
+}
+
+static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, s, j, k, r, c;
+    double *Ac = m->coarse, *cnt = m->coarse_rhs, *ctr = m->agg_centre;
+    m->coarse_ready = 0;
+    if (!A) return;
+    memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
+    memset(ctr, 0, sizeof(double) * 3 * (size_t)A);
+    for (k = 0; k < A; k++) cnt[k] = 0;
+    for (i = 0; i < m->frame_count; i++)
+        if (frm__coarse_mask(m, i)) {
+            for (r = 0; r < 3; r++) ctr[3 * m->f_agg[i] + r] += (double)m->pos[3 * i + r];
+            cnt[m->f_agg[i]] += 1;
+        }
+    for (k = 0; k < A; k++)
+        for (r = 0; r < 3; r++) ctr[3 * k + r] /= cnt[k] > 0 ? cnt[k] : 1;
+    if (a_stiff != 0 && m->lin_mode == FRM_STIFFNESS_BLOCKS)
+        for (i = 0; i < m->frame_count; i++)
+            frm__coarse_row(m, i, a_stiff);
+    else if (a_stiff != 0)
+        for (s = 0; s < m->sample_count; s++)
+            frm__coarse_sample(m, s, a_stiff);
+    for (i = 0; i < m->frame_count; i++) { /* per frame: frame-own terms, regularisation, mass */
+        double A6[36], PM[6 * FRM__COARSE_MODES], T[6 * FRM__COARSE_MODES], *blk;
+        frm_real col[6];
+        if (!frm__coarse_mask(m, i)) continue;
+        blk = Ac + (size_t)(FRM__COARSE_MODES * m->f_agg[i]) * D + FRM__COARSE_MODES * m->f_agg[i];
+        frm__mass_matrix(m, i, A6);
+        for (k = 0; k < 36; k++) A6[k] *= a_mass;
+        if (a_stiff != 0) {
+            frm_real H[36];
+            for (k = 0; k < 36; k++) H[k] = 0;
+            if (m->lin_mode != FRM_STIFFNESS_BLOCKS) frm__add_rotational(m->lin_hrot + 6 * (size_t)i, H); /* in the blocks */
+            for (k = 3; k < 6; k++) H[7 * k] += (frm_real)(m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
+            for (k = 0; k < 36; k++) A6[k] += a_stiff * (double)H[k];
+        }
+        for (c = 0; c < FRM__COARSE_MODES; c++) { /* PM = mask P_i, 6 x modes */
+            frm__coarse_mode(m, i, c, col);
+            for (r = 0; r < 6; r++) PM[FRM__COARSE_MODES * r + c] = (double)col[r];
+        }
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += A6[6 * r + k] * PM[FRM__COARSE_MODES * k + c];
+                T[FRM__COARSE_MODES * r + c] = t;
+            }
+        for (r = 0; r < FRM__COARSE_MODES; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += PM[FRM__COARSE_MODES * k + r] * T[FRM__COARSE_MODES * k + c];
+                blk[(size_t)r * D + c] += t;
+            }
+    }
+    for (r = 0; r < D; r++) /* the symmetric part */
+        for (c = 0; c < r; c++) {
+            double t = 0.5 * (Ac[(size_t)r * D + c] + Ac[(size_t)c * D + r]);
+            Ac[(size_t)r * D + c] = Ac[(size_t)c * D + r] = t;
+        }
+    for (k = 0; k < D; k++) cnt[k] = Ac[(size_t)k * D + k];
+    for (k = 0; k < D; k++) { /* Cholesky, lower triangle, in place */
+        double *Lk = Ac + (size_t)k * D, dk = Lk[k];
+        for (j = 0; j < k; j++) dk -= Lk[j] * Lk[j];
+        if (!(dk > 1e-10 * cnt[k]) || !frm__finite(dk)) {
+            for (i = k; i < D; i++) Ac[(size_t)i * D + k] = 0.0;
+            continue;
+        }
+        dk = sqrt(dk);
+        Lk[k] = dk;
+        for (i = k + 1; i < D; i++) {
+            double *Li = Ac + (size_t)i * D, t = Li[k];
+            for (j = 0; j < k; j++) t -= Li[j] * Lk[j];
+            Li[k] = t / dk;
+        }
+    }
+    m->coarse_ready = 1;
+}
+
+/* z += P A_c^-1 P^T r (P masked by the held components). */
+static void frm__coarse_apply(frm_model *m, const frm_real *rv, frm_real *z)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, j;
+    double *y = m->coarse_rhs, *L = m->coarse;
+    memset(y, 0, sizeof(double) * (size_t)D);
+    for (i = 0; i < m->frame_count; i++) /* y = P^T r */
+        if (frm__coarse_mask(m, i)) frm__coarse_restrict(m, i, rv + 6 * i, y + FRM__COARSE_MODES * m->f_agg[i]);
+    for (i = 0; i < D; i++) { /* L y' = y */
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+    for (i = D - 1; i >= 0; i--) { /* L^T x = y' */
+        double t = y[i], Lii = L[(size_t)i * D + i];
+        if (Lii == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
+        y[i] = t / Lii;
+    }
+    for (i = 0; i < m->frame_count; i++) /* z += P u */
+        if (frm__coarse_mask(m, i)) frm__coarse_prolong(m, i, y + FRM__COARSE_MODES * m->f_agg[i], z + 6 * i);
 }
 
 /* >>solver ----------------------------------------------------------------------------- */
@@ -5898,8 +6365,9 @@ static void frm__system_product(frm_model *m, double a_mass, double a_stiff, con
     frm__mask(m, out);
 }
 
-/* z = P r per frame. */
-static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *z)
+/* z = P r per frame, plus the coarse correction (built here at the first use after
+   frm__build_precond). */
+static void frm__precond_apply(frm_model *m, const frm_real *r, frm_real *z)
 {
     int i, a, b;
     for (i = 0; i < m->frame_count; i++) {
@@ -5909,6 +6377,10 @@ static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *
             for (b = 0; b < 6; b++) t += P[6 * a + b] * x[b];
             z[6 * i + a] = t;
         }
+    }
+    if (m->coarse_use) {
+        if (!m->coarse_ready) frm__coarse_build(m, m->precond_mass, m->precond_stiff);
+        frm__coarse_apply(m, r, z);
     }
 }
 
@@ -5986,6 +6458,10 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
     m->lin_iterations = it;
+    /* a short solve (a Newton iteration near convergence) does not predict the next: the
+       probe's or the next increment's solves are long again */
+    m->lin_predict = it > m->lin_predict / 2 ? it : m->lin_predict / 2;
+    if (!m->coarse_use) m->coarse_plain = it;
     return status;
 }
 
@@ -6002,8 +6478,29 @@ static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double
     case FRM_LINEAR_SOLVER_BTD:
         return frm__btd_model_solve(m, a_mass, a_stiff, tolerance, b, x);
     case FRM_LINEAR_SOLVER_CG:
-    default:
-        return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+    default: {
+        int st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+        if (st == FRM__CG_CAP && !m->coarse_use && m->agg_count && !m->vol_mode) { /* block-Jacobi alone was not enough: */
+            int first = m->stats.cg_iterations_last;                /* on from here, and again from its iterate */
+            m->coarse_use = 1;
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->stats.cg_iterations_last += first;
+        } else if ((st == FRM__CG_NEGATIVE || st == FRM__CG_CAP) && m->coarse_use) {
+            /* The coarse correction failed: once more from zero with block-Jacobi alone.
+               Near-singular systems (free rotations, no regularisation) make the coarse
+               matrix's solve amplify float's round-off until p.Kp or r.z turns non-positive
+               (float: frm_chain_link_compliance's cylinder, at 70 iterations); a genuinely
+               indefinite system stays NEGATIVE without it, so the minimum checks see the
+               same answer at twice the cost. */
+            int first = m->stats.cg_iterations_last;
+            m->coarse_use = 0;
+            memset(x, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->coarse_use = 1;
+            m->stats.cg_iterations_last += first;
+        }
+        return st;
+    }
     }
 }
 
@@ -9364,6 +9861,8 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
     if (md->block > 1024) return FRM_ERR_ARG;
     md->found = 0;
     frm__reset_stats(m);
+    m->coarse_plain = -1; /* a modal solve does not depend on earlier solves (its own bits repeat) */
+    m->lin_predict = -1;
     for (i = 0; i < m->frame_count; i++)
         if (m->state[i] == FRM__FREE)
             for (k = 0; k < 6; k++) free_dof += !((m->axes[i] >> k) & 1);

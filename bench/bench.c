@@ -4,7 +4,7 @@
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
    build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels]
-                     [--filter TEXT] [--repeats N] [--threads N] [--budget SECONDS]
+                     [--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
    (default 2 s; law variants get a quarter). Raise it to see finer levels.
@@ -87,6 +87,7 @@ static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", 
 typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
+    const char *scenes; /* --scenes: trade scenes to run (comma list of names; NULL: all) */
     int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time */
     double budget; /* s: a configuration slower than this stops its refinement */
 } options;
@@ -791,6 +792,7 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     printf("== 1. speed/accuracy trade ==\n");
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) {
         double t0 = now();
+        if (o->scenes && !strstr(o->scenes, scenes[s].name)) continue;
         printf("%s\n", scenes[s].title);
         if (!strcmp(scenes[s].name, "R3"))
             printf("  (frequency from the tip's zero crossings, corrected for the integrator's phase error: Euler "
@@ -1935,7 +1937,7 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
 static void usage(void)
 {
     fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels] [--filter TEXT] "
-                    "[--repeats N] [--threads N] [--budget SECONDS]\n");
+                    "[--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
 
@@ -1955,6 +1957,7 @@ int main(int argc, char **argv)
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else if (!strcmp(argv[i], "--filter") && i + 1 < argc) o.filter = argv[++i];
+        else if (!strcmp(argv[i], "--scenes") && i + 1 < argc) o.scenes = argv[++i];
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--budget") && i + 1 < argc) o.budget = atof(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
