@@ -1014,23 +1014,35 @@
    BLOCK-TRIDIAGONAL SOLVER (issue 15): frm_btd_factor / frm_btd_solve / frm_btd_compliance,
    usable on their own for any chain of 6-DoF nodes (rods, cables, catheters, trunk robots).
    The matrix: n diagonal 6x6 blocks and n - 1 sub-diagonal blocks A(i + 1, i), symmetric
-   positive definite. Block Cholesky (block Thomas in LL^T form; chosen over block LDL^T by
-   measurement: the same flops, and the inverted triangular factor G_i = L_i^-1 makes every
-   product of the factorisation and the solves a full fixed-size 6x6 one): L_i L_i^T = A_ii -
-   S_{i-1} S_{i-1}^T, S_i = A(i + 1, i) G_i^T; forward y_i = G_i (b_i - S_{i-1} y_{i-1}),
-   backward x_i = G_i^T (y_i - S_i^T x_{i+1}); O(n), 72 reals a block, one or many right-hand
-   sides, arithmetic in double whatever frm_real. A pivot at or below 4 (n + 16) eps(frm_real)
-   times the block's own diagonal entry is refused: FRM_ERR_BTD_INDEFINITE (negative) or
+   positive definite. Block LDL^T without square roots: A = L D L^T, L unit block-bidiagonal
+   with L(i + 1, i) = E_i = B_i D_i^-1 (B_i = A(i + 1, i)), D_{i+1} = A(i + 1, i + 1) - E_i B_i^T;
+   the factor stores D_i^-1 and E_i^T, so the solve is two sweeps of 6x6 products: forward
+   y_i = b_i - E_{i-1} y_{i-1} (and z_i = D_i^-1 y_i off the chain), backward
+   x_i = z_i - E_i^T x_{i+1}. D_i^-1, E_i and D_{i+1} come from one symmetric sweep
+   (Gauss-Jordan) of the 12 x 12 window [D_i B_i^T; B_i A(i + 1, i + 1)] over its first six
+   pivots: each pivot costs one division, and the next pivot is formed from it by one
+   multiply-add, so the sequential chain of the whole factorisation is 6 (division +
+   multiply-add) a block; every other operation is a row update of fixed size (rows as
+   vectors of 4 + 2 doubles with GCC / Clang, plain loops elsewhere). O(n), 72 reals a block,
+   one or many right-hand sides, arithmetic in double whatever frm_real. The pivots are
+   LDL^T's (Cholesky's squared diagonal): one at or below 4 (n + 16) eps(frm_real) times the
+   block's own diagonal entry is refused: FRM_ERR_BTD_INDEFINITE (negative) or
    FRM_ERR_BTD_SINGULAR (zero), the failing block reported; a non-finite pivot or result is
    FRM_ERR_NOT_FINITE (the solve then zeroes its output: never NaN). frm_btd_compliance gives
    W = J A^-1 J^T for a few constraint rows (eqs. 5.24-5.25) by rows solves, without A^-1.
    Tested against dense Cholesky for 1 to 60 blocks and by residuals at 1,000, with
-   symmetric scalings that put the condition number near 1e10 (tests/test_frames_chain.c).
-   Measured (one core of the development machine, gcc -O3 -march=native, double, 1,000
-   blocks): factor 170 us and solve 28 us at best of 50 runs; the bench's btd rows (median
-   of 5 batches, the machine loaded to 5-7 on 2 cores) 420-520 us and 33 us, linear from 10
-   to 10,000 blocks. The issue's goal of 50 us was not met: the factorisation is a sequential chain of 6x6 Cholesky steps whose
-   square roots and divisions (6 each a block) are latency-bound, about 0.2 us a block.
+   symmetric scalings that put the condition number near 1e10 (tests/test_frames_chain.c;
+   the sweep's rounding is invariant under such scalings, errors 4e-16 to 7e-16 as with the
+   Cholesky it replaced).
+   Choice by measurement (one core of the development machine, 1,000 blocks, double, best
+   of 50 runs, both builds run interleaved in one session, the machine shared): the block
+   Cholesky this replaced (L_i^-1 stored; 6 square roots and 6 divisions a block on the
+   chain) took 165 us to factor and 28 us to solve with gcc -O3 -march=native (AVX-512),
+   203 + 28 us with -march=x86-64-v3, 244 + 67 us with plain -O2; the LDL^T sweep takes
+   100-104 + 22 us, 161-172 + 21 us and 199-222 + 40 us. The issue's goal of 50 us for factor +
+   solve is not met: the sweep is bound by its row updates' throughput (about 650
+   multiply-adds a block on 6-wide rows) more than by the division chain (about 100 cycles
+   a block); the bench's btd rows give the timings under the bench's load.
    In the frames solvers: desc.linear_solver = FRM_LINEAR_SOLVER_BTD for a model whose block
    pattern is a chain (frame i coupled to i - 1 and i + 1 only; checked at creation,
    FRM_ERR_SOLVER otherwise); it assembles the blocks (block stiffness mode forced), makes
@@ -2208,9 +2220,9 @@ FRMDEF void frm_modal_destroy(frm_modal *md);
 /* >>btd (public) ----------------------------------------------------------------------
    Block-tridiagonal solver (issue 15): symmetric positive definite matrices of 6x6 blocks
    coupling each block row only to its two neighbours (a chain of 6-DoF frames: rods,
-   cables, catheters, trunk robots; the reduced chain below). Block Cholesky (block
-   Thomas in LL^T form), O(n) in the number of blocks, no allocation: the caller owns every
-   array. See BLOCK-TRIDIAGONAL SOLVER in the manual. */
+   cables, catheters, trunk robots; the reduced chain below). Block LDL^T without square
+   roots (the pivot blocks inverted by a symmetric sweep), O(n) in the number of blocks, no
+   allocation: the caller owns every array. See BLOCK-TRIDIAGONAL SOLVER in the manual. */
 #if FRM__CAT(FRM__IS_, FRM_REAL)
 #define frm_btd_factor_size frm_btd_factor_size_f32
 #define frm_btd_factor frm_btd_factor_f32
@@ -2243,8 +2255,8 @@ FRMDEF void frm_modal_destroy(frm_modal *md);
 #define frm_chain_link_compliance frm_chain_link_compliance_f32
 #endif
 
-/* Reals of a factor of n blocks (72 n: per block a Cholesky factor with its diagonal
-   inverted and the scaled sub-diagonal block). */
+/* Reals of a factor of n blocks (72 n: per block the inverse pivot block D_i^-1 and
+   E_i^T = D_i^-1 A(i + 1, i)^T). */
 FRMDEF size_t frm_btd_factor_size(int n);
 /* Factors the symmetric block-tridiagonal matrix of n >= 1 blocks: diag holds the n
    diagonal blocks (36 each, row-major; only their lower triangles are read), lower the
@@ -10183,93 +10195,187 @@ FRMDEF void frm_modal_destroy(frm_modal *md)
 
 /* >>btd -------------------------------------------------------------------------------- */
 
-/* Block Cholesky of a symmetric block-tridiagonal matrix, blocks of 6 (see the public
-   declarations and BLOCK-TRIDIAGONAL SOLVER). Per block i the factor holds
-       G_i = L_i^-1 (lower triangular, stored as a full 6x6), S_i = A(i + 1, i) G_i^T,
-   with L_i L_i^T = A(i, i) - S_{i-1} S_{i-1}^T. Forward y_i = G_i (b_i - S_{i-1} y_{i-1}),
-   backward x_i = G_i^T (y_i - S_i^T x_{i+1}). Storing the inverse makes every product a
-   full 6x6 one (fixed trip counts the compiler unrolls and vectorises); the Cholesky and
-   its inversion are the only triangular loops. */
+/* Block LDL^T of a symmetric block-tridiagonal matrix, blocks of 6 (see the public
+   declarations and BLOCK-TRIDIAGONAL SOLVER): A = L D L^T with L unit block lower
+   bidiagonal, L(i + 1, i) = E_i = B_i D_i^-1 (B_i = A(i + 1, i)) and
+   D_{i+1} = A(i + 1, i + 1) - E_i B_i^T. Per block i the factor holds
+       D_i^-1 (symmetric, stored full) and E_i^T = D_i^-1 B_i^T (row-major).
+   All three come from one symmetric sweep (Gauss-Jordan elimination without square roots)
+   of the 12 x 12 window [D_i B_i^T; B_i A(i + 1, i + 1)] over its first six pivots: pivot k
+   (p = a_kk, r = 1/p) subtracts a_jk a_km r from every other entry, scales row and column k
+   by r and leaves -r on the diagonal; after six pivots the window holds
+   [-D_i^-1, D_i^-1 B_i^T; B_i D_i^-1, D_{i+1}]. Each pivot's update of the next block's
+   diagonal happens as soon as that pivot is known, so the sequential chain through the
+   whole factorisation is one division and two multiply-adds a pivot; every other operation
+   is a fixed-size row update off that chain. The pivots are those of an LDL^T (Cholesky's
+   squared diagonal), judged as before. Solve: forward y_i = b_i - E_{i-1} y_{i-1},
+   z_i = D_i^-1 y_i; backward x_i = z_i - E_i^T x_{i+1}: one 6x6 product a block on each
+   sweep's chain (z off it). */
 
 FRMDEF size_t frm_btd_factor_size(int n) { return n < 1 ? 0 : (size_t)72 * (size_t)n; }
 
+/* A row of the window (6 doubles): with GCC or Clang vectors (AVX: one of 4 and one of 2,
+   a ymm and an xmm register; otherwise three of 2), elsewhere an array and loops. The
+   parts are named by FRM__BTD_PARTS; a lane is picked at compile time where the index is a
+   constant. */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(FRM_BTD_NO_VECTOR_EXTENSIONS)
+#define FRM__BTD_VECTOR 1
+typedef double frm__v2 __attribute__((vector_size(16)));
+#ifdef __AVX__
+typedef double frm__v4 __attribute__((vector_size(32)));
+typedef struct frm__v8 {
+    frm__v4 lo;
+    frm__v2 hi;
+} frm__v8;
+#define FRM__BTD_PARTS(OP) OP(lo) OP(hi)
+#define FRM__BTD_LANE(x, j) ((j) < 4 ? (x).lo[(j) & 3] : (x).hi[(j) & 1])
+#define FRM__BTD_LOAD(x, p) (memcpy(&(x).lo, (p), 4 * sizeof(double)), memcpy(&(x).hi, (p) + 4, 2 * sizeof(double)))
+#define FRM__BTD_STORE(p, x) (memcpy((p), &(x).lo, 4 * sizeof(double)), memcpy((p) + 4, &(x).hi, 2 * sizeof(double)))
+#else
+typedef struct frm__v8 {
+    frm__v2 p0, p1, hi;
+} frm__v8;
+#define FRM__BTD_PARTS(OP) OP(p0) OP(p1) OP(hi)
+#define FRM__BTD_LANE(x, j) ((j) < 2 ? (x).p0[(j) & 1] : (j) < 4 ? (x).p1[(j) & 1] : (x).hi[(j) & 1])
+#define FRM__BTD_LOAD(x, p)                                                                            \
+    (memcpy(&(x).p0, (p), 2 * sizeof(double)), memcpy(&(x).p1, (p) + 2, 2 * sizeof(double)),           \
+     memcpy(&(x).hi, (p) + 4, 2 * sizeof(double)))
+#define FRM__BTD_STORE(p, x)                                                                           \
+    (memcpy((p), &(x).p0, 2 * sizeof(double)), memcpy((p) + 2, &(x).p1, 2 * sizeof(double)),           \
+     memcpy((p) + 4, &(x).hi, 2 * sizeof(double)))
+#endif
+#define FRM__ALWAYS_INLINE static inline __attribute__((always_inline))
+#else
+typedef struct frm__v8 {
+    double e[6];
+} frm__v8;
+#define FRM__BTD_LANE(x, j) ((x).e[j])
+#define FRM__BTD_LOAD(x, p) memcpy((x).e, (p), 6 * sizeof(double))
+#define FRM__BTD_STORE(p, x) memcpy((p), (x).e, 6 * sizeof(double))
+#define FRM__ALWAYS_INLINE static inline
+#endif
+
+/* One pivot k (a constant where inlined; r = 1 / a_kk) of the sweep: every row a of T
+   becomes T_a s - c_a w0 with s = 1 but r in lane k and w0 = c r but 0 in lane k (so lane
+   k, the column, receives c_a r exactly: no column writes), then row k is replaced by c r
+   with -r in lane k; U's rows lose c_a (v r), N loses v v^T r (c, v: row k of T and of U
+   before the pivot). */
+FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, frm__v8 *U, frm__v8 *N)
+{
+    frm__v8 c = T[k], v = U[k], s, w0, wk, wu;
+    int a;
+#ifdef FRM__BTD_VECTOR
+    /* e_k and 1 - e_k as constant vectors: s = (1 - e_k) + e_k r, w0 = c r (1 - e_k),
+       wk = w0 - e_k r, each lane exact (a product by 1 or 0, a sum with 0) */
+    static const double eye[6][6] = {{1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0}, {0, 0, 1, 0, 0, 0},
+                                     {0, 0, 0, 1, 0, 0}, {0, 0, 0, 0, 1, 0}, {0, 0, 0, 0, 0, 1}};
+    static const double off[6][6] = {{0, 1, 1, 1, 1, 1}, {1, 0, 1, 1, 1, 1}, {1, 1, 0, 1, 1, 1},
+                                     {1, 1, 1, 0, 1, 1}, {1, 1, 1, 1, 0, 1}, {1, 1, 1, 1, 1, 0}};
+    frm__v8 m, m1;
+    FRM__BTD_LOAD(m, eye[k]);
+    FRM__BTD_LOAD(m1, off[k]);
+#define FRM__BTD_SCALE(P) wu.P = v.P * r, s.P = m1.P + m.P * r, w0.P = c.P * r * m1.P, wk.P = w0.P - m.P * r;
+    FRM__BTD_PARTS(FRM__BTD_SCALE)
+#undef FRM__BTD_SCALE
+    for (a = 0; a < 6; a++) {
+        const double ca = FRM__BTD_LANE(c, a), va = FRM__BTD_LANE(v, a);
+#define FRM__BTD_UPDATE(P) T[a].P = T[a].P * s.P - ca * w0.P, U[a].P = U[a].P - ca * wu.P, N[a].P = N[a].P - va * wu.P;
+        FRM__BTD_PARTS(FRM__BTD_UPDATE)
+#undef FRM__BTD_UPDATE
+    }
+#else
+    int b;
+    for (b = 0; b < 6; b++) {
+        s.e[b] = b == k ? r : 1.0;
+        wk.e[b] = b == k ? -r : c.e[b] * r;
+        w0.e[b] = b == k ? 0.0 : c.e[b] * r;
+        wu.e[b] = v.e[b] * r;
+    }
+    for (a = 0; a < 6; a++)
+        for (b = 0; b < 6; b++) {
+            T[a].e[b] = T[a].e[b] * s.e[b] - c.e[a] * w0.e[b];
+            U[a].e[b] -= c.e[a] * wu.e[b];
+            N[a].e[b] -= v.e[a] * wu.e[b];
+        }
+#endif
+    T[k] = wk;
+    U[k] = wu;
+}
+
+/* Pivot k of block i: refused below the tolerance, else swept; p becomes the next pivot,
+   computed from r by one multiply-add (the next pivot's entry loses e^2 r; e its entry in
+   row k), which is the factorisation's whole sequential chain. */
+#define FRM__BTD_PIVOT(k)                                                                              \
+    do {                                                                                               \
+        double scale_ = fabs((double)A[7 * (k)]), r_, q_, e_;                                        \
+        if (!frm__finite(p)) {                                                                         \
+            if (failed_block) *failed_block = i;                                                       \
+            return FRM_ERR_NOT_FINITE;                                                                 \
+        }                                                                                              \
+        if (!(p > tol * scale_)) {                                                                     \
+            if (failed_block) *failed_block = i;                                                       \
+            return p < -tol * scale_ ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;                  \
+        }                                                                                              \
+        r_ = 1.0 / p;                                                                                  \
+        e_ = (k) < 5 ? FRM__BTD_LANE(T[k], ((k) + 1) % 6) : FRM__BTD_LANE(U[k], 0);                   \
+        q_ = (k) < 5 ? FRM__BTD_LANE(T[((k) + 1) % 6], ((k) + 1) % 6) : FRM__BTD_LANE(N[0], 0);        \
+        frm__btd_sweep((k), r_, T, U, N);                                                              \
+        p = q_ - (e_ * e_) * r_;                                                                       \
+    } while (0)
+
 FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, frm_real *factor, int *failed_block)
 {
-    int i, a, b, k;
+    int i, a, b;
     const double tol = 4.0 * (double)(n + 16) * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON);
+    /* the window: T = rows / columns 0..5, U = rows 0..5 x columns 6..11, N = rows /
+       columns 6..11 */
+    frm__v8 T[6], U[6], N[6];
+    double t[6][6], p;
     if (failed_block) *failed_block = -1;
     if (n < 1 || !diag || !factor || (n > 1 && !lower)) return FRM_ERR_ARG;
+    memset(t, 0, sizeof t);
+    for (a = 0; a < 6; a++)
+        for (b = 0; b <= a; b++) t[a][b] = t[b][a] = (double)diag[6 * a + b];
+    for (a = 0; a < 6; a++) FRM__BTD_LOAD(T[a], t[a]);
+    p = t[0][0];
     for (i = 0; i < n; i++) {
         const frm_real *A = diag + 36 * (size_t)i;
-        frm_real *Gout = factor + 72 * (size_t)i, *S = Gout + 36;
-        double W[36], G[36];
-        /* W = A_i - S_{i-1} S_{i-1}^T (A's lower triangle mirrored) */
-        for (a = 0; a < 6; a++)
-            for (b = 0; b <= a; b++) W[6 * a + b] = W[6 * b + a] = (double)A[6 * a + b];
-        if (i > 0) {
-            const frm_real *Sp = factor + 72 * (size_t)(i - 1) + 36;
-            double P[36];
-            for (a = 0; a < 36; a++) P[a] = (double)Sp[a];
-            for (a = 0; a < 6; a++)
-                for (b = 0; b < 6; b++) {
-                    double s = 0;
-                    for (k = 0; k < 6; k++) s += P[6 * a + k] * P[6 * b + k];
-                    W[6 * a + b] -= s;
-                }
-        }
-        /* Cholesky of W (lower, in place); each pivot judged against the block's own
-           diagonal entry */
-        for (b = 0; b < 6; b++) {
-            double d = W[7 * b], scale = fabs((double)A[7 * b]);
-            for (k = 0; k < b; k++) d -= W[6 * b + k] * W[6 * b + k];
-            if (!frm__finite(d)) {
-                if (failed_block) *failed_block = i;
-                return FRM_ERR_NOT_FINITE;
-            }
-            if (!(d > tol * scale)) {
-                if (failed_block) *failed_block = i;
-                return d < -tol * scale ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;
-            }
-            d = sqrt(d);
-            W[7 * b] = d;
-            G[7 * b] = 1.0 / d; /* one division a column; products elsewhere */
-            for (a = b + 1; a < 6; a++) {
-                double s = W[6 * a + b];
-                for (k = 0; k < b; k++) s -= W[6 * a + k] * W[6 * b + k];
-                W[6 * a + b] = s * G[7 * b];
-            }
-        }
-        /* G = L^-1 (lower triangular), column by column */
-        for (b = 0; b < 6; b++) {
-            for (a = 0; a < b; a++) G[6 * a + b] = 0;
-            for (a = b + 1; a < 6; a++) {
-                double s = 0;
-                for (k = b; k < a; k++) s -= W[6 * a + k] * G[6 * k + b];
-                G[6 * a + b] = s * G[7 * a];
-            }
-        }
-        for (a = 0; a < 36; a++) Gout[a] = (frm_real)G[a];
-        /* S_i = B G^T (one finiteness test of the block's sum) */
+        frm_real *Dout = factor + 72 * (size_t)i, *Eout = Dout + 36;
+        double usum = 0, u[6][6];
+        memset(t, 0, sizeof t);
+        memset(u, 0, sizeof u);
         if (i + 1 < n) {
-            const frm_real *B = lower + 36 * (size_t)i;
-            double Bd[36], Sd[36], sum = 0;
-            for (a = 0; a < 36; a++) Bd[a] = (double)B[a];
+            const frm_real *B = lower + 36 * (size_t)i, *A1 = A + 36;
             for (a = 0; a < 6; a++)
-                for (b = 0; b < 6; b++) {
-                    double s = 0;
-                    for (k = 0; k < 6; k++) s += Bd[6 * a + k] * G[6 * b + k];
-                    Sd[6 * a + b] = s;
-                }
-            for (a = 0; a < 36; a++) S[a] = (frm_real)Sd[a], sum += Sd[a];
-            if (!frm__finite(sum)) {
-                if (failed_block) *failed_block = i;
-                return FRM_ERR_NOT_FINITE;
+                for (b = 0; b < 6; b++) u[b][a] = (double)B[6 * a + b]; /* B^T */
+            for (a = 0; a < 6; a++)
+                for (b = 0; b <= a; b++) t[a][b] = t[b][a] = (double)A1[6 * a + b];
+        }
+        for (a = 0; a < 6; a++) FRM__BTD_LOAD(U[a], u[a]), FRM__BTD_LOAD(N[a], t[a]);
+        FRM__BTD_PIVOT(0);
+        FRM__BTD_PIVOT(1);
+        FRM__BTD_PIVOT(2);
+        FRM__BTD_PIVOT(3);
+        FRM__BTD_PIVOT(4);
+        FRM__BTD_PIVOT(5);
+        for (a = 0; a < 6; a++) {
+            FRM__BTD_STORE(t[a], T[a]);
+            FRM__BTD_STORE(u[a], U[a]);
+            for (b = 0; b < 6; b++) {
+                Dout[6 * a + b] = (frm_real)-t[a][b];
+                Eout[6 * a + b] = (frm_real)u[a][b];
+                usum += u[a][b];
             }
-        } else
-            memset(S, 0, 36 * sizeof(frm_real));
+        }
+        if (!frm__finite(usum)) {
+            if (failed_block) *failed_block = i;
+            return FRM_ERR_NOT_FINITE;
+        }
+        for (a = 0; a < 6; a++) T[a] = N[a];
     }
     return FRM_OK;
 }
+#undef FRM__BTD_PIVOT
 
 FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
 {
@@ -10278,37 +10384,34 @@ FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
     if (n < 1 || !factor || !b || nrhs < 0) return FRM_ERR_ARG;
     for (r = 0; r < nrhs; r++) {
         frm_real *x = b + n6 * (size_t)r;
-        double y[6], t[6];
-        for (a = 0; a < 6; a++) y[a] = 0;
-        for (i = 0; i < n; i++) { /* forward: y_i = G_i (b_i - S_{i-1} y_{i-1}) */
-            const frm_real *G = factor + 72 * (size_t)i;
+        double y[6] = {0, 0, 0, 0, 0, 0}, t[6];
+        for (i = 0; i < n; i++) { /* forward: y_i = b_i - E_{i-1} y_{i-1}; x_i = z_i = D_i^-1 y_i */
+            const frm_real *Di = factor + 72 * (size_t)i;
             for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
             if (i > 0) {
-                const frm_real *S = G - 36;
-                for (a = 0; a < 6; a++)
-                    for (k = 0; k < 6; k++) t[a] -= (double)S[6 * a + k] * y[k];
+                const frm_real *Et = Di - 36;
+                for (k = 0; k < 6; k++)
+                    for (a = 0; a < 6; a++) t[a] -= (double)Et[6 * k + a] * y[k];
             }
+            for (a = 0; a < 6; a++) y[a] = t[a];
             for (a = 0; a < 6; a++) {
                 double s = 0;
-                for (k = 0; k < 6; k++) s += (double)G[6 * a + k] * t[k];
-                y[a] = s;
+                for (k = 0; k < 6; k++) s += (double)Di[6 * a + k] * t[k];
+                x[6 * i + a] = (frm_real)s;
             }
-            for (a = 0; a < 6; a++) x[6 * i + a] = (frm_real)y[a];
         }
-        for (i = n - 1; i >= 0; i--) { /* backward: x_i = G_i^T (y_i - S_i^T x_{i+1}) */
-            const frm_real *G = factor + 72 * (size_t)i;
-            for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
-            if (i + 1 < n) {
-                const frm_real *S = G + 36;
-                for (k = 0; k < 6; k++)
-                    for (a = 0; a < 6; a++) t[a] -= (double)S[6 * k + a] * y[k];
-            }
-            for (a = 0; a < 6; a++) y[a] = 0;
-            for (k = 0; k < 6; k++)
-                for (a = 0; a < 6; a++) y[a] += (double)G[6 * k + a] * t[k];
+        for (a = 0; a < 6; a++) y[a] = (double)x[n6 - 6 + a], bad |= !frm__finite(y[a]);
+        for (i = n - 2; i >= 0; i--) { /* backward: x_i = z_i - E_i^T x_{i+1} */
+            const frm_real *Et = factor + 72 * (size_t)i + 36;
             for (a = 0; a < 6; a++) {
-                x[6 * i + a] = (frm_real)y[a];
-                bad |= !frm__finite(y[a]);
+                double s = (double)x[6 * i + a];
+                for (k = 0; k < 6; k++) s -= (double)Et[6 * a + k] * y[k];
+                t[a] = s;
+            }
+            for (a = 0; a < 6; a++) {
+                y[a] = t[a];
+                x[6 * i + a] = (frm_real)t[a];
+                bad |= !frm__finite(t[a]);
             }
         }
     }
