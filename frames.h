@@ -997,6 +997,7 @@ typedef FRM_REAL frm_real;
 #define frm_model_default_desc frm_model_default_desc_f32
 #define frm_model_create frm_model_create_f32
 #define frm_model_destroy frm_model_destroy_f32
+#define frm_model_view frm_model_view_f32
 #define frm_model_fix_frame frm_model_fix_frame_f32
 #define frm_model_drive_frame frm_model_drive_frame_f32
 #define frm_model_release_frame frm_model_release_frame_f32
@@ -1472,6 +1473,46 @@ typedef struct frm_sampling {
 
 typedef struct frm_model frm_model;
 
+/* A plain view of a created model's arrays: what a backend running the two passes of the
+   force and of K v needs (>>kernels: frm_pass1_*, frm_pass2_*), and nothing else. The CPU
+   loops and the CUDA companion (frames_cuda.cu, see CUDA) call the same FRM_HOSTDEV pass
+   functions on it; frm_model_view fills one that points into the model's block (valid
+   until frm_model_destroy; a GPU backend copies the arrays and points a view of its own at
+   its copies). Counts: frames, samples, pairs; per frame i the reverse table
+   rev_pair[rev_start[i] .. rev_start[i + 1]) lists its pairs in pair order; per sample s
+   its pairs are s_start[s] .. s_start[s + 1]. Arrays the pass functions only read are
+   const; the outputs (p_out: 6 per pair, pass 1's partial force or K v) and the
+   linearisation's data (written by the force pass when it linearises) are not. NULL for
+   an option that is off (p_stab, s_stabY, s_stabD without the rotation stabilisation,
+   p_C without the coupling term). Units as in struct frm_model's comments (SI). */
+typedef struct frm_view {
+    int frame_count, sample_count, pair_count;
+    int law_cache;                   /* reals of lin_cache per sample */
+    /* per frame */
+    const frm_real *disp;            /* 3: u = x - xbar (m), the state */
+    const frm_real *rel, *relm;      /* 9 each: Q = R Rbar^T and Q - I (frm_frame_rotations) */
+    const frm_real *f_stab;          /* 6: projector on the rotations its samples do not see, or 0 */
+    const unsigned char *f_stab_on;  /* 1: f_stab is not zero */
+    const int *rev_start, *rev_pair; /* frame_count + 1, pair_count: the reverse table */
+    frm_real *lin_hrot;              /* 6: the frame-own rotational term at the linearisation */
+    /* per sample */
+    const int *s_start;                        /* sample_count + 1 */
+    const frm_real *s_rest, *s_volume;         /* 3 (m), 1 (m^3) */
+    const frm_real *s_couple, *s_mu, *s_hstab; /* coupling coefficient, shear modulus (Pa), gamma h^2 (m^2) */
+    const unsigned char *s_law, *s_stab;       /* frm_law; 1 if the stabilisation acts on it */
+    const frm_real *s_law_params;              /* FRM_LAW_PARAMS per sample (mu, lambda first for the
+                                                  kernels' laws, frm_material_stress) */
+    frm_real *s_stabY, *s_stabD;               /* 9, 1: the stabilisation at the linearisation */
+    frm_real *lin_F, *lin_S, *lin_cache;       /* 9, 6, law_cache: the linearisation's F, S, tangent data */
+    frm_real *s_pos;                           /* 3: sample positions (outputs) */
+    /* per pair (sample, neighbour) */
+    const int *p_frame;                        /* the neighbour's frame */
+    const frm_real *p_weight, *p_grad, *p_rlev; /* 1, 3 (1/m), 3 (m): w, grad w, rest lever abar */
+    frm_real *p_G, *p_H, *p_A, *p_C, *p_stab;  /* 9, 6, 3, 3, 3: the linearisation's G, Hs, lever a,
+                                                  coupling g, stabilisation conjugate */
+    frm_real *p_out;                           /* 6: pass 1's partial contributions */
+} frm_view;
+
 /* Library version string "major.minor.patch". */
 FRMDEF const char *frm_version(void);
 /* Name of an error code (static string). */
@@ -1756,6 +1797,9 @@ FRMDEF size_t frm_model_memory_bytes(const frm_model *m);
 /* Frames whose rotation the rotation stabilisation holds (their samples do not see it at
    first order; see MODEL), 0 with rotation_stabilization = 0. */
 FRMDEF int frm_model_stabilized_frames(const frm_model *m);
+/* Fills *out with a view of the model's arrays (see frm_view), for a backend running the
+   passes (frames_cuda.cu). FRM_ERR_ARG on NULL. */
+FRMDEF int frm_model_view(const frm_model *m, frm_view *out);
 
 /* ---- stiffness (K = -df/dq, 6 per frame: translation, then rotation about world axes:
    a rotation dtheta moves R to exp([dtheta]x) R) ---- */
@@ -2599,6 +2643,283 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
     }
 }
 
+
+/* >>passes: the bodies of the two passes over a frm_view, shared by the CPU loops (which
+   run them over fixed chunks, see THREADING) and the CUDA companion (one thread a sample
+   in pass 1, one a frame in pass 2). Pass 1 per sample s writes each of its pairs'
+   partial contribution (6 reals) into p_out; pass 2 per frame sums them through the
+   reverse table. The constitutive law sits between frm_pass1_deform and the pair loop:
+   a backend evaluates it its own way (the CPU through the law table, which also runs
+   user callbacks; the GPU through frm_material_stress / frm_sample_dP, the laws with a
+   fast path). Nothing here keeps a per-pair array on the stack: per-pair quantities the
+   sample's sums need twice (levers, the stabilisation's T_k and omega_k) are recomputed
+   by the same expressions (the same bits), and the stabilisation's K v torques wait in
+   p_out; only the coupling term (desc.frame_coupling, off by default) keeps 3 n levers
+   and offsets on the stack. */
+
+/* Pass 1, force and K v: the lever a = Q abar = abar + Qm abar of pair p (world axes, m),
+   by the expression of frm_sample_deformation. */
+FRM_HOSTDEV static inline void frm_pass_lever(const frm_view *w, int p, frm_real lever[3])
+{
+    const frm_real *Qm = w->relm + 9 * w->p_frame[p], *ab = w->p_rlev + 3 * (size_t)p;
+    int r;
+    for (r = 0; r < 3; r++) lever[r] = ab[r] + (Qm[3 * r] * ab[0] + Qm[3 * r + 1] * ab[1] + Qm[3 * r + 2] * ab[2]);
+}
+
+/* Pass 1 of the force, first part: H = F - I and F of sample s (eqs. 3.34, 3.40), and its
+   position into position (3; NULL: not wanted). */
+FRM_HOSTDEV static inline void frm_pass1_deform(const frm_view *w, int s, frm_real H[9], frm_real F[9],
+                                                frm_real *position)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, r;
+    frm_sample_deformation(n, w->p_frame + b, w->p_weight + b, w->p_grad + 3 * (size_t)b, w->p_rlev + 3 * (size_t)b,
+                           w->s_rest + 3 * (size_t)s, w->disp, w->relm, H, NULL, NULL, position);
+    for (r = 0; r < 9; r++) F[r] = H[r];
+    F[0] += 1; /* F = I + H */
+    F[4] += 1;
+    F[8] += 1;
+}
+
+/* Pass 1 of the force, the rotation stabilisation of sample s (see MODEL): adds its stress
+   to P (divided by the volume), sets *D (the divergence D = Y : F / 2, with Y = sum_k Z_k
+   over the pairs of frames without unseen rotations, Dall over all) and returns its
+   energy (J). With linearize, stores the data K v needs (p_stab per pair: the frames with
+   unseen rotations m_k = N omega_k + g D grad w_k, the others t_k = sum_j f_j x z_kj; Y
+   and D per sample). The frame-own torques and T_k: frm_pass1_stab_pair. */
+FRM_HOSTDEV static inline double frm_pass1_stab_force(const frm_view *w, int s, const frm_real H[9],
+                                                      const frm_real F[9], frm_real P[9], int linearize, frm_real *Dout)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, i;
+    frm_real v = w->s_volume[s], c = w->s_mu[s] * v, g = w->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
+    frm_real sD, Z[9];
+    double energy = 0;
+    for (r = 0; r < 9; r++) Dall[r] = 0;
+    for (k = 0; k < n; k++) { /* Z_k: Y over the plain pairs, Dall over the others */
+        i = w->p_frame[b + k];
+        frm_stab_direction(w->relm + 9 * i, w->p_grad + 3 * (size_t)(b + k), Z);
+        for (r = 0; r < 9; r++) {
+            if (w->f_stab_on[i]) Dall[r] += Z[r];
+            else Y[r] += Z[r];
+        }
+    }
+    for (r = 0; r < 9; r++) Dall[r] += Y[r];
+    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
+                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
+    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
+    sD = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
+    for (k = 0; k < n; k++) {
+        const frm_real *gk = w->p_grad + 3 * (size_t)(b + k);
+        i = w->p_frame[b + k];
+        if (w->f_stab_on[i]) {
+            const frm_real *N = w->f_stab + 6 * i;
+            frm_real om[3], mk[3], T[9];
+            frm_pair_stab_omega(H, w->relm + 9 * i, om);
+            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
+            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+            frm_stab_stress(c, w->relm + 9 * i, mk, T);
+            for (r = 0; r < 9; r++) P[r] += T[r] / v;
+            if (linearize)
+                for (r = 0; r < 3; r++) w->p_stab[3 * (size_t)(b + k) + r] = mk[r];
+        } else if (linearize) {
+            frm_real t[3];
+            frm_stab_direction(w->relm + 9 * i, gk, Z);
+            frm_column_cross_sum(F, Z, t);
+            for (r = 0; r < 3; r++) w->p_stab[3 * (size_t)(b + k) + r] = t[r];
+        }
+    }
+    if (linearize) {
+        for (r = 0; r < 9; r++) w->s_stabY[9 * (size_t)s + r] = Y[r];
+        w->s_stabD[s] = D;
+    }
+    *Dout = D;
+    return energy;
+}
+
+/* Pass 1 of the force, the stabilisation's T_k (9) and frame-own torque (3) of slot k of
+   sample s, given the sample's D (frm_pass1_stab_force computed the same values). */
+FRM_HOSTDEV static inline void frm_pass1_stab_pair(const frm_view *w, int s, int k, const frm_real H[9],
+                                                   const frm_real F[9], frm_real D, frm_real T[9], frm_real stq[3])
+{
+    int b = w->s_start[s], i = w->p_frame[b + k], r;
+    frm_real v = w->s_volume[s], c = w->s_mu[s] * v, g = w->s_hstab[s];
+    const frm_real *gk = w->p_grad + 3 * (size_t)(b + k);
+    if (w->f_stab_on[i]) {
+        const frm_real *N = w->f_stab + 6 * i;
+        frm_real om[3], mk[3];
+        frm_pair_stab_omega(H, w->relm + 9 * i, om);
+        mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+        mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+        mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+        for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+        frm_stab_stress(c, w->relm + 9 * i, mk, T);
+        frm_column_cross_sum(F, T, stq);
+    } else {
+        frm_real t[3], sD = (frm_real)0.5 * c * g * D;
+        frm_stab_direction(w->relm + 9 * i, gk, T);
+        frm_column_cross_sum(F, T, t);
+        for (r = 0; r < 3; r++) stq[r] = sD * t[r];
+        for (r = 0; r < 9; r++) T[r] *= sD;
+    }
+}
+
+/* Pass 1 of the force, the pairs of sample s for its final stress P (the law's, plus the
+   stabilisation's; D from frm_pass1_stab_force, unused without it): each pair's partial
+   force into p_out (eq. 3.52; the stabilisation's frame-own torque and the coupling
+   term's forces added), the coupling term's energy added to *energy; with linearize, the
+   pairs' lever a, G and Hs (the frame-own terms of the stabilisation and the coupling
+   included) and the coupling's g. */
+FRM_HOSTDEV static inline void frm_pass1_force_pairs(const frm_view *w, int s, const frm_real H[9],
+                                                     const frm_real F[9], const frm_real P[9], frm_real D,
+                                                     int linearize, double *energy)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, stab = w->s_stab[s];
+    frm_real v = w->s_volume[s];
+    for (k = 0; k < n; k++) {
+        int p = b + k, i = w->p_frame[p];
+        frm_real lever[3], T[9], stq[3], *out = w->p_out + 6 * (size_t)p;
+        frm_pass_lever(w, p, lever);
+        frm_pair_force(v, P, w->p_grad + 3 * (size_t)p, w->p_weight[p], lever, w->rel + 9 * i, out);
+        if (stab) {
+            frm_pass1_stab_pair(w, s, k, H, F, D, T, stq);
+            for (r = 0; r < 3; r++) out[3 + r] += stq[r];
+        }
+        if (linearize) {
+            frm_real *Hs = w->p_H + 6 * (size_t)p;
+            for (r = 0; r < 3; r++) w->p_A[3 * (size_t)p + r] = lever[r];
+            frm_pair_linearize(v, P, w->p_grad + 3 * (size_t)p, w->p_weight[p], lever, w->rel + 9 * i,
+                               w->p_G + 9 * (size_t)p, Hs);
+            if (stab) frm_pair_stab_rotation(F, T, Hs);
+        }
+    }
+    if (w->s_couple[s] != 0) {
+        frm_real lever[3 * FRM_MAX_NEIGHBORS], offset[3 * FRM_MAX_NEIGHBORS], Hc[9];
+        frm_sample_deformation(n, w->p_frame + b, w->p_weight + b, w->p_grad + 3 * (size_t)b, w->p_rlev + 3 * (size_t)b,
+                               w->s_rest + 3 * (size_t)s, w->disp, w->relm, Hc, lever, offset, NULL);
+        *energy += (double)frm_sample_coupling_force(n, w->p_weight + b, lever, offset, w->s_couple[s],
+                                                     w->p_out + 6 * (size_t)b, linearize ? w->p_C + 3 * (size_t)b : NULL);
+        if (linearize)
+            for (k = 0; k < n; k++)
+                frm_pair_coupling_rotation(w->p_C + 3 * (size_t)(b + k), lever + 3 * k, w->p_H + 6 * (size_t)(b + k));
+    }
+}
+
+/* Pass 1 of K v (pair mode), first part: dF of sample s from its neighbours' v (6 per
+   frame: translation, rotation) through the linearisation's G (eq. 3.43). */
+FRM_HOSTDEV static inline void frm_pass1_apply_dF(const frm_view *w, int s, const frm_real *v, frm_real dF[9])
+{
+    int b = w->s_start[s], e = w->s_start[s + 1], k;
+    for (k = 0; k < 9; k++) dF[k] = 0;
+    for (k = b; k < e; k++) frm_pair_dF(v + 6 * w->p_frame[k], w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, dF);
+}
+
+/* Pass 1 of K v, the pairs of sample s for its dF and the law's dP (dP receives the
+   stabilisation's stress-like part): each pair's v_s B^T vec(dP) (plus the stabilisation's
+   frame-own torque and the coupling's Gauss-Newton part) into p_out. definite: the
+   linearisation is K's positive-definite part (the stabilisation's Gauss-Newton part
+   only). The stabilisation (see frm_pair_stab_apply): dD = Y : dF / 2 + sum over the pairs
+   of frames with unseen rotations g_k . domega_k - sum over the others dtheta_k . t_k / 2;
+   its torques wait in p_out's rotational half until dP is complete. */
+FRM_HOSTDEV static inline void frm_pass1_apply_pairs(const frm_view *w, int s, const frm_real *v, const frm_real dF[9],
+                                                     frm_real dP[9], int definite)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, i, stab = w->s_stab[s];
+    frm_real vol = w->s_volume[s];
+    if (stab) {
+        const frm_real *F = w->lin_F + 9 * (size_t)s, *Y = w->s_stabY + 9 * (size_t)s;
+        frm_real c = w->s_mu[s] * w->s_volume[s], g = w->s_hstab[s], D = w->s_stabD[s], dD, s1, s2, dPx[9];
+        dD = (frm_real)0.5 * (Y[0] * dF[0] + Y[1] * dF[1] + Y[2] * dF[2] + Y[3] * dF[3] + Y[4] * dF[4] + Y[5] * dF[5] +
+                              Y[6] * dF[6] + Y[7] * dF[7] + Y[8] * dF[8]);
+        for (k = 0; k < n; k++) {
+            const frm_real *t = w->p_stab + 3 * (size_t)(b + k), *gk = w->p_grad + 3 * (size_t)(b + k);
+            const frm_real *th = v + 6 * w->p_frame[b + k] + 3;
+            i = w->p_frame[b + k];
+            if (w->f_stab_on[i]) {
+                frm_real om[3];
+                frm_pair_stab_domega(F, dF, w->relm + 9 * i, th, om);
+                dD += gk[0] * om[0] + gk[1] * om[1] + gk[2] * om[2];
+            } else
+                dD -= (frm_real)0.5 * (th[0] * t[0] + th[1] * t[1] + th[2] * t[2]);
+        }
+        s1 = (frm_real)0.5 * c * g * dD;
+        s2 = (frm_real)0.5 * c * g * D;
+        for (r = 0; r < 9; r++) dPx[r] = s1 * Y[r];
+        for (k = 0; k < n; k++) {
+            const frm_real *t = w->p_stab + 3 * (size_t)(b + k), *gk = w->p_grad + 3 * (size_t)(b + k);
+            const frm_real *th = v + 6 * w->p_frame[b + k] + 3;
+            frm_real *stq = w->p_out + 6 * (size_t)(b + k) + 3;
+            i = w->p_frame[b + k];
+            if (w->f_stab_on[i]) {
+                const frm_real *N = w->f_stab + 6 * i;
+                frm_real o[3], u[3], d[9];
+                frm_pair_stab_domega(F, dF, w->relm + 9 * i, th, o);
+                u[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2] + g * dD * gk[0];
+                u[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2] + g * dD * gk[1];
+                u[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2] + g * dD * gk[2];
+                frm_pair_stab_apply(F, dF, w->relm + 9 * i, c, u, t, th, definite, d, stq);
+                for (r = 0; r < 9; r++) dPx[r] += d[r];
+                continue;
+            }
+            for (r = 0; r < 3; r++) stq[r] = -s1 * t[r];
+            if (!definite && s2 != 0) {
+                frm_real Z[9], x[3];
+                frm_stab_direction(w->relm + 9 * i, gk, Z);
+                frm_column_cross_sum(dF, Z, x);
+                for (r = 0; r < 3; r++) stq[r] -= s2 * x[r];
+                for (r = 0; r < 3; r++) { /* dPx += [dtheta]x T_k, column r */
+                    dPx[r] += s2 * (th[1] * Z[6 + r] - th[2] * Z[3 + r]);
+                    dPx[3 + r] += s2 * (th[2] * Z[r] - th[0] * Z[6 + r]);
+                    dPx[6 + r] += s2 * (th[0] * Z[3 + r] - th[1] * Z[r]);
+                }
+            }
+        }
+        for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+        for (k = b; k < b + n; k++) { /* the pairs' products, the waiting torques added (the same sum) */
+            frm_real y[6], *out = w->p_out + 6 * (size_t)k;
+            frm_pair_apply(vol, dP, w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, y);
+            for (r = 0; r < 3; r++) {
+                out[r] = y[r];
+                out[3 + r] = y[3 + r] + out[3 + r];
+            }
+        }
+    } else
+        for (k = b; k < b + n; k++)
+            frm_pair_apply(vol, dP, w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, w->p_out + 6 * (size_t)k);
+    if (w->s_couple[s] != 0)
+        frm_sample_coupling_apply(n, w->p_frame + b, w->p_weight + b, w->p_A + 3 * (size_t)b, w->s_couple[s], v,
+                                  w->p_out + 6 * (size_t)b);
+}
+
+/* Pass 2 of frame i: dst (6) = the sum of src (6 per pair) over its pairs in pair order
+   through the reverse table, in double; scale (may be NULL) = the sum of their |src|^2. */
+FRM_HOSTDEV static inline void frm_pass2_gather(const frm_view *w, int i, const frm_real *src, frm_real *dst,
+                                                double *scale)
+{
+    double sum[6] = {0, 0, 0, 0, 0, 0}, sq = 0;
+    int e, k;
+    for (e = w->rev_start[i]; e < w->rev_start[i + 1]; e++) {
+        const frm_real *x = src + 6 * (size_t)w->rev_pair[e];
+        for (k = 0; k < 6; k++) sum[k] += (double)x[k];
+        if (scale)
+            for (k = 0; k < 6; k++) sq += (double)x[k] * x[k];
+    }
+    for (k = 0; k < 6; k++) dst[6 * i + k] = (frm_real)sum[k];
+    if (scale) scale[i] = sq;
+}
+
+/* Pass 2 of K v (pair mode), after the gather: the frame-own rotational term of frame i
+   (the pairs' Hs and gravity, lin_hrot) applied to v's rotation, added to out (6 per frame). */
+FRM_HOSTDEV static inline void frm_pass2_rotational(const frm_view *w, int i, const frm_real *v, frm_real *out)
+{
+    const frm_real *h = w->lin_hrot + 6 * i, *t = v + 6 * i + 3;
+    out[6 * i + 3] += h[0] * t[0] + h[5] * t[1] + h[4] * t[2];
+    out[6 * i + 4] += h[5] * t[0] + h[1] * t[1] + h[3] * t[2];
+    out[6 * i + 5] += h[4] * t[0] + h[3] * t[1] + h[2] * t[2];
+}
+
 #endif /* FRAMES_KERNELS */
 
 /* ======================================================================================
@@ -2777,6 +3098,7 @@ struct frm_model {
     int lin_valid, lin_mode, lin_iterations;
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
+    frm_view view; /* the passes' arrays (frm__fill_view, after the layout) */
 };
 
 /* >>math ------------------------------------------------------------------------------- */
@@ -4337,6 +4659,49 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     return FRM_OK;
 }
 
+/* The view the passes run on (frm_view): pointers into the block, set once. */
+static void frm__fill_view(frm_model *m)
+{
+    frm_view *w = &m->view;
+    w->frame_count = m->frame_count;
+    w->sample_count = m->sample_count;
+    w->pair_count = m->pair_count;
+    w->law_cache = m->law_cache;
+    w->disp = m->disp;
+    w->rel = m->rel;
+    w->relm = m->relm;
+    w->f_stab = m->f_stab;
+    w->f_stab_on = m->f_stab_on;
+    w->rev_start = m->rev_start;
+    w->rev_pair = m->rev_pair;
+    w->lin_hrot = m->lin_hrot;
+    w->s_start = m->s_start;
+    w->s_rest = m->s_rest;
+    w->s_volume = m->s_volume;
+    w->s_couple = m->s_couple;
+    w->s_mu = m->s_mu;
+    w->s_hstab = m->s_hstab;
+    w->s_law = m->s_law;
+    w->s_stab = m->s_stab;
+    w->s_law_params = m->s_law_params;
+    w->s_stabY = m->s_stabY;
+    w->s_stabD = m->s_stabD;
+    w->lin_F = m->lin_F;
+    w->lin_S = m->lin_S;
+    w->lin_cache = m->lin_cache;
+    w->s_pos = m->s_pos;
+    w->p_frame = m->p_frame;
+    w->p_weight = m->p_weight;
+    w->p_grad = m->p_grad;
+    w->p_rlev = m->p_rlev;
+    w->p_G = m->p_G;
+    w->p_H = m->p_H;
+    w->p_A = m->p_A;
+    w->p_C = m->p_C;
+    w->p_stab = m->p_stab;
+    w->p_out = m->p_out;
+}
+
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
 {
     frm_model tmp, *m = NULL;
@@ -4352,6 +4717,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     err = frm__create_size(d, &tmp, &tables);
     if (err) return err;
     err = frm__create_layout(d, &tmp, &m);
+    if (!err) frm__fill_view(m); /* the precomputation runs passes */
     if (!err) err = frm__create_precompute(m, d, &tables);
     frm__create_free_tables(d, &tables);
     if (err) {
@@ -4394,66 +4760,7 @@ static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
     for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
 }
 
-/* The rotation stabilisation of sample s (see MODEL): its energy (returned), its stress
-   added to P (divided by the volume), each pair's T_k into T (9 n, for the frame-own
-   second-order term) and the frame-own torques into stq (3 n). With D = sum_k grad w_k .
-   omega_k = Y : F / 2, Y = sum_k Z_k: pairs of frames without unseen rotations have
-   T_k = c g D / 2 Z_k (no omega_k needed); those with them the general
-   T_k = c/2 Q_k [N_k omega_k + g D grad w_k]x. With linearize, the data K v needs. */
-static double frm__stab_sample_force(frm_model *m, int s, const frm_real H[9], const frm_real F[9], frm_real P[9],
-                                     frm_real *T, frm_real *stq, int linearize)
-{
-    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
-    frm_real v = m->s_volume[s], c = m->s_mu[s] * v, g = m->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
-    frm_real sD;
-    double energy = 0;
-    for (r = 0; r < 9; r++) Dall[r] = 0;
-    for (k = 0; k < n; k++) { /* Z_k into T, Y over the plain pairs, Dall over the others */
-        const frm_real *gk = m->p_grad + 3 * (size_t)(b + k);
-        i = m->p_frame[b + k];
-        frm_stab_direction(m->relm + 9 * i, gk, T + 9 * k);
-        for (r = 0; r < 9; r++) {
-            if (m->f_stab_on[i]) Dall[r] += T[9 * k + r];
-            else Y[r] += T[9 * k + r];
-        }
-    }
-    for (r = 0; r < 9; r++) Dall[r] += Y[r];
-    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
-                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
-    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
-    sD = (frm_real)0.5 * c * g * D;
-    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
-    for (k = 0; k < n; k++) {
-        i = m->p_frame[b + k];
-        if (m->f_stab_on[i]) {
-            const frm_real *N = m->f_stab + 6 * i, *gk = m->p_grad + 3 * (size_t)(b + k);
-            frm_real om[3], mk[3];
-            frm_pair_stab_omega(H, m->relm + 9 * i, om);
-            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
-            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
-            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
-            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
-            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
-            frm_stab_stress(c, m->relm + 9 * i, mk, T + 9 * k);
-            frm_column_cross_sum(F, T + 9 * k, stq + 3 * k);
-            for (r = 0; r < 9; r++) P[r] += T[9 * k + r] / v;
-            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mk, sizeof mk);
-        } else {
-            frm_real t[3];
-            frm_column_cross_sum(F, T + 9 * k, t);
-            for (r = 0; r < 3; r++) stq[3 * k + r] = sD * t[r];
-            for (r = 0; r < 9; r++) T[9 * k + r] *= sD;
-            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), t, sizeof t);
-        }
-    }
-    if (linearize) {
-        memcpy(m->s_stabY + 9 * (size_t)s, Y, sizeof Y);
-        m->s_stabD[s] = D;
-    }
-    return energy;
-}
-
-/* The stabilisation's part of K v for sample s (see frm__stab_sample_force): for the
+/* The stabilisation's part of K v for sample s (see frm_pass1_stab_force), for the assembly: for the
    sample's dF and each pair's frame rotation dth[k] (NULL: zero), the stress-like sum
    dPx (absolute: divide by the volume) and each pair's frame-own torque row stq (3 n).
    dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (+ g_k . domega_k for the general pairs), the
@@ -4679,23 +4986,17 @@ static void frm__force_chunks(void *vctx, int begin, int end)
 {
     frm__force_ctx *ctx = (frm__force_ctx *)vctx;
     frm_model *m = ctx->m;
+    const frm_view *w = &m->view;
     int c;
     for (c = begin; c < end; c++) {
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
         double energy = m->vol_mode ? m->chunk_energy[c] : 0; /* volumetric: the law's energy of stage 3 */
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
-            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
-            frm_real offset[3 * FRM_MAX_NEIGHBORS], sT[9 * FRM_MAX_NEIGHBORS], stq[3 * FRM_MAX_NEIGHBORS];
-            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
-                                   m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
-                                   ctx->outputs ? m->s_pos + 3 * s : NULL);
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r;
+            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, D = 0, v = m->s_volume[s];
             const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
-            memcpy(F, H, sizeof F);
-            F[0] += 1; /* F = I + H */
-            F[4] += 1;
-            F[8] += 1;
+            frm_pass1_deform(w, s, H, F, ctx->outputs ? m->s_pos + 3 * s : NULL);
             if (m->vol_mode) { /* P = alpha P_bar + beta F^-T (the law ran in stage 3) */
                 frm_real Fi[9], J = 1 + m->v_jm1[s], al = 1 + m->v_am1[s], be = m->v_beta[s];
                 const frm_real *Pb = m->v_Pbar + 9 * (size_t)s;
@@ -4724,20 +5025,10 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 continue;
             }
             energy += (double)v * (double)psi; /* volumetric: 0 here, the law's energy came from stage 3 */
-            if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
-            for (k = 0; k < n; k++)
-                frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
-                               m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
-            if (stab)
-                for (k = 0; k < n; k++)
-                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
-            if (m->s_couple[s] != 0)
-                energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
-                                                            m->p_out + 6 * (size_t)b,
-                                                            ctx->linearize ? m->p_C + 3 * (size_t)b : NULL);
+            if (m->s_stab[s]) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
+                energy += frm_pass1_stab_force(w, s, H, F, P, ctx->linearize, &D);
+            frm_pass1_force_pairs(w, s, H, F, P, D, ctx->linearize, &energy);
             if (ctx->linearize) {
-                memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
                 if (m->vol_mode) { /* the law's data at F_bar were stored in stage 3 */
                 } else if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
@@ -4751,13 +5042,6 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 if (!m->vol_mode) {
                     memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
                     memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
-                }
-                for (k = 0; k < n; k++) {
-                    frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
-                    frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
-                                       m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k), Hs);
-                    if (stab) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
-                    if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)(b + k), lever + 3 * k, Hs);
                 }
             }
         }
@@ -4784,18 +5068,7 @@ static void frm__gather_chunks(void *vctx, int begin, int end)
     for (c = begin; c < end; c++) {
         int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
         if (i1 > m->frame_count) i1 = m->frame_count;
-        for (i = i0; i < i1; i++) {
-            double sum[6] = {0, 0, 0, 0, 0, 0}, sq = 0;
-            int e, k;
-            for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
-                const frm_real *src = ctx->src + 6 * (size_t)m->rev_pair[e];
-                for (k = 0; k < 6; k++) sum[k] += (double)src[k];
-                if (ctx->scale)
-                    for (k = 0; k < 6; k++) sq += (double)src[k] * src[k];
-            }
-            for (k = 0; k < 6; k++) ctx->dst[6 * i + k] = (frm_real)sum[k];
-            if (ctx->scale) ctx->scale[i] = sq;
-        }
+        for (i = i0; i < i1; i++) frm_pass2_gather(&m->view, i, ctx->src, ctx->dst, ctx->scale);
     }
 }
 
@@ -5043,20 +5316,19 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
 {
     frm__apply_ctx *ctx = (frm__apply_ctx *)vctx;
     const frm_model *m = ctx->m;
+    const frm_view *w = &m->view;
     const frm_real *v = ctx->v;
     int c;
     for (c = begin; c < end; c++) {
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
-            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
+            frm_real dF[9], dP[9];
             if (m->vol_mode) frm__vol_sample_dP(m, s, dF, dP);
             else {
-                for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
-            {
                 int law = m->s_law[s];
                 const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+                frm_pass1_apply_dF(w, s, v, dF);
                 if (frm__laws[law].fast_path)
                     frm_sample_dP(law, prm[0], prm[1], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
                                   m->lin_S + 6 * (size_t)s, dF, dP);
@@ -5064,22 +5336,7 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
                     frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
                                 m->lin_S + 6 * (size_t)s, dF, dP);
             }
-            }
-            if (m->s_stab[s]) {
-                frm_real dPx[9];
-                const frm_real *dth[FRM_MAX_NEIGHBORS];
-                for (k = 0; k < n; k++) dth[k] = v + 6 * m->p_frame[b + k] + 3;
-                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
-                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
-            }
-            for (k = b; k < b + n; k++)
-                frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
-            if (m->s_stab[s])
-                for (k = 0; k < n; k++)
-                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
-            if (m->s_couple[s] != 0)
-                frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->s_couple[s], v,
-                                          m->p_out + 6 * (size_t)b);
+            frm_pass1_apply_pairs(w, s, v, dF, dP, m->lin_definite);
         }
     }
 }
@@ -5150,12 +5407,7 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         if (m->vol_mode) frm__vol_apply_stages(m, v);
         frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
         frm__gather(m, m->p_out, out, NULL);
-        for (i = 0; i < m->frame_count; i++) { /* the frame-own rotational term (pairs' Hs + gravity) */
-            const frm_real *h = m->lin_hrot + 6 * i, *t = v + 6 * i + 3;
-            out[6 * i + 3] += h[0] * t[0] + h[5] * t[1] + h[4] * t[2];
-            out[6 * i + 4] += h[5] * t[0] + h[1] * t[1] + h[3] * t[2];
-            out[6 * i + 5] += h[4] * t[0] + h[3] * t[1] + h[2] * t[2];
-        }
+        for (i = 0; i < m->frame_count; i++) frm_pass2_rotational(&m->view, i, v, out); /* pairs' Hs + gravity */
     }
     if (exact)
         for (i = 0; i < m->frame_count; i++) {
@@ -6849,6 +7101,12 @@ FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36])
 
 FRMDEF size_t frm_model_memory_bytes(const frm_model *m) { return m ? m->block_bytes : 0; }
 FRMDEF int frm_model_stabilized_frames(const frm_model *m) { return m ? m->stab_frames : 0; }
+FRMDEF int frm_model_view(const frm_model *m, frm_view *out)
+{
+    if (!m || !out) return FRM_ERR_ARG;
+    *out = m->view;
+    return FRM_OK;
+}
 
 /* >>stiffness-api ---------------------------------------------------------------------- */
 
