@@ -1120,7 +1120,8 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_PART_FRAME, -38, "a part's frame map is malformed: an index out of range or repeated, a model frame no part gives, or two parts giving one frame different rest poses") \
     X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite") \
     X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0") \
-    X(FRM_ERR_VOLUMETRIC, -41, "volumetric averaging settings invalid (unknown mode, sample_cells missing or out of range, or a frame's averaging volume not > 0)")
+    X(FRM_ERR_VOLUMETRIC, -41, "volumetric averaging settings invalid (unknown mode, sample_cells missing or out of range, or a frame's averaging volume not > 0)") \
+    X(FRM_ERR_DEVICE, -42, "the CUDA companion (frames_cuda.h): no usable device, a device call failed, or the model uses what it does not run (volumetric averaging, a law without a kernel fast path, driven frames)")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
@@ -1511,6 +1512,16 @@ typedef struct frm_view {
     frm_real *p_G, *p_H, *p_A, *p_C, *p_stab;  /* 9, 6, 3, 3, 3: the linearisation's G, Hs, lever a,
                                                   coupling g, stabilisation conjugate */
     frm_real *p_out;                           /* 6: pass 1's partial contributions */
+    /* what a backend's solver needs besides the passes (frames_cuda.cu's implicit step) */
+    const frm_real *quat, *rest_quat, *vel;    /* 4, 4, 6 per frame: the state (with disp) */
+    const frm_real *ext;                       /* 6 per frame: external force (N), torque (N m) */
+    const unsigned char *state, *axes;         /* per frame: 0 free, 1 fixed, 2 driven; held axes bits */
+    const double *mass_local, *grav_local;     /* 10, 4 per frame: m, cbar, Jbar (rest axes); m_g, cbar_g */
+    const frm_real *kdiag_rest;                /* 36 per frame: the rest K_ii (pair mode's preconditioner) */
+    frm_real gravity[3];                       /* m/s^2 */
+    frm_real time_step, mass_damping, stiffness_damping, cg_tolerance; /* s, 1/s, s, relative */
+    int cg_max_iterations;
+    int volumetric;                            /* desc.volumetric (frm_volumetric): the CPU passes' extra stages */
 } frm_view;
 
 /* Library version string "major.minor.patch". */
@@ -4700,6 +4711,16 @@ static void frm__fill_view(frm_model *m)
     w->p_C = m->p_C;
     w->p_stab = m->p_stab;
     w->p_out = m->p_out;
+    w->quat = m->quat;
+    w->rest_quat = m->rest_quat;
+    w->vel = m->vel;
+    w->ext = m->ext;
+    w->state = m->state;
+    w->axes = m->axes;
+    w->mass_local = m->mass_local;
+    w->grav_local = m->grav_local;
+    w->kdiag_rest = m->kdiag_rest;
+    w->volumetric = m->vol_mode;
 }
 
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
@@ -7103,8 +7124,15 @@ FRMDEF size_t frm_model_memory_bytes(const frm_model *m) { return m ? m->block_b
 FRMDEF int frm_model_stabilized_frames(const frm_model *m) { return m ? m->stab_frames : 0; }
 FRMDEF int frm_model_view(const frm_model *m, frm_view *out)
 {
+    int r;
     if (!m || !out) return FRM_ERR_ARG;
     *out = m->view;
+    for (r = 0; r < 3; r++) out->gravity[r] = m->gravity[r]; /* the settings as they are now */
+    out->time_step = m->time_step;
+    out->mass_damping = m->mass_damping;
+    out->stiffness_damping = m->stiffness_damping;
+    out->cg_tolerance = m->cg_tolerance;
+    out->cg_max_iterations = m->cg_max_iterations;
     return FRM_OK;
 }
 
