@@ -17,7 +17,9 @@
    one model from several parts sharing frames, rigid bodies (see COUPLING). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
-   gathers them through a reverse table.
+   gathers them through a reverse table; the passes' bodies are FRM_HOSTDEV functions on
+   a plain view of the model's arrays (frm_view, >>passes) that the CPU loops and the
+   CUDA companion (frames_cuda.cu, see CUDA: compiled, not yet run on a GPU) both call.
 
    DO THIS in exactly one C or C++ file:
 
@@ -80,7 +82,8 @@
        FRM_PARALLEL_MIN_PAIRS
                        default of desc.parallel_min_pairs (20000).
        FRAMES_KERNELS  define (without FRAMES_IMPLEMENTATION) to get only the
-                       FRM_HOSTDEV kernels, e.g. in a .cu file (FRM_HOSTDEV is
+                       FRM_HOSTDEV kernels and pass functions (frm_pass1_*, frm_pass2_*
+                       on a frm_view), e.g. in a .cu file (FRM_HOSTDEV is
                        __host__ __device__ under nvcc, empty otherwise).
 
    STEP BY STEP
@@ -200,7 +203,8 @@
    positive definite (FRM_ERR_RIGID, as creation does for desc.frame_masses / _inertias, and
    FRM_ERR_SAMPLE_SIZE for desc.sample_sizes); frm_probe_create a point outside the body
    (FRM_ERR_POINT_OUTSIDE: in no element, or farther from each of its meshless frames than
-   that frame's farthest sample).
+   that frame's farthest sample). The CUDA companion (frames_cuda.h) returns FRM_ERR_DEVICE
+   for no device, a failed CUDA call or a model feature it does not run (see CUDA).
    A step or solve never reports success with an unconverged or unchecked result: one that
    meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
    FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
@@ -223,6 +227,7 @@
    contributions in pair order through the reverse table (pass 2), energies add chunk
    partial sums in chunk order, and the CG's vector work is serial: results are
    bit-identical whatever the number of threads or the job system's split. No atomics.
+   The chunks' bodies are the pass functions of >>passes (see CUDA).
 
    THE MODEL (thesis equations; our derivations where the printed ones differ)
        Kinematics. A sample s has rest position pbar_s, volume v_s and neighbours i with
@@ -794,8 +799,8 @@
          need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
          attached to a rigid body (the attached frames are no longer frames of the model).
        - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes, the
-         block-tridiagonal chain solver, inverse actuation and the CUDA companion are not in
-         this version.
+         block-tridiagonal chain solver and inverse actuation are not in this version; the
+         CUDA companion runs a subset and has not run on a GPU yet (see CUDA).
 
    MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
@@ -886,7 +891,62 @@
        momentum balance of each step with an internal impulse (7e-10), a weight on a strap
        reaches the strap's extension within 0.15 % (static solve and damped steps).
 
+   CUDA (issue 16; thesis sec. 4.4, Bosman, Duriez & Cotin 2013 sec. 3-5)
+       One kernel code. The bodies of the two passes are FRM_HOSTDEV functions (>>passes) on
+       a frm_view, a public struct of counts and pointers (frm_model_view fills one that
+       points into the model): pass 1 per sample, frm_pass1_deform (H, F, position), then the
+       law (the backend's: the CPU runs the law table, user callbacks included; a GPU the
+       kernels' laws frm_material_stress / frm_sample_dP), frm_pass1_stab_force (the
+       rotation stabilisation's stress and energy), frm_pass1_force_pairs (each pair's
+       partial force, the linearisation's G, Hs, levers); for K v frm_pass1_apply_dF, the
+       law's dP, frm_pass1_apply_pairs; pass 2 per frame frm_pass2_gather (the reverse
+       table, in pair order, in double) and frm_pass2_rotational. The CPU loops call exactly
+       these (results bit-identical to the loops they replaced, for every thread count:
+       measured on 12 scenes, hexahedra and tetrahedra, every law, the coupling term,
+       volumetric averaging, blocks, BDF2, double, float and 2 OpenMP threads, and
+       tests/test_frames_elem.c test_view_passes runs a serial backend of its own on the
+       view and gets the model's forces and K v bit for bit). No per-pair arrays on the
+       stack (a GPU thread's 290 numbers would spill): what a sample's sums need twice (a
+       pair's lever, the stabilisation's T_k and omega_k) is recomputed by the same
+       expression, and the stabilisation's K v torques wait in p_out until dP is complete;
+       only the coupling term (frame_coupling, off by default) keeps 96 reals (nvcc -Xptxas
+       -v: pass 1 of the force 768 bytes of stack, of K v 384, both from that term; no
+       spills). The volumetric option's extra stages (VOLUMETRIC AVERAGING) stay CPU-only.
+       The companion (frames_cuda.cu, declared in frames_cuda.h: a separate header, so that
+       frames.h needs no CUDA types and programs without a GPU see nothing of it; nvcc -c
+       frames_cuda.cu [-DFRM_REAL=float], link with -lcudart; frames.h's functions with C
+       linkage): frm_cuda_create uploads a created model (structure, rest data, state,
+       loads, settings) once; frm_cuda_step runs the linearised implicit Euler step (the
+       thesis's scheme, one linear solve a step) on one stream: the force pass and its
+       linearisation (pass 1 one thread a sample, pass 2 one thread a frame, 128 a block:
+       not measured yet; the thesis's 6 threads a frame in blocks of 96 parallelise inside
+       a frame, which pays when frames are few), the pair mode's block-Jacobi blocks
+       inverted per frame, CG with its dot products in double reduced by a fixed-order tree
+       (no floating-point atomics: repeatable bit for bit on one GPU) and the scalars on the
+       device (16 iterations between two looks at convergence; the iterations past it change
+       nothing, so the count equals the CPU's rule), then the update and the acceptance
+       (finite state, no sample with det F <= 0); a failed step restores the device state
+       of the step's start (FRM_ERR_NO_CONVERGENCE, FRM_ERR_NOT_FINITE, FRM_ERR_INVERTED,
+       as the CPU path). frm_cuda_forces, frm_cuda_linearize, frm_cuda_apply_stiffness (K v,
+       symmetric part), frm_cuda_download (into the host model), frm_cuda_upload_state.
+       Not on the device: the static solve, Newton-based implicit Euler and BDF2, the
+       definite fallback (the device step fails where the CPU retries with K's positive
+       part), the precision check, assembled blocks, volumetric averaging, Mooney-Rivlin
+       and user laws, driven frames (FRM_ERR_DEVICE at creation).
+       Verified: frames_cuda.cu compiles with nvcc 13.0 for sm_80 and sm_90 with warnings as
+       errors (make test, tests/test_cuda.sh: about 30 s); tests/cuda_frames.c builds and
+       links, and on a machine without a GPU frm_cuda_create returns FRM_ERR_DEVICE. NOT
+       verified: nothing of it has run on a GPU. tests/cuda_frames.c (forces, K v and one
+       step against the CPU within tolerances it justifies, two device runs bit-identical,
+       an overloaded step keeping the last valid state) and bench/gpu.sh (the thesis's
+       34,610-sample step at 60 CG iterations, 1e6 samples, device and CPU of the same run,
+       written to bench/results/gpu-<name>/) are ready for the first session with a GPU.
+
    HISTORY
+       unreleased (issue 16): frm_view and frm_model_view (frm_model_view_f32), the pass
+             functions frm_pass1_* and frm_pass2_* (>>passes) that the CPU loops now call;
+             frames_cuda.cu / frames_cuda.h (frm_cuda_*), FRM_ERR_DEVICE (-42). Results of
+             existing models bit-identical.
        unreleased (issue 14): coupling: mapped points (frm_probe_jacobian,
              frm_probe_jacobian_transpose, frm_probe_add_external; frm_probe_desc.nodes,
              node_frames, node_count), several parts (frm_part, frm_parts_combine,
