@@ -33,7 +33,8 @@ HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/tes
            tests/fixtures.h
 FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
 
-CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
+CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double \
+           simd-double simd-float
 
 CC_gcc-double   := gcc -std=c99 -O2
 CC_gcc-float    := gcc -std=c99 -O1 $(FLOAT)
@@ -44,6 +45,15 @@ CC_clang-float  := clang -std=c99 -O1 $(FLOAT) -DTEST_QUICK
 CC_omp-double   := gcc -std=c99 -O2 -fopenmp
 CC_asan-double  := gcc -std=c99 -O1 -g1 -fno-omit-frame-pointer -fsanitize=address,undefined \
                    -fno-sanitize-recover=all -DTEST_QUICK
+# The headers' vector paths (intrinsics behind compile-time checks of the target, issue 21)
+# exist only when the target has them: these two build for this machine (-march=native;
+# on a machine without AVX they test the scalar path again) and run the programs of the
+# headers that have such paths (heml.h: test_heml, whose test_vector_paths_match_scalar
+# compares them with the scalar path bit for bit; in double also test_heml_sim, whose
+# thread-count determinism and allocation tests then run the vector paths), on the
+# TEST_QUICK sizes, double with 2 OpenMP threads.
+CC_simd-double  := gcc -std=c99 -O2 -march=native -fopenmp -DTEST_QUICK
+CC_simd-float   := gcc -std=c99 -O2 -march=native $(FLOAT) -DTEST_QUICK
 
 # Passive waiting: libgomp's idle threads otherwise spin (about 300,000 polls, 0.1 to 1 ms)
 # at every barrier before they sleep. On a machine whose other core is busy the spinning
@@ -51,6 +61,7 @@ CC_asan-double  := gcc -std=c99 -O1 -g1 -fno-omit-frame-pointer -fsanitize=addre
 # thread, 141 s on 2, 1.3 s on 2 passive (issue 18), and `make test` 37 minutes instead of
 # 4. Passive: idle threads sleep at once; the tests check results, not speed.
 ENV_omp-double := OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive
+ENV_simd-double := OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive
 
 TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 COMPILE_ONLY := test_compile_all test_compile_static
@@ -58,6 +69,8 @@ COMPILE_ONLY := test_compile_all test_compile_static
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
 TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
+TESTS_simd-double := test_heml test_heml_sim
+TESTS_simd-float := test_heml
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
 # part of its own test programs)
@@ -192,8 +205,23 @@ build/bench/%_float.o: bench/%.c bench/bench.h bench/body_mesh.h bench/model_com
 	@mkdir -p build/bench
 	gcc $(BENCH_CFLAGS) $(WARN) -DBENCH_FLOAT -c -o $@ $<
 
-build/bench/bench: bench/bench.c bench/bench.h bench/svg.h $(BENCH_OBJS)
-	gcc $(BENCH_CFLAGS) $(WARN) $(BENCH_DEFS) -o $@ bench/bench.c $(BENCH_OBJS) -lm
+# The peer (issue 21): Bullet's deformable bodies, when Debian's libbullet-dev is installed
+# (pkg-config bullet); otherwise the bench prints how to install it and skips those rows.
+# (-Wno-maybe-uninitialized: gcc 12 warns inside Bullet's own array templates.)
+BULLET := $(shell pkg-config --exists bullet 2>/dev/null && echo 1)
+ifeq ($(BULLET),1)
+BENCH_PEER_OBJS := build/bench/peer_bullet.o
+BENCH_PEER_DEFS := -DBENCH_HAVE_BULLET
+BENCH_PEER_LIBS := $(shell pkg-config --libs bullet) -lstdc++
+endif
+
+build/bench/peer_bullet.o: bench/peer_bullet.cpp bench/bench.h bench/body_mesh.h examples/tetmesh.h
+	@mkdir -p build/bench
+	g++ -std=c++11 -O3 -march=native -Wall -Wextra -Werror -Wno-maybe-uninitialized $(patsubst -I%,-isystem %,$(shell pkg-config --cflags bullet)) -c -o $@ $<
+
+build/bench/bench: bench/bench.c bench/bench.h bench/svg.h $(BENCH_OBJS) $(BENCH_PEER_OBJS)
+	gcc $(BENCH_CFLAGS) $(WARN) $(BENCH_DEFS) $(BENCH_PEER_DEFS) -o $@ bench/bench.c $(BENCH_OBJS) $(BENCH_PEER_OBJS) \
+	  $(BENCH_PEER_LIBS) -lm
 
 # The bench's 2-thread kernel rows run with passive waiting too (see ENV_omp-double): on a
 # shared machine spinning threads measure the neighbours' load, not the kernel. It costs

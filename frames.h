@@ -9,8 +9,9 @@
    functions, Poisson-disk sampling of boxes and closed surfaces, St Venant-Kirchhoff,
    compressible Neo-Hookean, compressible Mooney-Rivlin and user-defined (callback)
    samples, exact forces and stiffness (material and geometric),
-   a static Newton solver, implicit Euler and BDF2, all with block-Jacobi conjugate
-   gradient, matrix-free or by assembled 6x6 blocks, modal analysis (the lowest natural
+   a static Newton solver, implicit Euler and BDF2, all with conjugate gradient
+   preconditioned by block-Jacobi plus a coarse space (two levels), matrix-free or by
+   assembled 6x6 blocks, modal analysis (the lowest natural
    frequencies and modes about the current state), point probes (a material point's
    position, displacement and velocity through the shape functions) that double as mapped
    points (their Jacobian J and J^T: point forces as frame loads, coupling), and coupling:
@@ -144,7 +145,7 @@
           2^order), energy behaviour on a free body, bit-identical results for 1 and 2
           threads (the determinism test of tests/test_frames.c), refusal of bad values.
        A linear solver: a value before FRM_LINEAR_SOLVER_COUNT in frm_linear_solver and a
-          case in frm__linear_solve (>>solver) returning the FRM__CG_* statuses (OK, CAP,
+          case in frm__linear_solve (>>solver; FRM_LINEAR_SOLVER_BTD's is in >>btd) returning the FRM__CG_* statuses (OK, CAP,
           NEGATIVE, NOT_FINITE), which the Newton loops map to FRM_ERR_NO_CONVERGENCE and
           FRM_ERR_NOT_FINITE. Scratch vectors are named by role in frm_model (cg_r, ...,
           newton_dx) and carved in frm__layout. Tests: the same solutions as CG to the
@@ -440,7 +441,7 @@
 
    SOLVERS
        Static (sec. 3.6): Newton iterations K dq = f on the free frames (f the total
-       force), each by block-Jacobi preconditioned CG stopped at an Eisenstat-Walker
+       force), each by two-level preconditioned CG (below) stopped at an Eisenstat-Walker
        relative residual (1e-3, then as fast as the residual falls, never below
        cg_tolerance, never tighter than the step can use), then a backtracking Armijo line
        search on the total potential (elastic + gravity - f_ext . dq; constant torques have
@@ -566,6 +567,52 @@
        linear solve (right-hand side, iterates, products and the block-Jacobi blocks), the
        line search and the step update; their velocity is zero; their forces count as
        reactions in the residual's scale.
+       Preconditioner (issue 21): two levels. The fine level is block-Jacobi (the inverse
+       6x6 diagonal blocks); the coarse level adds P A_c^-1 P^T, with the frames binned
+       into at most desc.coarse_aggregates (default FRM_COARSE_AGGREGATES = 32) cells of
+       their rest bounding box, at least FRM_COARSE_MIN_FRAMES (8) frames each, and 9
+       modes per aggregate: its translation t, its rigid rotation omega (frame i moves by
+       t + omega x (x_i - c), turns by omega) and the frames' own rotation phi (turns by
+       phi, does not move). The last is the one slender and stabilised bodies need: a
+       field of frame rotations that moves no material costs only the stabilisation's
+       h^2 energy, so block-Jacobi resolves it slowest, and rigid modes alone gained only
+       2-3 times (measured on R1). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin
+       product of the linearisation (rotation stabilisation and held axes included, the
+       coupling term left out), from the assembled blocks in block mode (about 150
+       multiply-adds a block) or a per-sample pass in pair mode (9 sample products per
+       aggregate the sample touches), dense and Cholesky-factored in double, a pivot at or
+       below 1e-10 of its diagonal dropping its mode; built at the first CG iteration after
+       each linearisation, serially in a fixed order (bit-identical for any thread count),
+       in the model's block (no allocation: (9 A)^2 doubles, 663 kB for 32 aggregates).
+       Static solves always use it; solves with mass (implicit steps, shifted modal
+       solves) once a solve by block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS (40)
+       or met cg_max_iterations (that solve is then continued with it): below that the
+       build (about ten products) costs more than it saves (float builds: only after a
+       solve met the cap; with it, a float implicit step of a tetrahedral plate one cell
+       thick met round-off curvature at 8e-4 relative residual and failed, tests/
+       test_frames.c test_i14_thin_plate). coarse_aggregates = 0 gives
+       block-Jacobi alone. Measured (issue 21; one core, gcc -O2 -march=native, CPU time;
+       R1 16 x 0.5 x 0.5 m steel cantilever, 32k x k x k cells, clamped, own weight), CG
+       iterations of the first Newton solve (to 1e-3) with / without the coarse level (64
+       aggregates; the default 32 measured 60 against 57 at k = 4):
+           hexahedral frames, 2^3 samples a cell:
+             k = 1 (132 frames) 35 / 424, k = 2 (585) 36 / 579, k = 3 (1,552) 45 / 829,
+             k = 4 (3,225) 57 / 1,097, k = 6 (9,457) 78 / 1,637
+           tetrahedral frames (6 a cube), one sample each:
+             k = 1 138 / 1,545, k = 2 61 / 2,125, k = 3 67 / 3,094, k = 4 81 / 4,101
+       so within 3x of the smallest mesh's count as the frames grow 72x. The whole static
+       solve (Newton and the minimum check's probe solve): hexahedral k = 3 (1.7 % off
+       R1's 3D solid) 0.92 s against 2.48 s CPU, k = 4 (0.91 %) 2.45 s against 9.9 s,
+       k = 6 (0.39 %) 13.3 s against 59 s; tetrahedral k = 4 0.61 s against 5.6 s. The
+       probe (CG to 1e-7 from a pseudo-random right-hand side) is now most of the hexahedral
+       solve: 1,112 of 1,233 iterations at k = 4 (it excites the stabilised rotation modes of
+       every wavelength, which no coarse mode holds). Implicit Euler on the same beam (k = 2,
+       five steps and creation, CPU, default 32 aggregates): steel at dt = 1 ms, 10 ms,
+       0.1 s 0.40 / 0.48 s, 0.66 / 1.02 s, 0.64 / 1.36 s (with / without; the last step's
+       solves 42 / 355, 66 / 1,282, 68 / 1,968 CG iterations); E = 1 MPa: dt = 1 ms and
+       10 ms need under 40 iterations (it stays off: same time), at dt = 0.1 s it turns on
+       and breaks even (0.72 against 0.70 s; 87 against 233 iterations; 64 aggregates
+       lost 30 %: its Cholesky each Newton iteration), see LIMITS.
        One CG policy: a linear solve stopped at cg_max_iterations above its tolerance fails
        the step or solve (FRM_ERR_NO_CONVERGENCE, state kept; stats.cg_residual tells how
        far it got); a non-finite |b|^2 or iterate is FRM_ERR_NOT_FINITE.
@@ -696,6 +743,32 @@
          21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
          Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
          test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
+       - Thin parts (issue 14): a plate one cell thick of hexahedral frames solves static and
+         implicit problems and converges under refinement (tests/test_frames.c
+         test_i14_thin_plate: 1 x 1 x 0.05 m cantilever plate under its own weight, 5.85,
+         6.12, 6.20 mm at 4, 8, 16 cells a side, beam theory 5.89 mm); tetrahedral frames
+         one cell thick (one sample each) solve but do not converge in sight (2.87, 5.47,
+         7.54 mm). A thin slab loaded in its plane can buckle: Cook's membrane one element
+         thick (48 x 44..60 x 1, E = 240.565 Pa, nu = 0.3) has no stable flat state beyond
+         F = 2.05 N (hexahedral frames, 16 cells a side; 4.5 N at 4): at the usual F = 32 N
+         the flat state is a saddle and, the load being symmetric about the mid-plane,
+         Newton cannot leave the plane: the static solve refuses (FRM_ERR_UNSTABLE, or
+         FRM_ERR_STALLED when the continuation wanders near the saddle; the stall message's
+         "rotations the samples do not see" is then not the cause). Hold the out-of-plane
+         axes for the plane problem (frm_model_set_frame_axes(m, i, 4, 3): test_i18_cook_membrane)
+         or nudge it out of plane (1e-3 of the load) for the buckled one (corner u_y 7.8,
+         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations). Frames along a
+         curve (meshless Shepard frames on a line, samples in a thin tube) solve but are not
+         consistent: zero-order weights on a line give no convergent bending (tip 0.65,
+         1.6, 3.1, 8.9 mm at 4 to 32 frames against 5.9 mm); a rod model is not done.
+       - Models with volumetric averaging (desc.volumetric, issue 13) solve with
+         block-Jacobi alone: the coarse matrix's per-sample pass does not know the cell
+         averages (not measured; to do).
+       - The coarse correction of implicit steps turns on after a solve needs 40
+         block-Jacobi iterations; on soft bodies at large steps (E = 1 MPa beam, dt = 0.1 s,
+         40 to 90 iterations a solve) it only breaks even (it is rebuilt every Newton
+         iteration; reusing it across a step's iterations is not done); more aggregates
+         lose there (64: 30 % slower than block-Jacobi alone).
        - Indefinite linearisations (compression, buckling, the invisible rotations above)
          make the static Newton fall back to K's positive-definite part, which converges
          linearly, not quadratically, while K stays indefinite.
@@ -798,15 +871,21 @@
          between bodies but shared or attached frames. Mesh-based probes on a combined model
          need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
          attached to a rigid body (the attached frames are no longer frames of the model).
-       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes, the
-         block-tridiagonal chain solver and inverse actuation are not in this version; the
-         CUDA companion runs a subset and has not run on a GPU yet (see CUDA).
+       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes is not in
+         this version; the CUDA companion runs a subset and has not run on a GPU yet (see
+         CUDA).
+       - Reduced chain (issue 15): each link is linear in its proximal frame's axes (small
+         strain, large rotations: the thesis's model), so a link bent by tens of degrees is
+         inaccurate (its rotation measure 2 sin(theta/2) saturates); use more vertebrae.
+         Vertebra masses are points with isotropic inertia; the actuators' geometric
+         stiffness is left out of the tangent; BTD factor + solve measured 4 to 5 times the
+         issue's 50 us goal for 1,000 blocks on this machine.
 
    MODAL ANALYSIS (issue 19): frm_modal_create(m, &desc, &md) sizes a workspace (block =
    count + max(count, 8) vectors); frm_modal_solve(md, m) linearises m at its current state
    (the symmetric part of K, gravity's and the stresses' geometric terms included; the
    constraints as set) and runs block shift-invert subspace iteration: Y = (K + shift M)^-1
-   M X by the model's linear solver (block-Jacobi CG, warm-started at X / (lambda + shift)
+   M X by the model's linear solver (two-level preconditioned CG, warm-started at X / (lambda + shift)
    once a Ritz value exists), Rayleigh-Ritz on Y (Cholesky of Y^T M Y, Jacobi), X the
    M-orthonormal Ritz vectors, until every wanted residual is below tolerance (or the Ritz
    values stop moving). Chosen over LOBPCG for its simplicity with a matrix-free K and an
@@ -942,11 +1021,132 @@
        34,610-sample step at 60 CG iterations, 1e6 samples, device and CPU of the same run,
        written to bench/results/gpu-<name>/) are ready for the first session with a GPU.
 
+   BLOCK-TRIDIAGONAL SOLVER (issue 15): frm_btd_factor / frm_btd_solve / frm_btd_compliance,
+   usable on their own for any chain of 6-DoF nodes (rods, cables, catheters, trunk robots).
+   The matrix: n diagonal 6x6 blocks and n - 1 sub-diagonal blocks A(i + 1, i), symmetric
+   positive definite. Block Cholesky (block Thomas in LL^T form; chosen over block LDL^T by
+   measurement: the same flops, and the inverted triangular factor G_i = L_i^-1 makes every
+   product of the factorisation and the solves a full fixed-size 6x6 one): L_i L_i^T = A_ii -
+   S_{i-1} S_{i-1}^T, S_i = A(i + 1, i) G_i^T; forward y_i = G_i (b_i - S_{i-1} y_{i-1}),
+   backward x_i = G_i^T (y_i - S_i^T x_{i+1}); O(n), 72 reals a block, one or many right-hand
+   sides, arithmetic in double whatever frm_real. A pivot at or below 4 (n + 16) eps(frm_real)
+   times the block's own diagonal entry is refused: FRM_ERR_BTD_INDEFINITE (negative) or
+   FRM_ERR_BTD_SINGULAR (zero), the failing block reported; a non-finite pivot or result is
+   FRM_ERR_NOT_FINITE (the solve then zeroes its output: never NaN). frm_btd_compliance gives
+   W = J A^-1 J^T for a few constraint rows (eqs. 5.24-5.25) by rows solves, without A^-1.
+   Tested against dense Cholesky for 1 to 60 blocks and by residuals at 1,000, with
+   symmetric scalings that put the condition number near 1e10 (tests/test_frames_chain.c).
+   Measured (one core of the development machine, gcc -O3 -march=native, double, 1,000
+   blocks): factor 170 us and solve 28 us at best of 50 runs; the bench's btd rows (median
+   of 5 batches, the machine loaded to 5-7 on 2 cores) 420-520 us and 33 us, linear from 10
+   to 10,000 blocks. The issue's goal of 50 us was not met: the factorisation is a sequential chain of 6x6 Cholesky steps whose
+   square roots and divisions (6 each a block) are latency-bound, about 0.2 us a block.
+   In the frames solvers: desc.linear_solver = FRM_LINEAR_SOLVER_BTD for a model whose block
+   pattern is a chain (frame i coupled to i - 1 and i + 1 only; checked at creation,
+   FRM_ERR_SOLVER otherwise); it assembles the blocks (block stiffness mode forced), makes
+   held components identity rows, factors a_mass M + a_stiff K, checks |b - A x| <= tolerance
+   |b| against the model's own product (up to three steps of iterative refinement: float
+   needs them), and reports a failed factorisation as negative curvature (the Newton loops
+   then retry with K's positive-definite part, as after CG). The default stays CG: a model
+   is not switched automatically (its results would change); the reduced chain below always
+   uses BTD.
+
+   REDUCED CHAIN (issue 15; thesis sec. 5.2): frm_chain, a soft arm with rigid vertebrae as
+   frames 0..n-1 (frame 0 the base, held at its pose: frm_chain_set_base moves it) joined by
+   n - 1 linear 6-DoF springs, each given by its compliance C_i (eq. 5.10) in frame i's rest
+   axes: the response (displacement, rotation) of frame i + 1 to a force and torque at its
+   origin with frame i held. A tapered arm is one compliance per link. Link energy, with
+   q_0, q_1 the link's frames (our formulation of eqs. 5.12-5.18, the thesis's rotations
+   carried in Omega_0):
+       d = R_0^T (x_1 - x_0) - dbar,   phi = 2 vec(q_e), q_e = conj(q_0) q_1 conj(qbar_rel)
+       (w >= 0),   E = 1/2 e^T C^-1 e,   e = (d, phi),
+   the link linear in frame 0's axes (dbar and qbar_rel the rest lever and relative
+   orientation); phi equals the relative rotation vector to O(theta^3) (0.04 % at 0.1 rad
+   a link). Forces: with g = C^-1 e, F = R_0 g_t and m = R_0 (w g_r + v x g_r) (v, w the parts
+   of q_e): frame 1 gets (-F, -m), frame 0 (F, m + (x_1 - x_0) x F), which is eq. 5.13-5.15
+   with H_{0,1} built on the current lever (exact moment balance) and the measure's Jacobian
+   w I + [v]x in place of I. The tangent K = -df/dq is the exact derivative (a 12 x 12 matrix
+   per link by 12 directional derivatives, closed form), whose symmetric part the solvers
+   factor; at rest it equals Omega Gamma Omega^T of eqs. 5.16-5.17. Where the exact symmetric
+   part is not positive definite (a link past a bifurcation) the Newton iteration factors the
+   Gauss-Newton part J^T C^-1 J instead (eqs. 5.16-5.17 with the current lever; positive
+   semi-definite, definite with the base held). Tests: force = -dE/dq and K = -df/dq by
+   central differences at a random large deformation, Euler-Bernoulli links reproducing the
+   cantilever's P L^3 / 3 E I (1e-5), pure bending to 90 degrees against the circular arc
+   (0.5 % of L; measured +0.01 % and +0.25 %), a moving base carrying the chain rigidly.
+   Masses are lumped at the frames' origins (kg) with an isotropic rotational inertia (kg m^2);
+   gravity acts at the origins (no torque), external loads are constant forces and torques.
+   frm_chain_solve_static: Newton (eq. 5.19) on frames 1..n-1 through the BTD solver, a
+   backtracking line search on the potential (elastic energy, gravity's and external forces'
+   work, cables' tension times length, cavities' -p V; constant torques by their work along
+   the step), converged when |f| <= newton_tolerance (|loads| + |base reaction| + |actuator
+   forces|), or, once an iteration no longer halves |f|, below its round-off floor (16 eps
+   times the links' force sums and stiffness times the positions' rounding); state unchanged
+   on failure. frm_chain_step: implicit Euler by the same Newton on the step's incremental
+   potential (mass M/dt^2, mass damping alpha; rotations as the step's accumulated world
+   rotation vectors, gyroscopic terms neglected), tested against the scheme's own recurrence.
+   The compliance of an intervertebra from a frames sub-model (eqs. 5.1-5.11):
+   frm_chain_link_compliance(m, end_a, end_b, origin_b, C) holds end A's frames' translations,
+   moves end B's frames' translations rigidly with a virtual frame at origin_b, and forms the
+   Schur complement of the model's linear stiffness at its current (rest) state by six
+   imposed unit rigid motions, the interior solved by the model's linear solver; C = K_red^-1.
+   The ends' frame rotations are left free: a frames model's frames do not turn with the
+   material in bending (on hexahedral grids about half as much, see MODEL), and holding them
+   to the rigid rotation made the sub-model 22 % too stiff in bending (measured on a 4-cell
+   segment). The reduced chain of a 0.1 x 0.1 x 2 m square cylinder (5 segments of 4 x 2 x 2
+   hexahedral cells) matches the full frames model's tip deflection within +0.34 % (the
+   thesis: 0.72 %; the reduced model keeps each segment's end sections rigid);
+   examples/heml_link_compliance.c does the same from a heml.h mesh by imposed motions and
+   reactions, without the headers including each other.
+
+   INVERSE ACTUATION (issue 15; thesis sec. 5.3). Actuators (frm_actuator, at creation): a
+   cable through points fixed to vertebrae (rest positions, world axes), its effort the
+   tension lambda >= 0 (force -lambda dL/dq, L the path's length through the points: each
+   point gets the difference of its segments' unit vectors); a pneumatic cavity, a closed
+   surface of triangles whose vertices are fixed to vertebrae, its effort the pressure p
+   (force p dV/dq: each vertex gets sum_j A_j n_j / 3 over its triangles, eq. 5.20, mapped to
+   its frame as a force and a torque about the frame's origin, the rigid mapping's J^T).
+   Bounds 0 <= min <= max per actuator. The actuators' own geometric stiffness (lambda d2L/dq2)
+   is not in the tangent: Newton converges linearly under large efforts (the line search and
+   the residual test keep the answer exact). Direct simulation: frm_chain_set_efforts, then
+   frm_chain_solve_static. Inverse (frm_chain_inverse_step, one control step): the free
+   motion dq_f = K^-1 f(q) without actuators (eq. 5.23's linearisation), W_ea = J_e K^-1 J_a^T,
+   W_aa = J_a K^-1 J_a^T by one BTD factorisation and na + 1 solves (eqs. 5.24-5.25), the
+   effector's linearised gap delta_free = p_e(q) - target + J_e dq_f (3 rows, or 6 with the
+   orientation: the rotation from the target to the effector frame), then the QP of eq. 5.29,
+       min 1/2 lambda^T (W_ea^T W_ea + eps W_aa) lambda + lambda^T W_ea^T delta_free
+   over the bounds, eps = inverse_epsilon tr(W_ea^T W_ea) / tr(W_aa) (default 1e-5: small
+   enough not to bias a reachable answer, large enough to make the QP definite when there
+   are more actuators than effector rows), solved by frm_qp_box, a primal active-set method
+   (chosen over projected Newton: exact finite termination for these sizes, a Cholesky of
+   the free set per change; at most 64 variables, 8 n + 32 changes), then the efforts are
+   applied by the direct simulation from the current state. frm_chain_inverse_solve repeats
+   the step with the linearisation updated (eq. 5.23) until the effector is within tolerance.
+   An unreachable target (the QP's own linearised error above tolerance, stalled over two
+   steps) returns FRM_ERR_UNREACHABLE with the chain at the closest pose found (a valid
+   equilibrium: the one code that leaves a new state); a QP that is not convex returns
+   FRM_ERR_QP_INDEFINITE, never NaN. Measured (tests/test_frames_chain.c, 16-vertebra
+   tapered arm, 2 x 3 cables): a reachable target within 0.03 % of the arm's length after
+   one linearisation; the unreachable target's closest pose passes a first-order check (no
+   single effort moved by 1 N within its bounds brings the tip closer). examples/
+   frames_soft_arm.c tracks the thesis's 60 mm circle and 80 mm square with one
+   linearisation a 20 ms control step: mean error 0.01-0.02 mm, about 0.45 ms a step.
+   PATENT NOTE: the thesis's control method, inverse simulation by a QP in constraint space
+   (this section's frm_chain_inverse_step / _solve), is the subject of patent FR3002047 /
+   WO2014122134A1 (Inria, priority 8 February 2013). The solver building blocks (BTD, the
+   box QP, the chain model, the actuators' direct simulation) are general; users deploying
+   the inverse controller commercially must check that patent's status themselves.
+
    HISTORY
        unreleased (issue 16): frm_view and frm_model_view (frm_model_view_f32), the pass
              functions frm_pass1_* and frm_pass2_* (>>passes) that the CPU loops now call;
-             frames_cuda.cu / frames_cuda.h (frm_cuda_*), FRM_ERR_DEVICE (-42). Results of
+             frames_cuda.cu / frames_cuda.h (frm_cuda_*), FRM_ERR_DEVICE (-49). Results of
              existing models bit-identical.
+       unreleased (issue 15): the block-tridiagonal solver (frm_btd_*, and
+             FRM_LINEAR_SOLVER_BTD for chain-pattern models), the box QP frm_qp_box, the
+             reduced chain model with actuators and the inverse model (frm_chain_*,
+             frm_actuator), error codes FRM_ERR_BTD_INDEFINITE .. FRM_ERR_QP_INDEFINITE.
+             Results of existing models bit-identical.
        unreleased (issue 14): coupling: mapped points (frm_probe_jacobian,
              frm_probe_jacobian_transpose, frm_probe_add_external; frm_probe_desc.nodes,
              node_frames, node_count), several parts (frm_part, frm_parts_combine,
@@ -968,6 +1168,9 @@
        0.1.0 (2026-12-01) first release: frames and samples, four shape functions, mesh
              and Poisson-disk sampling, SVK and Neo-Hookean, exact stiffness, static
              Newton and implicit Euler with block-Jacobi CG, matrix-free or by blocks.
+       unreleased (issue 21): CG preconditioned by two levels, block-Jacobi plus a coarse
+             space of 9 modes per aggregate of frames (desc.coarse_aggregates, default 32;
+             0 = block-Jacobi alone): results change within the solve tolerances.
        unreleased (issue 18): the divergence term of the rotation stabilisation
              (desc.rotation_divergence, default 4: removes the tetrahedral frames' spurious
              low modes and the hexahedral frames' zero-energy rotations; changes results
@@ -1122,6 +1325,12 @@ typedef FRM_REAL frm_real;
    memory, thesis sec. 4.4). */
 #define FRM_MAX_NEIGHBORS 16
 
+/* The two-level preconditioner's coarse space (desc.coarse_aggregates, see SOLVERS): the
+   default and largest number of aggregates, and the fewest frames an aggregate holds. */
+#define FRM_COARSE_AGGREGATES 32
+#define FRM_COARSE_MAX_AGGREGATES 256
+#define FRM_COARSE_MIN_FRAMES 8
+
 /* The least bytes each kernel streams per (sample, neighbour) pair (see PERFORMANCE), for
    bandwidth bounds: the force pass (pass 1 reads index, weight, gradient and rest lever,
    writes 6 reals; pass 2 reads them back with the pair index), the matrix-free K v (pass 1
@@ -1181,13 +1390,20 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_RIGID, -39, "rigid body mass not finite and > 0, or its inertia not finite, symmetric positive definite") \
     X(FRM_ERR_SAMPLE_SIZE, -40, "sample size (desc.sample_sizes) not finite and >= 0") \
     X(FRM_ERR_VOLUMETRIC, -41, "volumetric averaging settings invalid (unknown mode, sample_cells missing or out of range, or a frame's averaging volume not > 0)") \
-    X(FRM_ERR_DEVICE, -42, "the CUDA companion (frames_cuda.h): no usable device, a device call failed, or the model uses what it does not run (volumetric averaging, a law without a kernel fast path, driven frames)")
+    X(FRM_ERR_BTD_INDEFINITE, -42, "block-tridiagonal factorisation met a negative pivot: the matrix is not positive definite (the failing block is reported)") \
+    X(FRM_ERR_BTD_SINGULAR, -43, "block-tridiagonal factorisation met a zero pivot: the matrix is singular to working precision (the failing block is reported)") \
+    X(FRM_ERR_COMPLIANCE, -44, "link compliance not finite, not symmetric or not positive definite") \
+    X(FRM_ERR_ACTUATOR, -45, "actuator malformed: unknown kind, too few points, a point on a frame outside the chain, coincident cable points, a triangle index out of range or a cavity enclosing no volume") \
+    X(FRM_ERR_ACTUATOR_BOUNDS, -46, "actuator bounds invalid (not 0 <= min <= max) or an effort outside them") \
+    X(FRM_ERR_UNREACHABLE, -47, "target out of reach: the chain was left at the closest pose found (a valid equilibrium)") \
+    X(FRM_ERR_QP_INDEFINITE, -48, "quadratic program not convex (negative curvature beyond round-off)") \
+    X(FRM_ERR_DEVICE, -49, "the CUDA companion (frames_cuda.h): no usable device, a device call failed, or the model uses what it does not run (volumetric averaging, a law without a kernel fast path, driven frames)")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -42
+    FRM_ERR_LAST_ = -50
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1275,7 +1491,9 @@ typedef enum frm_integrator {
 
 /* Linear solvers of every Newton iteration (static solve and implicit steps). */
 typedef enum frm_linear_solver {
-    FRM_LINEAR_SOLVER_CG = 0, /* block-Jacobi preconditioned conjugate gradients (default) */
+    FRM_LINEAR_SOLVER_CG = 0, /* conjugate gradients, block-Jacobi plus the coarse space (default) */
+    FRM_LINEAR_SOLVER_BTD = 1, /* block-tridiagonal Cholesky (issue 15): models whose stiffness pattern is a
+                                  chain (frame i coupled to i - 1 and i + 1 only); assembled blocks */
     FRM_LINEAR_SOLVER_COUNT   /* sentinel: the number of solvers, not one */
 } frm_linear_solver;
 
@@ -1444,6 +1662,12 @@ typedef struct frm_desc {
                                        sit near 1e-7 of the diagonal; 0 gives the plain
                                        Newton step */
     frm_stiffness_mode stiffness_mode; /* default FRM_STIFFNESS_AUTO */
+    int coarse_aggregates;     /* two-level preconditioner (see SOLVERS, >>coarse): at most this
+                                  many aggregates of frames (cells of the rest bounding box, at
+                                  least FRM_COARSE_MIN_FRAMES frames each), whose rigid motions
+                                  form a coarse space solved exactly on top of block-Jacobi in
+                                  every CG solve; 0 = block-Jacobi only. Default
+                                  FRM_COARSE_AGGREGATES (0 to FRM_COARSE_MAX_AGGREGATES) */
 
     /* environment */
     frm_allocator allocator;          /* all NULL: FRM_MALLOC / FRM_FREE */
@@ -1822,7 +2046,7 @@ FRMDEF int frm_model_step(frm_model *m);
    state is unchanged. */
 FRMDEF int frm_model_step_ex(frm_model *m, frm_real dt);
 /* Static equilibrium (sec. 3.6) by Newton iterations with a backtracking line search on
-   the total potential energy, each solved by block-Jacobi CG, inside an adaptive load
+   the total potential energy, each solved by two-level preconditioned CG, inside an adaptive load
    continuation (see SOLVERS); velocities are set to zero. Driven frames end at their
    prescribed poses. On failure (see ERRORS) the state is unchanged. */
 FRMDEF int frm_model_solve_static(frm_model *m);
@@ -2032,6 +2256,214 @@ FRMDEF double frm_modal_frequency(const frm_modal *md, int i);
    zero on held components; NULL for i out of range. Valid until the next solve. */
 FRMDEF const frm_real *frm_modal_shape(const frm_modal *md, int i);
 FRMDEF void frm_modal_destroy(frm_modal *md);
+
+/* >>btd (public) ----------------------------------------------------------------------
+   Block-tridiagonal solver (issue 15): symmetric positive definite matrices of 6x6 blocks
+   coupling each block row only to its two neighbours (a chain of 6-DoF frames: rods,
+   cables, catheters, trunk robots; the reduced chain below). Block Cholesky (block
+   Thomas in LL^T form), O(n) in the number of blocks, no allocation: the caller owns every
+   array. See BLOCK-TRIDIAGONAL SOLVER in the manual. */
+#if FRM__CAT(FRM__IS_, FRM_REAL)
+#define frm_btd_factor_size frm_btd_factor_size_f32
+#define frm_btd_factor frm_btd_factor_f32
+#define frm_btd_solve frm_btd_solve_f32
+#define frm_btd_compliance frm_btd_compliance_f32
+#define frm_qp_box frm_qp_box_f32
+#define frm_chain_default_desc frm_chain_default_desc_f32
+#define frm_chain_create frm_chain_create_f32
+#define frm_chain_destroy frm_chain_destroy_f32
+#define frm_chain_frame_count frm_chain_frame_count_f32
+#define frm_chain_actuator_count frm_chain_actuator_count_f32
+#define frm_chain_positions frm_chain_positions_f32
+#define frm_chain_orientations frm_chain_orientations_f32
+#define frm_chain_velocities frm_chain_velocities_f32
+#define frm_chain_efforts frm_chain_efforts_f32
+#define frm_chain_set_poses frm_chain_set_poses_f32
+#define frm_chain_set_base frm_chain_set_base_f32
+#define frm_chain_set_external frm_chain_set_external_f32
+#define frm_chain_set_gravity frm_chain_set_gravity_f32
+#define frm_chain_set_efforts frm_chain_set_efforts_f32
+#define frm_chain_forces frm_chain_forces_f32
+#define frm_chain_energy frm_chain_energy_f32
+#define frm_chain_apply_stiffness frm_chain_apply_stiffness_f32
+#define frm_chain_actuator_measures frm_chain_actuator_measures_f32
+#define frm_chain_effector frm_chain_effector_f32
+#define frm_chain_solve_static frm_chain_solve_static_f32
+#define frm_chain_step frm_chain_step_f32
+#define frm_chain_inverse_step frm_chain_inverse_step_f32
+#define frm_chain_inverse_solve frm_chain_inverse_solve_f32
+#define frm_chain_link_compliance frm_chain_link_compliance_f32
+#endif
+
+/* Reals of a factor of n blocks (72 n: per block a Cholesky factor with its diagonal
+   inverted and the scaled sub-diagonal block). */
+FRMDEF size_t frm_btd_factor_size(int n);
+/* Factors the symmetric block-tridiagonal matrix of n >= 1 blocks: diag holds the n
+   diagonal blocks (36 each, row-major; only their lower triangles are read), lower the
+   n - 1 sub-diagonal blocks A(i + 1, i) (36 each, row-major; NULL when n = 1); factor
+   receives frm_btd_factor_size(n) reals. Returns 0, FRM_ERR_BTD_INDEFINITE (a pivot below
+   -tol), FRM_ERR_BTD_SINGULAR (a pivot within tol of zero; tol = 4 (n + 16) eps(frm_real)
+   times the block's original diagonal entry) or FRM_ERR_NOT_FINITE; *failed_block (may be
+   NULL) receives the block where it stopped (-1 on success). FRM_ERR_ARG for n < 1 or NULL
+   arrays. No allocation. */
+FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, frm_real *factor, int *failed_block);
+/* Solves A x = b in place for nrhs right-hand sides, each 6 n contiguous reals (b + 6 n r
+   is the r-th). FRM_ERR_NOT_FINITE if a result is not finite (then b holds zeros). */
+FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b);
+/* The compliance W = J A^-1 J^T (rows x rows, row-major) of `rows` constraint rows J
+   (row-major, rows x 6 n) without forming A^-1: rows solves of the factor. work: 6 n rows
+   reals. Symmetrised. Errors as frm_btd_solve. */
+FRMDEF int frm_btd_compliance(int n, const frm_real *factor, int rows, const frm_real *J, frm_real *W, frm_real *work);
+/* Small dense box-constrained convex QP: minimise 1/2 x^T H x + c^T x over lo <= x <= hi
+   (n <= 64, H row-major symmetric positive semi-definite, lo <= hi; +-HUGE_VAL allowed).
+   Primal active-set method (see INVERSE ACTUATION): x (in: a start, clamped; out: the
+   minimiser) satisfies the KKT conditions to round-off. A semi-definite H gets a diagonal
+   shift of 1e-12 of its largest diagonal entry (the minimiser of smallest H-norm step then);
+   *iterations (may be NULL) receives the active-set changes. Errors: FRM_ERR_ARG (n out of
+   range, NULL, non-finite entries, lo > hi), FRM_ERR_QP_INDEFINITE (H has a negative
+   curvature beyond round-off: x is then the feasible start), FRM_ERR_NO_CONVERGENCE (more
+   than 8 n + 32 active-set changes: cycling; x is feasible). Never returns non-finite x. */
+FRMDEF int frm_qp_box(int n, const double *H, const double *c, const double *lo, const double *hi, double *x,
+                      int *iterations);
+
+/* >>chain (public) ---------------------------------------------------------------------
+   Reduced chain model of a soft arm with rigid vertebrae (thesis sec. 5.2, issue 15): frames
+   0..n-1 (frame 0 the base, fixed or moved by frm_chain_set_base) joined by n - 1 linear
+   6-DoF springs given by their compliance in the proximal frame's rest axes. See REDUCED
+   CHAIN in the manual. */
+
+typedef enum frm_actuator_kind {
+    FRM_ACTUATOR_CABLE = 0, /* effort: tension (N); pulls the routed points together along the path */
+    FRM_ACTUATOR_CAVITY = 1 /* effort: pressure (Pa) on a closed surface of triangles (eq. 5.20) */
+} frm_actuator_kind;
+
+typedef struct frm_actuator {
+    frm_actuator_kind kind;
+    int point_count;              /* cable: routed points in path order (>= 2); cavity: vertices (>= 4) */
+    const int *point_frames;      /* frame each point is fixed to (0 .. frame_count - 1) */
+    const frm_real *points;       /* 3 per point: rest position, m, world axes */
+    int triangle_count;           /* cavity: triangles (>= 4), outward normals (counter-clockwise seen
+                                     from outside) */
+    const int *triangles;         /* cavity: 3 point indices per triangle */
+    frm_real min_effort;          /* N or Pa, >= 0 (default 0) */
+    frm_real max_effort;          /* N or Pa, >= min_effort (default HUGE_VAL: no upper bound) */
+} frm_actuator;
+
+typedef struct frm_chain_desc {
+    int frame_count;                 /* vertebrae, the base included: >= 2 */
+    const frm_real *positions;       /* 3 per frame: rest positions, m, world axes */
+    const frm_real *orientations;    /* 4 per frame (x, y, z, w): rest orientations; NULL: identity */
+    const frm_real *compliances;     /* 36 per link (frame_count - 1), row-major, symmetric positive definite:
+                                        link i maps a force (N) and torque (N m) applied at frame i + 1's
+                                        origin, frame i held, to frame i + 1's displacement (m) and rotation
+                                        (rad), all in frame i's rest axes (eq. 5.10; m/N, 1/N, rad/(N m)) */
+    const frm_real *masses;          /* 1 per frame, kg, lumped at the frame's origin; NULL: none (quasi-static
+                                        only: frm_chain_step then refuses with FRM_ERR_DENSITY) */
+    const frm_real *inertias;        /* 1 per frame, kg m^2 (isotropic); NULL: none */
+    frm_real gravity[3];             /* m/s^2, default (0, 0, -9.81) */
+    frm_real time_step;              /* s, default 0.01 (frm_chain_step) */
+    frm_real mass_damping;           /* 1/s, default 0 */
+    frm_real newton_tolerance;       /* relative residual, default 1e-9 (float 1e-4) */
+    int newton_max_iterations;       /* default 50 */
+    const frm_actuator *actuators;   /* read during frm_chain_create only */
+    int actuator_count;              /* 0 .. 64 */
+    int effector_frame;              /* default -1: the last frame */
+    frm_real effector_offset[3];     /* the effector point in that frame's rest axes, m (default 0) */
+    int effector_orientation;        /* 1: the inverse model also targets the effector frame's orientation */
+    frm_real inverse_epsilon;        /* eq. 5.29's eps relative to tr(W_ea^T W_ea) / tr(W_aa), default 1e-5 */
+    frm_allocator allocator;         /* all NULL: FRM_MALLOC / FRM_FREE */
+    void (*log)(int code, const char *message, void *user); /* validation details, or NULL */
+    void *log_user;
+    unsigned int internal_cookie;    /* set by frm_chain_default_desc; do not touch */
+} frm_chain_desc;
+
+/* Statistics of an inverse step or solve. */
+typedef struct frm_inverse_stats {
+    int linearizations;     /* eq. 5.23 linearisations (QPs) run */
+    int qp_iterations;      /* active-set changes, summed */
+    int newton_iterations;  /* direct-simulation Newton iterations, summed */
+    int active_bounds;      /* efforts at a bound in the last QP */
+    int reached;            /* 1: the effector is within tolerance of the target */
+    double error;           /* |effector - target| at the returned state, m (orientation rows in rad
+                               when targeted, added in the 2-norm) */
+    double predicted_error; /* the last QP's linearised error |W_ea lambda + delta_free|, m */
+} frm_inverse_stats;
+
+typedef struct frm_chain frm_chain;
+
+FRMDEF frm_chain_desc frm_chain_default_desc(void);
+/* Validates and allocates once. Errors: FRM_ERR_DESC, FRM_ERR_ARG (NULL arrays, non-finite
+   values), FRM_ERR_FRAME_COUNT, FRM_ERR_QUATERNION, FRM_ERR_COMPLIANCE (a link's compliance not
+   finite, not symmetric to 1e-6 relative, or not positive definite), FRM_ERR_DENSITY (negative
+   mass or inertia), FRM_ERR_ACTUATOR, FRM_ERR_ACTUATOR_BOUNDS, FRM_ERR_TIME_STEP,
+   FRM_ERR_DAMPING, FRM_ERR_SOLVER, FRM_ERR_ALLOC. */
+FRMDEF int frm_chain_create(const frm_chain_desc *d, frm_chain **out);
+FRMDEF void frm_chain_destroy(frm_chain *c);
+FRMDEF int frm_chain_frame_count(const frm_chain *c);
+FRMDEF int frm_chain_actuator_count(const frm_chain *c);
+FRMDEF const frm_real *frm_chain_positions(const frm_chain *c);    /* 3 per frame, m */
+FRMDEF const frm_real *frm_chain_orientations(const frm_chain *c); /* 4 per frame (x, y, z, w) */
+FRMDEF const frm_real *frm_chain_velocities(const frm_chain *c);   /* 6 per frame, m/s, rad/s (world) */
+FRMDEF const frm_real *frm_chain_efforts(const frm_chain *c);      /* 1 per actuator, N or Pa */
+/* Every frame's pose (the base's too; unit quaternions). Velocities zeroed. */
+FRMDEF int frm_chain_set_poses(frm_chain *c, const frm_real *positions, const frm_real *orientations);
+/* The base frame's pose (a moving base): later solves and steps hold it there. */
+FRMDEF int frm_chain_set_base(frm_chain *c, const frm_real position[3], const frm_real orientation[4]);
+/* Constant force (N) and torque (N m, about the frame's origin), world axes; NULL for zero. */
+FRMDEF int frm_chain_set_external(frm_chain *c, int frame, const frm_real force[3], const frm_real torque[3]);
+FRMDEF int frm_chain_set_gravity(frm_chain *c, const frm_real g[3]);
+/* Actuator efforts (N, Pa), each within its bounds (FRM_ERR_ACTUATOR_BOUNDS otherwise). */
+FRMDEF int frm_chain_set_efforts(frm_chain *c, const frm_real *efforts);
+/* The links' elastic generalized forces (6 per frame: N, N m about the frame's origin, world
+   axes) into out, and their energy (J) into *energy (either may be NULL). */
+FRMDEF int frm_chain_forces(frm_chain *c, frm_real *out, double *energy);
+/* The links' elastic energy, J. */
+FRMDEF double frm_chain_energy(const frm_chain *c);
+/* out = K v, K = -d(elastic force)/dq at the current state (6 per frame, rotations about
+   world axes: R -> exp([dtheta]x) R), every frame; symmetric = 0 the exact derivative,
+   1 its symmetric part (what the solvers factor). */
+FRMDEF int frm_chain_apply_stiffness(frm_chain *c, const frm_real *v, frm_real *out, int symmetric);
+/* Each actuator's measure at the current state: a cable's path length (m), a cavity's volume
+   (m^3). Its generalized force is -tension dL/dq, pressure dV/dq. */
+FRMDEF int frm_chain_actuator_measures(const frm_chain *c, double *out);
+/* The effector point (3, m, world), and with orientation != NULL its frame's orientation. */
+FRMDEF int frm_chain_effector(const frm_chain *c, frm_real position[3], frm_real orientation[4]);
+/* Direct simulation: static equilibrium under gravity, external loads and the current
+   efforts by Newton iterations (eq. 5.19) through the block-tridiagonal solver, with a line
+   search; the base held. On failure the state is unchanged. */
+FRMDEF int frm_chain_solve_static(frm_chain *c);
+/* One implicit Euler step of time_step (needs masses and inertias > 0 on the free frames). */
+FRMDEF int frm_chain_step(frm_chain *c);
+/* One control step of the inverse model (sec. 5.3): linearise (eq. 5.23), factor, the
+   compliance blocks W_ea, W_aa (eqs. 5.24-5.25), the QP of eq. 5.29 with the efforts' bounds,
+   then apply the efforts (direct simulation from the current state). target: 3 reals (m), 6
+   with effector_orientation (the last 3 a rotation vector, world axes, of the target
+   orientation relative to the effector's rest orientation). stats may be NULL. Returns 0
+   when the effector ends within `tolerance` (m) of the target, FRM_ERR_UNREACHABLE when the
+   QP's own linearised prediction is farther (the state is then the applied pose: the
+   closest the linearisation found), or the direct simulation's error (state unchanged). */
+FRMDEF int frm_chain_inverse_step(frm_chain *c, const frm_real *target, double tolerance, frm_inverse_stats *stats);
+/* Inverse steps until the effector is within tolerance, at most max_linearizations (>= 1).
+   FRM_ERR_UNREACHABLE: the target is out of reach; the chain is left at the closest pose
+   found (a valid equilibrium). FRM_ERR_NO_CONVERGENCE: not reached in max_linearizations
+   although the last linearisation predicted it reachable; the chain is likewise left at
+   the closest pose found (at worst the start state). A direct simulation's failure returns
+   its code with the state of the step before it. */
+FRMDEF int frm_chain_inverse_solve(frm_chain *c, const frm_real *target, double tolerance, int max_linearizations,
+                                   frm_inverse_stats *stats);
+/* The compliance of an intervertebra sub-model of frames with rigid ends (eqs. 5.1-5.11):
+   the frames end_a[0 .. na-1] are held, the frames end_b[] move rigidly with a virtual frame
+   at origin_b; C (36, row-major) is that frame's compliance in the model's world axes (build
+   the sub-model in the proximal vertebra's rest axes), the Schur complement of the model's
+   linear stiffness at its current (rest) state through its own linear solver, by six imposed
+   unit rigid motions and their reactions (ends' frame rotations free: see REDUCED CHAIN).
+   Give the sub-model no gravity (its stiffness terms would enter). The model's fixed /
+   driven frames and held axes are restored; its state is untouched. One temporary
+   allocation (3 vectors) through the model's allocator. Errors: FRM_ERR_ARG, FRM_ERR_FRAME_RANGE, the linear solver's
+   FRM_ERR_NO_CONVERGENCE / FRM_ERR_NOT_FINITE, FRM_ERR_COMPLIANCE (the reduced stiffness
+   is not positive definite: end B not held by the material). */
+FRMDEF int frm_chain_link_compliance(frm_model *m, const int *end_a, int na, const int *end_b, int nb,
+                                     const frm_real origin_b[3], frm_real C[36]);
 
 #endif /* FRAMES_H */
 
@@ -3024,6 +3456,11 @@ FRM_HOSTDEV static inline void frm_pass2_rotational(const frm_view *w, int i, co
 #endif
 
 #define FRM__COOKIE 0x46524D53u         /* "FRMS" */
+#ifndef FRM__COARSE_MODES
+#define FRM__COARSE_MODES 9 /* per aggregate: translation, rigid rotation, the frames' own rotation */
+#endif
+#define FRM__COARSE_MIN_ITERATIONS 40 /* solves with mass: block-Jacobi iterations that turn the coarse correction on */
+
 #define FRM__SHAPE_COOKIE 0x46524D48u   /* "FRMH" */
 #define FRM__POISSON_COOKIE 0x46524D50u /* "FRMP" */
 #define FRM__PROBE_COOKIE 0x46524D51u   /* "FRMQ" */
@@ -3100,6 +3537,7 @@ struct frm_model {
     int *rev_start, *rev_pair; /* frame -> pairs (the reverse table) */
     int *blk_start, *blk_col;  /* block pattern (frame adjacency) */
     frm_real *blocks;          /* 36 per block (assembled K, symmetric part) */
+    frm_real *btd;             /* 144 per frame with FRM_LINEAR_SOLVER_BTD: diagonal, sub-diagonal, factor */
     int *sq_start, *pair_blk;  /* per sample n^2 block indices of its slot pairs */
 
     /* samples */
@@ -3166,7 +3604,20 @@ struct frm_model {
                                 discontinuity or a change of dt) */
     double history_dt;       /* the step length the history was made with */
 
+    /* coarse space (>>coarse): rigid motions of aggregates of frames */
+    int agg_count;       /* aggregates (0: block-Jacobi only) */
+    int *f_agg;          /* 1 per frame: its aggregate */
+    double *coarse;      /* (6 A)^2: A_c = P^T (a_mass M + a_stiff K) P, then its Cholesky factor */
+    double *coarse_rhs;  /* 6 A: the coarse right-hand side and solution */
+    double *agg_centre;  /* 3 A: the aggregates' mean position at the coarse matrix's build */
+    frm_real *coarse_dq; /* 6 per slot of a sample (scratch): a coarse mode's dq on its frames */
+    int coarse_ready;    /* the factor matches the last frm__build_precond */
+    double precond_mass, precond_stiff; /* a_mass, a_stiff of the last frm__build_precond */
+    int coarse_use;      /* the coarse correction serves the solves after the last frm__build_precond */
+    int coarse_plain;    /* CG iterations of the last solve without it (-1: none yet) */
+
     int lin_valid, lin_mode, lin_iterations;
+    int lin_predict; /* the next linear solve's iterations, predicted: max(last, previous prediction / 2) (-1: none yet) */
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
     frm_view view; /* the passes' arrays (frm__fill_view, after the layout) */
@@ -3789,6 +4240,7 @@ static void frm__layout(frm_model *m, frm__carver *c)
         FRM__CARVE(c, m->sq_start, int, S + 1);
         FRM__CARVE(c, m->pair_blk, int, sq);
     }
+    if (m->linear_solver == FRM_LINEAR_SOLVER_BTD) FRM__CARVE(c, m->btd, frm_real, 144 * n);
     FRM__CARVE(c, m->s_rest, frm_real, 3 * S);
     FRM__CARVE(c, m->s_volume, frm_real, S);
     FRM__CARVE(c, m->s_mu, frm_real, S);
@@ -3872,6 +4324,71 @@ static void frm__layout(frm_model *m, frm__carver *c)
     FRM__CARVE(c, m->history, frm_real, 13 * n);
     FRM__CARVE(c, m->step_offset, frm_real, 6 * n);
     FRM__CARVE(c, m->step_velocity, frm_real, 6 * n);
+    if (m->agg_count) {
+        size_t D = FRM__COARSE_MODES * (size_t)m->agg_count;
+        FRM__CARVE(c, m->f_agg, int, n);
+        FRM__CARVE(c, m->coarse, double, D * D);
+        FRM__CARVE(c, m->coarse_rhs, double, D);
+        FRM__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
+        FRM__CARVE(c, m->coarse_dq, frm_real, 6 * FRM_MAX_NEIGHBORS);
+    }
+}
+
+/* >>coarse (aggregation) ---------------------------------------------------------------- */
+
+/* Bins the frames' rest positions into roughly cubic cells of their bounding box, at most
+   min(max_agg, n / FRM_COARSE_MIN_FRAMES) cells; returns the number of non-empty cells (0:
+   no coarse space, fewer than 2 aggregates) and, when agg is not NULL, each frame's cell
+   renumbered 0.. in cell order. Deterministic: a function of the rest positions only. */
+static int frm__aggregate(const frm_real *x, int n, int max_agg, int *agg)
+{
+    double lo[3], hi[3], ext[3], size, vol = 1.0, big = 0.0;
+    int dims[3], i, r, target = n / FRM_COARSE_MIN_FRAMES, cells, count = 0;
+    int used[FRM_COARSE_MAX_AGGREGATES];
+    if (target > max_agg) target = max_agg;
+    if (target < 2) return 0;
+    for (r = 0; r < 3; r++) lo[r] = hi[r] = (double)x[r];
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            double v = (double)x[3 * i + r];
+            if (v < lo[r]) lo[r] = v;
+            if (v > hi[r]) hi[r] = v;
+        }
+    for (r = 0; r < 3; r++) big = hi[r] - lo[r] > big ? hi[r] - lo[r] : big;
+    if (!(big > 0)) return 0;
+    for (r = 0; r < 3; r++) { /* a flat or thin body: its thin axes count as 1e-6 of the largest */
+        ext[r] = hi[r] - lo[r] > 1e-6 * big ? hi[r] - lo[r] : 1e-6 * big;
+        vol *= ext[r];
+    }
+    size = cbrt(vol / target);
+    for (;;) {
+        cells = 1;
+        for (r = 0; r < 3; r++) {
+            dims[r] = (int)(ext[r] / size + 0.5);
+            if (dims[r] < 1) dims[r] = 1;
+            cells *= dims[r];
+        }
+        if (cells <= target) break;
+        size *= 1.05;
+    }
+    for (i = 0; i < cells; i++) used[i] = -1;
+    for (i = 0; i < n; i++) {
+        int c = 0;
+        for (r = 2; r >= 0; r--) {
+            int k = (int)(((double)x[3 * i + r] - lo[r]) / ext[r] * dims[r]);
+            if (k >= dims[r]) k = dims[r] - 1;
+            if (k < 0) k = 0;
+            c = c * dims[r] + k;
+        }
+        if (agg) agg[i] = c;
+        used[c] = 0;
+    }
+    for (i = 0; i < cells; i++)
+        if (used[i] == 0) used[i] = count++;
+    if (count < 2) return 0;
+    if (agg)
+        for (i = 0; i < n; i++) agg[i] = used[agg[i]];
+    return count;
 }
 
 /* >>validation ------------------------------------------------------------------------- */
@@ -3946,6 +4463,8 @@ static int frm__validate_settings(const frm_desc *d)
         return frm__fail(d, FRM_ERR_ARG, "rotation_divergence must be finite and >= 0");
     if ((int)d->stiffness_mode < 0 || (int)d->stiffness_mode > 2)
         return frm__fail(d, FRM_ERR_STIFFNESS_MODE, "stiffness_mode");
+    if (d->coarse_aggregates < 0 || d->coarse_aggregates > FRM_COARSE_MAX_AGGREGATES)
+        return frm__fail(d, FRM_ERR_SOLVER, "coarse_aggregates must be 0 to FRM_COARSE_MAX_AGGREGATES");
     if ((unsigned)d->volumetric >= FRM_VOLUMETRIC_COUNT) return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric");
     if (!(frm__finite((double)d->volumetric_stabilization) && d->volumetric_stabilization >= 0))
         return frm__fail(d, FRM_ERR_VOLUMETRIC, "volumetric_stabilization must be finite and >= 0");
@@ -4157,6 +4676,7 @@ FRMDEF frm_desc frm_model_default_desc(void)
     d.rotation_divergence = (frm_real)4;
     d.volumetric_stabilization = 2;
     d.stiffness_mode = FRM_STIFFNESS_AUTO;
+    d.coarse_aggregates = FRM_COARSE_AGGREGATES;
     d.parallel_min_pairs = FRM_PARALLEL_MIN_PAIRS;
     d.internal_cookie = FRM__COOKIE;
     return d;
@@ -4455,6 +4975,7 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
         for (s = 0; s < S; s++)
             if (d->sample_cells[s] + 1 > tmp->vol_groups) tmp->vol_groups = d->sample_cells[s] + 1;
     }
+    tmp->linear_solver = (int)d->linear_solver; /* FRM_LINEAR_SOLVER_BTD carves its blocks */
     if (tmp->has_blocks) {
         long long blocks, sq = 0;
         for (i = 0; i < n; i++) t->marker[i] = -1;
@@ -4471,6 +4992,7 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
         tmp->block_count = (int)blocks;
         tmp->sq_total = (int)sq;
     }
+    tmp->agg_count = frm__aggregate(d->frame_positions, n, d->coarse_aggregates, NULL);
     tmp->stab_beta = d->rotation_stabilization;
     tmp->stab_gamma = d->rotation_divergence;
     if (tmp->stab_beta > 0)
@@ -4711,6 +5233,7 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     int i;
     frm__create_settings(m, d);
     frm__create_frames(m, d, t);
+    if (m->agg_count) frm__aggregate(d->frame_positions, m->frame_count, d->coarse_aggregates, m->f_agg);
     frm__create_samples(m, d);
     frm__create_pairs(m, d);
     i = frm__compute_masses(m, d);
@@ -4725,6 +5248,8 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     }
     frm__create_blocks(m, t->marker);
     m->lin_iterations = -1;
+    m->lin_predict = -1;
+    m->coarse_plain = -1;
     frm__update_frames(m);
     frm__rest_diagonal(m);
     return FRM_OK;
@@ -4783,6 +5308,7 @@ static void frm__fill_view(frm_model *m)
     w->volumetric = m->vol_mode;
 }
 
+static int frm__btd_model_check(const frm_model *m, const frm_desc *d);
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
 {
     frm_model tmp, *m = NULL;
@@ -4800,6 +5326,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     err = frm__create_layout(d, &tmp, &m);
     if (!err) frm__fill_view(m); /* the precomputation runs passes */
     if (!err) err = frm__create_precompute(m, d, &tables);
+    if (!err && m->linear_solver == FRM_LINEAR_SOLVER_BTD) err = frm__btd_model_check(m, d);
     frm__create_free_tables(d, &tables);
     if (err) {
         if (m) {
@@ -5653,13 +6180,17 @@ static int frm__choose_mode(const frm_model *m)
 {
     double it, pairs, blocks;
     if (m->stiffness_mode == FRM_STIFFNESS_PAIRS || !m->has_blocks) return FRM_STIFFNESS_PAIRS;
-    if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS) return FRM_STIFFNESS_BLOCKS;
+    if (m->stiffness_mode == FRM_STIFFNESS_BLOCKS || m->linear_solver == FRM_LINEAR_SOLVER_BTD) return FRM_STIFFNESS_BLOCKS;
     /* the last solve's iteration count predicts the next; before any, a typical 50 */
-    it = m->lin_iterations >= 0 ? (double)m->lin_iterations + 1 : 50.0;
+    it = m->lin_predict >= 0 ? (double)m->lin_predict + 1 : 50.0;
     if (it > m->cg_max_iterations + 1) it = m->cg_max_iterations + 1;
     pairs = it * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
     blocks = FRM__COST_ASSEMBLE_PAIR * m->pair_count + FRM__COST_ASSEMBLE_SLOT * m->sq_total +
              it * FRM__COST_BLOCK_ITER * m->block_count;
+    if (m->coarse_use) { /* the coarse matrix: from the blocks, or a sample pass of 9 products per aggregate */
+        pairs += FRM__COARSE_MODES * 1.5 * (FRM__COST_PAIR_ITER + (m->stab_gamma > 0 ? FRM__COST_PAIR_STAB : 0.0)) * m->pair_count;
+        blocks += 3 * FRM__COST_BLOCK_ITER * m->block_count;
+    }
     return blocks < pairs ? FRM_STIFFNESS_BLOCKS : FRM_STIFFNESS_PAIRS;
 }
 
@@ -5834,7 +6365,292 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
                 if (((m->axes[i] >> (k / 6)) & 1) || ((m->axes[i] >> (k % 6)) & 1)) inv[k] = 0;
         for (k = 0; k < 36; k++) P[k] = (frm_real)inv[k];
     }
+    m->precond_mass = a_mass;
+    m->precond_stiff = a_stiff;
+    m->coarse_ready = 0;
+    /* static solves always; a solve with mass (implicit steps, shifted modal solves) once
+       block-Jacobi alone needed FRM__COARSE_MIN_ITERATIONS: below that the coarse matrix's
+       build (about ten stiffness products) costs more than it saves */
+    m->coarse_use = m->agg_count && !m->vol_mode && (a_mass == 0 || m->coarse_plain >= m->cg_max_iterations ||
+                                     (!FRM__IS_FLOAT && m->coarse_plain >= FRM__COARSE_MIN_ITERATIONS));
     return fixed;
+}
+
+/* >>coarse ------------------------------------------------------------------------------ */
+
+/* The two-level preconditioner (SOLVERS): block-Jacobi plus a coarse correction
+   P A_c^-1 P^T over the aggregates of frm__aggregate, 9 modes each: a translation t, a
+   rigid rotation omega (frame i moves by omega x d_i, d_i = x_i - c_a with current
+   positions and c_a the aggregate's mean, and turns by omega) and the frames' own
+   rotation phi (frame i turns by phi and does not move), so per frame
+   P_i = [I, -[d_i]x, 0; 0, I, I], masked by its held components (fixed and driven frames
+   take no part). A_c = P^T (a_mass M + a_stiff K) P is the exact Galerkin product of the
+   linearisation the solve uses: frm__coarse_row from the assembled blocks (block mode),
+   frm__coarse_sample per sample as the pair-mode product computes it (pair mode; the
+   coupling term left out), plus per frame the mass, the frame-own rotational terms (pair
+   mode) and the regularisation. Serial, in frame or sample order: deterministic for any
+   thread count. Dense, symmetrised and Cholesky-factored in double; a pivot at or below
+   1e-10 of its diagonal (a mode held by fixed frames, an indefinite linearisation) drops
+   that mode. */
+
+/* The components of frame i that take part in the coarse space: 0 for fixed and driven
+   frames, the free axes of a free one (bit k for component k). */
+static unsigned frm__coarse_mask(const frm_model *m, int i) { return m->state[i] == FRM__FREE ? 63u & ~(unsigned)m->axes[i] : 0u; }
+
+/* dq = mask (P_i e) for the coarse direction e of frame i's aggregate (0-2: translation
+   t, 3-5: rigid rotation omega, 6-8: the frames' own rotation phi). */
+static void frm__coarse_mode(const frm_model *m, int i, int e, frm_real dq[6])
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    double d[3], v[6] = {0, 0, 0, 0, 0, 0};
+    unsigned mask = frm__coarse_mask(m, i);
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    if (e >= 6) e -= 3; /* phi: the rotation alone */
+    else if (e >= 3) { /* omega: and omega x d */
+        v[e] = 1;
+        v[0] = v[4] * d[2] - v[5] * d[1];
+        v[1] = v[5] * d[0] - v[3] * d[2];
+        v[2] = v[3] * d[1] - v[4] * d[0];
+    }
+    v[e] = 1;
+    for (r = 0; r < 6; r++) dq[r] = (mask >> r) & 1 ? (frm_real)v[r] : 0;
+}
+
+/* y += (mask P_i)^T r for frame i's 6 values r: (r_t, r_w + d x r_t, r_w) of the masked r. */
+static void frm__coarse_restrict(const frm_model *m, int i, const frm_real *rv, double *y)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], x[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    for (r = 0; r < 6; r++) x[r] = (mask >> r) & 1 ? (double)rv[r] : 0.0;
+    for (r = 0; r < 3; r++) y[r] += x[r];
+    y[3] += x[3] + (d[1] * x[2] - d[2] * x[1]);
+    y[4] += x[4] + (d[2] * x[0] - d[0] * x[2]);
+    y[5] += x[5] + (d[0] * x[1] - d[1] * x[0]);
+    for (r = 6; r < FRM__COARSE_MODES; r++) y[r] += x[r - 3];
+}
+
+/* z += mask P_i u: (u_t + u_w x d, u_w + u_phi) on frame i's free components. */
+static void frm__coarse_prolong(const frm_model *m, int i, const double *u, frm_real *z)
+{
+    const double *c = m->agg_centre + 3 * m->f_agg[i];
+    unsigned mask = frm__coarse_mask(m, i);
+    double d[3], o[6];
+    int r;
+    for (r = 0; r < 3; r++) d[r] = (double)m->pos[3 * i + r] - c[r];
+    o[0] = u[0] + (u[4] * d[2] - u[5] * d[1]);
+    o[1] = u[1] + (u[5] * d[0] - u[3] * d[2]);
+    o[2] = u[2] + (u[3] * d[1] - u[4] * d[0]);
+    for (r = 3; r < 6; r++) o[r] = u[r] + (FRM__COARSE_MODES > 6 ? u[r + 3] : 0.0);
+    for (r = 0; r < 6; r++)
+        if ((mask >> r) & 1) z[r] += (frm_real)o[r];
+}
+
+/* Sample s's part of P^T K P: for each aggregate among its neighbours and each of its six
+   rigid motions, the sample's K v exactly as the pair-mode product computes it (dF, the
+   law's dP, the rotation stabilisation's stress and torques; not the coupling term), its
+   output per slot projected by P^T. */
+static void frm__coarse_sample(frm_model *m, int s, double a_stiff)
+{
+    int b = m->s_start[s], n = m->s_start[s + 1] - b, slots[FRM_MAX_NEIGHBORS], agg_of[FRM_MAX_NEIGHBORS];
+    int na = 0, j, e, k, r, c, D = FRM__COARSE_MODES * m->agg_count, law = m->s_law[s];
+    const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+    frm_real *dqs = m->coarse_dq, vol = m->s_volume[s];
+    for (k = 0; k < n; k++) {
+        int f = m->p_frame[b + k];
+        agg_of[k] = -1;
+        if (!frm__coarse_mask(m, f)) continue;
+        for (j = 0; j < na && slots[j] != m->f_agg[f]; j++) {}
+        if (j == na) slots[na++] = m->f_agg[f];
+        agg_of[k] = j;
+    }
+    for (j = 0; j < na; j++)
+        for (e = 0; e < FRM__COARSE_MODES; e++) {
+            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], stq[3 * FRM_MAX_NEIGHBORS], out[6];
+            const frm_real *dth[FRM_MAX_NEIGHBORS];
+            static const frm_real zero[3] = {0, 0, 0};
+            for (k = 0; k < n; k++) {
+                frm_real *dq = dqs + 6 * k;
+                if (agg_of[k] == j) frm__coarse_mode(m, m->p_frame[b + k], e, dq);
+                else
+                    for (r = 0; r < 6; r++) dq[r] = 0;
+                frm_pair_dF(dq, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), dF);
+                dth[k] = agg_of[k] == j ? dq + 3 : zero;
+            }
+            frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
+                        m->lin_S + 6 * (size_t)s, dF, dP);
+            if (m->s_stab[s]) {
+                frm_real dPx[9];
+                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
+                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+            }
+            for (k = 0; k < n; k++) {
+                int q = agg_of[k];
+                double y[FRM__COARSE_MODES] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+                if (q < 0) continue;
+                frm_pair_apply(vol, dP, m->p_grad + 3 * (size_t)(b + k), m->p_G + 9 * (size_t)(b + k), out);
+                if (m->s_stab[s])
+                    for (r = 0; r < 3; r++) out[3 + r] += stq[3 * k + r];
+                /* row block slots[q], column 6 slots[j] + e: (mask P_f)^T out */
+                frm__coarse_restrict(m, m->p_frame[b + k], out, y);
+                for (c = 0; c < FRM__COARSE_MODES; c++) m->coarse[(size_t)(FRM__COARSE_MODES * slots[q] + c) * D + FRM__COARSE_MODES * slots[j] + e] += a_stiff * y[c];
+            }
+        }
+}
+
+/* Row i of the assembled blocks' part of P^T K P (block mode): (mask P_i)^T K_ij (mask P_j)
+   for each block, K P_j and then P_i^T by their structure (about 150 multiply-adds a
+   block). The blocks hold the lin_hrot term on the diagonal, which the per-frame loop of
+   frm__coarse_build then does not add again. */
+static void frm__coarse_row(frm_model *m, int i, double a_stiff)
+{
+    const int NM = FRM__COARSE_MODES;
+    int e, r, c, D = NM * m->agg_count;
+    unsigned mi = frm__coarse_mask(m, i);
+    double di[3];
+    if (!mi) return;
+    for (r = 0; r < 3; r++) di[r] = (double)m->pos[3 * i + r] - m->agg_centre[3 * m->f_agg[i] + r];
+    for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+        const frm_real *K = m->blocks + 36 * (size_t)e;
+        int f = m->blk_col[e];
+        unsigned mj = frm__coarse_mask(m, f);
+        double Km[36], X[6 * FRM__COARSE_MODES], Y[FRM__COARSE_MODES * FRM__COARSE_MODES], dj[3], *blk;
+        if (!mj) continue;
+        for (r = 0; r < 3; r++) dj[r] = (double)m->pos[3 * f + r] - m->agg_centre[3 * m->f_agg[f] + r];
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < 6; c++) Km[6 * r + c] = ((mi >> r) & 1) && ((mj >> c) & 1) ? (double)K[6 * r + c] : 0.0;
+        for (r = 0; r < 6; r++) { /* X = Km P_j: (K_t, K_w + K_t (e_k x d), K_w) */
+            const double *k = Km + 6 * r;
+            double *x = X + NM * r;
+            x[0] = k[0], x[1] = k[1], x[2] = k[2];
+            x[3] = k[3] + (k[2] * dj[1] - k[1] * dj[2]); /* K_t (e_k x d) */
+            x[4] = k[4] + (k[0] * dj[2] - k[2] * dj[0]);
+            x[5] = k[5] + (k[1] * dj[0] - k[0] * dj[1]);
+            if (NM > 6) x[6] = k[3], x[7] = k[4], x[8] = k[5];
+        }
+        for (c = 0; c < NM; c++) { /* Y = P_i^T X: (X_t, X_w + d x X_t, X_w) */
+            double t0 = X[c], t1 = X[NM + c], t2 = X[2 * NM + c];
+            Y[c] = t0, Y[NM + c] = t1, Y[2 * NM + c] = t2;
+            Y[3 * NM + c] = X[3 * NM + c] + (di[1] * t2 - di[2] * t1);
+            Y[4 * NM + c] = X[4 * NM + c] + (di[2] * t0 - di[0] * t2);
+            Y[5 * NM + c] = X[5 * NM + c] + (di[0] * t1 - di[1] * t0);
+            if (NM > 6) Y[6 * NM + c] = X[3 * NM + c], Y[7 * NM + c] = X[4 * NM + c], Y[8 * NM + c] = X[5 * NM + c];
+        }
+        blk = m->coarse + (size_t)(NM * m->f_agg[i]) * D + NM * m->f_agg[f];
+        for (r = 0; r < NM; r++)
+            for (c = 0; c < NM; c++) blk[(size_t)r * D + c] += a_stiff * Y[NM * r + c];
+    }
+}
+
+static void frm__coarse_build(frm_model *m, double a_mass, double a_stiff)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, s, j, k, r, c;
+    double *Ac = m->coarse, *cnt = m->coarse_rhs, *ctr = m->agg_centre;
+    m->coarse_ready = 0;
+    if (!A) return;
+    memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
+    memset(ctr, 0, sizeof(double) * 3 * (size_t)A);
+    for (k = 0; k < A; k++) cnt[k] = 0;
+    for (i = 0; i < m->frame_count; i++)
+        if (frm__coarse_mask(m, i)) {
+            for (r = 0; r < 3; r++) ctr[3 * m->f_agg[i] + r] += (double)m->pos[3 * i + r];
+            cnt[m->f_agg[i]] += 1;
+        }
+    for (k = 0; k < A; k++)
+        for (r = 0; r < 3; r++) ctr[3 * k + r] /= cnt[k] > 0 ? cnt[k] : 1;
+    if (a_stiff != 0 && m->lin_mode == FRM_STIFFNESS_BLOCKS)
+        for (i = 0; i < m->frame_count; i++)
+            frm__coarse_row(m, i, a_stiff);
+    else if (a_stiff != 0)
+        for (s = 0; s < m->sample_count; s++)
+            frm__coarse_sample(m, s, a_stiff);
+    for (i = 0; i < m->frame_count; i++) { /* per frame: frame-own terms, regularisation, mass */
+        double A6[36], PM[6 * FRM__COARSE_MODES], T[6 * FRM__COARSE_MODES], *blk;
+        frm_real col[6];
+        if (!frm__coarse_mask(m, i)) continue;
+        blk = Ac + (size_t)(FRM__COARSE_MODES * m->f_agg[i]) * D + FRM__COARSE_MODES * m->f_agg[i];
+        frm__mass_matrix(m, i, A6);
+        for (k = 0; k < 36; k++) A6[k] *= a_mass;
+        if (a_stiff != 0) {
+            frm_real H[36];
+            for (k = 0; k < 36; k++) H[k] = 0;
+            if (m->lin_mode != FRM_STIFFNESS_BLOCKS) frm__add_rotational(m->lin_hrot + 6 * (size_t)i, H); /* in the blocks */
+            for (k = 3; k < 6; k++) H[7 * k] += (frm_real)(m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
+            for (k = 0; k < 36; k++) A6[k] += a_stiff * (double)H[k];
+        }
+        for (c = 0; c < FRM__COARSE_MODES; c++) { /* PM = mask P_i, 6 x modes */
+            frm__coarse_mode(m, i, c, col);
+            for (r = 0; r < 6; r++) PM[FRM__COARSE_MODES * r + c] = (double)col[r];
+        }
+        for (r = 0; r < 6; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += A6[6 * r + k] * PM[FRM__COARSE_MODES * k + c];
+                T[FRM__COARSE_MODES * r + c] = t;
+            }
+        for (r = 0; r < FRM__COARSE_MODES; r++)
+            for (c = 0; c < FRM__COARSE_MODES; c++) {
+                double t = 0;
+                for (k = 0; k < 6; k++) t += PM[FRM__COARSE_MODES * k + r] * T[FRM__COARSE_MODES * k + c];
+                blk[(size_t)r * D + c] += t;
+            }
+    }
+    for (r = 0; r < D; r++) /* the symmetric part */
+        for (c = 0; c < r; c++) {
+            double t = 0.5 * (Ac[(size_t)r * D + c] + Ac[(size_t)c * D + r]);
+            Ac[(size_t)r * D + c] = Ac[(size_t)c * D + r] = t;
+        }
+    for (k = 0; k < D; k++) cnt[k] = Ac[(size_t)k * D + k];
+    for (k = 0; k < D; k++) { /* Cholesky, lower triangle, in place */
+        double *Lk = Ac + (size_t)k * D, dk = Lk[k];
+        for (j = 0; j < k; j++) dk -= Lk[j] * Lk[j];
+        if (!(dk > 1e-10 * cnt[k]) || !frm__finite(dk)) {
+            for (i = k; i < D; i++) Ac[(size_t)i * D + k] = 0.0;
+            continue;
+        }
+        dk = sqrt(dk);
+        Lk[k] = dk;
+        for (i = k + 1; i < D; i++) {
+            double *Li = Ac + (size_t)i * D, t = Li[k];
+            for (j = 0; j < k; j++) t -= Li[j] * Lk[j];
+            Li[k] = t / dk;
+        }
+    }
+    m->coarse_ready = 1;
+}
+
+/* z += P A_c^-1 P^T r (P masked by the held components). */
+static void frm__coarse_apply(frm_model *m, const frm_real *rv, frm_real *z)
+{
+    int A = m->agg_count, D = FRM__COARSE_MODES * A, i, j;
+    double *y = m->coarse_rhs, *L = m->coarse;
+    memset(y, 0, sizeof(double) * (size_t)D);
+    for (i = 0; i < m->frame_count; i++) /* y = P^T r */
+        if (frm__coarse_mask(m, i)) frm__coarse_restrict(m, i, rv + 6 * i, y + FRM__COARSE_MODES * m->f_agg[i]);
+    for (i = 0; i < D; i++) { /* L y' = y */
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+    for (i = D - 1; i >= 0; i--) { /* L^T x = y' */
+        double t = y[i], Lii = L[(size_t)i * D + i];
+        if (Lii == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
+        y[i] = t / Lii;
+    }
+    for (i = 0; i < m->frame_count; i++) /* z += P u */
+        if (frm__coarse_mask(m, i)) frm__coarse_prolong(m, i, y + FRM__COARSE_MODES * m->f_agg[i], z + 6 * i);
 }
 
 /* >>solver ----------------------------------------------------------------------------- */
@@ -5871,8 +6687,9 @@ static void frm__system_product(frm_model *m, double a_mass, double a_stiff, con
     frm__mask(m, out);
 }
 
-/* z = P r per frame. */
-static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *z)
+/* z = P r per frame, plus the coarse correction (built here at the first use after
+   frm__build_precond). */
+static void frm__precond_apply(frm_model *m, const frm_real *r, frm_real *z)
 {
     int i, a, b;
     for (i = 0; i < m->frame_count; i++) {
@@ -5882,6 +6699,10 @@ static void frm__precond_apply(const frm_model *m, const frm_real *r, frm_real *
             for (b = 0; b < 6; b++) t += P[6 * a + b] * x[b];
             z[6 * i + a] = t;
         }
+    }
+    if (m->coarse_use) {
+        if (!m->coarse_ready) frm__coarse_build(m, m->precond_mass, m->precond_stiff);
+        frm__coarse_apply(m, r, z);
     }
 }
 
@@ -5959,6 +6780,10 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
     m->stats.cg_iterations += it;
     m->stats.cg_residual = (frm_real)sqrt(rr / bb);
     m->lin_iterations = it;
+    /* a short solve (a Newton iteration near convergence) does not predict the next: the
+       probe's or the next increment's solves are long again */
+    m->lin_predict = it > m->lin_predict / 2 ? it : m->lin_predict / 2;
+    if (!m->coarse_use) m->coarse_plain = it;
     return status;
 }
 
@@ -5966,14 +6791,38 @@ static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance
    the free components to |r| <= tolerance |b|, by the model's linear_solver. Returns the
    FRM__CG_* statuses (OK, CAP, NEGATIVE, NOT_FINITE), which the Newton loops map to
    FRM_OK, FRM_ERR_NO_CONVERGENCE (cap; negative curvature when no retry helps) and
-   FRM_ERR_NOT_FINITE. A new solver (e.g. issue 15's block-tridiagonal one) adds a
-   frm_linear_solver value and a case here, with the same statuses. */
+   FRM_ERR_NOT_FINITE. A new solver adds a frm_linear_solver value and a case here, with
+   the same statuses. */
+static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x);
 static int frm__linear_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
     switch (m->linear_solver) {
+    case FRM_LINEAR_SOLVER_BTD:
+        return frm__btd_model_solve(m, a_mass, a_stiff, tolerance, b, x);
     case FRM_LINEAR_SOLVER_CG:
-    default:
-        return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+    default: {
+        int st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+        if (st == FRM__CG_CAP && !m->coarse_use && m->agg_count && !m->vol_mode) { /* block-Jacobi alone was not enough: */
+            int first = m->stats.cg_iterations_last;                /* on from here, and again from its iterate */
+            m->coarse_use = 1;
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->stats.cg_iterations_last += first;
+        } else if ((st == FRM__CG_NEGATIVE || st == FRM__CG_CAP) && m->coarse_use) {
+            /* The coarse correction failed: once more from zero with block-Jacobi alone.
+               Near-singular systems (free rotations, no regularisation) make the coarse
+               matrix's solve amplify float's round-off until p.Kp or r.z turns non-positive
+               (float: frm_chain_link_compliance's cylinder, at 70 iterations); a genuinely
+               indefinite system stays NEGATIVE without it, so the minimum checks see the
+               same answer at twice the cost. */
+            int first = m->stats.cg_iterations_last;
+            m->coarse_use = 0;
+            memset(x, 0, sizeof(frm_real) * 6 * (size_t)m->frame_count);
+            st = frm__cg(m, a_mass, a_stiff, tolerance, b, x);
+            m->coarse_use = 1;
+            m->stats.cg_iterations_last += first;
+        }
+        return st;
+    }
     }
 }
 
@@ -9347,6 +10196,8 @@ FRMDEF int frm_modal_solve(frm_modal *md, frm_model *m)
     if (md->block > 1024) return FRM_ERR_ARG;
     md->found = 0;
     frm__reset_stats(m);
+    m->coarse_plain = -1; /* a modal solve does not depend on earlier solves (its own bits repeat) */
+    m->lin_predict = -1;
     for (i = 0; i < m->frame_count; i++)
         if (m->state[i] == FRM__FREE)
             for (k = 0; k < 6; k++) free_dof += !((m->axes[i] >> k) & 1);
@@ -9468,6 +10319,1589 @@ FRMDEF void frm_modal_destroy(frm_modal *md)
     if (!md) return;
     a = md->allocator;
     frm__free(&a, md, md->bytes);
+}
+
+/* >>btd -------------------------------------------------------------------------------- */
+
+/* Block Cholesky of a symmetric block-tridiagonal matrix, blocks of 6 (see the public
+   declarations and BLOCK-TRIDIAGONAL SOLVER). Per block i the factor holds
+       G_i = L_i^-1 (lower triangular, stored as a full 6x6), S_i = A(i + 1, i) G_i^T,
+   with L_i L_i^T = A(i, i) - S_{i-1} S_{i-1}^T. Forward y_i = G_i (b_i - S_{i-1} y_{i-1}),
+   backward x_i = G_i^T (y_i - S_i^T x_{i+1}). Storing the inverse makes every product a
+   full 6x6 one (fixed trip counts the compiler unrolls and vectorises); the Cholesky and
+   its inversion are the only triangular loops. */
+
+FRMDEF size_t frm_btd_factor_size(int n) { return n < 1 ? 0 : (size_t)72 * (size_t)n; }
+
+FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, frm_real *factor, int *failed_block)
+{
+    int i, a, b, k;
+    const double tol = 4.0 * (double)(n + 16) * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON);
+    if (failed_block) *failed_block = -1;
+    if (n < 1 || !diag || !factor || (n > 1 && !lower)) return FRM_ERR_ARG;
+    for (i = 0; i < n; i++) {
+        const frm_real *A = diag + 36 * (size_t)i;
+        frm_real *Gout = factor + 72 * (size_t)i, *S = Gout + 36;
+        double W[36], G[36];
+        /* W = A_i - S_{i-1} S_{i-1}^T (A's lower triangle mirrored) */
+        for (a = 0; a < 6; a++)
+            for (b = 0; b <= a; b++) W[6 * a + b] = W[6 * b + a] = (double)A[6 * a + b];
+        if (i > 0) {
+            const frm_real *Sp = factor + 72 * (size_t)(i - 1) + 36;
+            double P[36];
+            for (a = 0; a < 36; a++) P[a] = (double)Sp[a];
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) {
+                    double s = 0;
+                    for (k = 0; k < 6; k++) s += P[6 * a + k] * P[6 * b + k];
+                    W[6 * a + b] -= s;
+                }
+        }
+        /* Cholesky of W (lower, in place); each pivot judged against the block's own
+           diagonal entry */
+        for (b = 0; b < 6; b++) {
+            double d = W[7 * b], scale = fabs((double)A[7 * b]);
+            for (k = 0; k < b; k++) d -= W[6 * b + k] * W[6 * b + k];
+            if (!frm__finite(d)) {
+                if (failed_block) *failed_block = i;
+                return FRM_ERR_NOT_FINITE;
+            }
+            if (!(d > tol * scale)) {
+                if (failed_block) *failed_block = i;
+                return d < -tol * scale ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;
+            }
+            d = sqrt(d);
+            W[7 * b] = d;
+            G[7 * b] = 1.0 / d; /* one division a column; products elsewhere */
+            for (a = b + 1; a < 6; a++) {
+                double s = W[6 * a + b];
+                for (k = 0; k < b; k++) s -= W[6 * a + k] * W[6 * b + k];
+                W[6 * a + b] = s * G[7 * b];
+            }
+        }
+        /* G = L^-1 (lower triangular), column by column */
+        for (b = 0; b < 6; b++) {
+            for (a = 0; a < b; a++) G[6 * a + b] = 0;
+            for (a = b + 1; a < 6; a++) {
+                double s = 0;
+                for (k = b; k < a; k++) s -= W[6 * a + k] * G[6 * k + b];
+                G[6 * a + b] = s * G[7 * a];
+            }
+        }
+        for (a = 0; a < 36; a++) Gout[a] = (frm_real)G[a];
+        /* S_i = B G^T (one finiteness test of the block's sum) */
+        if (i + 1 < n) {
+            const frm_real *B = lower + 36 * (size_t)i;
+            double Bd[36], Sd[36], sum = 0;
+            for (a = 0; a < 36; a++) Bd[a] = (double)B[a];
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) {
+                    double s = 0;
+                    for (k = 0; k < 6; k++) s += Bd[6 * a + k] * G[6 * b + k];
+                    Sd[6 * a + b] = s;
+                }
+            for (a = 0; a < 36; a++) S[a] = (frm_real)Sd[a], sum += Sd[a];
+            if (!frm__finite(sum)) {
+                if (failed_block) *failed_block = i;
+                return FRM_ERR_NOT_FINITE;
+            }
+        } else
+            memset(S, 0, 36 * sizeof(frm_real));
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
+{
+    int i, r, a, k, bad = 0;
+    size_t n6 = 6 * (size_t)n;
+    if (n < 1 || !factor || !b || nrhs < 0) return FRM_ERR_ARG;
+    for (r = 0; r < nrhs; r++) {
+        frm_real *x = b + n6 * (size_t)r;
+        double y[6], t[6];
+        for (a = 0; a < 6; a++) y[a] = 0;
+        for (i = 0; i < n; i++) { /* forward: y_i = G_i (b_i - S_{i-1} y_{i-1}) */
+            const frm_real *G = factor + 72 * (size_t)i;
+            for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
+            if (i > 0) {
+                const frm_real *S = G - 36;
+                for (a = 0; a < 6; a++)
+                    for (k = 0; k < 6; k++) t[a] -= (double)S[6 * a + k] * y[k];
+            }
+            for (a = 0; a < 6; a++) {
+                double s = 0;
+                for (k = 0; k < 6; k++) s += (double)G[6 * a + k] * t[k];
+                y[a] = s;
+            }
+            for (a = 0; a < 6; a++) x[6 * i + a] = (frm_real)y[a];
+        }
+        for (i = n - 1; i >= 0; i--) { /* backward: x_i = G_i^T (y_i - S_i^T x_{i+1}) */
+            const frm_real *G = factor + 72 * (size_t)i;
+            for (a = 0; a < 6; a++) t[a] = (double)x[6 * i + a];
+            if (i + 1 < n) {
+                const frm_real *S = G + 36;
+                for (k = 0; k < 6; k++)
+                    for (a = 0; a < 6; a++) t[a] -= (double)S[6 * k + a] * y[k];
+            }
+            for (a = 0; a < 6; a++) y[a] = 0;
+            for (k = 0; k < 6; k++)
+                for (a = 0; a < 6; a++) y[a] += (double)G[6 * k + a] * t[k];
+            for (a = 0; a < 6; a++) {
+                x[6 * i + a] = (frm_real)y[a];
+                bad |= !frm__finite(y[a]);
+            }
+        }
+    }
+    if (bad) {
+        memset(b, 0, sizeof(frm_real) * n6 * (size_t)nrhs);
+        return FRM_ERR_NOT_FINITE;
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_btd_compliance(int n, const frm_real *factor, int rows, const frm_real *J, frm_real *W, frm_real *work)
+{
+    int a, b, err;
+    size_t k, n6 = 6 * (size_t)n;
+    if (n < 1 || !factor || rows < 1 || !J || !W || !work) return FRM_ERR_ARG;
+    memcpy(work, J, sizeof(frm_real) * n6 * (size_t)rows);
+    err = frm_btd_solve(n, factor, rows, work);
+    if (err) return err;
+    for (a = 0; a < rows; a++)
+        for (b = 0; b <= a; b++) {
+            double s = 0, t = 0;
+            for (k = 0; k < n6; k++) {
+                s += (double)J[n6 * (size_t)a + k] * (double)work[n6 * (size_t)b + k];
+                t += (double)J[n6 * (size_t)b + k] * (double)work[n6 * (size_t)a + k];
+            }
+            W[rows * a + b] = W[rows * b + a] = (frm_real)(0.5 * (s + t));
+        }
+    return FRM_OK;
+}
+
+/* FRM_LINEAR_SOLVER_BTD on a frames model (frm__linear_solve's case): the model's assembled
+   blocks, whose pattern creation checked is a chain, as a block-tridiagonal a_mass M +
+   a_stiff K (static_regularization on the rotational diagonal, as CG's product); held
+   components (fixed and driven frames, held axes) become identity rows and columns. A
+   failed factorisation is FRM__CG_NEGATIVE (the Newton loops then retry with K's definite
+   part) or FRM__CG_NOT_FINITE; the answer is checked against the model's own product
+   (|b - A x| <= tolerance |b|, with up to three steps of iterative refinement, which float
+   needs; else FRM__CG_CAP). */
+static int frm__btd_model_check(const frm_model *m, const frm_desc *d)
+{
+    int i, e;
+    if (!m->has_blocks) return frm__fail(d, FRM_ERR_SOLVER, "linear_solver FRM_LINEAR_SOLVER_BTD needs block storage (stiffness_mode not PAIRS)");
+    for (i = 0; i < m->frame_count; i++)
+        for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++)
+            if (m->blk_col[e] < i - 1 || m->blk_col[e] > i + 1)
+                return frm__fail(d, FRM_ERR_SOLVER, "linear_solver FRM_LINEAR_SOLVER_BTD needs a chain: frame i coupled to i - 1 and i + 1 only");
+    return FRM_OK;
+}
+
+static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
+{
+    int n = m->frame_count, i, e, a, c, err, k;
+    size_t n6 = 6 * (size_t)n;
+    frm_real *D = m->btd, *Lo = D + 36 * (size_t)n, *F = Lo + 36 * (size_t)n, *r = m->cg_r;
+    double bb, rr;
+    unsigned char held[6];
+    m->stats.cg_iterations_last = 0;
+    m->stats.cg_residual = 0;
+    m->lin_iterations = 0;
+    frm__mask(m, b);
+    bb = frm__dot(m, b, b);
+    if (!frm__finite(bb)) return FRM__CG_NOT_FINITE;
+    memset(D, 0, sizeof(frm_real) * 72 * (size_t)n);
+    for (i = 0; i < n; i++) {
+        double mb[36];
+        for (k = 0; k < 36; k++) mb[k] = 0;
+        if (a_mass != 0)
+            for (c = 0; c < 6; c++) { /* column c of the mass block */
+                frm_real v[6] = {0, 0, 0, 0, 0, 0};
+                double o[6];
+                v[c] = 1;
+                frm__mass_apply(m, i, v, o);
+                for (a = 0; a < 6; a++) mb[6 * a + c] = o[a];
+            }
+        for (e = m->blk_start[i]; e < m->blk_start[i + 1]; e++) {
+            const frm_real *K = m->blocks + 36 * (size_t)e;
+            int j = m->blk_col[e];
+            if (j == i)
+                for (k = 0; k < 36; k++) D[36 * (size_t)i + k] = (frm_real)(a_stiff * (double)K[k] + a_mass * mb[k]);
+            else if (j == i - 1)
+                for (k = 0; k < 36; k++) Lo[36 * (size_t)j + k] = (frm_real)(a_stiff * (double)K[k]);
+        }
+        if (m->solve_regularization != 0)
+            for (k = 3; k < 6; k++)
+                D[36 * (size_t)i + 7 * k] += (frm_real)(a_stiff * m->solve_regularization * fabs((double)m->kdiag[36 * (size_t)i + 7 * k]));
+    }
+    for (i = 0; i < n; i++) { /* held components: identity rows and columns */
+        for (k = 0; k < 6; k++) held[k] = (unsigned char)(m->state[i] != FRM__FREE || ((m->axes[i] >> k) & 1));
+        for (k = 0; k < 6; k++) {
+            if (!held[k]) continue;
+            for (a = 0; a < 6; a++) {
+                D[36 * (size_t)i + 6 * k + a] = D[36 * (size_t)i + 6 * a + k] = 0;
+                if (i > 0) Lo[36 * (size_t)(i - 1) + 6 * k + a] = 0;        /* row k of A(i, i-1) */
+                if (i + 1 < n) Lo[36 * (size_t)i + 6 * a + k] = 0;          /* column k of A(i+1, i) */
+            }
+            D[36 * (size_t)i + 7 * k] = 1;
+        }
+    }
+    err = frm_btd_factor(n, D, Lo, F, NULL);
+    if (err) {
+        if (err == FRM_ERR_NOT_FINITE) return FRM__CG_NOT_FINITE;
+        m->stats.negative_curvature++;
+        memcpy(x, b, sizeof(frm_real) * n6); /* a descent direction for the retry's caller */
+        return FRM__CG_NEGATIVE;
+    }
+    memcpy(x, b, sizeof(frm_real) * n6);
+    if (frm_btd_solve(n, F, 1, x)) return FRM__CG_NOT_FINITE;
+    frm__mask(m, x);
+    if (bb == 0) return FRM__CG_OK;
+    for (k = 0;; k++) { /* the residual by the model's product; iterative refinement (float) */
+        int j;
+        frm__system_product(m, a_mass, a_stiff, x, r);
+        for (j = 0; j < (int)n6; j++) r[j] = b[j] - r[j];
+        frm__mask(m, r);
+        rr = frm__dot(m, r, r);
+        m->stats.cg_residual = (frm_real)sqrt(rr / bb);
+        m->lin_iterations = k;
+        if (!frm__finite(rr)) return FRM__CG_NOT_FINITE;
+        if (rr <= tolerance * tolerance * bb) return FRM__CG_OK;
+        if (k == 3 || frm_btd_solve(n, F, 1, r)) return FRM__CG_CAP;
+        frm__mask(m, r);
+        for (j = 0; j < (int)n6; j++) x[j] += r[j];
+    }
+}
+
+/* Primal active-set method for min 1/2 x^T H x + c^T x, lo <= x <= hi (the public comment).
+   The working set holds variables at a bound; each iteration solves the equality-constrained
+   problem on the free ones (Cholesky), steps to it or to the first bound in the way (which
+   joins the set), and at a feasible stationary point releases the bound variable whose
+   multiplier has the wrong sign most. */
+#define FRM__QP_MAX 64
+FRMDEF int frm_qp_box(int n, const double *H, const double *c, const double *lo, const double *hi, double *x,
+                      int *iterations)
+{
+    int bound[FRM__QP_MAX], fr[FRM__QP_MAX];
+    double L[FRM__QP_MAX * FRM__QP_MAX], y[FRM__QP_MAX], g[FRM__QP_MAX];
+    double hmax = 0, shift, gscale = 0;
+    int i, j, k, it = 0, cap, nf;
+    if (iterations) *iterations = 0;
+    if (n < 1 || n > FRM__QP_MAX || !H || !c || !lo || !hi || !x) return FRM_ERR_ARG;
+    for (i = 0; i < n; i++) {
+        if (!frm__finite(c[i]) || lo[i] != lo[i] || hi[i] != hi[i] || lo[i] > hi[i] || lo[i] == HUGE_VAL ||
+            hi[i] == -HUGE_VAL)
+            return FRM_ERR_ARG;
+        for (j = 0; j < n; j++)
+            if (!frm__finite(H[n * i + j])) return FRM_ERR_ARG;
+        if (!frm__finite(x[i])) x[i] = 0;
+        x[i] = x[i] < lo[i] ? lo[i] : x[i] > hi[i] ? hi[i] : x[i];
+        if (!frm__finite(x[i])) x[i] = frm__finite(lo[i]) ? lo[i] : frm__finite(hi[i]) ? hi[i] : 0;
+        bound[i] = x[i] == lo[i] ? -1 : x[i] == hi[i] ? 1 : 0;
+        if (fabs(H[(n + 1) * i]) > hmax) hmax = fabs(H[(n + 1) * i]);
+        if (H[(n + 1) * i] < 0) return FRM_ERR_QP_INDEFINITE;
+        gscale += fabs(c[i]);
+    }
+    if (hmax == 0) hmax = 1;
+    shift = 1e-12 * hmax;
+    cap = 8 * n + 32;
+    for (;;) {
+        double alpha = 1.0;
+        int block = -1;
+        /* free set and its right-hand side -(c_F + H_FB x_B) */
+        nf = 0;
+        for (i = 0; i < n; i++)
+            if (!bound[i]) fr[nf++] = i;
+        for (j = 0; j < nf; j++) {
+            double s = -c[fr[j]];
+            for (k = 0; k < n; k++)
+                if (bound[k]) s -= H[n * fr[j] + k] * x[k];
+            y[j] = s;
+        }
+        /* Cholesky of H_FF + shift I */
+        for (j = 0; j < nf; j++)
+            for (k = 0; k <= j; k++) {
+                double s = H[n * fr[j] + fr[k]] + (j == k ? shift : 0.0);
+                int m2;
+                for (m2 = 0; m2 < k; m2++) s -= L[nf * j + m2] * L[nf * k + m2];
+                if (j == k) {
+                    if (!(s > 1e-14 * hmax)) return FRM_ERR_QP_INDEFINITE;
+                    L[nf * j + j] = sqrt(s);
+                } else
+                    L[nf * j + k] = s / L[nf * k + k];
+            }
+        for (j = 0; j < nf; j++) {
+            for (k = 0; k < j; k++) y[j] -= L[nf * j + k] * y[k];
+            y[j] /= L[nf * j + j];
+        }
+        for (j = nf - 1; j >= 0; j--) {
+            for (k = j + 1; k < nf; k++) y[j] -= L[nf * k + j] * y[k];
+            y[j] /= L[nf * j + j];
+        }
+        /* step towards y, stopping at the first bound */
+        for (j = 0; j < nf; j++) {
+            double xi = x[fr[j]], d = y[j] - xi, t;
+            if (d < 0 && y[j] < lo[fr[j]]) {
+                t = (lo[fr[j]] - xi) / d;
+                if (t < alpha) alpha = t, block = j;
+            } else if (d > 0 && y[j] > hi[fr[j]]) {
+                t = (hi[fr[j]] - xi) / d;
+                if (t < alpha) alpha = t, block = j;
+            }
+        }
+        if (alpha < 0) alpha = 0;
+        for (j = 0; j < nf; j++) {
+            int v = fr[j];
+            x[v] = j == block ? (y[j] < lo[v] ? lo[v] : hi[v]) : x[v] + alpha * (y[j] - x[v]);
+            if (x[v] < lo[v]) x[v] = lo[v];
+            if (x[v] > hi[v]) x[v] = hi[v];
+        }
+        if (block >= 0) {
+            bound[fr[block]] = y[block] < lo[fr[block]] ? -1 : 1;
+        } else {
+            /* stationary on the free set: multipliers of the bound variables */
+            double worst = 0, tol;
+            int release = -1;
+            double xs = 0;
+            for (i = 0; i < n; i++) {
+                double s = c[i];
+                for (k = 0; k < n; k++) s += H[n * i + k] * x[k];
+                g[i] = s;
+                xs += fabs(x[i]);
+            }
+            tol = 1e-12 * (gscale + hmax * xs) + 1e-300;
+            for (i = 0; i < n; i++)
+                if (lo[i] < hi[i] && ((bound[i] < 0 && g[i] < -tol && -g[i] > worst) ||
+                                      (bound[i] > 0 && g[i] > tol && g[i] > worst)))
+                    worst = fabs(g[i]), release = i;
+            if (release < 0) break;
+            bound[release] = 0;
+        }
+        if (++it > cap) {
+            if (iterations) *iterations = it;
+            return FRM_ERR_NO_CONVERGENCE;
+        }
+    }
+    if (iterations) *iterations = it;
+    for (i = 0; i < n; i++)
+        if (!frm__finite(x[i])) return FRM_ERR_NOT_FINITE;
+    return FRM_OK;
+}
+
+/* >>chain ------------------------------------------------------------------------------ */
+
+#define FRM__CHAIN_COOKIE 0x46524D43u /* "FRMC" */
+
+struct frm_chain {
+    int n, na, eff_frame, eff_orient, max_it;
+    frm_allocator allocator;
+    size_t bytes;
+    double gravity[3], dt, alpha, tol, eps_inv, eff_off[3];
+    double fsq;                              /* the last force pass's sum of squared link forces */
+    frm_real *pos, *quat, *vel, *effort;     /* 3, 4, 6 per frame; 1 per actuator */
+    double *mass, *inertia, *ext;            /* 1, 1, 6 per frame */
+    double *kc, *dbar, *qbar;                /* per link: C^-1 (36), rest lever in frame i's axes (3),
+                                                rest relative orientation conj(qbar_i) qbar_{i+1} (4) */
+    double *eff_qrest;                       /* 4: the effector frame's rest orientation */
+    int *a_kind, *a_pstart, *a_tstart;       /* per actuator; point and triangle ranges (na + 1) */
+    int *p_frame, *tri;                      /* per point; 3 per triangle */
+    double *p_local, *a_min, *a_max;         /* 3 per point (frame's rest axes); per actuator */
+    /* scratch, carved at creation (nothing allocates later) */
+    frm_real *diag, *lower, *factor;         /* BTD of the n - 1 free frames */
+    frm_real *rhs;                           /* 6 n (na + 2): Newton's right-hand side, J_a^T columns */
+    double *g, *dq, *delta, *delta0, *ja, *je; /* 6 n, 6 n, 6 n, 6 n, 6 n na, 6 n 6 */
+    frm_real *save, *best, *trial;           /* 13 n + na each: poses, velocities, efforts */
+    double *qp;                              /* na (na + 6) + 6 na */
+};
+
+static void frm__ch_qmul(const double a[4], const double b[4], double o[4])
+{
+    double t[4];
+    t[0] = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
+    t[1] = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
+    t[2] = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
+    t[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    memcpy(o, t, sizeof t);
+}
+static void frm__ch_qconj(const double a[4], double o[4]) { o[0] = -a[0], o[1] = -a[1], o[2] = -a[2], o[3] = a[3]; }
+static void frm__ch_qload(const frm_real *q, double o[4])
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < 4; k++) s += (double)q[k] * (double)q[k];
+    s = 1.0 / sqrt(s);
+    for (k = 0; k < 4; k++) o[k] = (double)q[k] * s;
+}
+static void frm__ch_rot(const double q[4], double R[9])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    R[0] = 1 - 2 * (y * y + z * z), R[1] = 2 * (x * y - z * w), R[2] = 2 * (x * z + y * w);
+    R[3] = 2 * (x * y + z * w), R[4] = 1 - 2 * (x * x + z * z), R[5] = 2 * (y * z - x * w);
+    R[6] = 2 * (x * z - y * w), R[7] = 2 * (y * z + x * w), R[8] = 1 - 2 * (x * x + y * y);
+}
+static void frm__ch_qexp(const double t[3], double o[4])
+{
+    double a = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]), s = a > 1e-12 ? sin(0.5 * a) / a : 0.5 - a * a / 48;
+    o[0] = s * t[0], o[1] = s * t[1], o[2] = s * t[2], o[3] = cos(0.5 * a);
+}
+static void frm__ch_cross(const double a[3], const double b[3], double o[3])
+{
+    double t[3];
+    t[0] = a[1] * b[2] - a[2] * b[1], t[1] = a[2] * b[0] - a[0] * b[2], t[2] = a[0] * b[1] - a[1] * b[0];
+    o[0] = t[0], o[1] = t[1], o[2] = t[2];
+}
+static void frm__ch_mv(const double R[9], const double v[3], double o[3])
+{
+    double t[3];
+    int k;
+    for (k = 0; k < 3; k++) t[k] = R[3 * k] * v[0] + R[3 * k + 1] * v[1] + R[3 * k + 2] * v[2];
+    o[0] = t[0], o[1] = t[1], o[2] = t[2];
+}
+static void frm__ch_mtv(const double R[9], const double v[3], double o[3])
+{
+    double t[3];
+    int k;
+    for (k = 0; k < 3; k++) t[k] = R[k] * v[0] + R[3 + k] * v[1] + R[6 + k] * v[2];
+    o[0] = t[0], o[1] = t[1], o[2] = t[2];
+}
+/* 2 vec(q) with w >= 0: the rotation vector to O(theta^3) (the link's rotation measure). */
+static void frm__ch_qvec(double q[4])
+{
+    if (q[3] < 0) q[0] = -q[0], q[1] = -q[1], q[2] = -q[2], q[3] = -q[3];
+}
+
+/* A link's state: e = (d, phi), d = R0^T (x1 - x0) - dbar, phi = 2 vec(q_e) with
+   q_e = conj(q0) q1 conj(qbar_rel) (w >= 0); g = C^-1 e; F = R0 g_t, mw = R0 (w g_r + v x g_r). */
+typedef struct frm__ch_link {
+    double R0[9], r[3], v[3], w, e[6], g[6], F[3], mw[3];
+    const double *kc;
+} frm__ch_link;
+
+static void frm__ch_link_eval(const frm_chain *c, int i, frm__ch_link *L)
+{
+    double q0[4], q1[4], t[4], m[3];
+    int a, b;
+    frm__ch_qload(c->quat + 4 * i, q0);
+    frm__ch_qload(c->quat + 4 * (i + 1), q1);
+    frm__ch_rot(q0, L->R0);
+    for (a = 0; a < 3; a++) L->r[a] = (double)c->pos[3 * (i + 1) + a] - (double)c->pos[3 * i + a];
+    frm__ch_mtv(L->R0, L->r, L->e);
+    for (a = 0; a < 3; a++) L->e[a] -= c->dbar[3 * i + a];
+    frm__ch_qconj(q0, t);
+    frm__ch_qmul(t, q1, t);
+    frm__ch_qconj(c->qbar + 4 * i, q0);
+    frm__ch_qmul(t, q0, t);
+    frm__ch_qvec(t);
+    for (a = 0; a < 3; a++) L->v[a] = t[a], L->e[3 + a] = 2 * t[a];
+    L->w = t[3];
+    L->kc = c->kc + 36 * (size_t)i;
+    for (a = 0; a < 6; a++) {
+        double s = 0;
+        for (b = 0; b < 6; b++) s += L->kc[6 * a + b] * L->e[b];
+        L->g[a] = s;
+    }
+    frm__ch_mv(L->R0, L->g, L->F);
+    frm__ch_cross(L->v, L->g + 3, m);
+    for (a = 0; a < 3; a++) m[a] += L->w * L->g[3 + a];
+    frm__ch_mv(L->R0, m, L->mw);
+}
+
+/* The link's forces on its two frames (12: f0, tau0, f1, tau1; world, about each origin). */
+static void frm__ch_link_force(const frm__ch_link *L, double f[12])
+{
+    double t[3];
+    int a;
+    frm__ch_cross(L->r, L->F, t);
+    for (a = 0; a < 3; a++) {
+        f[a] = L->F[a], f[3 + a] = L->mw[a] + t[a];
+        f[6 + a] = -L->F[a], f[9 + a] = -L->mw[a];
+    }
+}
+
+/* out = K d (12) for the link: gn = 0 the exact K = -df/dq, gn = 1 the Gauss-Newton part
+   J^T C^-1 J (eqs. 5.16-5.17's Omega Gamma Omega^T with the current lever and the measure's
+   Jacobian: positive semi-definite). */
+static void frm__ch_link_apply(const frm__ch_link *L, const double d[12], double out[12], int gn)
+{
+    double dr[3], a3[3], dd[6], dg[6], om[3], t[3], u[3], dF[3], dmw[3], dv[3], dw;
+    int a, b;
+    for (a = 0; a < 3; a++) dr[a] = d[6 + a] - d[a], t[a] = d[9 + a] - d[3 + a];
+    frm__ch_cross(L->r, d + 3, a3);
+    for (a = 0; a < 3; a++) a3[a] += dr[a];
+    frm__ch_mtv(L->R0, a3, dd);
+    frm__ch_mtv(L->R0, t, om);
+    frm__ch_cross(L->v, om, u);
+    for (a = 0; a < 3; a++) dd[3 + a] = L->w * om[a] - u[a], dv[a] = 0.5 * dd[3 + a];
+    dw = -0.5 * (L->v[0] * om[0] + L->v[1] * om[1] + L->v[2] * om[2]);
+    for (a = 0; a < 6; a++) {
+        double s = 0;
+        for (b = 0; b < 6; b++) s += L->kc[6 * a + b] * dd[b];
+        dg[a] = s;
+    }
+    if (gn) { /* J^T dg */
+        double Y1[3], Y2[3], m[3];
+        frm__ch_mv(L->R0, dg, Y1);
+        frm__ch_cross(L->v, dg + 3, m);
+        for (a = 0; a < 3; a++) m[a] += L->w * dg[3 + a];
+        frm__ch_mv(L->R0, m, Y2);
+        frm__ch_cross(Y1, L->r, t);
+        for (a = 0; a < 3; a++) {
+            out[a] = -Y1[a], out[3 + a] = t[a] - Y2[a];
+            out[6 + a] = Y1[a], out[9 + a] = Y2[a];
+        }
+        return;
+    }
+    /* dF = dtheta0 x F + R0 dg_t; dm_loc = dw g_r + w dg_r + dv x g_r + v x dg_r;
+       dmw = dtheta0 x mw + R0 dm_loc; df0 = (dF, dmw + dr x F + r x dF), df1 = -(dF, dmw) */
+    frm__ch_cross(d + 3, L->F, dF);
+    frm__ch_mv(L->R0, dg, t);
+    for (a = 0; a < 3; a++) dF[a] += t[a];
+    {
+        double ml[3], p[3], q[3];
+        frm__ch_cross(dv, L->g + 3, p);
+        frm__ch_cross(L->v, dg + 3, q);
+        for (a = 0; a < 3; a++) ml[a] = dw * L->g[3 + a] + L->w * dg[3 + a] + p[a] + q[a];
+        frm__ch_mv(L->R0, ml, dmw);
+        frm__ch_cross(d + 3, L->mw, p);
+        for (a = 0; a < 3; a++) dmw[a] += p[a];
+    }
+    frm__ch_cross(dr, L->F, t);
+    frm__ch_cross(L->r, dF, u);
+    for (a = 0; a < 3; a++) {
+        out[a] = -dF[a], out[3 + a] = -(dmw[a] + t[a] + u[a]);
+        out[6 + a] = dF[a], out[9 + a] = dmw[a];
+    }
+}
+
+/* The 12 x 12 link matrix (row-major) by 12 products with unit vectors. */
+static void frm__ch_link_matrix(const frm__ch_link *L, double K[144], int gn)
+{
+    double d[12], o[12];
+    int j, a;
+    memset(d, 0, sizeof d);
+    for (j = 0; j < 12; j++) {
+        d[j] = 1;
+        frm__ch_link_apply(L, d, o, gn);
+        d[j] = 0;
+        for (a = 0; a < 12; a++) K[12 * a + j] = o[a];
+    }
+}
+
+/* Elastic forces (6 n, may be NULL) and energy of every link; *fsq (may be NULL) receives
+   the sum of the links' squared force components (the round-off scale of the sums). */
+static double frm__ch_elastic(const frm_chain *c, double *f, double *fsq)
+{
+    double E = 0, fl[12], s = 0;
+    int i, k;
+    if (f) memset(f, 0, sizeof(double) * 6 * (size_t)c->n);
+    for (i = 0; i + 1 < c->n; i++) {
+        frm__ch_link L;
+        frm__ch_link_eval(c, i, &L);
+        for (k = 0; k < 6; k++) E += 0.5 * L.e[k] * L.g[k];
+        if (f) {
+            double kmax = 0, xmax = 0;
+            frm__ch_link_force(&L, fl);
+            for (k = 0; k < 12; k++) f[6 * i + k] += fl[k], s += fl[k] * fl[k];
+            /* and K times one unit of the positions' rounding */
+            for (k = 0; k < 6; k++) kmax = L.kc[7 * k] > kmax ? L.kc[7 * k] : kmax;
+            for (k = 0; k < 6; k++) xmax = fabs((double)c->pos[3 * i + k]) > xmax ? fabs((double)c->pos[3 * i + k]) : xmax;
+            s += kmax * xmax * kmax * xmax;
+        }
+    }
+    if (fsq) *fsq = s;
+    return E;
+}
+
+/* A point fixed to frame f at local offset o: world position and lever R o. */
+static void frm__ch_point(const frm_chain *c, int f, const double *o, double P[3], double lev[3])
+{
+    double q[4], R[9];
+    int a;
+    frm__ch_qload(c->quat + 4 * f, q);
+    frm__ch_rot(q, R);
+    frm__ch_mv(R, o, lev);
+    for (a = 0; a < 3; a++) P[a] = (double)c->pos[3 * f + a] + lev[a];
+}
+
+/* Each actuator's measure (cable length, cavity volume) and, with rows != NULL, its row
+   J_a (6 n): the generalized force per unit effort (-dL/dq for a cable, dV/dq for a cavity). */
+static void frm__ch_actuators(const frm_chain *c, double *meas, double *rows)
+{
+    int a, k, j, n6 = 6 * c->n;
+    for (a = 0; a < c->na; a++) {
+        double *J = rows ? rows + (size_t)n6 * (size_t)a : NULL, s = 0;
+        int p0 = c->a_pstart[a], np = c->a_pstart[a + 1] - p0;
+        if (J) memset(J, 0, sizeof(double) * (size_t)n6);
+        if (c->a_kind[a] == FRM_ACTUATOR_CABLE) {
+            double P[3], lev[3], Pn[3], levn[3], u[3], uprev[3] = {0, 0, 0};
+            frm__ch_point(c, c->p_frame[p0], c->p_local + 3 * p0, P, lev);
+            for (k = 0; k < np; k++) {
+                double t[3], tor[3];
+                int f = c->p_frame[p0 + k];
+                if (k + 1 < np) {
+                    double len;
+                    frm__ch_point(c, c->p_frame[p0 + k + 1], c->p_local + 3 * (p0 + k + 1), Pn, levn);
+                    for (j = 0; j < 3; j++) u[j] = Pn[j] - P[j];
+                    len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+                    s += len;
+                    for (j = 0; j < 3; j++) u[j] = len > 0 ? u[j] / len : 0;
+                } else
+                    u[0] = u[1] = u[2] = 0;
+                if (J) { /* -dL/dP_k = u_k - u_{k-1} */
+                    for (j = 0; j < 3; j++) t[j] = u[j] - uprev[j];
+                    frm__ch_cross(lev, t, tor);
+                    for (j = 0; j < 3; j++) J[6 * f + j] += t[j], J[6 * f + 3 + j] += tor[j];
+                }
+                memcpy(uprev, u, sizeof u);
+                if (k + 1 < np) memcpy(P, Pn, sizeof P), memcpy(lev, levn, sizeof lev);
+            }
+        } else {
+            int t0 = c->a_tstart[a], t1 = c->a_tstart[a + 1], t;
+            for (t = t0; t < t1; t++) {
+                double P[3][3], L3[3][3], x[3];
+                int v;
+                for (v = 0; v < 3; v++) {
+                    int p = p0 + c->tri[3 * t + v];
+                    frm__ch_point(c, c->p_frame[p], c->p_local + 3 * p, P[v], L3[v]);
+                }
+                frm__ch_cross(P[1], P[2], x);
+                s += (P[0][0] * x[0] + P[0][1] * x[1] + P[0][2] * x[2]) / 6;
+                if (J)
+                    for (v = 0; v < 3; v++) { /* dV/dP_v = P_{v+1} x P_{v+2} / 6 */
+                        double gv[3], tor[3];
+                        int p = p0 + c->tri[3 * t + v], f = c->p_frame[p];
+                        frm__ch_cross(P[(v + 1) % 3], P[(v + 2) % 3], gv);
+                        for (j = 0; j < 3; j++) gv[j] /= 6;
+                        frm__ch_cross(L3[v], gv, tor);
+                        for (j = 0; j < 3; j++) J[6 * f + j] += gv[j], J[6 * f + 3 + j] += tor[j];
+                    }
+            }
+        }
+        if (meas) meas[a] = s;
+    }
+}
+
+/* Total generalized force (6 n: elastic + gravity + external + actuators with `with_act`)
+   and the potential (elastic - gravity's and external forces' work + actuators' lambda L,
+   -p V; constant torques have none). The actuator rows are left in c->ja. */
+static double frm__ch_total(frm_chain *c, double *g, int with_act)
+{
+    double pot = frm__ch_elastic(c, g, &c->fsq), meas[64];
+    int i, k, a, n6 = 6 * c->n;
+    for (i = 0; i < c->n; i++)
+        for (k = 0; k < 3; k++) {
+            double fk = c->mass[i] * c->gravity[k] + c->ext[6 * i + k];
+            g[6 * i + k] += fk;
+            g[6 * i + 3 + k] += c->ext[6 * i + 3 + k];
+            pot -= fk * (double)c->pos[3 * i + k];
+        }
+    if (c->na > 0) {
+        frm__ch_actuators(c, meas, c->ja);
+        if (with_act)
+            for (a = 0; a < c->na; a++) {
+                double lam = (double)c->effort[a];
+                if (lam == 0) continue;
+                for (k = 0; k < n6; k++) g[k] += lam * c->ja[(size_t)n6 * a + k];
+                pot += c->a_kind[a] == FRM_ACTUATOR_CABLE ? lam * meas[a] : -lam * meas[a];
+            }
+    }
+    return pot;
+}
+
+/* The BTD blocks of the free frames 1 .. n-1: the links' symmetric K (gn = 0) or their
+   Gauss-Newton part (gn = 1), plus diag_add (1/s^2) times each frame's mass. */
+static void frm__ch_assemble(frm_chain *c, int gn, double diag_add)
+{
+    int i, a, b, nb = c->n - 1;
+    double K[144];
+    memset(c->diag, 0, sizeof(frm_real) * 36 * (size_t)nb);
+    memset(c->lower, 0, sizeof(frm_real) * 36 * (size_t)nb);
+    for (i = 0; i + 1 < c->n; i++) {
+        frm__ch_link L;
+        frm__ch_link_eval(c, i, &L);
+        frm__ch_link_matrix(&L, K, gn);
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) {
+                /* frame i + 1 is block i; frame i is block i - 1 (the base, i = 0, is held) */
+                c->diag[36 * i + 6 * a + b] += (frm_real)(0.5 * (K[12 * (6 + a) + 6 + b] + K[12 * (6 + b) + 6 + a]));
+                if (i > 0) {
+                    c->diag[36 * (i - 1) + 6 * a + b] += (frm_real)(0.5 * (K[12 * a + b] + K[12 * b + a]));
+                    c->lower[36 * (i - 1) + 6 * a + b] += (frm_real)(0.5 * (K[12 * (6 + a) + b] + K[12 * b + 6 + a]));
+                }
+            }
+    }
+    if (diag_add > 0)
+        for (i = 1; i < c->n; i++)
+            for (a = 0; a < 6; a++)
+                c->diag[36 * (i - 1) + 7 * a] += (frm_real)(diag_add * (a < 3 ? c->mass[i] : c->inertia[i]));
+}
+
+/* Factors the free frames' tangent: the exact symmetric part, or (indefinite: a stressed
+   state past a bifurcation) the positive semi-definite Gauss-Newton part. */
+static int frm__ch_factor(frm_chain *c, double diag_add)
+{
+    int err, failed;
+    frm__ch_assemble(c, 0, diag_add);
+    err = frm_btd_factor(c->n - 1, c->diag, c->lower, c->factor, &failed);
+    if (err == FRM_ERR_BTD_INDEFINITE || err == FRM_ERR_BTD_SINGULAR) {
+        frm__ch_assemble(c, 1, diag_add);
+        err = frm_btd_factor(c->n - 1, c->diag, c->lower, c->factor, &failed);
+    }
+    return err;
+}
+
+static void frm__ch_store(const frm_chain *c, frm_real *s)
+{
+    size_t n = (size_t)c->n;
+    memcpy(s, c->pos, sizeof(frm_real) * 3 * n);
+    memcpy(s + 3 * n, c->quat, sizeof(frm_real) * 4 * n);
+    memcpy(s + 7 * n, c->vel, sizeof(frm_real) * 6 * n);
+    if (c->na) memcpy(s + 13 * n, c->effort, sizeof(frm_real) * (size_t)c->na);
+}
+static void frm__ch_restore(frm_chain *c, const frm_real *s)
+{
+    size_t n = (size_t)c->n;
+    memcpy(c->pos, s, sizeof(frm_real) * 3 * n);
+    memcpy(c->quat, s + 3 * n, sizeof(frm_real) * 4 * n);
+    memcpy(c->vel, s + 7 * n, sizeof(frm_real) * 6 * n);
+    if (c->na) memcpy(c->effort, s + 13 * n, sizeof(frm_real) * (size_t)c->na);
+}
+
+/* Frames 1 .. n-1 of the stored state s moved by alpha dq (world rotation vectors). */
+static void frm__ch_move(frm_chain *c, const frm_real *s, const double *dq, double alpha)
+{
+    size_t n = (size_t)c->n;
+    int i, k;
+    for (i = 1; i < c->n; i++) {
+        double q[4], e[4], t[3];
+        for (k = 0; k < 3; k++) c->pos[3 * i + k] = (frm_real)((double)s[3 * i + k] + alpha * dq[6 * i + k]);
+        for (k = 0; k < 3; k++) t[k] = alpha * dq[6 * i + 3 + k];
+        frm__ch_qload(s + 3 * n + 4 * i, q);
+        frm__ch_qexp(t, e);
+        frm__ch_qmul(e, q, q);
+        t[0] = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (k = 0; k < 4; k++) c->quat[4 * i + k] = (frm_real)(q[k] * t[0]);
+    }
+}
+
+/* |v| over the free frames (1 .. n-1). */
+static double frm__ch_norm(const frm_chain *c, const double *v)
+{
+    double s = 0;
+    int k;
+    for (k = 6; k < 6 * c->n; k++) s += v[k] * v[k];
+    return sqrt(s);
+}
+
+/* Newton iterations on the free frames (eq. 5.19), through the BTD solver, with a
+   backtracking line search on the potential (or on |residual| where the potential's change
+   is below its round-off). dyn = 1: implicit Euler of step h (residual g - M (delta / h -
+   v_n) / h - alpha M delta / h over the step's increment delta, tangent K + M (1 + alpha h)
+   / h^2). Converged when |r| <= tol * scale (the loads, the base's reaction, the inertia
+   term). On failure the state is restored. *iterations receives the iterations. */
+static int frm__ch_newton(frm_chain *c, int dyn, int *iterations)
+{
+    int it, i, k, err = FRM_ERR_NO_CONVERGENCE, n6 = 6 * c->n;
+    double h = c->dt, a_m = dyn ? (1 + c->alpha * h) / (h * h) : 0, res = 0, pot = 0, previous = HUGE_VAL;
+    double *g = c->g, *dq = c->dq, *dl = c->delta, *dl0 = c->delta0;
+    frm__ch_store(c, c->save);
+    if (iterations) *iterations = 0;
+    memset(dl, 0, sizeof(double) * (size_t)n6);
+    for (it = 0; it <= c->max_it; it++) {
+        double scale = 0, rn, slope, alpha = 1, base_pot, floor;
+        /* residual and its scale */
+        pot = frm__ch_total(c, g, 1);
+        for (k = 0; k < n6; k++) dq[k] = 0;
+        for (i = 1; i < c->n; i++)
+            for (k = 0; k < 3; k++) {
+                double fk = c->mass[i] * c->gravity[k] + c->ext[6 * i + k];
+                scale += fk * fk + c->ext[6 * i + 3 + k] * c->ext[6 * i + 3 + k];
+            }
+        for (k = 0; k < 6; k++) scale += g[k] * g[k]; /* the base's reaction */
+        if (a_m > 0)
+            for (i = 1; i < c->n; i++)
+                for (k = 0; k < 6; k++) {
+                double M = k < 3 ? c->mass[i] : c->inertia[i], v = (double)c->vel[6 * i + k];
+                double r = M * ((dl[6 * i + k] / h - v) / h + c->alpha * dl[6 * i + k] / h);
+                g[6 * i + k] -= r;
+                scale += (M * v / h) * (M * v / h);
+                pot += 0.5 * M / (h * h) * ((dl[6 * i + k] - h * v) * (dl[6 * i + k] - h * v) + c->alpha * h * dl[6 * i + k] * dl[6 * i + k]);
+            }
+        {
+            int a;
+            for (a = 0; a < c->na; a++) {
+                double s = 0;
+                for (k = 0; k < n6; k++) s += c->ja[(size_t)n6 * a + k] * c->ja[(size_t)n6 * a + k];
+                scale += (double)c->effort[a] * (double)c->effort[a] * s;
+            }
+        }
+        scale = sqrt(scale);
+        rn = frm__ch_norm(c, g);
+        res = rn;
+        if (!frm__finite(rn) || !frm__finite(pot)) {
+            err = FRM_ERR_NOT_FINITE;
+            break;
+        }
+        /* converged, or at the round-off floor of the force sums once an iteration no longer
+           halves the residual */
+        floor = 16 * (FRM__IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON) * sqrt(c->fsq);
+        if (rn <= c->tol * scale || (it > 0 && rn > 0.5 * previous && rn <= floor)) {
+            err = FRM_OK;
+            break;
+        }
+        if (it == c->max_it) break;
+        previous = rn;
+        /* Newton direction */
+        err = frm__ch_factor(c, a_m);
+        if (err) break;
+        for (k = 6; k < n6; k++) c->rhs[k - 6] = (frm_real)g[k];
+        err = frm_btd_solve(c->n - 1, c->factor, 1, c->rhs);
+        if (err) break;
+        for (k = 6; k < n6; k++) dq[k] = (double)c->rhs[k - 6];
+        slope = 0;
+        for (k = 6; k < n6; k++) slope += g[k] * dq[k];
+        /* line search from this iterate */
+        frm__ch_store(c, c->trial);
+        memcpy(dl0, dl, sizeof(double) * (size_t)n6);
+        base_pot = pot;
+        for (k = 0; k < 40; k++) {
+            double tp, tr;
+            int j;
+            frm__ch_move(c, c->trial, dq, alpha);
+            for (j = 6; j < n6; j++) dl[j] = dl0[j] + alpha * dq[j];
+            tp = frm__ch_total(c, g, 1);
+            for (i = 1; i < c->n; i++) /* constant torques: their work along the step */
+                for (j = 3; j < 6; j++) tp -= alpha * c->ext[6 * i + j] * dq[6 * i + j];
+            if (a_m > 0)
+                for (i = 1; i < c->n; i++)
+                    for (j = 0; j < 6; j++) {
+                        double M = j < 3 ? c->mass[i] : c->inertia[i], v = (double)c->vel[6 * i + j];
+                        g[6 * i + j] -= M * ((dl[6 * i + j] / h - v) / h + c->alpha * dl[6 * i + j] / h);
+                        tp += 0.5 * M / (h * h) * ((dl[6 * i + j] - h * v) * (dl[6 * i + j] - h * v) + c->alpha * h * dl[6 * i + j] * dl[6 * i + j]);
+                    }
+            tr = frm__ch_norm(c, g);
+            if (frm__finite(tp) && frm__finite(tr) &&
+                (tp <= base_pot - 1e-4 * alpha * slope ||
+                 (fabs(tp - base_pot) <= 1e-12 * (fabs(base_pot) + 1) && tr < rn)))
+                break;
+            alpha *= 0.5;
+        }
+        if (k == 40) { /* no decrease: converged only if already at the round-off floor */
+            frm__ch_restore(c, c->trial);
+            memcpy(dl, dl0, sizeof(double) * (size_t)n6);
+            err = rn <= floor ? FRM_OK : FRM_ERR_NO_CONVERGENCE;
+            break;
+        }
+        if (iterations) (*iterations)++;
+    }
+    (void)res;
+    if (err) {
+        frm__ch_restore(c, c->save);
+        return err;
+    }
+    if (dyn)
+        for (i = 1; i < c->n; i++)
+            for (k = 0; k < 6; k++) c->vel[6 * i + k] = (frm_real)(dl[6 * i + k] / h);
+    else
+        memset(c->vel, 0, sizeof(frm_real) * (size_t)n6);
+    return FRM_OK;
+}
+
+static int frm__ch_fail(const frm_chain_desc *d, int code, const char *detail)
+{
+    if (d && d->log) d->log(code, detail, d->log_user);
+    return code;
+}
+
+FRMDEF frm_chain_desc frm_chain_default_desc(void)
+{
+    frm_chain_desc d;
+    memset(&d, 0, sizeof d);
+    d.gravity[2] = (frm_real)-9.81;
+    d.time_step = (frm_real)0.01;
+    d.newton_tolerance = (frm_real)(FRM__IS_FLOAT ? 1e-4 : 1e-9);
+    d.newton_max_iterations = 50;
+    d.effector_frame = -1;
+    d.inverse_epsilon = (frm_real)1e-5;
+    d.internal_cookie = FRM__CHAIN_COOKIE;
+    return d;
+}
+
+static size_t frm__ch_carve(char *base, size_t *off, size_t bytes, void **out)
+{
+    *out = base ? (void *)(base + *off) : NULL;
+    *off += (bytes + 63) / 64 * 64;
+    return *off;
+}
+
+static size_t frm__ch_layout(frm_chain *c, char *base, int np, int nt)
+{
+    size_t off = (sizeof(frm_chain) + 63) / 64 * 64, n = (size_t)c->n, na = (size_t)c->na, nl = n - 1, R = sizeof(frm_real),
+           D = sizeof(double);
+    void *p;
+#define FRM__CH_CARVE(field, bytes) (frm__ch_carve(base, &off, (bytes), &p), (base ? (void)(*(void **)&c->field = p) : (void)0))
+    FRM__CH_CARVE(pos, R * 3 * n);
+    FRM__CH_CARVE(quat, R * 4 * n);
+    FRM__CH_CARVE(vel, R * 6 * n);
+    FRM__CH_CARVE(effort, R * (na + 1));
+    FRM__CH_CARVE(mass, D * n);
+    FRM__CH_CARVE(inertia, D * n);
+    FRM__CH_CARVE(ext, D * 6 * n);
+    FRM__CH_CARVE(kc, D * 36 * nl);
+    FRM__CH_CARVE(dbar, D * 3 * nl);
+    FRM__CH_CARVE(qbar, D * 4 * nl);
+    FRM__CH_CARVE(eff_qrest, D * 4);
+    FRM__CH_CARVE(a_kind, sizeof(int) * (na + 1));
+    FRM__CH_CARVE(a_pstart, sizeof(int) * (na + 1));
+    FRM__CH_CARVE(a_tstart, sizeof(int) * (na + 1));
+    FRM__CH_CARVE(p_frame, sizeof(int) * ((size_t)np + 1));
+    FRM__CH_CARVE(tri, sizeof(int) * 3 * ((size_t)nt + 1));
+    FRM__CH_CARVE(p_local, D * 3 * ((size_t)np + 1));
+    FRM__CH_CARVE(a_min, D * (na + 1));
+    FRM__CH_CARVE(a_max, D * (na + 1));
+    FRM__CH_CARVE(diag, R * 36 * nl);
+    FRM__CH_CARVE(lower, R * 36 * nl);
+    FRM__CH_CARVE(factor, R * 72 * nl);
+    FRM__CH_CARVE(rhs, R * 6 * n * (na + 2));
+    FRM__CH_CARVE(g, D * 6 * n);
+    FRM__CH_CARVE(dq, D * 6 * n);
+    FRM__CH_CARVE(delta, D * 6 * n);
+    FRM__CH_CARVE(delta0, D * 6 * n);
+    FRM__CH_CARVE(ja, D * 6 * n * (na + 1));
+    FRM__CH_CARVE(je, D * 6 * n * 6);
+    FRM__CH_CARVE(save, R * (13 * n + na + 1));
+    FRM__CH_CARVE(best, R * (13 * n + na + 1));
+    FRM__CH_CARVE(trial, R * (13 * n + na + 1));
+    FRM__CH_CARVE(qp, D * (na * (na + 6) + 6 * na + 8 * na + 8));
+#undef FRM__CH_CARVE
+    return off;
+}
+
+/* C^-1 of a symmetric positive definite 6x6 (Cholesky); 0 or FRM_ERR_COMPLIANCE. */
+static int frm__ch_spd_inverse(const double *C, double *out)
+{
+    double L[36], cmax = 0;
+    int a, b, k;
+    for (a = 0; a < 36; a++) {
+        if (!frm__finite(C[a])) return FRM_ERR_COMPLIANCE;
+        if (fabs(C[a]) > cmax) cmax = fabs(C[a]);
+    }
+    for (a = 0; a < 6; a++)
+        for (b = 0; b < a; b++)
+            if (fabs(C[6 * a + b] - C[6 * b + a]) > 1e-6 * cmax) return FRM_ERR_COMPLIANCE;
+    for (b = 0; b < 6; b++) {
+        double d = C[7 * b];
+        for (k = 0; k < b; k++) d -= L[6 * b + k] * L[6 * b + k];
+        if (!(d > 1e-13 * fabs(C[7 * b])) || !(C[7 * b] > 0)) return FRM_ERR_COMPLIANCE;
+        L[7 * b] = sqrt(d);
+        for (a = b + 1; a < 6; a++) {
+            double s = 0.5 * (C[6 * a + b] + C[6 * b + a]);
+            for (k = 0; k < b; k++) s -= L[6 * a + k] * L[6 * b + k];
+            L[6 * a + b] = s / L[7 * b];
+        }
+    }
+    for (b = 0; b < 6; b++) { /* column b of the inverse */
+        double z[6];
+        for (a = 0; a < 6; a++) {
+            double s = a == b ? 1.0 : 0.0;
+            for (k = 0; k < a; k++) s -= L[6 * a + k] * z[k];
+            z[a] = s / L[7 * a];
+        }
+        for (a = 5; a >= 0; a--) {
+            double s = z[a];
+            for (k = a + 1; k < 6; k++) s -= L[6 * k + a] * z[k];
+            z[a] = s / L[7 * a];
+        }
+        for (a = 0; a < 6; a++) out[6 * a + b] = z[a];
+    }
+    for (a = 0; a < 36; a++)
+        if (!frm__finite(out[a])) return FRM_ERR_COMPLIANCE;
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_create(const frm_chain_desc *d, frm_chain **out)
+{
+    frm_chain tmp, *c;
+    char msg[160];
+    int i, k, a, np = 0, nt = 0, n;
+    size_t bytes;
+    if (out) *out = NULL;
+    if (!d || !out) return FRM_ERR_ARG;
+    if (d->internal_cookie != FRM__CHAIN_COOKIE) return FRM_ERR_DESC;
+    n = d->frame_count;
+    if (n < 2 || n > 1000000) return frm__ch_fail(d, FRM_ERR_FRAME_COUNT, "frame_count below 2 or too large");
+    if (!d->positions || !d->compliances) return frm__ch_fail(d, FRM_ERR_ARG, "positions and compliances are required");
+    for (i = 0; i < 3 * n; i++)
+        if (!frm__finite((double)d->positions[i])) return frm__ch_fail(d, FRM_ERR_FRAME_NOT_FINITE, "position not finite");
+    if (d->orientations)
+        for (i = 0; i < n; i++)
+            if (!frm__quat_valid(d->orientations + 4 * i)) return frm__ch_fail(d, FRM_ERR_QUATERNION, "orientation");
+    for (i = 0; i < n; i++) {
+        if (d->masses && !(d->masses[i] >= 0 && frm__finite((double)d->masses[i])))
+            return frm__ch_fail(d, FRM_ERR_DENSITY, "mass not finite and >= 0");
+        if (d->inertias && !(d->inertias[i] >= 0 && frm__finite((double)d->inertias[i])))
+            return frm__ch_fail(d, FRM_ERR_DENSITY, "inertia not finite and >= 0");
+    }
+    for (i = 0; i < 3; i++)
+        if (!frm__finite((double)d->gravity[i])) return frm__ch_fail(d, FRM_ERR_ARG, "gravity");
+    if (!(d->time_step > 0) || !frm__finite((double)d->time_step)) return frm__ch_fail(d, FRM_ERR_TIME_STEP, "time_step");
+    if (!(d->mass_damping >= 0) || !frm__finite((double)d->mass_damping)) return frm__ch_fail(d, FRM_ERR_DAMPING, "mass_damping");
+    if (!(d->newton_tolerance > 0) || !frm__finite((double)d->newton_tolerance) || d->newton_max_iterations < 1 ||
+        !(d->inverse_epsilon >= 0) || !frm__finite((double)d->inverse_epsilon))
+        return frm__ch_fail(d, FRM_ERR_SOLVER, "newton_tolerance, newton_max_iterations or inverse_epsilon");
+    if (d->effector_frame < -1 || d->effector_frame >= n || !frm__vec3_finite(d->effector_offset))
+        return frm__ch_fail(d, FRM_ERR_ARG, "effector_frame out of range or effector_offset not finite");
+    if (d->actuator_count < 0 || d->actuator_count > 64 || (d->actuator_count > 0 && !d->actuators))
+        return frm__ch_fail(d, FRM_ERR_ACTUATOR, "actuator_count outside 0..64 or actuators NULL");
+    for (a = 0; a < d->actuator_count; a++) {
+        const frm_actuator *A = d->actuators + a;
+        int cable = A->kind == FRM_ACTUATOR_CABLE;
+        if (A->kind != FRM_ACTUATOR_CABLE && A->kind != FRM_ACTUATOR_CAVITY) {
+            snprintf(msg, sizeof msg, "actuator %d: unknown kind", a);
+            return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+        }
+        if (A->point_count < (cable ? 2 : 4) || !A->point_frames || !A->points ||
+            (!cable && (A->triangle_count < 4 || !A->triangles))) {
+            snprintf(msg, sizeof msg, "actuator %d: too few points or triangles, or NULL arrays", a);
+            return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+        }
+        for (k = 0; k < A->point_count; k++) {
+            if (A->point_frames[k] < 0 || A->point_frames[k] >= n) {
+                snprintf(msg, sizeof msg, "actuator %d: point %d on frame %d, outside the chain", a, k, A->point_frames[k]);
+                return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+            }
+            if (!frm__vec3_finite(A->points + 3 * k)) return frm__ch_fail(d, FRM_ERR_ACTUATOR, "actuator point not finite");
+            if (cable && k > 0) {
+                const frm_real *p = A->points + 3 * k, *q = p - 3;
+                if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
+                    snprintf(msg, sizeof msg, "actuator %d: cable points %d and %d coincide", a, k - 1, k);
+                    return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+                }
+            }
+        }
+        if (!cable)
+            for (k = 0; k < 3 * A->triangle_count; k++)
+                if (A->triangles[k] < 0 || A->triangles[k] >= A->point_count) {
+                    snprintf(msg, sizeof msg, "actuator %d: triangle vertex index out of range", a);
+                    return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+                }
+        if (!(A->min_effort >= 0) || !(A->max_effort >= A->min_effort) || !frm__finite((double)A->min_effort)) {
+            snprintf(msg, sizeof msg, "actuator %d: bounds need 0 <= min_effort <= max_effort", a);
+            return frm__ch_fail(d, FRM_ERR_ACTUATOR_BOUNDS, msg);
+        }
+        np += A->point_count;
+        nt += cable ? 0 : A->triangle_count;
+    }
+    memset(&tmp, 0, sizeof tmp);
+    tmp.n = n;
+    tmp.na = d->actuator_count;
+    bytes = frm__ch_layout(&tmp, NULL, np, nt);
+    c = (frm_chain *)frm__alloc(&d->allocator, bytes);
+    if (!c) return frm__ch_fail(d, FRM_ERR_ALLOC, "out of memory");
+    memset(c, 0, bytes);
+    c->n = n;
+    c->na = d->actuator_count;
+    c->allocator = d->allocator;
+    c->bytes = bytes;
+    frm__ch_layout(c, (char *)c, np, nt);
+    for (k = 0; k < 3; k++) c->gravity[k] = (double)d->gravity[k], c->eff_off[k] = (double)d->effector_offset[k];
+    c->dt = (double)d->time_step;
+    c->alpha = (double)d->mass_damping;
+    c->tol = (double)d->newton_tolerance;
+    c->max_it = d->newton_max_iterations;
+    c->eps_inv = (double)d->inverse_epsilon;
+    c->eff_frame = d->effector_frame < 0 ? n - 1 : d->effector_frame;
+    c->eff_orient = d->effector_orientation != 0;
+    for (i = 0; i < n; i++) {
+        double q[4] = {0, 0, 0, 1};
+        for (k = 0; k < 3; k++) c->pos[3 * i + k] = d->positions[3 * i + k];
+        if (d->orientations) frm__ch_qload(d->orientations + 4 * i, q);
+        for (k = 0; k < 4; k++) c->quat[4 * i + k] = (frm_real)q[k];
+        c->mass[i] = d->masses ? (double)d->masses[i] : 0;
+        c->inertia[i] = d->inertias ? (double)d->inertias[i] : 0;
+    }
+    for (i = 0; i + 1 < n; i++) {
+        double C[36], q0[4], q1[4], R[9], r[3];
+        int err;
+        for (k = 0; k < 36; k++) C[k] = (double)d->compliances[36 * (size_t)i + k];
+        err = frm__ch_spd_inverse(C, c->kc + 36 * (size_t)i);
+        if (err) {
+            snprintf(msg, sizeof msg, "link %d: compliance not finite, not symmetric or not positive definite", i);
+            frm__free(&c->allocator, c, bytes);
+            return frm__ch_fail(d, err, msg);
+        }
+        frm__ch_qload(c->quat + 4 * i, q0);
+        frm__ch_qload(c->quat + 4 * (i + 1), q1);
+        frm__ch_rot(q0, R);
+        for (k = 0; k < 3; k++) r[k] = (double)c->pos[3 * (i + 1) + k] - (double)c->pos[3 * i + k];
+        frm__ch_mtv(R, r, c->dbar + 3 * i);
+        frm__ch_qconj(q0, q0);
+        frm__ch_qmul(q0, q1, c->qbar + 4 * i);
+    }
+    frm__ch_qload(c->quat + 4 * c->eff_frame, c->eff_qrest);
+    np = nt = 0;
+    for (a = 0; a < c->na; a++) {
+        const frm_actuator *A = d->actuators + a;
+        c->a_kind[a] = (int)A->kind;
+        c->a_pstart[a] = np;
+        c->a_tstart[a] = nt;
+        c->a_min[a] = (double)A->min_effort;
+        c->a_max[a] = (double)A->max_effort;
+        c->effort[a] = A->min_effort;
+        for (k = 0; k < A->point_count; k++) {
+            int f = A->point_frames[k], j;
+            double q[4], R[9], r[3];
+            frm__ch_qload(c->quat + 4 * f, q);
+            frm__ch_rot(q, R);
+            for (j = 0; j < 3; j++) r[j] = (double)A->points[3 * k + j] - (double)c->pos[3 * f + j];
+            frm__ch_mtv(R, r, c->p_local + 3 * (np + k));
+            c->p_frame[np + k] = f;
+        }
+        if (A->kind == FRM_ACTUATOR_CAVITY)
+            for (k = 0; k < 3 * A->triangle_count; k++) c->tri[3 * nt + k] = A->triangles[k];
+        np += A->point_count;
+        nt += A->kind == FRM_ACTUATOR_CAVITY ? A->triangle_count : 0;
+    }
+    c->a_pstart[c->na] = np;
+    c->a_tstart[c->na] = nt;
+    if (c->na > 0) { /* cavities must enclose a positive volume (outward triangles) */
+        double meas[64];
+        frm__ch_actuators(c, meas, NULL);
+        for (a = 0; a < c->na; a++)
+            if (c->a_kind[a] == FRM_ACTUATOR_CAVITY && !(meas[a] > 0)) {
+                snprintf(msg, sizeof msg, "actuator %d: the cavity's triangles enclose no positive volume", a);
+                frm__free(&c->allocator, c, bytes);
+                return frm__ch_fail(d, FRM_ERR_ACTUATOR, msg);
+            }
+    }
+    *out = c;
+    return FRM_OK;
+}
+
+FRMDEF void frm_chain_destroy(frm_chain *c)
+{
+    frm_allocator a;
+    if (!c) return;
+    a = c->allocator;
+    frm__free(&a, c, c->bytes);
+}
+
+FRMDEF int frm_chain_frame_count(const frm_chain *c) { return c ? c->n : 0; }
+FRMDEF int frm_chain_actuator_count(const frm_chain *c) { return c ? c->na : 0; }
+FRMDEF const frm_real *frm_chain_positions(const frm_chain *c) { return c ? c->pos : NULL; }
+FRMDEF const frm_real *frm_chain_orientations(const frm_chain *c) { return c ? c->quat : NULL; }
+FRMDEF const frm_real *frm_chain_velocities(const frm_chain *c) { return c ? c->vel : NULL; }
+FRMDEF const frm_real *frm_chain_efforts(const frm_chain *c) { return c ? c->effort : NULL; }
+
+FRMDEF int frm_chain_set_poses(frm_chain *c, const frm_real *positions, const frm_real *orientations)
+{
+    int i, k;
+    if (!c || !positions || !orientations) return FRM_ERR_ARG;
+    for (i = 0; i < c->n; i++) {
+        if (!frm__vec3_finite(positions + 3 * i)) return FRM_ERR_ARG;
+        if (!frm__quat_valid(orientations + 4 * i)) return FRM_ERR_QUATERNION;
+    }
+    for (i = 0; i < c->n; i++) {
+        double q[4];
+        frm__ch_qload(orientations + 4 * i, q);
+        for (k = 0; k < 3; k++) c->pos[3 * i + k] = positions[3 * i + k];
+        for (k = 0; k < 4; k++) c->quat[4 * i + k] = (frm_real)q[k];
+    }
+    memset(c->vel, 0, sizeof(frm_real) * 6 * (size_t)c->n);
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_set_base(frm_chain *c, const frm_real position[3], const frm_real orientation[4])
+{
+    double q[4];
+    int k;
+    if (!c || !position || !orientation || !frm__vec3_finite(position)) return FRM_ERR_ARG;
+    if (!frm__quat_valid(orientation)) return FRM_ERR_QUATERNION;
+    frm__ch_qload(orientation, q);
+    for (k = 0; k < 3; k++) c->pos[k] = position[k];
+    for (k = 0; k < 4; k++) c->quat[k] = (frm_real)q[k];
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_set_external(frm_chain *c, int frame, const frm_real force[3], const frm_real torque[3])
+{
+    int k;
+    if (!c) return FRM_ERR_ARG;
+    if (frame < 0 || frame >= c->n) return FRM_ERR_FRAME_RANGE;
+    if ((force && !frm__vec3_finite(force)) || (torque && !frm__vec3_finite(torque))) return FRM_ERR_ARG;
+    for (k = 0; k < 3; k++) {
+        c->ext[6 * frame + k] = force ? (double)force[k] : 0;
+        c->ext[6 * frame + 3 + k] = torque ? (double)torque[k] : 0;
+    }
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_set_gravity(frm_chain *c, const frm_real g[3])
+{
+    int k;
+    if (!c || !g || !frm__vec3_finite(g)) return FRM_ERR_ARG;
+    for (k = 0; k < 3; k++) c->gravity[k] = (double)g[k];
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_set_efforts(frm_chain *c, const frm_real *efforts)
+{
+    int a;
+    if (!c || (c->na > 0 && !efforts)) return FRM_ERR_ARG;
+    for (a = 0; a < c->na; a++)
+        if (!((double)efforts[a] >= c->a_min[a] && (double)efforts[a] <= c->a_max[a])) return FRM_ERR_ACTUATOR_BOUNDS;
+    for (a = 0; a < c->na; a++) c->effort[a] = efforts[a];
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_forces(frm_chain *c, frm_real *out, double *energy)
+{
+    double E;
+    int k;
+    if (!c) return FRM_ERR_ARG;
+    E = frm__ch_elastic(c, c->g, NULL);
+    if (!frm__finite(E)) return FRM_ERR_NOT_FINITE;
+    if (energy) *energy = E;
+    if (out)
+        for (k = 0; k < 6 * c->n; k++) out[k] = (frm_real)c->g[k];
+    return FRM_OK;
+}
+
+FRMDEF double frm_chain_energy(const frm_chain *c) { return c ? frm__ch_elastic(c, NULL, NULL) : 0.0; }
+
+FRMDEF int frm_chain_apply_stiffness(frm_chain *c, const frm_real *v, frm_real *out, int symmetric)
+{
+    int i, k;
+    double K[144], o[12];
+    if (!c || !v || !out) return FRM_ERR_ARG;
+    memset(c->g, 0, sizeof(double) * 6 * (size_t)c->n);
+    for (i = 0; i + 1 < c->n; i++) {
+        frm__ch_link L;
+        int a;
+        frm__ch_link_eval(c, i, &L);
+        frm__ch_link_matrix(&L, K, 0);
+        for (a = 0; a < 12; a++) {
+            double s = 0;
+            for (k = 0; k < 12; k++)
+                s += (symmetric ? 0.5 * (K[12 * a + k] + K[12 * k + a]) : K[12 * a + k]) * (double)v[6 * i + k];
+            o[a] = s;
+        }
+        for (k = 0; k < 12; k++) c->g[6 * i + k] += o[k];
+    }
+    for (k = 0; k < 6 * c->n; k++) out[k] = (frm_real)c->g[k];
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_actuator_measures(const frm_chain *c, double *out)
+{
+    if (!c || (c->na > 0 && !out)) return FRM_ERR_ARG;
+    frm__ch_actuators(c, out, NULL);
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_effector(const frm_chain *c, frm_real position[3], frm_real orientation[4])
+{
+    double P[3], lev[3];
+    int k;
+    if (!c || !position) return FRM_ERR_ARG;
+    frm__ch_point(c, c->eff_frame, c->eff_off, P, lev);
+    for (k = 0; k < 3; k++) position[k] = (frm_real)P[k];
+    if (orientation) memcpy(orientation, c->quat + 4 * c->eff_frame, 4 * sizeof(frm_real));
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_solve_static(frm_chain *c)
+{
+    if (!c) return FRM_ERR_ARG;
+    return frm__ch_newton(c, 0, NULL);
+}
+
+FRMDEF int frm_chain_step(frm_chain *c)
+{
+    int i;
+    if (!c) return FRM_ERR_ARG;
+    for (i = 1; i < c->n; i++)
+        if (!(c->mass[i] > 0) || !(c->inertia[i] > 0)) return FRM_ERR_DENSITY;
+    return frm__ch_newton(c, 1, NULL);
+}
+
+/* >>actuation -------------------------------------------------------------------------- */
+
+/* Effector rows J_e (ne x 6 n: position rows dP = dx - a x dtheta, orientation rows dtheta)
+   and the current error e = effector - target (ne). */
+static int frm__ch_effector_rows(frm_chain *c, const frm_real *target, double *err)
+{
+    int ne = c->eff_orient ? 6 : 3, n6 = 6 * c->n, f = c->eff_frame, j;
+    double P[3], lev[3];
+    memset(c->je, 0, sizeof(double) * (size_t)n6 * 6);
+    frm__ch_point(c, f, c->eff_off, P, lev);
+    for (j = 0; j < 3; j++) {
+        double e[3] = {0, 0, 0}, t[3];
+        double *row = c->je + (size_t)n6 * j;
+        e[j] = 1;
+        frm__ch_cross(lev, e, t);
+        row[6 * f + j] = 1;
+        row[6 * f + 3] = t[0], row[6 * f + 4] = t[1], row[6 * f + 5] = t[2];
+        err[j] = P[j] - (double)target[j];
+    }
+    if (c->eff_orient) {
+        double tq[4], e[4], q[4], th[3];
+        for (j = 0; j < 3; j++) th[j] = (double)target[3 + j];
+        frm__ch_qexp(th, e);
+        frm__ch_qmul(e, c->eff_qrest, tq);
+        frm__ch_qload(c->quat + 4 * f, q);
+        frm__ch_qconj(tq, tq);
+        frm__ch_qmul(q, tq, e);
+        frm__ch_qvec(e);
+        for (j = 0; j < 3; j++) {
+            c->je[(size_t)n6 * (3 + j) + 6 * f + 3 + j] = 1;
+            err[3 + j] = 2 * e[j];
+        }
+    }
+    return ne;
+}
+
+static double frm__ch_effector_error(frm_chain *c, const frm_real *target)
+{
+    double e[6], s = 0;
+    int ne = frm__ch_effector_rows(c, target, e), j;
+    for (j = 0; j < ne; j++) s += e[j] * e[j];
+    return sqrt(s);
+}
+
+/* One linearisation (eq. 5.23) and QP (eq. 5.29): efforts into lam, the predicted error. */
+static int frm__ch_inverse_qp(frm_chain *c, const frm_real *target, double *lam, double *predicted, int *qp_it, int *active)
+{
+    int na = c->na, n6 = 6 * c->n, nb = c->n - 1, ne, a, b, j, k, err;
+    size_t nb6 = 6 * (size_t)nb;
+    double e[6], *Wea = c->qp, *Waa = Wea + 6 * na, *H = Waa + na * na, *cv = H + na * na, *lo = cv + na, *hi = lo + na;
+    double trE = 0, trA = 0, eps, pred = 0;
+    *qp_it = 0;
+    *active = 0;
+    /* free motion: the total force without the actuators at the current state */
+    frm__ch_total(c, c->g, 0); /* also fills c->ja */
+    err = frm__ch_factor(c, 0.0);
+    if (err) return err;
+    ne = frm__ch_effector_rows(c, target, e);
+    for (k = 0; k < (int)nb6; k++) c->rhs[k] = (frm_real)c->g[6 + k];
+    for (a = 0; a < na; a++)
+        for (k = 0; k < (int)nb6; k++) c->rhs[nb6 * (size_t)(a + 1) + k] = (frm_real)c->ja[(size_t)n6 * a + 6 + k];
+    err = frm_btd_solve(nb, c->factor, na + 1, c->rhs);
+    if (err) return err;
+    /* delta_e^free = e + J_e dq_free; W_ea = J_e K^-1 J_a^T; W_aa = J_a K^-1 J_a^T */
+    for (j = 0; j < ne; j++) {
+        const double *row = c->je + (size_t)n6 * j + 6;
+        double s = e[j];
+        for (k = 0; k < (int)nb6; k++) s += row[k] * (double)c->rhs[k];
+        e[j] = s;
+        for (a = 0; a < na; a++) {
+            const frm_real *y = c->rhs + nb6 * (size_t)(a + 1);
+            double t = 0;
+            for (k = 0; k < (int)nb6; k++) t += row[k] * (double)y[k];
+            Wea[na * j + a] = t;
+        }
+    }
+    for (a = 0; a < na; a++)
+        for (b = 0; b < na; b++) {
+            const double *ra = c->ja + (size_t)n6 * a + 6;
+            const frm_real *y = c->rhs + nb6 * (size_t)(b + 1);
+            double t = 0;
+            for (k = 0; k < (int)nb6; k++) t += ra[k] * (double)y[k];
+            Waa[na * a + b] = t;
+        }
+    for (a = 0; a < na; a++) {
+        for (b = 0; b < na; b++) {
+            double t = 0;
+            for (j = 0; j < ne; j++) t += Wea[na * j + a] * Wea[na * j + b];
+            H[na * a + b] = t;
+        }
+        trE += H[na * a + a];
+        trA += fabs(Waa[na * a + a]);
+    }
+    eps = trA > 0 ? c->eps_inv * trE / trA : 0;
+    for (a = 0; a < na; a++) {
+        double t = 0;
+        for (b = 0; b < na; b++) H[na * a + b] += eps * 0.5 * (Waa[na * a + b] + Waa[na * b + a]);
+        for (j = 0; j < ne; j++) t += Wea[na * j + a] * e[j];
+        cv[a] = t;
+        lo[a] = c->a_min[a];
+        hi[a] = c->a_max[a];
+        lam[a] = (double)c->effort[a];
+    }
+    err = frm_qp_box(na, H, cv, lo, hi, lam, qp_it);
+    if (err) return err;
+    for (j = 0; j < ne; j++) {
+        double t = e[j];
+        for (a = 0; a < na; a++) t += Wea[na * j + a] * lam[a];
+        pred += t * t;
+    }
+    for (a = 0; a < na; a++) *active += lam[a] <= lo[a] || lam[a] >= hi[a];
+    *predicted = sqrt(pred);
+    return FRM_OK;
+}
+
+FRMDEF int frm_chain_inverse_step(frm_chain *c, const frm_real *target, double tolerance, frm_inverse_stats *stats)
+{
+    double lam[64], pred = 0;
+    int a, err, qp_it = 0, active = 0, newton = 0;
+    frm_inverse_stats st;
+    memset(&st, 0, sizeof st);
+    if (stats) *stats = st;
+    if (!c || !target || !(tolerance > 0) || c->na < 1) return FRM_ERR_ARG;
+    for (a = 0; a < (c->eff_orient ? 6 : 3); a++)
+        if (!frm__finite((double)target[a])) return FRM_ERR_ARG;
+    err = frm__ch_inverse_qp(c, target, lam, &pred, &qp_it, &active);
+    st.linearizations = 1;
+    st.qp_iterations = qp_it;
+    st.active_bounds = active;
+    st.predicted_error = pred;
+    if (!err) {
+        frm_real keep[64];
+        for (a = 0; a < c->na; a++) keep[a] = c->effort[a], c->effort[a] = (frm_real)lam[a];
+        err = frm__ch_newton(c, 0, &newton);
+        if (err)
+            for (a = 0; a < c->na; a++) c->effort[a] = keep[a];
+    }
+    st.newton_iterations = newton;
+    st.error = frm__ch_effector_error(c, target);
+    st.reached = st.error <= tolerance;
+    if (stats) *stats = st;
+    if (err) return err;
+    return st.reached || pred <= tolerance ? FRM_OK : FRM_ERR_UNREACHABLE;
+}
+
+FRMDEF int frm_chain_inverse_solve(frm_chain *c, const frm_real *target, double tolerance, int max_linearizations,
+                                   frm_inverse_stats *stats)
+{
+    frm_inverse_stats st, sum;
+    double best = HUGE_VAL, previous = HUGE_VAL;
+    int it, err = FRM_ERR_NO_CONVERGENCE, stalled = 0;
+    memset(&sum, 0, sizeof sum);
+    if (stats) *stats = sum;
+    if (!c || !target || !(tolerance > 0) || max_linearizations < 1 || c->na < 1) return FRM_ERR_ARG;
+    frm__ch_store(c, c->best);
+    best = frm__ch_effector_error(c, target);
+    for (it = 0; it < max_linearizations; it++) {
+        err = frm_chain_inverse_step(c, target, tolerance, &st);
+        sum.linearizations++;
+        sum.qp_iterations += st.qp_iterations;
+        sum.newton_iterations += st.newton_iterations;
+        sum.active_bounds = st.active_bounds;
+        sum.predicted_error = st.predicted_error;
+        if (err && err != FRM_ERR_UNREACHABLE) break;
+        if (st.error < best) {
+            best = st.error;
+            frm__ch_store(c, c->best);
+        }
+        if (st.reached) break;
+        /* out of reach and no longer improving: the closest pose */
+        if (err == FRM_ERR_UNREACHABLE && !(st.error < previous * (1 - 1e-3))) {
+            if (++stalled >= 2) break;
+        } else
+            stalled = 0;
+        previous = st.error;
+    }
+    if (st.reached)
+        err = FRM_OK;
+    else if (err == FRM_OK || err == FRM_ERR_UNREACHABLE) {
+        /* the closest pose found (a valid equilibrium) */
+        frm__ch_restore(c, c->best);
+        err = st.predicted_error > tolerance ? FRM_ERR_UNREACHABLE : FRM_ERR_NO_CONVERGENCE;
+    }
+    sum.error = frm__ch_effector_error(c, target);
+    sum.reached = sum.error <= tolerance;
+    if (stats) *stats = sum;
+    return err;
+}
+
+/* Eqs. 5.1-5.11 on a frames sub-model: end A held, end B rigid with a virtual frame at
+   origin_b. For each unit rigid motion t_k of end B (translation, then rotation about
+   origin_b): the interior's response u_I = -K_II^-1 K_IB t_k by the model's linear solver,
+   the reaction r = K (t_k + u_I) on end B's frames, reduced to origin_b: column k of the
+   condensed stiffness K_red = T^T (K_BB - K_BI K_II^-1 K_IB) T; C = K_red^-1 (eq. 5.10). */
+FRMDEF int frm_chain_link_compliance(frm_model *m, const int *end_a, int na, const int *end_b, int nb,
+                                     const frm_real origin_b[3], frm_real C[36])
+{
+    unsigned char *keep_state, *keep_axes;
+    size_t n6, bytes;
+    frm_real *v, *x, *kv;
+    double Kr[36], Ci[36], reg;
+    int i, k, j, err = FRM_OK, n, cg_cap;
+    if (!m || !end_a || !end_b || na < 1 || nb < 1 || !origin_b || !C || !frm__vec3_finite(origin_b)) return FRM_ERR_ARG;
+    n = m->frame_count;
+    for (i = 0; i < na; i++)
+        if (end_a[i] < 0 || end_a[i] >= n) return FRM_ERR_FRAME_RANGE;
+    for (i = 0; i < nb; i++)
+        if (end_b[i] < 0 || end_b[i] >= n) return FRM_ERR_FRAME_RANGE;
+    n6 = 6 * (size_t)n;
+    bytes = 2 * (size_t)n + 3 * n6 * sizeof(frm_real) + 64;
+    keep_state = (unsigned char *)frm__alloc(&m->allocator, bytes);
+    if (!keep_state) return FRM_ERR_ALLOC;
+    keep_axes = keep_state + n;
+    v = (frm_real *)(void *)(keep_state + ((2 * (size_t)n + 63) / 64) * 64);
+    x = v + n6;
+    kv = x + n6;
+    memcpy(keep_state, m->state, (size_t)n);
+    memcpy(keep_axes, m->axes, (size_t)n);
+    reg = m->solve_regularization;
+    cg_cap = m->cg_max_iterations;
+    /* the ends' frames: translations held (end A) or imposed (end B), rotations free */
+    for (i = 0; i < n; i++) m->state[i] = FRM__FREE, m->axes[i] = 0;
+    for (i = 0; i < na; i++) m->axes[end_a[i]] = 7;
+    for (i = 0; i < nb; i++) m->axes[end_b[i]] = 7;
+    m->solve_regularization = 0;
+    if (m->cg_max_iterations < 20 * n) m->cg_max_iterations = 20 * n;
+    err = frm__linearize(m, NULL, 0);
+    if (!err) frm__build_precond(m, 0.0, 1.0);
+    for (k = 0; k < 6 && !err; k++) {
+        double F[6] = {0, 0, 0, 0, 0, 0};
+        int cg;
+        memset(v, 0, sizeof(frm_real) * n6);
+        for (i = 0; i < nb; i++) {
+            int f = end_b[i];
+            double lev[3], e[3] = {0, 0, 0}, t[3];
+            for (j = 0; j < 3; j++) lev[j] = (double)m->pos[3 * f + j] - (double)origin_b[j];
+            if (k < 3)
+                v[6 * f + k] = 1;
+            else {
+                e[k - 3] = 1;
+                frm__ch_cross(e, lev, t);
+                for (j = 0; j < 3; j++) v[6 * f + j] = (frm_real)t[j];
+            }
+        }
+        frm__stiffness_product(m, v, kv, 0);
+        for (j = 0; j < (int)n6; j++) kv[j] = -kv[j];
+        memset(x, 0, sizeof(frm_real) * n6);
+        cg = frm__linear_solve(m, 0.0, 1.0, FRM__IS_FLOAT ? 1e-6 : 1e-11, kv, x);
+        if (cg != FRM__CG_OK) {
+            err = cg == FRM__CG_NOT_FINITE ? FRM_ERR_NOT_FINITE : FRM_ERR_NO_CONVERGENCE;
+            break;
+        }
+        for (j = 0; j < (int)n6; j++) v[j] += x[j];
+        frm__stiffness_product(m, v, kv, 0);
+        for (i = 0; i < nb; i++) {
+            int f = end_b[i];
+            double lev[3], fo[3], t[3];
+            for (j = 0; j < 3; j++) lev[j] = (double)m->pos[3 * f + j] - (double)origin_b[j], fo[j] = (double)kv[6 * f + j];
+            frm__ch_cross(lev, fo, t);
+            for (j = 0; j < 3; j++) F[j] += fo[j], F[3 + j] += (double)kv[6 * f + 3 + j] + t[j];
+        }
+        for (j = 0; j < 6; j++) Kr[6 * j + k] = F[j];
+    }
+    memcpy(m->state, keep_state, (size_t)n);
+    memcpy(m->axes, keep_axes, (size_t)n);
+    m->solve_regularization = reg;
+    m->cg_max_iterations = cg_cap;
+    m->lin_valid = 0;
+    frm__free(&m->allocator, keep_state, bytes);
+    if (err) return err;
+    for (k = 0; k < 6; k++) /* symmetrise (round-off of the solves) */
+        for (j = 0; j < k; j++) Kr[6 * k + j] = Kr[6 * j + k] = 0.5 * (Kr[6 * k + j] + Kr[6 * j + k]);
+    err = frm__ch_spd_inverse(Kr, Ci);
+    if (err) return err;
+    for (k = 0; k < 36; k++) C[k] = (frm_real)Ci[k];
+    return FRM_OK;
 }
 
 #if defined(FRM_STATIC) && defined(__GNUC__)

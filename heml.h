@@ -64,6 +64,8 @@
        HEML_STATIC     make every function static (private to the including file).
        HEML_PARALLEL_MIN_TETS
                        meshes with fewer tetrahedra run serially (default 16384).
+       HEML_NO_SIMD    no intrinsics: the portable scalar gather, scatter and square
+                       roots even where the target has AVX (results are the same bits).
 
    STEP BY STEP
        1. heml_desc d = heml_default_desc(); fill the mesh, the material (or a table of
@@ -593,7 +595,8 @@
    least a pass must move from memory: the stream plus each node's displacement read once
    and force written once (105 bytes per tetrahedron on the beam below). Tetrahedra sit in
    blocks of 16 (structure of arrays inside a block); a block's arithmetic is vectorised
-   loops over its lanes; gather and scatter are scalar loops (AVX2 has no scatter). The
+   loops over its lanes; gather and scatter are vector code where the target has AVX
+   (issue 21, below), scalar loops elsewhere. The
    Neo-Hookean force: 9 subtractions (the link displacements), H = du V^-1 (27
    multiply-adds), cof H (18), J - 1, one logarithm with its log1p correction (a
    branch-free fdlibm polynomial, which vectorises where libm's log is a call), two
@@ -690,6 +693,60 @@
    was set for REFERENCES.md's machine (Zen 5, 4.2 GHz, AVX-512, a 40 GB/s triad); the
    kernel figures above come from the Zen 3 named earlier. There the clock alone would bring
    20 ns near 15, and the bound halves with the bandwidth; neither is measured.
+   Issue 21 (this machine is not the Zen 3 above any more: /proc/cpuinfo says AMD EPYC
+   family 26 (Zen 5) with AVX-512, gcc 12 takes -march=native as znver3 plus AVX-512;
+   shared by several jobs, load 4 to 7 on 2 vCPUs, so timings move by 2x: figures are the
+   minimum of 5 to 15 interleaved runs, ns per tetrahedron, 8,640-tetrahedron beam, force /
+   differential, and instruction counts by callgrind of -march=x86-64-v3 builds, which
+   valgrind can run):
+                                    before           after         instructions (v3)
+       Neo-Hookean, -march=native   12.5 / 15.9      10.1 / 12.4
+       Neo-Hookean, x86-64-v3       13.5 / 21.1      11.4 / 17.7   213 / 278 -> 160 / 198
+       St Venant-Kirchhoff          14.6             (unchanged)   259 / 376 -> 207 / 296
+       Mooney-Rivlin (split)        39 / 45          17 / 22       490 / 606 -> 230 / 320
+       springs                      284 / 34         17            451 / 509 -> 248 / 270
+   So every law's force is within 1.5 times the Neo-Hookean force (SVK 1.17, Mooney-Rivlin
+   1.35, springs 1.34, all measured in one interleaved run before the gather change; the
+   gather and scatter serve every law alike). What changed, all bit-identical to the scalar
+   path except the cube root:
+   - the spring force: heml__spring_forces took the differential's terms under a branch on
+     dt, which gcc if-converted, so the force pass multiplied the unset workspace de, whose
+     stack garbage held subnormals (microcode assists: 15x). The differential is now
+     heml__spring_dforces. Its six square roots per tetrahedron go through
+     heml__sqrt_lanes (AVX _mm256_sqrt, correctly rounded like sqrt; libm's sqrt keeps
+     errno, so gcc does not vectorise it, and optimize("no-math-errno") on the function
+     had no effect).
+   - Mooney-Rivlin: J^-1/3 by heml__inv_cbrt (a float bit-trick guess and Newton steps,
+     3.6 ulp in double, 2 in float, where libm's cbrt is a call), its energy terms
+     (log1p, expm1 calls) in a loop of their own: the law's loop vectorises. Forces move
+     by round-off against 0.3.0's.
+   - the gather (heml__gather_vec): per lane and node one masked 3-component load
+     (AVX-512 VL masks, or AVX's vmaskmov: never reads past an array's end), differences in
+     AoS, a 4 x 4 transpose per link into the lanes' rows. The scatter (heml__scatter_vec):
+     per lane and node a 16-byte (x, y) and a scalar z read-modify-write, lanes in order;
+     masked 3-component stores were tried and lost (force 12.7 -> 20.4 ns: a masked store
+     does not forward to the next lane's load of a shared node), as did unmasked 32-byte
+     stores (they would write a neighbour node's x, a race with another colour group).
+     AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
+     conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
+     (tests compare both, bit for bit, every law).
+   - tried and not kept: software prefetch of the next block's nodes and the rest constants
+     of the block after (large meshes): no difference measurable above this machine's
+     noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns in the
+     same interleaved series: noise).
+   The bench's ratio lines (bench/bench.c, kernels part, `--filter heml`; one loaded run of
+   git ea15902 plus these kernels, double, 1 thread) put the Neo-Hookean force at 20 to 23 %
+   of its bandwidth bound at 1e3 to 1e4 tetrahedra and 13 to 14 % at 1e5 to 1e6 (goal 40 %:
+   not met), at 2.3 to 2.6 times its arithmetic floor in cache (the `arith` rows: the same
+   pass without gather and scatter; goal 2: not met, the gather/scatter still costs more than
+   the arithmetic), and the differential at 0.85 to 0.89 times a CSR product of the same
+   assembled tangent at 1e3 tetrahedra but 1.2 to 2.1 times at 1e4 to 1e6 in double; in float
+   0.46 to 0.98 times at every size (a float CSR still reads a 4-byte column index per value,
+   so halving the real size saves it less than it saves the kernel).
+   What the remaining gap needs (not done): more independent chains per block in double
+   (HEML__W = 32: a change of the chunk structure, so of every sum's order), and a
+   differential that caches F, cof F and the volumetric scalars per tetrahedron at the
+   linearisation point (88 more bytes per tetrahedron: still below the CSR's about 300).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -782,6 +839,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
+             masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
+             spring force 15x faster (no differential terms on an unset workspace) and its
+             square roots vectorised; Mooney-Rivlin's J^-1/3 by a branch-free Newton cube
+             root (forces change by round-off). See PERFORMANCE, issue 21.
        unreleased (issue 19) HEML_BDF2 (second order, the same Newton minimisation as
              implicit Euler; the model keeps its history, 2 more 3n vectors, and 2 3n
              scratch vectors); point probes (heml_probe_*); modal analysis (heml_modal_*).
@@ -1410,6 +1472,18 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #else
 #define HEML__SCALAR_FN
 #endif
+/* Vector intrinsics, only where the target has them (compile-time checks; never required):
+   the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
+   do not vectorise it; _mm*_sqrt_* round the same, correctly, so results are
+   bit-identical to the scalar path), and the node gather and scatter (heml__gather_vec).
+   HEML_NO_SIMD forces the portable scalar code. */
+#if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
+#include <immintrin.h>
+#define HEML__AVX 1
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+#define HEML__AVX512 1 /* the gather's masked node loads with AVX-512 masks (else AVX's vmaskmov) */
+#endif
+#endif
 #if defined(__clang__)
 #define HEML__SCALAR_LOOP _Pragma("clang loop vectorize(disable)")
 #else
@@ -1509,6 +1583,8 @@ struct heml_model {
     int material_count, prony_total, has_prony, has_springs, has_user_without_second;
     int agg_count;                         /* aggregates of the coarse space (0: none) */
     int nodal;                             /* desc.nodal_pressure (NEAR-INCOMPRESSIBLE BODIES) */
+    int simd;                              /* 1: the vector gather and scatter where compiled in
+                                              (HEML__AVX); tests set 0 to compare with the scalar path */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
     heml_integrator integrator;
     heml_linear_solver linear_solver;
@@ -1878,6 +1954,28 @@ static void heml__law_raw(const heml__mat *mt, heml__blk *b, int valid, int want
         }
 }
 
+/* Jc^(-1/3) for Jc > 0, branch-free so that the law's loop vectorises (libm's cbrt is a
+   call): a first guess from the bits of the float (the exponent divided by 3, error below
+   4 %), then Newton steps r <- r (4 - Jc r^3) / 3, whose relative error e becomes about
+   2 e^2: 4 steps in double, 3 in float, to within a few ulps (libm's cbrt, correctly
+   rounded to 1 ulp, gave the same forces to round-off in the all-law tests). Valid for
+   Jc in [2^-60, 2^60]; heml__law_split sends other lanes to libm. */
+HEML__INLINE heml_real heml__inv_cbrt(heml_real Jc)
+{
+    float xf = (float)Jc, gf;
+    int i;
+    heml_real r, x3 = Jc / 3;
+    memcpy(&i, &xf, sizeof i);
+    i = 0x54a21d2a - (int)((float)i * (1.0f / 3.0f));
+    memcpy(&gf, &i, sizeof gf);
+    r = (heml_real)gf;
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    if (sizeof(heml_real) > sizeof(float)) r = r * ((heml_real)(4.0 / 3.0) - x3 * (r * r * r));
+    return r;
+}
+
 /* heml__law_split, the compressible Mooney-Rivlin (eqs. 21-25): w = c1 (I1 a - 3) + c2 (I2 b - 3) + kappa/2 (J - 1)^2 with
    a = J^-2/3, b = J^-4/3, both continued below J0 by their quadratic Taylor polynomials
    (a' = -2/3 a / J, a'' = 10/9 a / J^2, b' = -4/3 b / J, b'' = 28/9 b / J^2). s0 uses
@@ -1887,12 +1985,22 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
 {
     (void)valid;
     const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
-    int k;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real Jc = b->Jc[k];
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside) /* (NaN lanes stay NaN either way) */
+        for (k = 0; k < HEML__W; k++)
+            if (b->Jc[k] < lo || b->Jc[k] > hi) rc[k] = (heml_real)(1 / cbrt((double)b->Jc[k]));
     for (k = 0; k < HEML__W; k++) {
         heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
         heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], I1 = 3 + I1m3, I2 = 3 + I2m3;
-        heml_real t = (heml_real)cbrt((double)Jc), iJ = 1 / Jc;
-        heml_real a = 1 / (t * t), bq = a * a;
+        heml_real r = rc[k], iJ = 1 / Jc;
+        heml_real a = r * r, bq = a * a;
         heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
         heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
         heml_real at = a + d * (a1 + d / 2 * a2), at1 = a1 + d * a2;
@@ -1907,14 +2015,21 @@ static void heml__law_split(const heml__mat *mt, heml__blk *b, int valid, int wa
         b->h[2][k] = c1 * at1;
         b->h[4][k] = c2 * bt1;
         b->h[5][k] = c1 * I1 * a2 + c2 * I2 * b2 + kappa;
-        if (want & HEML__WANT_ENERGY) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+    }
+    /* the energy in a loop of its own (library calls), so that the one above vectorises */
+    if (want & HEML__WANT_ENERGY)
+        for (k = 0; k < HEML__W; k++) { /* I1 at - 3 = 3 (at - 1) + (I1 - 3) at, a - 1 by expm1 (double) */
+            heml_real Jc = b->Jc[k], jc1 = b->jc1[k], d = b->dJ0[k], jm1 = b->jm1[k];
+            heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], r = rc[k], iJ = 1 / Jc;
+            heml_real a = r * r, bq = a * a;
+            heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
+            heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
             double L = log1p((double)jc1), dd = (double)d;
             double am1 = expm1(-2.0 / 3.0 * L) + dd * ((double)a1 + dd / 2 * (double)a2);
             double bm1 = expm1(-4.0 / 3.0 * L) + dd * ((double)b1 + dd / 2 * (double)b2);
             b->w[k] = (heml_real)((double)c1 * (3 * am1 + (double)I1m3 * (1 + am1)) +
                                   (double)c2 * (3 * bm1 + (double)I2m3 * (1 + bm1)) + (double)kappa / 2 * jm1 * jm1);
         }
-    }
 }
 
 /* heml__law_svk (table 3) in invariants: w = lambda/8 (I1 - 3)^2 + mu/4 (I1^2 - 2 I1 - 2 I2 + 3)
@@ -2073,8 +2188,8 @@ static void heml__dilation(const heml__mat *mt, heml_real jm1_0, const heml_real
 /* >>forces ---------------------------------------------------------------------------- */
 
 /* Links du_1, du_2, du_3 of the block's lanes from a 3n field (displacements or dx). */
-HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
-                                         heml_real (*HEML__RESTRICT e)[HEML__W])
+HEML__SCALAR_FN static void heml__gather_scalar(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                                                heml_real (*HEML__RESTRICT e)[HEML__W])
 {
     int k, r;
     HEML__SCALAR_LOOP
@@ -2092,8 +2207,8 @@ HEML__SCALAR_FN static void heml__gather(const int *HEML__RESTRICT idx, const he
 /* Adds the block's node forces (f on nodes 1..3, minus their sum on node 0) into out. The
    lanes go in order, so a node shared by two lanes of a block is updated twice in a
    fixed order. */
-static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
-                          heml_real *HEML__RESTRICT out)
+static void heml__scatter_scalar(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                                 heml_real *HEML__RESTRICT out)
 {
     int k, r;
     for (k = 0; k < HEML__W; k++) {
@@ -2107,6 +2222,172 @@ static void heml__scatter(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTR
             o0[r] -= (a + b) + c;
         }
     }
+}
+
+#if defined(HEML__AVX)
+/* The vector gather and scatter (AVX; AVX-512 VL masks where present), 4 lanes at a time.
+   Gather: one masked load moves a node's 3 components (the mask never faults past the
+   array's end), 4 x 4 transposes turn them into the lanes' rows. Scatter: per node a
+   16-byte (x, y) and a scalar z read-modify-write (masked stores were tried: 1.6 times
+   slower, their store-to-load forwarding fails where the next lane updates the same node).
+   The same operations in the same order as the scalar loops (the links are differences of
+   the same pairs; a node shared by lanes receives the lanes' terms in lane order, node 0
+   the same (a + b) + c), so the forces are bit-identical to the scalar path. */
+#if defined(HEML__AVX512)
+#define HEML__LOAD3D(p) _mm256_maskz_loadu_pd((__mmask8)7, (p))
+#define HEML__LOAD3F(p) _mm_maskz_loadu_ps((__mmask8)7, (p))
+#else
+#define HEML__LOAD3D(p) _mm256_maskload_pd((p), _mm256_set_epi64x(0, -1, -1, -1))
+#define HEML__LOAD3F(p) _mm_maskload_ps((p), _mm_set_epi32(0, -1, -1, -1))
+#endif
+static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                             heml_real (*HEML__RESTRICT e)[HEML__W])
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            const double *xd = (const double *)(const void *)x;
+            __m256d p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3D(xd + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m256d d[4], t0, t1, t2, t3;
+                double *row = (double *)(void *)e[3 * (j - 1)];
+                for (l = 0; l < 4; l++)
+                    d[l] = _mm256_sub_pd(HEML__LOAD3D(xd + 3 * (size_t)idx[j * HEML__W + k + l]),
+                                         p0[l]);
+                t0 = _mm256_unpacklo_pd(d[0], d[1]); /* x0 x1 z0 z1 */
+                t1 = _mm256_unpackhi_pd(d[0], d[1]); /* y0 y1 .. */
+                t2 = _mm256_unpacklo_pd(d[2], d[3]);
+                t3 = _mm256_unpackhi_pd(d[2], d[3]);
+                _mm256_storeu_pd(row + k, _mm256_permute2f128_pd(t0, t2, 0x20));
+                _mm256_storeu_pd(row + HEML__W + k, _mm256_permute2f128_pd(t1, t3, 0x20));
+                _mm256_storeu_pd(row + 2 * HEML__W + k, _mm256_permute2f128_pd(t0, t2, 0x31));
+            }
+        } else {
+            const float *xf = (const float *)(const void *)x;
+            __m128 p0[4];
+            for (l = 0; l < 4; l++) p0[l] = HEML__LOAD3F(xf + 3 * (size_t)idx[k + l]);
+            for (j = 1; j < 4; j++) {
+                __m128 d0, d1, d2, d3;
+                float *row = (float *)(void *)e[3 * (j - 1)];
+                d0 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k]), p0[0]);
+                d1 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 1]), p0[1]);
+                d2 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 2]), p0[2]);
+                d3 = _mm_sub_ps(HEML__LOAD3F(xf + 3 * (size_t)idx[j * HEML__W + k + 3]), p0[3]);
+                _MM_TRANSPOSE4_PS(d0, d1, d2, d3);
+                _mm_storeu_ps(row + k, d0);
+                _mm_storeu_ps(row + HEML__W + k, d1);
+                _mm_storeu_ps(row + 2 * HEML__W + k, d2);
+            }
+        }
+    }
+}
+
+static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                              heml_real *HEML__RESTRICT out)
+{
+    int k, j, l;
+    for (k = 0; k < HEML__W; k += 4) {
+        if (sizeof(heml_real) == sizeof(double)) {
+            double *od = (double *)(void *)out;
+            __m128d xy[4][4]; /* [node][lane] */
+            double zz[4][4];
+            for (j = 0; j < 4; j++) {
+                __m256d X, Y, Z, t0, t1;
+                if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                    const double *f0 = (const double *)(const void *)f[0] + k;
+                    X = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0), _mm256_loadu_pd(f0 + 3 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 6 * HEML__W));
+                    Y = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + HEML__W), _mm256_loadu_pd(f0 + 4 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 7 * HEML__W));
+                    Z = _mm256_add_pd(_mm256_add_pd(_mm256_loadu_pd(f0 + 2 * HEML__W), _mm256_loadu_pd(f0 + 5 * HEML__W)),
+                                      _mm256_loadu_pd(f0 + 8 * HEML__W));
+                } else {
+                    const double *fj = (const double *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm256_loadu_pd(fj);
+                    Y = _mm256_loadu_pd(fj + HEML__W);
+                    Z = _mm256_loadu_pd(fj + 2 * HEML__W);
+                }
+                t0 = _mm256_unpacklo_pd(X, Y); /* x0 y0 x2 y2 */
+                t1 = _mm256_unpackhi_pd(X, Y); /* x1 y1 x3 y3 */
+                xy[j][0] = _mm256_castpd256_pd128(t0);
+                xy[j][1] = _mm256_castpd256_pd128(t1);
+                xy[j][2] = _mm256_extractf128_pd(t0, 1);
+                xy[j][3] = _mm256_extractf128_pd(t1, 1);
+                _mm256_storeu_pd(zz[j], Z);
+            }
+            for (l = 0; l < 4; l++) { /* lanes in order: shared nodes see the scalar order */
+                for (j = 1; j < 4; j++) {
+                    double *o = od + 3 * (size_t)idx[j * HEML__W + k + l];
+                    _mm_storeu_pd(o, _mm_add_pd(_mm_loadu_pd(o), xy[j][l]));
+                    o[2] += zz[j][l];
+                }
+                {
+                    double *o = od + 3 * (size_t)idx[k + l];
+                    _mm_storeu_pd(o, _mm_sub_pd(_mm_loadu_pd(o), xy[0][l]));
+                    o[2] -= zz[0][l];
+                }
+            }
+        } else {
+            float *of = (float *)(void *)out;
+            __m128 v[4][4];
+            for (j = 0; j < 4; j++) {
+                __m128 X, Y, Z, W = _mm_setzero_ps();
+                if (j == 0) {
+                    const float *f0 = (const float *)(const void *)f[0] + k;
+                    X = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0), _mm_loadu_ps(f0 + 3 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 6 * HEML__W));
+                    Y = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + HEML__W), _mm_loadu_ps(f0 + 4 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 7 * HEML__W));
+                    Z = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + 2 * HEML__W), _mm_loadu_ps(f0 + 5 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 8 * HEML__W));
+                } else {
+                    const float *fj = (const float *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm_loadu_ps(fj);
+                    Y = _mm_loadu_ps(fj + HEML__W);
+                    Z = _mm_loadu_ps(fj + 2 * HEML__W);
+                }
+                _MM_TRANSPOSE4_PS(X, Y, Z, W);
+                v[j][0] = X, v[j][1] = Y, v[j][2] = Z, v[j][3] = W;
+            }
+            for (l = 0; l < 4; l++) {
+                for (j = 0; j < 4; j++) {
+                    float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
+                    __m128 xyo = _mm_castpd_ps(_mm_load_sd((const double *)(const void *)o)), r;
+                    r = j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]);
+                    _mm_store_sd((double *)(void *)o, _mm_castps_pd(r));
+                    o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
+                             : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
+                }
+            }
+        }
+    }
+}
+#endif
+
+/* The gather and scatter of a model: vector where compiled in and m->simd, else scalar. */
+static void heml__gather(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__gather_vec(idx, x, e);
+        return;
+    }
+#endif
+    (void)m;
+    heml__gather_scalar(idx, x, e);
+}
+
+static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HEML__W], heml_real *out)
+{
+#if defined(HEML__AVX)
+    if (m->simd) {
+        heml__scatter_vec(idx, f, out);
+        return;
+    }
+#endif
+    (void)m;
+    heml__scatter_scalar(idx, f, out);
 }
 
 /* The same with absolute values (the size of the terms each node's force sums). */
@@ -2233,6 +2514,24 @@ static void heml__spring_rest_links(const heml_real *HEML__RESTRICT R, heml__blk
     }
 }
 
+/* x[i] = sqrt(x[i]) for n non-negative values: vector
+   square roots where the target has them (HEML__AVX), the same correctly rounded values. */
+static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
+{
+    int i = 0;
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(double)) {
+        double *d = (double *)(void *)x;
+        for (; i + 4 <= n; i += 4) _mm256_storeu_pd(d + i, _mm256_sqrt_pd(_mm256_loadu_pd(d + i)));
+    } else {
+        float *f = (float *)(void *)x;
+        for (; i + 8 <= n; i += 8) _mm256_storeu_ps(f + i, _mm256_sqrt_ps(_mm256_loadu_ps(f + i)));
+    }
+#endif
+    HEML__SCALAR_LOOP
+    for (; i < n; i++) x[i] = (heml_real)sqrt((double)x[i]);
+}
+
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
@@ -2255,15 +2554,16 @@ static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *
             }
             dl2[l][k] = acc;
         }
-    for (l = 0; l < 6; l++) /* the square roots (library calls) */
+    for (l = 0; l < 6; l++) /* l^2 (clamped at 0) */
         for (k = 0; k < HEML__W; k++) {
-            heml_real L = S[l * HEML__W + k];
-            b->len[l][k] = (heml_real)sqrt((double)heml__max(L * L + dl2[l][k], 0));
+            heml_real L = S[l * HEML__W + k], q = L * L + dl2[l][k];
+            b->len[l][k] = q > 0 ? q : 0;
         }
+    heml__sqrt_lanes(b->len[0], 6 * HEML__W);
     for (l = 0; l < 6; l++)
         for (k = 0; k < HEML__W; k++) {
             heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k], len = b->len[l][k];
-            heml_real lc = heml__max(len, (heml_real)1e-12 * L);
+            heml_real lo = (heml_real)1e-12 * L, lc = len > lo ? len : lo;
             b->len[l][k] = lc;
             b->co[l][k] = kk * dl2[l][k] / ((lc + L) * lc); /* k (l - L) / l */
         }
@@ -2293,10 +2593,8 @@ static void heml__spring_links(const heml__blk *b, int k, heml_real v[6][3])
 }
 
 /* Node forces from the link tensions t_e: t_e v_e on the link's start, -t_e v_e on its end
-   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). With dt (differential) each term
-   t v becomes t dv + dt v, dv the links of de. */
-static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
-                                heml_real (*HEML__RESTRICT t)[HEML__W], heml_real (*HEML__RESTRICT dt)[HEML__W])
+   (v4 = v2 - v1, v5 = v3 - v2, v6 = v1 - v3, v = V + du). */
+static void heml__spring_forces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W])
 {
     int k, r;
     for (r = 0; r < 3; r++)
@@ -2305,15 +2603,32 @@ static void heml__spring_forces(heml__blk *HEML__RESTRICT b,
             heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
             heml_real p1 = t[0][k] * v1, p2 = t[1][k] * v2, p3 = t[2][k] * v3;
             heml_real p4 = t[3][k] * (v2 - v1), p5 = t[4][k] * (v3 - v2), p6 = t[5][k] * (v1 - v3);
-            if (dt) {
-                heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
-                p1 = t[0][k] * d1 + dt[0][k] * v1;
-                p2 = t[1][k] * d2 + dt[1][k] * v2;
-                p3 = t[2][k] * d3 + dt[2][k] * v3;
-                p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
-                p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
-                p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
-            }
+            b->f[r][k] = -p1 + p4 - p6;
+            b->f[3 + r][k] = -p2 - p4 + p5;
+            b->f[6 + r][k] = -p3 - p5 + p6;
+        }
+}
+
+/* The differential of heml__spring_forces: each term t v becomes t dv + dt v, dv the links
+   of de. A function of its own: one loop with a branch on dt was if-converted by gcc, so
+   the force pass computed (and discarded) the differential's products from the unset
+   workspace de, whose garbage included subnormals: 15 times the Neo-Hookean force on Zen
+   (measured, issue 21). */
+static void heml__spring_dforces(heml__blk *HEML__RESTRICT b, heml_real (*HEML__RESTRICT t)[HEML__W],
+                                 heml_real (*HEML__RESTRICT dt)[HEML__W])
+{
+    int k, r;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real v1 = b->H[r][k] + b->e[r][k], v2 = b->H[3 + r][k] + b->e[3 + r][k];
+            heml_real v3 = b->H[6 + r][k] + b->e[6 + r][k];
+            heml_real d1 = b->de[r][k], d2 = b->de[3 + r][k], d3 = b->de[6 + r][k];
+            heml_real p1 = t[0][k] * d1 + dt[0][k] * v1;
+            heml_real p2 = t[1][k] * d2 + dt[1][k] * v2;
+            heml_real p3 = t[2][k] * d3 + dt[2][k] * v3;
+            heml_real p4 = t[3][k] * (d2 - d1) + dt[3][k] * (v2 - v1);
+            heml_real p5 = t[4][k] * (d3 - d2) + dt[4][k] * (v3 - v2);
+            heml_real p6 = t[5][k] * (d1 - d3) + dt[5][k] * (v1 - v3);
             b->f[r][k] = -p1 + p4 - p6;
             b->f[3 + r][k] = -p2 - p4 + p5;
             b->f[6 + r][k] = -p3 - p5 + p6;
@@ -2556,14 +2871,14 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    heml__gather(idx, u, b->e);
+    heml__gather(m, idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml__spring_rest_links(R, b);
         heml__spring_J(R, b);
         heml__spring_tensions(S, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
-        heml__spring_forces(b, b->co, NULL);
+        heml__spring_forces(b, b->co);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
@@ -2680,8 +2995,8 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml_real sp;
     int k;
-    heml__gather(idx, u, b->e);
-    heml__gather(idx, dx, b->de);
+    heml__gather(m, idx, u, b->e);
+    heml__gather(m, idx, dx, b->de);
     if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(mt, m->jm1_0, R, b);
         return;
@@ -2711,7 +3026,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
                 dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
             }
         }
-        heml__spring_forces(b, b->co, dsig);
+        heml__spring_dforces(b, b->co, dsig);
         return;
     }
     /* (fast-path laws reach here only with Prony: the general path covers them, with
@@ -2808,8 +3123,8 @@ static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
 }
 
 /* Adds the block's scalar v of each lane into out at its four nodes (lanes in order). */
-static void heml__scatter_scalar(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT v,
-                                 heml_real *HEML__RESTRICT out)
+static void heml__scatter_lane_values(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT v,
+                                      heml_real *HEML__RESTRICT out)
 {
     int k;
     for (k = 0; k < HEML__W; k++) {
@@ -2876,7 +3191,7 @@ static void heml__chunks(void *vctx, int begin, int end)
             case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
                     below += b.jm1[k] < jm1_0;
                     inverted += b.jm1[k] <= -1;
@@ -2884,21 +3199,21 @@ static void heml__chunks(void *vctx, int begin, int end)
                 break;
             case HEML__DIFF:
                 heml__block_diff(m, mt, blk, p->x, p->dx, &b);
-                heml__scatter(idx, b.f, p->out);
+                heml__scatter(m, idx, b.f, p->out);
                 break;
             case HEML__ABS:
                 heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 heml__scatter_abs(idx, b.f, p->out);
                 break;
             case HEML__NODAL_SUMS:
-                heml__gather(idx, p->x, b.e);
-                if (p->dx) heml__gather(idx, p->dx, b.de);
+                heml__gather(m, idx, p->x, b.e);
+                if (p->dx) heml__gather(m, idx, p->dx, b.de);
                 heml__nodal_sums(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b, p->dx != NULL);
-                heml__scatter_scalar(idx, b.jm1, m->nod_j);
-                if (p->dx) heml__scatter_scalar(idx, b.dp, m->nod_dj);
+                heml__scatter_lane_values(idx, b.jm1, m->nod_j);
+                if (p->dx) heml__scatter_lane_values(idx, b.dp, m->nod_dj);
                 break;
             case HEML__ENERGY:
-                heml__gather(idx, p->x, b.e);
+                heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
                     heml__spring_rest_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
@@ -4134,6 +4449,7 @@ static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml
     m->parallel_for = d->parallel_for;
     m->parallel_user = d->parallel_user;
     m->parallel = d->tet_count >= HEML_PARALLEL_MIN_TETS;
+    m->simd = 1;
     memcpy(m->rest, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     memcpy(m->pos, d->rest_positions, sizeof(heml_real) * 3 * (size_t)d->node_count);
     *out = m;

@@ -4,7 +4,7 @@
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
    build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels]
-                     [--filter TEXT] [--repeats N] [--threads N] [--budget SECONDS]
+                     [--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
    (default 2 s; law variants get a quarter). Raise it to see finer levels.
@@ -62,10 +62,21 @@ const bench_model *bench_models_heml_double(int *count);
 const bench_model *bench_models_heml_float(int *count);
 const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
+int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 static const bench_models_fn registry[] = {
     bench_models_tensormass_double, bench_models_tensormass_float, bench_models_heml_double,
     bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
 };
+
+/* peers (issue 21): other libraries, timed by the kernels part only (bench/peer_*.cpp,
+   built when their packages are installed: see the Makefile) */
+#ifdef BENCH_HAVE_BULLET
+#ifdef __cplusplus
+extern "C"
+#endif
+const bench_model *bench_models_bullet(int *count);
+#endif
 
 #define BIT(i) (1u << (i))
 #define PI 3.14159265358979323846
@@ -76,6 +87,7 @@ static const char *integrator_name[BENCH_INTEGRATOR_COUNT] = {"explicit-euler", 
 typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
+    const char *scenes; /* --scenes: trade scenes to run (comma list of names; NULL: all) */
     int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time */
     double budget; /* s: a configuration slower than this stops its refinement */
 } options;
@@ -780,6 +792,7 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     printf("== 1. speed/accuracy trade ==\n");
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) {
         double t0 = now();
+        if (o->scenes && !strstr(o->scenes, scenes[s].name)) continue;
         printf("%s\n", scenes[s].title);
         if (!strcmp(scenes[s].name, "R3"))
             printf("  (frequency from the tip's zero crossings, corrected for the integrator's phase error: Euler "
@@ -1707,16 +1720,91 @@ static void print_kernel_spans(const kernel_span *spans, int count, const char *
     }
 }
 
-static void run_kernels(const options *o, const bench_model *const *models, int count)
+/* The reduced chain of frames.h (issue 15), in the kernels part: block-tridiagonal factor
+   and solve against the block count, one inverse control step of the 16-vertebra arm
+   (examples/frames_soft_arm.c). One thread. chain.csv; --filter chain or btd selects it. */
+static void run_chain(const options *o)
 {
+    const char *names[16];
+    double sizes[16], seconds[16];
+    int p, i, rows;
+    FILE *f;
+    if (o->filter && !strstr("frames chain btd", o->filter)) return;
+    printf("\n== frames.h reduced chain (issue 15), 1 thread ==\n");
+    f = open_csv(o, "chain.csv", "precision,kernel,blocks,us,ns_per_block");
+    for (p = 0; p < 2; p++) {
+        rows = (p ? bench_chain_rows_float : bench_chain_rows_double)(o->quick, now, names, sizes, seconds);
+        for (i = 0; i < rows; i++) {
+            printf("  %-6s %-17s %6.0f blocks: %10.2f us (%.1f ns a block)\n", p ? "float" : "double", names[i],
+                   sizes[i], 1e6 * seconds[i], 1e9 * seconds[i] / sizes[i]);
+            if (f) csv_prefix(f);
+            if (f)
+                fprintf(f, "%s,%s,%.0f,%.3f,%.2f\n", p ? "float" : "double", names[i], sizes[i], 1e6 * seconds[i],
+                        1e9 * seconds[i] / sizes[i]);
+        }
+    }
+    if (f) fclose(f);
+}
+
+/* single-thread results of this run, for the peer ratios */
+typedef struct kernel_result {
+    const bench_model *m;
+    int kernel;
+    double elems, ns;
+} kernel_result;
+static kernel_result kernel_results[4096];
+static int kernel_result_count;
+
+/* The kernels part's model list: the selected entries, then the peers (when built, and the
+   filter is empty or names them or heml, their comparison). */
+static int kernel_models(const options *o, const bench_model *const *models, int count, const bench_model **out)
+{
+    int i, n = 0;
+    for (i = 0; i < count && n < 250; i++) out[n++] = models[i];
+#ifdef BENCH_HAVE_BULLET
+    {
+        int pc = 0;
+        const bench_model *peers = bench_models_bullet(&pc);
+        if (!o->filter || strstr("bullet heml neo-hookean corotated", o->filter))
+            for (i = 0; i < pc && n < 256; i++) out[n++] = peers + i;
+    }
+#else
+    printf("Bullet rows skipped: install Debian's libbullet-dev (apt-get install libbullet-dev) and rebuild the "
+           "bench (make build/bench/bench) to time Bullet's Neo-Hookean and corotated forces and implicit step\n");
+#endif
+    return n;
+}
+
+static void print_peer_ratios(const char *const *kernel_name)
+{
+    int i, j;
+    for (i = 0; i < kernel_result_count; i++) {
+        const kernel_result *p = kernel_results + i;
+        if (strcmp(p->m->model, "bullet")) continue;
+        for (j = 0; j < kernel_result_count; j++) {
+            const kernel_result *h = kernel_results + j;
+            if (strcmp(h->m->model, "heml") || strcmp(h->m->variant, "neo-hookean") || h->kernel != p->kernel ||
+                h->elems != p->elems)
+                continue;
+            printf("  peer: bullet %-11s %-5s %7.0f tets: %8.1f ns = %6.1f x heml neo-hookean %s (%.1f ns)\n",
+                   p->m->variant, kernel_name[p->kernel], p->elems, p->ns, p->ns / h->ns, h->m->precision, h->ns);
+        }
+    }
+}
+
+static void run_kernels(const options *o, const bench_model *const *models_in, int count_in)
+{
+    static const bench_model *models[256];
+    int count;
     static kernel_span spans[256 * BENCH_KERNEL_COUNT]; /* 256 model entries at most (main) */
     int span_count = 0;
     static const double targets[4] = {1e3, 1e4, 1e5, 1e6};
-    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move"};
+    static const char *kernel_name[BENCH_KERNEL_COUNT] = {"force", "K*v", "K*v-blk", "move", "K*v-csr", "arith", "step"};
     double bandwidth[3];
     int i, s, th, kern, sizes = o->quick ? 1 : 4, max_threads = o->threads;
     FILE *f;
     printf("\n== 3. kernel throughput ==\n");
+    count = kernel_models(o, models_in, count_in, models);
     for (th = 1; th <= max_threads; th++) {
         bandwidth[th] = stream_triad(o->quick ? (size_t)1 << 22 : (size_t)1 << 25, th);
         printf("STREAM triad, %d thread%s: %.1f GB/s\n", th, th > 1 ? "s" : "", bandwidth[th]);
@@ -1745,12 +1833,15 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
             bench_body b = make_body(n * 0.01, n * 0.01, n * 0.01, n, n, n, 1e5, 0.3, 1000);
             void *sim = NULL;
             if (m->create(&b, &sim)) continue;
+            double ns1[BENCH_KERNEL_COUNT], bound1 = NAN;
+            for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++) ns1[kern] = NAN;
             /* one step under gravity, so the kernels see a generic deformed state */
             m->step(sim, 1e-5, (m->integrators & BIT(BENCH_SEMI_IMPLICIT_EULER)) ? BENCH_SEMI_IMPLICIT_EULER
                                                                                  : BENCH_IMPLICIT_EULER);
             for (kern = 0; kern < BENCH_KERNEL_COUNT; kern++)
                 for (th = 1; th <= max_threads; th++) {
                     double sec, elems = m->elements(sim), bytes = m->kernel_bytes(sim, kern), bound, ns;
+                    if (kern == BENCH_KERNEL_STEP && (th > 1 || elems > 2e5)) break; /* (seconds per step) */
                     set_threads(th);
                     sec = time_kernel(m, sim, kern, o->quick ? 0.01 : 0.02, &code);
                     if (code) break;
@@ -1766,7 +1857,15 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                         }
                         k->large_elems = elems, k->large_ns = ns;
                     }
-                    bound = bytes / (bandwidth[th] * 1e9) * 1e9 / elems;
+                    bound = bytes > 0 ? bytes / (bandwidth[th] * 1e9) * 1e9 / elems : NAN;
+                    if (th == 1 && kernel_result_count < (int)(sizeof kernel_results / sizeof kernel_results[0])) {
+                        kernel_result *r = kernel_results + kernel_result_count++;
+                        r->m = m, r->kernel = kern, r->elems = elems, r->ns = ns;
+                    }
+                    if (th == 1) {
+                        ns1[kern] = ns;
+                        if (kern == BENCH_KERNEL_FORCE) bound1 = bound;
+                    }
                     printf("%-10s %-12s %-6s %-6s %-2d %9.0f %10.2f %10.1f %9.2f %7.2f\n", m->model, m->variant,
                            m->precision, kernel_name[kern], th, elems, ns, bytes / elems, bound, ns / bound);
                     fflush(stdout);
@@ -1775,10 +1874,21 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
                             m->precision, kernel_name[kern], th, elems, m->element, ns, bytes / elems, bound,
                             ns / bound, bandwidth[th]);
                 }
+            /* the issue-21 ratios, measured in this run (1 thread) */
+            if (ns1[BENCH_KERNEL_FORCE] > 0 && (ns1[BENCH_KERNEL_ARITH] > 0 || ns1[BENCH_KERNEL_CSR] > 0)) {
+                printf("  ratios %s %s %s, %.0f elements, 1 thread: force at %.0f %% of its bandwidth bound", m->model,
+                       m->variant, m->precision, m->elements(sim), 100 * bound1 / ns1[BENCH_KERNEL_FORCE]);
+                if (ns1[BENCH_KERNEL_ARITH] > 0)
+                    printf(", %.2f x its arithmetic floor", ns1[BENCH_KERNEL_FORCE] / ns1[BENCH_KERNEL_ARITH]);
+                if (ns1[BENCH_KERNEL_CSR] > 0)
+                    printf(", K*v %.2f x the CSR product's time", ns1[BENCH_KERNEL_KV] / ns1[BENCH_KERNEL_CSR]);
+                printf("\n");
+            }
             m->destroy(sim);
         }
     }
     print_kernel_spans(spans, span_count, kernel_name);
+    print_peer_ratios(kernel_name);
     /* haptic scenes: precomputed contact models */
     for (i = 0; i < count; i++) {
         double upd[3], pre = 0, mem = 0;
@@ -1827,7 +1937,7 @@ static void run_kernels(const options *o, const bench_model *const *models, int 
 static void usage(void)
 {
     fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels] [--filter TEXT] "
-                    "[--repeats N] [--threads N] [--budget SECONDS]\n");
+                    "[--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
 
@@ -1847,6 +1957,7 @@ int main(int argc, char **argv)
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else if (!strcmp(argv[i], "--filter") && i + 1 < argc) o.filter = argv[++i];
+        else if (!strcmp(argv[i], "--scenes") && i + 1 < argc) o.scenes = argv[++i];
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--budget") && i + 1 < argc) o.budget = atof(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
@@ -1894,6 +2005,7 @@ int main(int argc, char **argv)
         for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
         run_kernels(&o, all, n);
     }
+    if (o.parts & 4) run_chain(&o);
     printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
     return 0;
 }

@@ -32,7 +32,15 @@ enum {
     BENCH_KERNEL_MOVE = 3,      /* the force pass with its arithmetic taken out (gather the
                                    nodes, stream the per-element data, scatter): the floor
                                    under the force, where a model can time it */
-    BENCH_KERNEL_COUNT = 4
+    BENCH_KERNEL_CSR = 4,       /* K * v by a CSR matrix (scalar rows, 4-byte column
+                                   indices, the model's real type) of the same tangent
+                                   stiffness, assembled by the adapter at the first call
+                                   (issue 21: the differential against an assembled matrix) */
+    BENCH_KERNEL_ARITH = 5,     /* the force pass's arithmetic alone (no gather or scatter:
+                                   one gathered block reused), the arithmetic floor */
+    BENCH_KERNEL_STEP = 6,      /* one implicit step of 1 ms under gravity (per element), where
+                                   an adapter times it: the peer comparison (issue 21) */
+    BENCH_KERNEL_COUNT = 7
 };
 
 typedef struct bench_body {

@@ -391,3 +391,115 @@ const bench_model *BENCH_TABLE(int *count)
     *count = (int)(sizeof fr_models / sizeof fr_models[0]);
     return fr_models;
 }
+
+/* >>chain (issue 15): the block-tridiagonal solver's factor + solve per block count and one
+   inverse control step of the 16-vertebra tapered arm of examples/frames_soft_arm.c, the
+   median of 5 batches of repeated calls (seconds each, measured by the caller's clock). Fills
+   up to 8 rows: BTD at 10, 100, 1,000, 10,000 blocks (factor, solve), then the arm. Returns
+   the row count. */
+#ifdef BENCH_FLOAT
+#define BENCH_CHAIN_ROWS bench_chain_rows_float
+#else
+#define BENCH_CHAIN_ROWS bench_chain_rows_double
+#endif
+int BENCH_CHAIN_ROWS(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+static double fr_median5(double *t)
+{
+    int i, j;
+    for (i = 0; i < 5; i++)
+        for (j = i + 1; j < 5; j++)
+            if (t[j] < t[i]) {
+                double x = t[i];
+                t[i] = t[j], t[j] = x;
+            }
+    return t[2];
+}
+int BENCH_CHAIN_ROWS(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds)
+{
+    static const int counts[4] = {10, 100, 1000, 10000};
+    int rows = 0, s, i, k, r;
+    for (s = 0; s < (quick ? 3 : 4); s++) {
+        int n = counts[s], reps = 20000 / n + 1;
+        frm_real *d = (frm_real *)malloc(sizeof(frm_real) * 36 * (size_t)n), *l = (frm_real *)malloc(sizeof(frm_real) * 36 * (size_t)n);
+        frm_real *f = (frm_real *)malloc(sizeof(frm_real) * 72 * (size_t)n), *b = (frm_real *)malloc(sizeof(frm_real) * 6 * (size_t)n);
+        double tf[5], ts[5];
+        if (!d || !l || !f || !b) {
+            free(d), free(l), free(f), free(b);
+            return rows;
+        }
+        for (i = 0; i < n; i++) /* a diagonally dominant chain */
+            for (k = 0; k < 36; k++) {
+                d[36 * i + k] = (frm_real)(k % 7 == 0 ? 10.0 : 0.1);
+                l[36 * i + k] = (frm_real)((k * 7) % 5 == 0 ? 0.5 : 0.0);
+            }
+        for (r = 0; r < 5; r++) {
+            double t0 = clock_s(), t1, t2;
+            for (k = 0; k < reps; k++) frm_btd_factor(n, d, l, f, NULL);
+            t1 = clock_s();
+            for (k = 0; k < reps; k++) {
+                for (i = 0; i < 6 * n; i++) b[i] = 1;
+                frm_btd_solve(n, f, 1, b);
+            }
+            t2 = clock_s();
+            tf[r] = (t1 - t0) / reps, ts[r] = (t2 - t1) / reps;
+        }
+        names[rows] = "btd factor", sizes[rows] = n, seconds[rows++] = fr_median5(tf);
+        names[rows] = "btd solve", sizes[rows] = n, seconds[rows++] = fr_median5(ts);
+        free(d), free(l), free(f), free(b);
+    }
+    { /* the arm of examples/frames_soft_arm.c: one inverse step per 20 ms along the circle */
+        enum { NA = 17 };
+        frm_real pos[3 * NA], comp[36 * NA], mass[NA], inertia[NA], pts[3 * 2 * NA * 3], tip[3], target[3];
+        int pf[2 * NA * 3], np = 0, a, steps = quick ? 20 : 100;
+        frm_actuator act[6];
+        frm_chain_desc cd = frm_chain_default_desc();
+        frm_chain *c = NULL;
+        double L = 0.5, E = 2e7, t[5], pi = 3.14159265358979323846;
+        for (i = 0; i < NA; i++) {
+            double rr = 0.03 - 0.015 * i / (NA - 1.0), rm = 0.03 - 0.015 * (i + 0.5) / (NA - 1.0), l = L / (NA - 1);
+            double A = pi * rm * rm, I = pi * rm * rm * rm * rm / 4, G = E / 2.9;
+            pos[3 * i] = (frm_real)(L * i / (NA - 1)), pos[3 * i + 1] = pos[3 * i + 2] = 0;
+            mass[i] = (frm_real)(1100 * pi * rr * rr * l), inertia[i] = (frm_real)(mass[i] * rr * rr / 2);
+            for (k = 0; k < 36; k++) comp[36 * i + k] = 0;
+            comp[36 * i] = (frm_real)(l / (E * A));
+            comp[36 * i + 7] = comp[36 * i + 14] = (frm_real)(l * l * l / (3 * E * I));
+            comp[36 * i + 21] = (frm_real)(l / (G * 2 * I));
+            comp[36 * i + 28] = comp[36 * i + 35] = (frm_real)(l / (E * I));
+            comp[36 * i + 11] = comp[36 * i + 31] = (frm_real)(l * l / (2 * E * I));
+            comp[36 * i + 16] = comp[36 * i + 26] = (frm_real)(-l * l / (2 * E * I));
+        }
+        for (a = 0; a < 6; a++) {
+            int last = a < 3 ? 8 : 16;
+            double ang = 2 * pi * (a % 3) / 3 + (a < 3 ? 0 : pi / 3);
+            memset(&act[a], 0, sizeof act[a]);
+            act[a].kind = FRM_ACTUATOR_CABLE, act[a].point_count = last + 1, act[a].point_frames = pf + np;
+            act[a].points = pts + 3 * np, act[a].max_effort = 300;
+            for (k = 0; k <= last; k++) {
+                double rr = 0.8 * (0.03 - 0.015 * k / (NA - 1.0));
+                pf[np + k] = k, pts[3 * (np + k)] = pos[3 * k];
+                pts[3 * (np + k) + 1] = (frm_real)(rr * cos(ang)), pts[3 * (np + k) + 2] = (frm_real)(rr * sin(ang));
+            }
+            np += last + 1;
+        }
+        cd.frame_count = NA, cd.positions = pos, cd.compliances = comp, cd.masses = mass, cd.inertias = inertia;
+        cd.actuators = act, cd.actuator_count = 6;
+        if (frm_chain_create(&cd, &c) || frm_chain_solve_static(c)) {
+            frm_chain_destroy(c);
+            return rows;
+        }
+        frm_chain_effector(c, tip, NULL);
+        for (r = 0; r < 5; r++) {
+            double t0 = clock_s();
+            for (k = 1; k <= steps; k++) {
+                double ang = 0.025 * 0.02 * (k + r * steps) / 0.06;
+                target[0] = (frm_real)(tip[0] - 0.01), target[1] = (frm_real)(tip[1] + 0.06 * cos(ang));
+                target[2] = (frm_real)(tip[2] + 0.06 * sin(ang));
+                frm_chain_inverse_step(c, target, 1e-4, NULL);
+            }
+            t[r] = (clock_s() - t0) / steps;
+        }
+        frm_chain_destroy(c);
+        names[rows] = "arm inverse step", sizes[rows] = 16, seconds[rows++] = fr_median5(t);
+    }
+    return rows;
+}

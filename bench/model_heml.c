@@ -17,6 +17,7 @@
 #include "bench.h"
 #include "body_mesh.h"
 #include "model_common.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,6 +27,9 @@ typedef struct hm_sim {
     int *tet_nodes;
     double *rest; /* 3n, with the offset, in double */
     heml_real *dx, *out; /* K*v kernel vectors */
+    /* the CSR matrix of the tangent (BENCH_KERNEL_CSR), assembled at its first call */
+    int *csr_row, *csr_col, csr_failed;
+    heml_real *csr_val;
     heml_probe *probe;   /* the last probed point (hm_probe) */
     double probe_at[3];
 } hm_sim;
@@ -95,6 +99,7 @@ static void hm_destroy(void *v)
     if (!s) return;
     heml_probe_destroy(s->probe);
     heml_destroy(s->m);
+    free(s->csr_row), free(s->csr_col), free(s->csr_val);
     free(s->tet_nodes);
     free(s->rest);
     free(s->dx);
@@ -171,11 +176,164 @@ static int hm_probe(void *v, const double p[3], double u[3])
 
 static double hm_elements(void *v) { return (double)((hm_sim *)v)->tets; }
 
+static int hm_csr_nnz(const hm_sim *s) { return s->csr_row ? s->csr_row[3 * s->nodes] : 0; }
+
 static double hm_kernel_bytes(void *v, int kernel)
 {
+    hm_sim *s = (hm_sim *)v;
     size_t r = 0, w = 0;
-    heml_kernel_bytes(((hm_sim *)v)->m, kernel == BENCH_KERNEL_MOVE ? BENCH_KERNEL_FORCE : kernel, &r, &w);
+    if (kernel == BENCH_KERNEL_CSR) /* values and column indices, row starts, x read, y written */
+        return (double)hm_csr_nnz(s) * (sizeof(heml_real) + sizeof(int)) + (3.0 * s->nodes + 1) * sizeof(int) +
+               6.0 * s->nodes * sizeof(heml_real);
+    heml_kernel_bytes(s->m, kernel == BENCH_KERNEL_MOVE || kernel == BENCH_KERNEL_ARITH ? BENCH_KERNEL_FORCE : kernel,
+                      &r, &w);
     return (double)(r + w);
+}
+
+/* The differential of one block for the link directions already in b->de (heml__block_diff
+   without its gathers). */
+static void hm_block_diff(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
+{
+    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    if (mt->fast) heml__diff_nh(mt, m->jm1_0, R, b);
+    else {
+        heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
+        heml__diff_general(1, R, b);
+    }
+}
+
+static int hm_int_cmp(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }
+
+/* Assembles the tangent (the differential's matrix: out = A dx) at the current state into
+   CSR: rows 3 i + r, for every neighbour j of node i (itself included) the columns 3 j ..
+   3 j + 2. Element columns come from the library's own differential of each block applied
+   to the 12 unit directions of its tetrahedra's nodes. Not springs (their differential has
+   its own kernel; no CSR row). */
+static int hm_csr_build(hm_sim *s)
+{
+    heml_model *m = s->m;
+    int n = s->nodes, i, t, a, b, blk, *deg = (int *)calloc((size_t)n + 1, sizeof(int)), *nb, *start;
+    heml__blk *w = (heml__blk *)malloc(sizeof *w);
+    if (!deg || !w || m->has_springs || m->has_prony) {
+        free(deg), free(w);
+        return BENCH_UNSUPPORTED;
+    }
+    for (t = 0; t < s->tets; t++)
+        for (a = 0; a < 4; a++) deg[s->tet_nodes[4 * t + a]] += 4;
+    start = (int *)malloc(sizeof(int) * ((size_t)n + 1));
+    nb = (int *)malloc(sizeof(int) * (size_t)s->tets * 16);
+    if (!start || !nb) {
+        free(deg), free(w), free(start), free(nb);
+        return HEML_ERR_ALLOC;
+    }
+    for (start[0] = 0, i = 0; i < n; i++) start[i + 1] = start[i] + deg[i], deg[i] = 0;
+    for (t = 0; t < s->tets; t++)
+        for (a = 0; a < 4; a++)
+            for (b = 0; b < 4; b++) {
+                int p = s->tet_nodes[4 * t + a];
+                nb[start[p] + deg[p]++] = s->tet_nodes[4 * t + b];
+            }
+    for (i = 0; i < n; i++) { /* sort, unique */
+        int *l = nb + start[i], c = 0, k;
+        qsort(l, (size_t)deg[i], sizeof(int), hm_int_cmp);
+        for (k = 0; k < deg[i]; k++)
+            if (!c || l[k] != l[c - 1]) l[c++] = l[k];
+        deg[i] = c;
+    }
+    s->csr_row = (int *)malloc(sizeof(int) * (3 * (size_t)n + 1));
+    for (i = 0, t = 0; s->csr_row && i < n; i++) t += 9 * deg[i];
+    s->csr_col = (int *)malloc(sizeof(int) * (size_t)t);
+    s->csr_val = (heml_real *)calloc((size_t)t, sizeof(heml_real));
+    if (!s->csr_row || !s->csr_col || !s->csr_val) {
+        free(deg), free(w), free(start), free(nb);
+        return HEML_ERR_ALLOC;
+    }
+    s->csr_row[0] = 0;
+    for (i = 0; i < n; i++) {
+        int r, k, c;
+        for (r = 0; r < 3; r++) {
+            int row = 3 * i + r, p = s->csr_row[row];
+            for (k = 0; k < deg[i]; k++)
+                for (c = 0; c < 3; c++) s->csr_col[p++] = 3 * nb[start[i] + k] + c;
+            s->csr_row[row + 1] = p;
+        }
+    }
+    for (blk = 0; blk < m->block_count; blk++) {
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        const heml__mat *mt = m->mats + m->chunk_material[0];
+        int ci, jn, c, k, r, valid = m->blk_valid[blk];
+        for (ci = 0; ci < m->chunk_count; ci++)
+            if (blk >= m->chunk_begin[ci] && blk < m->chunk_end[ci]) mt = m->mats + m->chunk_material[ci];
+        heml__gather(m, idx, m->disp, w->e);
+        for (jn = 0; jn < 4; jn++)
+            for (c = 0; c < 3; c++) { /* unit direction on node jn, component c */
+                memset(w->de, 0, sizeof w->de);
+                for (k = 0; k < HEML__W; k++) {
+                    if (jn) w->de[3 * (jn - 1) + c][k] = 1;
+                    else w->de[c][k] = w->de[3 + c][k] = w->de[6 + c][k] = -1;
+                }
+                hm_block_diff(m, mt, blk, w);
+                for (k = 0; k < valid; k++) {
+                    int col = 3 * idx[jn * HEML__W + k] + c;
+                    for (a = 0; a < 4; a++)
+                        for (r = 0; r < 3; r++) {
+                            int row = 3 * idx[a * HEML__W + k] + r, p;
+                            heml_real v = a ? w->f[3 * (a - 1) + r][k]
+                                            : -((w->f[r][k] + w->f[3 + r][k]) + w->f[6 + r][k]);
+                            for (p = s->csr_row[row]; s->csr_col[p] != col; p++) continue;
+                            s->csr_val[p] += v;
+                        }
+                }
+            }
+    }
+    free(deg), free(w), free(start), free(nb);
+    return 0;
+}
+
+/* y = A x by the CSR rows (the threads of the bench's OpenMP build, static rows). */
+static void hm_csr_product(const hm_sim *s, const heml_real *x, heml_real *y)
+{
+    const int *rp = s->csr_row, *col = s->csr_col;
+    const heml_real *val = s->csr_val;
+    int row, rows = 3 * s->nodes;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static)
+#endif
+    for (row = 0; row < rows; row++) {
+        heml_real acc = 0;
+        int p;
+        for (p = rp[row]; p < rp[row + 1]; p++) acc += val[p] * x[col[p]];
+        y[row] = acc;
+    }
+}
+
+/* The arithmetic floor: the force pass's blocks, colours and groups with the law's
+   arithmetic and the rest-constant stream, but no gather or scatter (every block computes
+   on the links gathered once for block 0; the forces are summed into a sink). */
+static volatile double hm_sink;
+static int hm_arith(hm_sim *s)
+{
+    heml_model *m = s->m;
+    heml__blk *b = (heml__blk *)malloc(sizeof *b);
+    double acc = 0;
+    int ci, blk;
+    if (!b) return HEML_ERR_ALLOC;
+    heml__gather(m, m->blk_idx, m->disp, b->e);
+    for (ci = 0; ci < m->chunk_count; ci++) {
+        const heml__mat *mt = m->mats + m->chunk_material[ci];
+        for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
+            const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+            if (mt->fast) heml__forces_nh(mt, m->jm1_0, R, b);
+            else {
+                heml__block_stress(m, mt, blk, b, 0, 0);
+                heml__pk1_forces(R, b);
+            }
+            acc += (double)b->f[0][0];
+        }
+    }
+    hm_sink = acc;
+    free(b);
+    return 0;
 }
 
 /* The move kernel: the force pass of heml.h (its colours, groups and blocks, its gather
@@ -206,9 +364,9 @@ static void hm_move_groups(void *ctx, int begin, int end)
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++)
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-            heml__gather(idx, m->disp, b.e);
+            heml__gather(m, idx, m->disp, b.e);
             hm_move_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
-            heml__scatter(idx, b.f, p->out);
+            heml__scatter(m, idx, b.f, p->out);
         }
 }
 
@@ -217,6 +375,33 @@ static int hm_kernel(void *v, int kernel)
     hm_sim *s = (hm_sim *)v;
     if (kernel == BENCH_KERNEL_FORCE) return heml_compute_forces(s->m) ? 0 : HEML_ERR_ARG;
     if (kernel == BENCH_KERNEL_KV) return heml_apply_stiffness(s->m, s->dx, s->out);
+    if (kernel == BENCH_KERNEL_CSR) {
+        if (!s->csr_row && !s->csr_failed) { /* first call: assemble, and check it against the differential */
+            int err = hm_csr_build(s), i, n3 = 3 * s->nodes;
+            double dmax = 0, fmax = 0;
+            heml_real *y = (heml_real *)malloc(sizeof(heml_real) * (size_t)n3);
+            if (!err && y && !heml_apply_stiffness(s->m, s->dx, s->out)) {
+                hm_csr_product(s, s->dx, y);
+                for (i = 0; i < n3; i++) {
+                    double d = fabs((double)y[i] - (double)s->out[i]), f = fabs((double)s->out[i]);
+                    dmax = d > dmax ? d : dmax;
+                    fmax = f > fmax ? f : fmax;
+                }
+                if (!(dmax <= 1e-3 * fmax)) err = HEML_ERR_NOT_FINITE; /* (a wrong matrix times nothing) */
+            }
+            free(y);
+            if (err) {
+                free(s->csr_row), free(s->csr_col), free(s->csr_val);
+                s->csr_row = s->csr_col = NULL, s->csr_val = NULL, s->csr_failed = 1;
+                return err;
+            }
+        }
+        if (s->csr_failed) return BENCH_UNSUPPORTED;
+        hm_csr_product(s, s->dx, s->out);
+        return 0;
+    }
+    if (kernel == BENCH_KERNEL_ARITH && !s->m->has_springs) return hm_arith(s);
+    if (kernel == BENCH_KERNEL_STEP) return heml_step_ex(s->m, (heml_real)1e-3, HEML_IMPLICIT_EULER);
     if (kernel == BENCH_KERNEL_MOVE && !s->m->has_springs) { /* (springs stream more) */
         hm_move p;
         p.m = s->m;

@@ -16,7 +16,10 @@
 # 2. the largest stable time step (stability.csv, test max-dt, double);
 # 3. the other extremes (stability.csv: poisson, squash, twist-180, far-origin);
 # 4. the stress sweep (sweep.csv): per model entry, how many runs were right, returned an
-#    error code, returned success with a wrong answer, or could not be judged.
+#    error code, returned success with a wrong answer, or could not be judged;
+# 5. the kernel ratios (kernels.csv, where it has the K*v-csr rows, issue 21): per model entry
+#    and size, 1 thread, the force's share of its bandwidth bound, the force over its
+#    arithmetic floor (arith rows), the differential over the CSR product.
 # Errors are as the bench wrote them: R1 and R3 against the converged 3D solid, R3's
 # frequency corrected for the integrator's phase error (bench.c, integrator_frequency).
 # The prose around the tables quotes figures from them: check it after regenerating.
@@ -220,4 +223,34 @@ if [ -r "$dir/sweep.csv" ]; then
                    count[models[m], "WRONG"], count[models[m], "unjudged"]
         printf "| all | %d | %d | %d | %d |\n", total["right"], total["error"], total["WRONG"], total["unjudged"]
     }' "$dir/sweep.csv"
+fi
+
+if [ -r "$dir/kernels.csv" ] && grep -q ',K\*v-csr,' "$dir/kernels.csv"; then
+    echo
+    echo "Kernel ratios (\`kernels.csv\`, 1 thread, each ratio from rows of the same run): the force's"
+    echo "share of its memory-bandwidth bound (bound / time), the force against its arithmetic alone"
+    echo "(\`arith\`: the pass without gather and scatter), and the force differential against a CSR"
+    echo "product of the same assembled tangent (\`K*v-csr\`, assembled by the bench):"
+    echo
+    awk -F, '
+    NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+    $col["threads"] == 1 {
+        key = $col["model"] " " $col["variant"] " " $col["precision"] "|" $col["elements"]
+        if (!(key in seen)) { seen[key] = 1; keys[++n] = key }
+        ns[key, $col["kernel"]] = $col["ns_per_element"]
+        if ($col["kernel"] == "force") bound[key] = $col["bound_ns_per_element"]
+    }
+    END {
+        print "| model | elements | force ns | % of bound | force / arith | K*v ns | K*v / CSR |"
+        print "| --- | --- | --- | --- | --- | --- | --- |"
+        for (i = 1; i <= n; i++) {
+            k = keys[i]
+            if (ns[k, "K*v-csr"] == "" || ns[k, "force"] == "") continue
+            split(k, p, "|")
+            f = ns[k, "force"]; a = ns[k, "arith"]; kv = ns[k, "K*v"]; c = ns[k, "K*v-csr"]
+            fa = "-"
+            if (a > 0) fa = sprintf("%.2f", f / a)
+            printf "| %s | %d | %.1f | %.0f %% | %s | %.1f | %.2f |\n", p[1], p[2], f, 100 * bound[k] / f, fa, kv, kv / c
+        }
+    }' "$dir/kernels.csv"
 fi

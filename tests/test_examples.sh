@@ -54,9 +54,12 @@ run_case beam_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_beam" "$tmp"
 run_case cut_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_cut" --bogus
 run_case hybrid_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" --bogus
 run_case hybrid_two_directories 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" "$tmp" "$tmp"
+run_case soft_arm_bad_option 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" --bogus
+run_case link_compliance_bad_argument 2 '^usage' "$tmp/out" -- "$bin/heml_link_compliance" bogus
+run_case soft_arm_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" "$tmp" "$tmp"
 
 # 2. an output directory that does not exist: exit status 1, a message, no success claim
-for e in frames_beam tensormass_cut tensormass_hybrid; do
+for e in frames_beam tensormass_cut tensormass_hybrid frames_soft_arm; do
     run_case "${e}_missing_directory" 1 'cannot write' "$tmp/out" -- "$bin/$e" "$missing"
     case "${e}_missing_directory_claim" in *"$filter"*)
         if grep -q 'written\|wrote' "$tmp/out"; then
@@ -94,6 +97,18 @@ case beam_files in *"$filter"*)
         report beam_files 0 ""
     else
         report beam_files 1 "the VTK files are missing or empty"
+    fi ;;
+esac
+run_case link_compliance_runs 0 '' "$tmp/out" -- "$bin/heml_link_compliance"
+mkdir -p "$tmp/arm"
+run_case soft_arm_runs 0 '' "$tmp/out" -- "$bin/frames_soft_arm" "$tmp/arm"
+case soft_arm_csv in *"$filter"*)
+    lines=$(wc -l < "$tmp/arm/frames_soft_arm.csv" 2>/dev/null || echo 0)
+    if head -n 1 "$tmp/arm/frames_soft_arm.csv" 2>/dev/null | grep -q '^path,step,time_s,target_x' && [ "$lines" -gt 1000 ] &&
+        grep -q '^wrote .*frames_soft_arm.csv' "$tmp/out"; then
+        report soft_arm_csv 0 ""
+    else
+        report soft_arm_csv 1 "$lines lines"
     fi ;;
 esac
 run_case hybrid_runs 0 '' "$tmp/out" -- "$bin/tensormass_hybrid" "$tmp/hybrid"

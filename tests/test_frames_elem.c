@@ -92,7 +92,14 @@ static void test_float_renames(void)
         NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_jacobian), NAME(frm_probe_jacobian_transpose),
         NAME(frm_probe_add_external), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
         NAME(frm_modal_create), NAME(frm_modal_solve), NAME(frm_modal_count), NAME(frm_modal_frequency),
-        NAME(frm_modal_shape), NAME(frm_modal_destroy)};
+        NAME(frm_modal_shape), NAME(frm_modal_destroy), NAME(frm_btd_factor_size), NAME(frm_btd_factor),
+        NAME(frm_btd_solve), NAME(frm_btd_compliance), NAME(frm_qp_box), NAME(frm_chain_default_desc),
+        NAME(frm_chain_create), NAME(frm_chain_destroy), NAME(frm_chain_frame_count), NAME(frm_chain_actuator_count),
+        NAME(frm_chain_positions), NAME(frm_chain_orientations), NAME(frm_chain_velocities), NAME(frm_chain_efforts),
+        NAME(frm_chain_set_poses), NAME(frm_chain_set_base), NAME(frm_chain_set_external), NAME(frm_chain_set_gravity),
+        NAME(frm_chain_set_efforts), NAME(frm_chain_forces), NAME(frm_chain_energy), NAME(frm_chain_apply_stiffness),
+        NAME(frm_chain_actuator_measures), NAME(frm_chain_effector), NAME(frm_chain_solve_static), NAME(frm_chain_step),
+        NAME(frm_chain_inverse_step), NAME(frm_chain_inverse_solve), NAME(frm_chain_link_compliance)};
     int count = (int)(sizeof names / sizeof names[0]), i, declared = 0, renamed = 0;
     char line[1024];
     FILE *f;
