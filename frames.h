@@ -871,9 +871,17 @@
          between bodies but shared or attached frames. Mesh-based probes on a combined model
          need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
          attached to a rigid body (the attached frames are no longer frames of the model).
-       - At most 16 neighbours per sample. Coupling to heml.h and tensormass.h meshes is not in
-         this version; the CUDA companion runs a subset and has not run on a GPU yet (see
-         CUDA).
+       - At most 16 neighbours per sample. The CUDA companion runs a subset and has not run on a
+         GPU yet (see CUDA).
+       - Coupling to heml.h meshes is by iteration between the models (tensormass.h: not yet)
+         (COUPLING), not one monolithic solve: each coupled step costs several steps of
+         each model (7 to 9 measured), the staggered exchange has a small time-step limit,
+         and the glue is a penalty (its compliance is a modelling error, about 1 / k per
+         glued node). Assembled blocks (frm_model_stiffness_blocks) hold the anchors' own
+         rotational term on the diagonal but not J^T k J (the products add it). In float
+         builds the coupled beams of tests/test_frames_coupling.c fail (a model's solve
+         stops at its round-off before the interface settles; skipped there, not yet
+         investigated); the anchors' own finite-difference tests pass in float.
        - Reduced chain (issue 15): each link is linear in its proximal frame's axes (small
          strain, large rotations: the thesis's model), so a link bent by tens of degrees is
          inaccurate (its rotation measure 2 sin(theta/2) saturates); use more vertebrae.
@@ -938,9 +946,48 @@
        neither creates nor loses energy; the total force sum f_n and moment sum p_n x f_n
        are carried exactly in any state. frm_probe_add_external adds J^T f to the external
        loads (constant through the following steps and solves: once per step for a
-       staggered coupling). What a stiff coupling needs (J and J^T as products, no
-       allocation) is public; the coupled implicit solve itself is not here (LIMITS).
-       Measured cost: see README (bench kernels part, "frames mapped point").
+       staggered coupling). Measured cost: see README (bench kernels part, "frames mapped
+       point").
+       Anchors (frm_model_set_anchors; heml_set_anchors is the same hook for nodes,
+       tensormass.h's is not written yet): zero-length springs from a probe's mapped points to targets, energy
+       sum_n k_n / 2 |p_n(q) - t_n|^2, part of the model (forces J^T (-k d), d = p - t; the
+       stiffness J^T k J plus the levers' own term k w (a d^T - (a . d) I) per pair, whose
+       antisymmetric half is the 1/2 [tau]x of every torque; energies; the block-Jacobi
+       blocks; every solve). Tested against central differences of the energy and force
+       (tests/test_frames_coupling.c, with heml's).
+       Coupling a heml.h or tensormass.h mesh (no header includes another; the user's code
+       holds both models; examples/glue.h is one, used by the tests and
+       examples/frames_connective.c). Glued nodes x_n of the mesh and the mapped points
+       p_n(q) of a probe at their rest positions:
+       (a) Staggered, once a step: the frames step under J^T of the mesh's last forces on
+       the glued nodes (elastic force plus weight; their inertia left out), then the glued
+       nodes are prescribed at the new mapped points (heml_set_displacement) and the mesh
+       steps. Explicit in the exchange: measured on R3's soft beam (1 x 0.1 x 0.1 m,
+       E = 1 MPa, 1000 kg/m^3, half frames 0.1 m hexahedra, half heml.h, glued at mid-span),
+       stable up to 1.5 ms and diverging from 2 ms with the mesh's 0.05 m cells, 0.95 /
+       1.19 ms with 0.1 m cells (T/1300 of the beam's first period; heavier glued nodes,
+       whose inertia the exchange leaves out, lower it). Above it the frames' Newton fails
+       within a few steps (FRM_ERR_NO_CONVERGENCE, state kept), never a silent blow-up in
+       the tests; use it only for light meshes and small steps.
+       (b) Stiff: springs of stiffness k between x_n and p_n, as anchors in one model
+       (targets the other's interface points) and as loads in the other (heml: the
+       springs' force on the nodes; frames: J^T of it). One coupled step minimises both
+       models' incremental potentials plus the springs' energy; a Robin-Neumann iteration
+       reaches it (the side with the anchors solves with the other held, the other under
+       the springs' forces, each from the step's start; J at the latest iterate, so the
+       transfer is exact at convergence), accelerated by Anderson mixing of the interface
+       points (depth 6), until they move less than a tolerance. Put the anchors on the side
+       that is less held (the outer part of a beam; a Neumann side must be held, or its
+       static solve has rigid modes). Measured: plain block Gauss-Seidel with springs in
+       both models stalls (a side held by stiff springs moves 1e-6 m an iteration on R1
+       with 0.055 m to go); plain Robin-Neumann diverges on R1's interface modes; with
+       Anderson mixing R1 (half frames 16 x 2 x 2 hexahedra clamped, half heml.h 16 x 2 x 2
+       cells of P1 tetrahedra) converges in 7 iterations to +0.13 % of Timoshenko (frames
+       alone +3.49 %, heml alone -64.9 %: P1 locking, which the outer half feels 1/16 of),
+       and the soft beam above steps at dt = 10 ms with at most 9 iterations a step. k
+       trades the glue's compliance against the iteration: k = 0.1, 0.3, 1, 3 E h (h the
+       mesh's cell size across) gave +1.41, +0.13, -0.40, -0.57 % on R1 (the last not
+       converged in 30 iterations); 0.3 E h is the tests' choice.
        Several parts (frm_parts_combine): each part's samples keep their weights and
        gradients, their frames are renumbered by the part's frame_map into the model's;
        frames several parts give are one frame (same rest position required), so a shared
@@ -1311,6 +1358,7 @@ typedef FRM_REAL frm_real;
 #define frm_probe_jacobian frm_probe_jacobian_f32
 #define frm_probe_jacobian_transpose frm_probe_jacobian_transpose_f32
 #define frm_probe_add_external frm_probe_add_external_f32
+#define frm_model_set_anchors frm_model_set_anchors_f32
 #define frm_probe_destroy frm_probe_destroy_f32
 #define frm_modal_default_desc frm_modal_default_desc_f32
 #define frm_modal_create frm_modal_create_f32
@@ -2202,6 +2250,22 @@ FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, 
    per step with the points' current forces (a staggered coupling, a render mesh's
    contact). FRM_ERR_ARG as above, or a non-finite force (nothing added). */
 FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f);
+/* Anchors (issue 14; the same hook as heml_set_anchors; tensormass.h's is planned): zero-length
+   springs from each mapped point p_n of the probe to targets[3n..3n+2] (m) with stiffness
+   stiffness[n] (N/m, >= 0), energy sum_n k_n / 2 |p_n(q) - t_n|^2. They are part of the
+   model from then on: internal forces (frm_model_forces; J^T of -k (p - t)), energies,
+   stiffness products (frm_model_apply_stiffness: J^T k J plus the levers' second-order
+   term, exact), the block-Jacobi preconditioner, every static solve, step and modal
+   analysis. This is how a frames body is glued to a heml.h or tensormass.h mesh (COUPLING:
+   the targets are the mesh's glued nodes, updated between solves). The probe and both
+   arrays are the caller's: kept by pointer and read at every evaluation until the next
+   call, so they must outlive the model's use of them (update targets in place or call
+   again). p = NULL removes the anchors (default none: results bit-identical to a model
+   without the call). Errors (nothing kept): FRM_ERR_ARG (NULL model or array, a probe made
+   for a model with another frame count, a stiffness negative or not finite, a target not
+   finite, a model with FRM_LINEAR_SOLVER_BTD: its factor holds the assembled blocks, which
+   lack the anchors' J^T k J). */
+FRMDEF int frm_model_set_anchors(frm_model *m, const frm_probe *p, const frm_real *stiffness, const frm_real *targets);
 /* Points of the probe. */
 FRMDEF int frm_probe_count(const frm_probe *p);
 /* Frees the probe. NULL is allowed. */
@@ -3517,6 +3581,8 @@ struct frm_model {
     double *grav_local;                        /* 4: m_g, cbar_g (3), frame axes */
     frm_real *mass_world;                      /* 10: m, c (3), J (6), world axes (mass_update) */
     frm_real *ext;                             /* 6: external force, torque */
+    const frm_probe *anchor_probe;             /* anchors (frm_model_set_anchors): the caller's */
+    const frm_real *anchor_k, *anchor_target;  /* probe and arrays, or NULL */
     unsigned char *state;
     unsigned char *axes;   /* 1: held components of a free frame (bits 0-2 translation, 3-5 rotation) */
     frm_real *ext_full;    /* 6: the external loads while a static solve scales them */
@@ -5696,6 +5762,10 @@ static void frm__gravity_stiffness(const frm_model *m, int i, double K[9]);
    the symmetric part of K; 2: its positive-definite part, see SOLVERS), the stiffness data
    of the state too (and lin_torque, lin_gravity, lin_hrot). Returns FRM_OK,
    FRM_ERR_INVERTED or FRM_ERR_NOT_FINITE. */
+static double frm__anchor_force(frm_model *m, int linearize);
+static void frm__anchor_product(const frm_model *m, const frm_real *v, frm_real *out);
+static void frm__anchor_diagonal(frm_model *m);
+
 static int frm__force_pass(frm_model *m, int linearize, int outputs, double *energy)
 {
     frm__force_ctx ctx;
@@ -5721,13 +5791,17 @@ static int frm__force_pass(frm_model *m, int linearize, int outputs, double *ene
         W += m->chunk_energy[c];
         if (m->chunk_err[c] && !err) err = m->chunk_err[c];
     }
-    if (energy) *energy = W;
-    if (err) return err;
+    if (err) {
+        if (energy) *energy = W;
+        return err;
+    }
     frm__gather(m, m->p_out, m->force, m->force_scale);
+    if (linearize) frm__gather(m, m->p_H, m->lin_hrot, NULL); /* the frame-own rotational terms, summed in pair order */
+    if (m->anchor_probe) W += frm__anchor_force(m, linearize);
+    if (energy) *energy = W;
     if (!frm__finite(W) || !frm__all_finite(m->force, 6 * (size_t)m->frame_count)) return FRM_ERR_NOT_FINITE;
     if (linearize) {
         int i, r;
-        frm__gather(m, m->p_H, m->lin_hrot, NULL); /* the frame-own rotational terms, summed in pair order */
         for (i = 0; i < m->frame_count; i++) {
             frm_real cg[3], tg[3];
             double Kg[9], h[6];
@@ -6017,6 +6091,7 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         frm__gather(m, m->p_out, out, NULL);
         for (i = 0; i < m->frame_count; i++) frm_pass2_rotational(&m->view, i, v, out); /* pairs' Hs + gravity */
     }
+    if (m->anchor_probe) frm__anchor_product(m, v, out);
     if (exact)
         for (i = 0; i < m->frame_count; i++) {
             frm_real t[3];
@@ -6208,6 +6283,7 @@ static void frm__prepare_mode(frm_model *m, int mode)
     m->stats.stiffness_mode = mode;
     if (mode == FRM_STIFFNESS_BLOCKS) {
         frm__run(m, m->frame_chunks, frm__assemble_chunks, &g);
+        if (m->anchor_probe) frm__anchor_diagonal(m);
         return;
     }
     /* pair mode: the block-Jacobi blocks are the rest ones turned with the frame,
@@ -6235,6 +6311,7 @@ static void frm__prepare_mode(frm_model *m, int mode)
             }
         frm__add_rotational(m->lin_hrot + 6 * (size_t)i, K);
     }
+    if (m->anchor_probe) frm__anchor_diagonal(m);
 }
 
 /* World mass data (m, c = R cbar, J = R Jbar R^T) of every frame at its current pose. */
@@ -10016,6 +10093,136 @@ FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_re
 {
     if (!p || !m || !f || p->frame_count != m->frame_count || !frm__all_finite(f, 3 * (size_t)p->count)) return FRM_ERR_ARG;
     return frm_probe_jacobian_transpose(p, m, f, m->ext, 1);
+}
+
+FRMDEF int frm_model_set_anchors(frm_model *m, const frm_probe *p, const frm_real *stiffness, const frm_real *targets)
+{
+    int n;
+    if (!m) return FRM_ERR_ARG;
+    if (p) { /* the BTD solver factors the assembled blocks, which lack J^T k J */
+        if (!stiffness || !targets || p->frame_count != m->frame_count || m->linear_solver == FRM_LINEAR_SOLVER_BTD)
+            return FRM_ERR_ARG;
+        for (n = 0; n < p->count; n++)
+            if (!(frm__finite((double)stiffness[n]) && stiffness[n] >= 0) || !frm__vec3_finite(targets + 3 * n))
+                return FRM_ERR_ARG;
+    }
+    m->anchor_probe = p;
+    m->anchor_k = p ? stiffness : NULL;
+    m->anchor_target = p ? targets : NULL;
+    m->lin_valid = 0;
+    return FRM_OK;
+}
+
+/* The lever a = Q abar of a probe pair at the current pose. */
+static void frm__anchor_lever(const frm_model *m, const frm_probe *p, int k, double l[3])
+{
+    const double *a = p->lever + 3 * (size_t)k;
+    const frm_real *Q = m->rel + 9 * p->frame[k];
+    int r;
+    for (r = 0; r < 3; r++) l[r] = (double)Q[3 * r] * a[0] + (double)Q[3 * r + 1] * a[1] + (double)Q[3 * r + 2] * a[2];
+}
+
+/* The anchors' part of a force pass (frm_model_set_anchors), after the frames' update: per
+   point d = p - t (p in the probes' displacement form, minus t), energy k |d|^2 / 2, and
+   J^T (-k d) added to m->force (force -k w d, torque -k w a x d per pair). With
+   `linearize`, the frame-own rotational term's symmetric part joins lin_hrot:
+   K_own = k w (a d^T - (a . d) I) (the derivative of the torque through the lever's turn;
+   its antisymmetric part is 1/2 [tau]x of the torque, which the exact product takes from
+   lin_torque). Points in order: deterministic. Returns the energy. */
+static double frm__anchor_force(frm_model *m, int linearize)
+{
+    const frm_probe *p = m->anchor_probe;
+    double W = 0;
+    int n, k, r;
+    for (n = 0; n < p->count; n++) {
+        double d[3], kn = (double)m->anchor_k[n];
+        for (r = 0; r < 3; r++) d[r] = p->rest[3 * n + r] - (double)m->anchor_target[3 * n + r];
+        for (k = p->start[n]; k < p->start[n + 1]; k++) {
+            const double *a = p->lever + 3 * (size_t)k, w = p->weight[k];
+            const frm_real *Qm = m->relm + 9 * p->frame[k], *u = m->disp + 3 * p->frame[k];
+            for (r = 0; r < 3; r++)
+                d[r] += w * ((double)u[r] + (double)Qm[3 * r] * a[0] + (double)Qm[3 * r + 1] * a[1] + (double)Qm[3 * r + 2] * a[2]);
+        }
+        W += 0.5 * kn * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (k = p->start[n]; k < p->start[n + 1]; k++) {
+            double l[3], w = p->weight[k], c = -kn * w;
+            frm_real *o = m->force + 6 * p->frame[k];
+            frm__anchor_lever(m, p, k, l);
+            o[0] = (frm_real)((double)o[0] + c * d[0]);
+            o[1] = (frm_real)((double)o[1] + c * d[1]);
+            o[2] = (frm_real)((double)o[2] + c * d[2]);
+            o[3] = (frm_real)((double)o[3] + c * (l[1] * d[2] - l[2] * d[1]));
+            o[4] = (frm_real)((double)o[4] + c * (l[2] * d[0] - l[0] * d[2]));
+            o[5] = (frm_real)((double)o[5] + c * (l[0] * d[1] - l[1] * d[0]));
+            if (linearize) { /* k w (sym(a d^T) - (a . d) I): xx, yy, zz, yz, xz, xy */
+                frm_real *h = m->lin_hrot + 6 * p->frame[k];
+                double ad = l[0] * d[0] + l[1] * d[1] + l[2] * d[2], kw = kn * w;
+                h[0] = (frm_real)((double)h[0] + kw * (l[0] * d[0] - ad));
+                h[1] = (frm_real)((double)h[1] + kw * (l[1] * d[1] - ad));
+                h[2] = (frm_real)((double)h[2] + kw * (l[2] * d[2] - ad));
+                h[3] = (frm_real)((double)h[3] + kw * 0.5 * (l[1] * d[2] + l[2] * d[1]));
+                h[4] = (frm_real)((double)h[4] + kw * 0.5 * (l[0] * d[2] + l[2] * d[0]));
+                h[5] = (frm_real)((double)h[5] + kw * 0.5 * (l[0] * d[1] + l[1] * d[0]));
+            }
+        }
+    }
+    return W;
+}
+
+/* out += J^T k J v (the anchors' Gauss-Newton part; their frame-own term is in lin_hrot). */
+static void frm__anchor_product(const frm_model *m, const frm_real *v, frm_real *out)
+{
+    const frm_probe *p = m->anchor_probe;
+    int n, k;
+    for (n = 0; n < p->count; n++) {
+        double jv[3] = {0, 0, 0}, kn = (double)m->anchor_k[n];
+        for (k = p->start[n]; k < p->start[n + 1]; k++) {
+            const frm_real *x = v + 6 * p->frame[k];
+            double l[3], w = p->weight[k];
+            frm__anchor_lever(m, p, k, l);
+            jv[0] += w * ((double)x[0] + (double)x[4] * l[2] - (double)x[5] * l[1]);
+            jv[1] += w * ((double)x[1] + (double)x[5] * l[0] - (double)x[3] * l[2]);
+            jv[2] += w * ((double)x[2] + (double)x[3] * l[1] - (double)x[4] * l[0]);
+        }
+        for (k = p->start[n]; k < p->start[n + 1]; k++) {
+            double l[3], c = kn * p->weight[k];
+            frm_real *o = out + 6 * p->frame[k];
+            frm__anchor_lever(m, p, k, l);
+            o[0] = (frm_real)((double)o[0] + c * jv[0]);
+            o[1] = (frm_real)((double)o[1] + c * jv[1]);
+            o[2] = (frm_real)((double)o[2] + c * jv[2]);
+            o[3] = (frm_real)((double)o[3] + c * (l[1] * jv[2] - l[2] * jv[1]));
+            o[4] = (frm_real)((double)o[4] + c * (l[2] * jv[0] - l[0] * jv[2]));
+            o[5] = (frm_real)((double)o[5] + c * (l[0] * jv[1] - l[1] * jv[0]));
+        }
+    }
+}
+
+/* The diagonal blocks of J^T k J added to kdiag (the block-Jacobi preconditioner's K_ii):
+   per pair k w^2 [I, -[a]x; [a]x, |a|^2 I - a a^T]. */
+static void frm__anchor_diagonal(frm_model *m)
+{
+    const frm_probe *p = m->anchor_probe;
+    int n, k, r, c;
+    for (n = 0; n < p->count; n++)
+        for (k = p->start[n]; k < p->start[n + 1]; k++) {
+            double l[3], B[36], c2 = (double)m->anchor_k[n] * p->weight[k] * p->weight[k], aa;
+            frm_real *K = m->kdiag + 36 * (size_t)p->frame[k];
+            frm__anchor_lever(m, p, k, l);
+            aa = l[0] * l[0] + l[1] * l[1] + l[2] * l[2];
+            memset(B, 0, sizeof B);
+            for (r = 0; r < 3; r++) {
+                B[7 * r] = 1;
+                for (c = 0; c < 3; c++) B[6 * (r + 3) + c + 3] = (r == c ? aa : 0) - l[r] * l[c];
+            }
+            /* [a]x in the lower-left block, -[a]x upper-right */
+            B[6 * 3 + 1] = -l[2], B[6 * 3 + 2] = l[1];
+            B[6 * 4 + 0] = l[2], B[6 * 4 + 2] = -l[0];
+            B[6 * 5 + 0] = -l[1], B[6 * 5 + 1] = l[0];
+            for (r = 0; r < 3; r++)
+                for (c = 0; c < 3; c++) B[6 * c + r + 3] = B[6 * (r + 3) + c];
+            for (r = 0; r < 36; r++) K[r] = (frm_real)((double)K[r] + c2 * B[r]);
+        }
 }
 
 FRMDEF void frm_probe_destroy(frm_probe *p)

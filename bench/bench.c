@@ -64,6 +64,10 @@ const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
 int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+/* the coupled scenes (issue 14): bench/model_glue.c, not a bench_model (two models glued) */
+int bench_glue_rows_double(int quick, double *v);
+int bench_glue_rows_float(int quick, double *v);
+
 static const bench_models_fn registry[] = {
     bench_models_tensormass_double, bench_models_tensormass_float, bench_models_heml_double,
     bench_models_heml_float,        bench_models_frames_double,    bench_models_frames_float,
@@ -1137,7 +1141,9 @@ static void run_stability(const options *o, const bench_model *const *models, in
    is not unique beyond a stretch of about 0.58, by 0.25 m), both faces held laterally.
    Grid: E = 1 Pa, 1 kPa, 1 MPa, 200 GPa; nu = 0, 0.45, 0.4999; static, and implicit Euler and
    BDF2 (issue 19; where the entry has it) at dt = 1e-6, 1e-3, 1 s; density 1000 kg/m^3; every model entry, double and float (quick:
-   E = 1 Pa and 200 GPa, nu = 0 and 0.4999, dt = 1e-6 and 1 s, the primary double entries).
+   E = 1 Pa and 200 GPa, nu = 0 and 0.4999, dt = 1e-6 and 1 s, the primary double entries;
+   the near-incompressible options' entries, primary = -1, not in quick: E = 1 kPa and 1 MPa,
+   nu = 0.45 and 0.4999, dt = 1e-3 and 1 s).
    A disagreement between two successes of the same model means one of them is wrong; the
    sweep counts it against the one-call or large-step run.
    The right answer, from the same model by a more careful path:
@@ -1368,9 +1374,15 @@ static void sweep_model(const bench_model *m, const options *o, sweep_counts *to
     static const double youngs_full[4] = {1, 1e3, 1e6, 2e11}, youngs_quick[2] = {1, 2e11};
     static const double dts_full[3] = {1e-6, 1e-3, 1}, dts_quick[2] = {1e-6, 1};
     static const double nus_full[3] = {0, 0.45, 0.4999}, nus_quick[2] = {0, 0.4999};
-    const double *nus = o->quick ? nus_quick : nus_full, *youngs = o->quick ? youngs_quick : youngs_full,
-                 *dts = o->quick ? dts_quick : dts_full;
-    int nnu = o->quick ? 2 : 3, ne = o->quick ? 2 : 4, ndt = o->quick ? 2 : 3, k = 1, scene, e, q, d, it;
+    /* the primary = -1 entries (issue 13's near-incompressible options): their regime only,
+       tissue stiffnesses, the user's time steps (a quarter of the full grid's runs) */
+    static const double youngs_option[2] = {1e3, 1e6}, dts_option[2] = {1e-3, 1}, nus_option[2] = {0.45, 0.4999};
+    int option = m->primary < 0;
+    const double *nus = option ? nus_option : o->quick ? nus_quick : nus_full,
+                 *youngs = option ? youngs_option : o->quick ? youngs_quick : youngs_full,
+                 *dts = option ? dts_option : o->quick ? dts_quick : dts_full;
+    int nnu = o->quick || option ? 2 : 3, ne = o->quick || option ? 2 : 4, ndt = o->quick || option ? 2 : 3, k = 1, scene,
+        e, q, d, it;
     double eps = strcmp(m->precision, "float") ? DBL_EPSILON : FLT_EPSILON, t_model = now();
     sweep_counts c;
     memset(&c, 0, sizeof c);
@@ -1929,6 +1941,30 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
         }
         m->destroy(sim);
     }
+    /* the glue (issue 14): a heml.h half beam glued to a frames half beam, stiff coupling
+       (bench/model_glue.c); --filter glue runs these rows alone */
+    if (!o->filter || strstr(o->filter, "glue")) {
+        double v[8];
+        set_threads(1);
+        if (!bench_glue_rows_double(o->quick, v)) {
+            static const char *what[4] = {"glue-step", "glue-step-frames", "glue-step-heml", "glue-R1-error-glued"};
+            printf("glue heml+frames double: soft beam at dt 10 ms %.1f ms a step (frames %.1f, heml %.1f, %.1f "
+                   "iterations); R1 tip against Timoshenko: glued %+.2f %%, frames alone %+.2f %%, heml alone %+.2f "
+                   "%% (%g iterations)\n", v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]);
+            for (i = 0; i < 3; i++) {
+                csv_prefix(f);
+                fprintf(f, "glue,heml+frames,double,%s,1,1,step,%.4g,,,,\n", what[i], 1e6 * v[i]); /* ns a step */
+            }
+            csv_prefix(f);
+            fprintf(f, "glue,heml+frames,double,%s,1,1,percent,%.4g,,,,\n", what[3], v[4]);
+            csv_prefix(f);
+            fprintf(f, "glue,frames-alone,double,glue-R1-error-frames,1,1,percent,%.4g,,,,\n", v[5]);
+            csv_prefix(f);
+            fprintf(f, "glue,heml-alone,double,glue-R1-error-heml,1,1,percent,%.4g,,,,\n", v[6]);
+        } else
+            printf("glue heml+frames: a coupled solve failed\n");
+        (void)bench_glue_rows_float;
+    }
     fclose(f);
 }
 
@@ -1995,7 +2031,13 @@ int main(int argc, char **argv)
     set_threads(1);
     if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
     set_threads(1);
-    if (o.parts & 8) run_sweep(&o, models, count);
+    if (o.parts & 8) { /* the primary = -1 entries too (issue 13's options near nu = 0.5), not in --quick */
+        static const bench_model *all[256];
+        int n = 0;
+        for (i = 0; i < count && n < 256; i++) all[n++] = models[i];
+        for (i = 0; i < variant_count && n < 256 && !o.quick; i++) all[n++] = variants[i];
+        run_sweep(&o, all, n);
+    }
     set_threads(1);
     if (o.parts & 16) run_time(&o, models, count);
     if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */

@@ -178,10 +178,14 @@ static double hm_elements(void *v) { return (double)((hm_sim *)v)->tets; }
 
 static int hm_csr_nnz(const hm_sim *s) { return s->csr_row ? s->csr_row[3 * s->nodes] : 0; }
 
+static int hm_kernel(void *v, int kernel);
+
 static double hm_kernel_bytes(void *v, int kernel)
 {
     hm_sim *s = (hm_sim *)v;
     size_t r = 0, w = 0;
+    if (kernel == BENCH_KERNEL_CSR && !s->csr_row && !s->csr_failed)
+        (void)hm_kernel(v, BENCH_KERNEL_CSR); /* (assembled at its first call: its size) */
     if (kernel == BENCH_KERNEL_CSR) /* values and column indices, row starts, x read, y written */
         return (double)hm_csr_nnz(s) * (sizeof(heml_real) + sizeof(int)) + (3.0 * s->nodes + 1) * sizeof(int) +
                6.0 * s->nodes * sizeof(heml_real);
@@ -195,7 +199,7 @@ static double hm_kernel_bytes(void *v, int kernel)
 static void hm_block_diff(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
     const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    if (mt->fast) heml__diff_nh(mt, m->jm1_0, R, b);
+    if (mt->fast) heml__diff_nh(m, mt, blk, b);
     else {
         heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
         heml__diff_general(1, R, b);

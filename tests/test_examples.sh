@@ -8,7 +8,8 @@
 #
 #   sh tests/test_examples.sh BUILD_EXAMPLES_DIR TMP_DIR [name-filter]
 #
-# Run by the Makefile as build/examples/test_examples.result; about 4 s.
+# Run by the Makefile as build/examples/test_examples.result; about 9 s (frames_connective
+# runs twice, 2 s each).
 bin=$1
 tmp=$2
 filter=$3
@@ -54,12 +55,14 @@ run_case beam_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_beam" "$tmp"
 run_case cut_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_cut" --bogus
 run_case hybrid_bad_option 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" --bogus
 run_case hybrid_two_directories 2 '^usage' "$tmp/out" -- "$bin/tensormass_hybrid" "$tmp" "$tmp"
+run_case connective_bad_option 2 '^usage' "$tmp/out" -- "$bin/frames_connective" --bogus
+run_case connective_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_connective" "$tmp" "$tmp"
 run_case soft_arm_bad_option 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" --bogus
 run_case link_compliance_bad_argument 2 '^usage' "$tmp/out" -- "$bin/heml_link_compliance" bogus
 run_case soft_arm_two_directories 2 '^usage' "$tmp/out" -- "$bin/frames_soft_arm" "$tmp" "$tmp"
 
 # 2. an output directory that does not exist: exit status 1, a message, no success claim
-for e in frames_beam tensormass_cut tensormass_hybrid frames_soft_arm; do
+for e in frames_beam tensormass_cut tensormass_hybrid frames_soft_arm frames_connective; do
     run_case "${e}_missing_directory" 1 'cannot write' "$tmp/out" -- "$bin/$e" "$missing"
     case "${e}_missing_directory_claim" in *"$filter"*)
         if grep -q 'written\|wrote' "$tmp/out"; then
@@ -74,6 +77,8 @@ done
 if [ -w /dev/full ]; then
     run_case hello_full_stdout 1 'failed' /dev/full -- "$bin/tensormass_hello"
     run_case compression_full_stdout 1 'failed' /dev/full -- "$bin/heml_compression" nh
+    mkdir -p "$tmp/connective_full"
+    run_case connective_full_stdout 1 'failed' /dev/full -- "$bin/frames_connective" "$tmp/connective_full"
 else
     echo "(no /dev/full here: the full-disk cases are skipped)"
 fi
@@ -89,7 +94,7 @@ case compression_csv in *"$filter"*)
         report compression_csv 1 "$lines lines, header '$(head -n 1 "$tmp/curve.csv")'"
     fi ;;
 esac
-mkdir -p "$tmp/beam" "$tmp/hybrid"
+mkdir -p "$tmp/beam" "$tmp/hybrid" "$tmp/connective"
 run_case beam_runs 0 '' "$tmp/out" -- "$bin/frames_beam" "$tmp/beam"
 case beam_files in *"$filter"*)
     if [ -s "$tmp/beam/frames_beam_samples.vtk" ] && [ -s "$tmp/beam/frames_beam_frames.vtk" ] &&
@@ -118,6 +123,18 @@ case hybrid_files in *"$filter"*)
         report hybrid_files 0 ""
     else
         report hybrid_files 1 "$n VTK files"
+    fi ;;
+esac
+
+run_case connective_runs 0 '' "$tmp/out" -- "$bin/frames_connective" "$tmp/connective"
+case connective_files in *"$filter"*)
+    n=$(ls "$tmp/connective"/frames_connective_lower_*.vtk 2>/dev/null | wc -l)
+    m=$(ls "$tmp/connective"/frames_connective_frames_*.vtk 2>/dev/null | wc -l)
+    if [ "$n" -eq 25 ] && [ "$m" -eq 25 ] && grep -q "^25 VTK frames written" "$tmp/out" &&
+        grep -q "per step .* ms: frames .* heml .* ms" "$tmp/out"; then
+        report connective_files 0 ""
+    else
+        report connective_files 1 "$n + $m VTK files"
     fi ;;
 esac
 

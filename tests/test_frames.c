@@ -4098,7 +4098,10 @@ static void test_i14_cook_slab(void)
                nudge ? "nudged" : "flat", frm_error_string(err), frm_model_last_stats(sc.m)->increments,
                frm_model_last_stats(sc.m)->newton_iterations);
         if (nudge) CHECK_INT(FRM_OK, err);
-        else CHECK(err == FRM_ERR_UNSTABLE || err == FRM_ERR_STALLED);
+        else /* the flat state buckles (see above): any refusal but a success; which one
+                depends on where the Newton path meets the instability (float: its CG
+                fails to converge there) */
+            CHECK(err == FRM_ERR_UNSTABLE || err == FRM_ERR_STALLED || err == FRM_ERR_NO_CONVERGENCE);
         if (nudge) { /* the corner moved up and out of plane (about 8 mm and 10 mm at this resolution) */
             const frm_real *x = frm_model_positions(sc.m);
             int corner = n + nx * n + nx * nx; /* (48, 60, 1) */

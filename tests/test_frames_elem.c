@@ -90,7 +90,7 @@ static void test_float_renames(void)
         NAME(frm_part_default), NAME(frm_rigid_body_default), NAME(frm_parts_combine), NAME(frm_assembly_apply), NAME(frm_assembly_free),
         NAME(frm_probe_default_desc), NAME(frm_probe_create), NAME(frm_probe_positions), NAME(frm_probe_displacements),
         NAME(frm_probe_velocities), NAME(frm_probe_count), NAME(frm_probe_jacobian), NAME(frm_probe_jacobian_transpose),
-        NAME(frm_probe_add_external), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
+        NAME(frm_probe_add_external), NAME(frm_model_set_anchors), NAME(frm_probe_destroy), NAME(frm_modal_default_desc),
         NAME(frm_modal_create), NAME(frm_modal_solve), NAME(frm_modal_count), NAME(frm_modal_frequency),
         NAME(frm_modal_shape), NAME(frm_modal_destroy), NAME(frm_btd_factor_size), NAME(frm_btd_factor),
         NAME(frm_btd_solve), NAME(frm_btd_compliance), NAME(frm_qp_box), NAME(frm_chain_default_desc),

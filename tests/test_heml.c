@@ -1711,6 +1711,154 @@ static void test_vector_paths_match_scalar(void)
     tetmesh_free(&mesh);
 }
 
+/* The stiffness cache (desc.stiffness_cache, PERFORMANCE): for every law, with and without
+   nodal pressure, heml_apply_stiffness and the implicit step on a model with the cache
+   equal those of the same model without it (desc.stiffness_cache = 0): the first product
+   at a state (which fills the cache), the next ones (which read it), and the first after
+   each change of the state, the pins, J0 and the viscous state (each must invalidate it:
+   a stale cache gives the old state's product, off by the size of the change, far beyond
+   round-off). The cached product runs the same arithmetic on the same values, so it is
+   expected bit-identical (printed); the check allows 64 units of round-off of the
+   product's largest entry (a compiler contracting the two call sites differently).
+   The cache's memory is HEML__NC reals per slot exactly where a fast-path (Neo-Hookean)
+   material is in use without nodal pressure, none otherwise; no allocation after create. */
+static int cache_compare(heml_model *a, heml_model *b, const heml_real *dx, int n3, int *bitwise)
+{
+    heml_real *ka = alloc_reals(n3), *kb = alloc_reals(n3);
+    double dmax = 0, kmax = 0;
+    int i, ok = heml_apply_stiffness(a, dx, ka) == HEML_OK && heml_apply_stiffness(b, dx, kb) == HEML_OK;
+    for (i = 0; i < n3; i++) {
+        double d = fabs((double)ka[i] - (double)kb[i]), k = fabs((double)kb[i]);
+        dmax = d > dmax ? d : dmax;
+        kmax = k > kmax ? k : kmax;
+    }
+    if (memcmp(ka, kb, sizeof(heml_real) * (size_t)n3)) *bitwise = 0;
+    free(ka), free(kb);
+    return ok && kmax > 0 && dmax <= 64 * EPS * kmax;
+}
+
+static void test_stiffness_cache(void)
+{
+    tetmesh mesh;
+    int li, nodal;
+#ifdef TEST_QUICK
+    box_mesh(&mesh, 3, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+#else
+    box_mesh(&mesh, 4, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
+#endif
+    { /* the field is 0 or 1 */
+        heml_desc d = heml_default_desc();
+        heml_model *m = NULL;
+        heml_real *X = alloc_reals(3 * mesh.node_count);
+        int i;
+        for (i = 0; i < 3 * mesh.node_count; i++) X[i] = (heml_real)mesh.nodes[i];
+        d.rest_positions = X;
+        d.node_count = mesh.node_count;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        CHECK_INT(1, d.stiffness_cache);
+        d.stiffness_cache = 2;
+        CHECK_INT(HEML_ERR_ARG, heml_create(&d, &m));
+        CHECK(m == NULL);
+        free(X);
+    }
+    for (nodal = 0; nodal < 2; nodal++)
+        for (li = 0; li < NLAWS; li++) {
+            heml_material mt = material_of(all_laws[li]);
+            int n3 = 3 * mesh.node_count, i, c, bitwise = 1, allocs, fast, ok = 1, steps_same = 1;
+            double *x;
+            heml_real *dx1, *dx2, *X, u[3] = {0.01f, 0, -0.02f};
+            counting_allocator ca = {0, 0, 0, 0};
+            heml_model *m[2] = {NULL, NULL};
+            unsigned seed = 301u + (unsigned)li;
+            if (nodal && all_laws[li] == HEML_MASS_SPRING) continue; /* (refused: test_nodal_pressure_refused) */
+            x = (double *)malloc(sizeof(double) * (size_t)n3);
+            dx1 = alloc_reals(n3), dx2 = alloc_reals(n3), X = alloc_reals(n3);
+            for (i = 0; i < n3; i++) X[i] = (heml_real)mesh.nodes[i];
+            for (c = 0; c < 2; c++) {
+                heml_desc d = heml_default_desc();
+                d.rest_positions = X;
+                d.node_count = mesh.node_count;
+                d.tets = mesh.tets;
+                d.tet_count = mesh.tet_count;
+                d.material = mt;
+                d.nodal_pressure = nodal;
+                d.stiffness_cache = c == 0; /* m[0] with the cache, m[1] without */
+                d.allocator.alloc = count_alloc;
+                d.allocator.free = count_free;
+                d.allocator.user = &ca;
+                CHECK_INT(HEML_OK, heml_create(&d, &m[c]));
+            }
+            if (!m[0] || !m[1]) break;
+            fast = m[0]->mats[0].fast;
+            { /* (within the 64-byte alignment of the carved arrays) */
+                long long want = fast ? HEML__NC * (long long)sizeof(heml_real) * m[0]->slot_count : 0;
+                long long got = (long long)heml_memory_bytes(m[0]) - (long long)heml_memory_bytes(m[1]);
+                CHECK(got > want - HEML__ALIGN && got < want + HEML__ALIGN);
+            }
+            for (i = 0; i < n3; i++) dx1[i] = (heml_real)rnd(&seed), dx2[i] = (heml_real)rnd(&seed);
+            allocs = ca.allocs;
+            for (c = 0; c < 8; c++) { /* the changes, each followed by three products */
+                int k;
+                for (k = 0; k < 2; k++) {
+                    switch (c) {
+                    case 0: /* a deformed state, some tetrahedra below J0 */
+                        deformed_state(&mesh, 0.12, seed, x);
+                        set_positions_d(m[k], x, mesh.node_count);
+                        break;
+                    case 1: /* positions again */
+                        deformed_state(&mesh, 0.03, seed + 1, x);
+                        set_positions_d(m[k], x, mesh.node_count);
+                        break;
+                    case 2: { /* displacements */
+                        heml_real *v = alloc_reals(n3);
+                        for (i = 0; i < n3; i++) v[i] = heml_displacements(m[k])[i] * (heml_real)0.5;
+                        CHECK_INT(HEML_OK, heml_set_displacements(m[k], v));
+                        free(v);
+                        break;
+                    }
+                    case 3: /* pins */
+                        CHECK_INT(HEML_OK, heml_fix_node(m[k], 0));
+                        CHECK(m[k]->dc_key == NULL);
+                        (void)heml_apply_stiffness(m[k], dx1, m[k]->work_f);
+                        CHECK_INT(HEML_OK, heml_set_displacement(m[k], 1, u));
+                        break;
+                    case 4:
+                        CHECK_INT(HEML_OK, heml_release_node(m[k], 1));
+                        break;
+                    case 5: /* J0 (products change where J < J0) */
+                        CHECK_INT(HEML_OK, heml_set_inversion_threshold(m[k], (heml_real)0.7));
+                        break;
+                    case 6:
+                        heml_reset_viscous_state(m[k]);
+                        break;
+                    default: /* two implicit steps (products inside, and a new state after) */
+                        for (i = 0; i < 2; i++) (void)heml_step_ex(m[k], (heml_real)1e-3, HEML_IMPLICIT_EULER);
+                        break;
+                    }
+                    CHECK(m[k]->dc_key == NULL); /* every change invalidates */
+                }
+                if (c == 7)
+                    steps_same = !memcmp(heml_positions(m[0]), heml_positions(m[1]), sizeof(heml_real) * (size_t)n3);
+                if (mt.law == HEML_USER && !mt.user.second) continue;
+                ok &= cache_compare(m[0], m[1], dx1, n3, &bitwise); /* fills */
+                CHECK(!fast || m[0]->dc_key == heml_displacements(m[0]));
+                ok &= cache_compare(m[0], m[1], dx2, n3, &bitwise); /* reads */
+                ok &= cache_compare(m[0], m[1], dx1, n3, &bitwise);
+            }
+            printf("    %-18s nodal %d: cache %s, products %s, implicit steps %s\n", law_name[li], nodal,
+                   fast ? "on" : "none", ok ? (bitwise ? "bit-identical" : "equal to round-off") : "DIFFER",
+                   steps_same ? "bit-identical" : "differ");
+            CHECK(ok);
+            CHECK(steps_same || !bitwise);
+            CHECK_INT(allocs, ca.allocs); /* no allocation after create */
+            heml_destroy(m[0]);
+            heml_destroy(m[1]);
+            free(x), free(dx1), free(dx2), free(X);
+        }
+    tetmesh_free(&mesh);
+}
+
 static const test_case cases[] = {
     TEST(test_log_accuracy),
     TEST(test_forces_are_energy_gradient),
@@ -1731,6 +1879,7 @@ static const test_case cases[] = {
     TEST(test_nodal_pressure_refused),
     TEST(test_inv_cbrt_accuracy),
     TEST(test_vector_paths_match_scalar),
+    TEST(test_stiffness_cache),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }
