@@ -88,7 +88,7 @@ EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # when its tools are absent.
 RESULTS := $(foreach c,$(CONFIGS),$(foreach t,$(TESTS_$(c)),build/$(c)/$(t).result)) \
            build/examples/test_examples.result build/packaging/test_packaging.result \
-           build/viewer/test_viewer.result
+           build/viewer/test_viewer.result build/cuda/test_cuda.result
 
 .PHONY: all test test-run examples viewer bench bench-quick clean
 # keep the test binaries between runs (they are intermediate files of the .result rules)
@@ -135,6 +135,15 @@ build/packaging/test_packaging.result: tests/test_packaging.sh tests/consumer/CM
 	@sh tests/test_packaging.sh build/tmp/packaging > build/packaging/test_packaging.log 2>&1; \
 	  echo "$$?" > build/packaging/test_packaging.status; \
 	  grep '^RESULT ' build/packaging/test_packaging.log > $@ || echo "RESULT 0 1 crashed" > $@
+
+# The CUDA companion (issue 16): tests/test_cuda.sh compiles frames_cuda.cu with nvcc (sm_80
+# and sm_90 in one invocation, warnings as errors) when nvcc is found, and runs the GPU tests
+# (tests/cuda_frames.c) when a GPU is present; one skip line otherwise.
+build/cuda/test_cuda.result: tests/test_cuda.sh frames_cuda.cu frames_cuda.h tests/cuda_frames.c $(HEADERS)
+	@mkdir -p build/cuda
+	@sh tests/test_cuda.sh build/tmp/cuda > build/cuda/test_cuda.log 2>&1; \
+	  echo "$$?" > build/cuda/test_cuda.status; \
+	  grep '^RESULT ' build/cuda/test_cuda.log > $@ || echo "RESULT 0 1 crashed" > $@
 
 # The viewer (examples/viewer/, issue 17): GLFW and OpenGL 3.3 core, built when pkg-config
 # finds glfw3 (Debian: libglfw3-dev, libgl-dev), otherwise one line and success. sim.c (the

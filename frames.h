@@ -18,7 +18,9 @@
    one model from several parts sharing frames, rigid bodies (see COUPLING). The per-sample and per-frame math are
    FRM_HOSTDEV static inline kernels (>>kernels) in the same two-pass structure a GPU
    uses: pass 1 per sample writes a contribution per (sample, slot), pass 2 per frame
-   gathers them through a reverse table.
+   gathers them through a reverse table; the passes' bodies are FRM_HOSTDEV functions on
+   a plain view of the model's arrays (frm_view, >>passes) that the CPU loops and the
+   CUDA companion (frames_cuda.cu, see CUDA: compiled, not yet run on a GPU) both call.
 
    DO THIS in exactly one C or C++ file:
 
@@ -81,7 +83,8 @@
        FRM_PARALLEL_MIN_PAIRS
                        default of desc.parallel_min_pairs (20000).
        FRAMES_KERNELS  define (without FRAMES_IMPLEMENTATION) to get only the
-                       FRM_HOSTDEV kernels, e.g. in a .cu file (FRM_HOSTDEV is
+                       FRM_HOSTDEV kernels and pass functions (frm_pass1_*, frm_pass2_*
+                       on a frm_view), e.g. in a .cu file (FRM_HOSTDEV is
                        __host__ __device__ under nvcc, empty otherwise).
 
    STEP BY STEP
@@ -201,7 +204,8 @@
    positive definite (FRM_ERR_RIGID, as creation does for desc.frame_masses / _inertias, and
    FRM_ERR_SAMPLE_SIZE for desc.sample_sizes); frm_probe_create a point outside the body
    (FRM_ERR_POINT_OUTSIDE: in no element, or farther from each of its meshless frames than
-   that frame's farthest sample).
+   that frame's farthest sample). The CUDA companion (frames_cuda.h) returns FRM_ERR_DEVICE
+   for no device, a failed CUDA call or a model feature it does not run (see CUDA).
    A step or solve never reports success with an unconverged or unchecked result: one that
    meets a non-finite value, including a load or residual whose norm overflows (1e156 N:
    FRM_ERR_NOT_FINITE), would leave a sample inverted (det F <= 0) that was not inverted at
@@ -224,6 +228,7 @@
    contributions in pair order through the reverse table (pass 2), energies add chunk
    partial sums in chunk order, and the CG's vector work is serial: results are
    bit-identical whatever the number of threads or the job system's split. No atomics.
+   The chunks' bodies are the pass functions of >>passes (see CUDA).
 
    THE MODEL (thesis equations; our derivations where the printed ones differ)
        Kinematics. A sample s has rest position pbar_s, volume v_s and neighbours i with
@@ -866,7 +871,8 @@
          between bodies but shared or attached frames. Mesh-based probes on a combined model
          need the part's own nodes (frm_probe_desc.nodes, node_frames) when frames were
          attached to a rigid body (the attached frames are no longer frames of the model).
-       - At most 16 neighbours per sample. The CUDA companion is not in this version.
+       - At most 16 neighbours per sample. The CUDA companion runs a subset and has not run on a
+         GPU yet (see CUDA).
        - Coupling to heml.h meshes is by iteration between the models (tensormass.h: not yet)
          (COUPLING), not one monolithic solve: each coupled step costs several steps of
          each model (7 to 9 measured), the staggered exchange has a small time-step limit,
@@ -1011,6 +1017,57 @@
        momentum balance of each step with an internal impulse (7e-10), a weight on a strap
        reaches the strap's extension within 0.15 % (static solve and damped steps).
 
+   CUDA (issue 16; thesis sec. 4.4, Bosman, Duriez & Cotin 2013 sec. 3-5)
+       One kernel code. The bodies of the two passes are FRM_HOSTDEV functions (>>passes) on
+       a frm_view, a public struct of counts and pointers (frm_model_view fills one that
+       points into the model): pass 1 per sample, frm_pass1_deform (H, F, position), then the
+       law (the backend's: the CPU runs the law table, user callbacks included; a GPU the
+       kernels' laws frm_material_stress / frm_sample_dP), frm_pass1_stab_force (the
+       rotation stabilisation's stress and energy), frm_pass1_force_pairs (each pair's
+       partial force, the linearisation's G, Hs, levers); for K v frm_pass1_apply_dF, the
+       law's dP, frm_pass1_apply_pairs; pass 2 per frame frm_pass2_gather (the reverse
+       table, in pair order, in double) and frm_pass2_rotational. The CPU loops call exactly
+       these (results bit-identical to the loops they replaced, for every thread count:
+       measured on 12 scenes, hexahedra and tetrahedra, every law, the coupling term,
+       volumetric averaging, blocks, BDF2, double, float and 2 OpenMP threads, and
+       tests/test_frames_elem.c test_view_passes runs a serial backend of its own on the
+       view and gets the model's forces and K v bit for bit). No per-pair arrays on the
+       stack (a GPU thread's 290 numbers would spill): what a sample's sums need twice (a
+       pair's lever, the stabilisation's T_k and omega_k) is recomputed by the same
+       expression, and the stabilisation's K v torques wait in p_out until dP is complete;
+       only the coupling term (frame_coupling, off by default) keeps 96 reals (nvcc -Xptxas
+       -v: pass 1 of the force 768 bytes of stack, of K v 384, both from that term; no
+       spills). The volumetric option's extra stages (VOLUMETRIC AVERAGING) stay CPU-only.
+       The companion (frames_cuda.cu, declared in frames_cuda.h: a separate header, so that
+       frames.h needs no CUDA types and programs without a GPU see nothing of it; nvcc -c
+       frames_cuda.cu [-DFRM_REAL=float], link with -lcudart; frames.h's functions with C
+       linkage): frm_cuda_create uploads a created model (structure, rest data, state,
+       loads, settings) once; frm_cuda_step runs the linearised implicit Euler step (the
+       thesis's scheme, one linear solve a step) on one stream: the force pass and its
+       linearisation (pass 1 one thread a sample, pass 2 one thread a frame, 128 a block:
+       not measured yet; the thesis's 6 threads a frame in blocks of 96 parallelise inside
+       a frame, which pays when frames are few), the pair mode's block-Jacobi blocks
+       inverted per frame, CG with its dot products in double reduced by a fixed-order tree
+       (no floating-point atomics: repeatable bit for bit on one GPU) and the scalars on the
+       device (16 iterations between two looks at convergence; the iterations past it change
+       nothing, so the count equals the CPU's rule), then the update and the acceptance
+       (finite state, no sample with det F <= 0); a failed step restores the device state
+       of the step's start (FRM_ERR_NO_CONVERGENCE, FRM_ERR_NOT_FINITE, FRM_ERR_INVERTED,
+       as the CPU path). frm_cuda_forces, frm_cuda_linearize, frm_cuda_apply_stiffness (K v,
+       symmetric part), frm_cuda_download (into the host model), frm_cuda_upload_state.
+       Not on the device: the static solve, Newton-based implicit Euler and BDF2, the
+       definite fallback (the device step fails where the CPU retries with K's positive
+       part), the precision check, assembled blocks, volumetric averaging, Mooney-Rivlin
+       and user laws, driven frames (FRM_ERR_DEVICE at creation).
+       Verified: frames_cuda.cu compiles with nvcc 13.0 for sm_80 and sm_90 with warnings as
+       errors (make test, tests/test_cuda.sh: about 30 s); tests/cuda_frames.c builds and
+       links, and on a machine without a GPU frm_cuda_create returns FRM_ERR_DEVICE. NOT
+       verified: nothing of it has run on a GPU. tests/cuda_frames.c (forces, K v and one
+       step against the CPU within tolerances it justifies, two device runs bit-identical,
+       an overloaded step keeping the last valid state) and bench/gpu.sh (the thesis's
+       34,610-sample step at 60 CG iterations, 1e6 samples, device and CPU of the same run,
+       written to bench/results/gpu-<name>/) are ready for the first session with a GPU.
+
    BLOCK-TRIDIAGONAL SOLVER (issue 15): frm_btd_factor / frm_btd_solve / frm_btd_compliance,
    usable on their own for any chain of 6-DoF nodes (rods, cables, catheters, trunk robots).
    The matrix: n diagonal 6x6 blocks and n - 1 sub-diagonal blocks A(i + 1, i), symmetric
@@ -1140,6 +1197,10 @@
    the inverse controller commercially must check that patent's status themselves.
 
    HISTORY
+       unreleased (issue 16): frm_view and frm_model_view (frm_model_view_f32), the pass
+             functions frm_pass1_* and frm_pass2_* (>>passes) that the CPU loops now call;
+             frames_cuda.cu / frames_cuda.h (frm_cuda_*), FRM_ERR_DEVICE (-49). Results of
+             existing models bit-identical.
        unreleased (issue 15): the block-tridiagonal solver (frm_btd_*, and
              FRM_LINEAR_SOLVER_BTD for chain-pattern models), the box QP frm_qp_box, the
              reduced chain model with actuators and the inverse model (frm_chain_*,
@@ -1258,6 +1319,7 @@ typedef FRM_REAL frm_real;
 #define frm_model_default_desc frm_model_default_desc_f32
 #define frm_model_create frm_model_create_f32
 #define frm_model_destroy frm_model_destroy_f32
+#define frm_model_view frm_model_view_f32
 #define frm_model_fix_frame frm_model_fix_frame_f32
 #define frm_model_drive_frame frm_model_drive_frame_f32
 #define frm_model_release_frame frm_model_release_frame_f32
@@ -1394,13 +1456,14 @@ typedef FRM_REAL frm_real;
     X(FRM_ERR_ACTUATOR, -45, "actuator malformed: unknown kind, too few points, a point on a frame outside the chain, coincident cable points, a triangle index out of range or a cavity enclosing no volume") \
     X(FRM_ERR_ACTUATOR_BOUNDS, -46, "actuator bounds invalid (not 0 <= min <= max) or an effort outside them") \
     X(FRM_ERR_UNREACHABLE, -47, "target out of reach: the chain was left at the closest pose found (a valid equilibrium)") \
-    X(FRM_ERR_QP_INDEFINITE, -48, "quadratic program not convex (negative curvature beyond round-off)")
+    X(FRM_ERR_QP_INDEFINITE, -48, "quadratic program not convex (negative curvature beyond round-off)") \
+    X(FRM_ERR_DEVICE, -49, "the CUDA companion (frames_cuda.h): no usable device, a device call failed, or the model uses what it does not run (volumetric averaging, a law without a kernel fast path, driven frames)")
 
 enum {
 #define FRM__ENUM(name, value, text) name = value,
     FRM_ERROR_LIST(FRM__ENUM)
 #undef FRM__ENUM
-    FRM_ERR_LAST_ = -49
+    FRM_ERR_LAST_ = -50
 };
 
 /* Constitutive laws (per sample). They are written in terms of the Green-Lagrange strain
@@ -1755,6 +1818,56 @@ typedef struct frm_sampling {
 
 typedef struct frm_model frm_model;
 
+/* A plain view of a created model's arrays: what a backend running the two passes of the
+   force and of K v needs (>>kernels: frm_pass1_*, frm_pass2_*), and nothing else. The CPU
+   loops and the CUDA companion (frames_cuda.cu, see CUDA) call the same FRM_HOSTDEV pass
+   functions on it; frm_model_view fills one that points into the model's block (valid
+   until frm_model_destroy; a GPU backend copies the arrays and points a view of its own at
+   its copies). Counts: frames, samples, pairs; per frame i the reverse table
+   rev_pair[rev_start[i] .. rev_start[i + 1]) lists its pairs in pair order; per sample s
+   its pairs are s_start[s] .. s_start[s + 1]. Arrays the pass functions only read are
+   const; the outputs (p_out: 6 per pair, pass 1's partial force or K v) and the
+   linearisation's data (written by the force pass when it linearises) are not. NULL for
+   an option that is off (p_stab, s_stabY, s_stabD without the rotation stabilisation,
+   p_C without the coupling term). Units as in struct frm_model's comments (SI). */
+typedef struct frm_view {
+    int frame_count, sample_count, pair_count;
+    int law_cache;                   /* reals of lin_cache per sample */
+    /* per frame */
+    const frm_real *disp;            /* 3: u = x - xbar (m), the state */
+    const frm_real *rel, *relm;      /* 9 each: Q = R Rbar^T and Q - I (frm_frame_rotations) */
+    const frm_real *f_stab;          /* 6: projector on the rotations its samples do not see, or 0 */
+    const unsigned char *f_stab_on;  /* 1: f_stab is not zero */
+    const int *rev_start, *rev_pair; /* frame_count + 1, pair_count: the reverse table */
+    frm_real *lin_hrot;              /* 6: the frame-own rotational term at the linearisation */
+    /* per sample */
+    const int *s_start;                        /* sample_count + 1 */
+    const frm_real *s_rest, *s_volume;         /* 3 (m), 1 (m^3) */
+    const frm_real *s_couple, *s_mu, *s_hstab; /* coupling coefficient, shear modulus (Pa), gamma h^2 (m^2) */
+    const unsigned char *s_law, *s_stab;       /* frm_law; 1 if the stabilisation acts on it */
+    const frm_real *s_law_params;              /* FRM_LAW_PARAMS per sample (mu, lambda first for the
+                                                  kernels' laws, frm_material_stress) */
+    frm_real *s_stabY, *s_stabD;               /* 9, 1: the stabilisation at the linearisation */
+    frm_real *lin_F, *lin_S, *lin_cache;       /* 9, 6, law_cache: the linearisation's F, S, tangent data */
+    frm_real *s_pos;                           /* 3: sample positions (outputs) */
+    /* per pair (sample, neighbour) */
+    const int *p_frame;                        /* the neighbour's frame */
+    const frm_real *p_weight, *p_grad, *p_rlev; /* 1, 3 (1/m), 3 (m): w, grad w, rest lever abar */
+    frm_real *p_G, *p_H, *p_A, *p_C, *p_stab;  /* 9, 6, 3, 3, 3: the linearisation's G, Hs, lever a,
+                                                  coupling g, stabilisation conjugate */
+    frm_real *p_out;                           /* 6: pass 1's partial contributions */
+    /* what a backend's solver needs besides the passes (frames_cuda.cu's implicit step) */
+    const frm_real *quat, *rest_quat, *vel;    /* 4, 4, 6 per frame: the state (with disp) */
+    const frm_real *ext;                       /* 6 per frame: external force (N), torque (N m) */
+    const unsigned char *state, *axes;         /* per frame: 0 free, 1 fixed, 2 driven; held axes bits */
+    const double *mass_local, *grav_local;     /* 10, 4 per frame: m, cbar, Jbar (rest axes); m_g, cbar_g */
+    const frm_real *kdiag_rest;                /* 36 per frame: the rest K_ii (pair mode's preconditioner) */
+    frm_real gravity[3];                       /* m/s^2 */
+    frm_real time_step, mass_damping, stiffness_damping, cg_tolerance; /* s, 1/s, s, relative */
+    int cg_max_iterations;
+    int volumetric;                            /* desc.volumetric (frm_volumetric): the CPU passes' extra stages */
+} frm_view;
+
 /* Library version string "major.minor.patch". */
 FRMDEF const char *frm_version(void);
 /* Name of an error code (static string). */
@@ -2039,6 +2152,9 @@ FRMDEF size_t frm_model_memory_bytes(const frm_model *m);
 /* Frames whose rotation the rotation stabilisation holds (their samples do not see it at
    first order; see MODEL), 0 with rotation_stabilization = 0. */
 FRMDEF int frm_model_stabilized_frames(const frm_model *m);
+/* Fills *out with a view of the model's arrays (see frm_view), for a backend running the
+   passes (frames_cuda.cu). FRM_ERR_ARG on NULL. */
+FRMDEF int frm_model_view(const frm_model *m, frm_view *out);
 
 /* ---- stiffness (K = -df/dq, 6 per frame: translation, then rotation about world axes:
    a rotation dtheta moves R to exp([dtheta]x) R) ---- */
@@ -3106,6 +3222,283 @@ FRM_HOSTDEV static inline void frm_pair_block(frm_real volume, const frm_real co
     }
 }
 
+
+/* >>passes: the bodies of the two passes over a frm_view, shared by the CPU loops (which
+   run them over fixed chunks, see THREADING) and the CUDA companion (one thread a sample
+   in pass 1, one a frame in pass 2). Pass 1 per sample s writes each of its pairs'
+   partial contribution (6 reals) into p_out; pass 2 per frame sums them through the
+   reverse table. The constitutive law sits between frm_pass1_deform and the pair loop:
+   a backend evaluates it its own way (the CPU through the law table, which also runs
+   user callbacks; the GPU through frm_material_stress / frm_sample_dP, the laws with a
+   fast path). Nothing here keeps a per-pair array on the stack: per-pair quantities the
+   sample's sums need twice (levers, the stabilisation's T_k and omega_k) are recomputed
+   by the same expressions (the same bits), and the stabilisation's K v torques wait in
+   p_out; only the coupling term (desc.frame_coupling, off by default) keeps 3 n levers
+   and offsets on the stack. */
+
+/* Pass 1, force and K v: the lever a = Q abar = abar + Qm abar of pair p (world axes, m),
+   by the expression of frm_sample_deformation. */
+FRM_HOSTDEV static inline void frm_pass_lever(const frm_view *w, int p, frm_real lever[3])
+{
+    const frm_real *Qm = w->relm + 9 * w->p_frame[p], *ab = w->p_rlev + 3 * (size_t)p;
+    int r;
+    for (r = 0; r < 3; r++) lever[r] = ab[r] + (Qm[3 * r] * ab[0] + Qm[3 * r + 1] * ab[1] + Qm[3 * r + 2] * ab[2]);
+}
+
+/* Pass 1 of the force, first part: H = F - I and F of sample s (eqs. 3.34, 3.40), and its
+   position into position (3; NULL: not wanted). */
+FRM_HOSTDEV static inline void frm_pass1_deform(const frm_view *w, int s, frm_real H[9], frm_real F[9],
+                                                frm_real *position)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, r;
+    frm_sample_deformation(n, w->p_frame + b, w->p_weight + b, w->p_grad + 3 * (size_t)b, w->p_rlev + 3 * (size_t)b,
+                           w->s_rest + 3 * (size_t)s, w->disp, w->relm, H, NULL, NULL, position);
+    for (r = 0; r < 9; r++) F[r] = H[r];
+    F[0] += 1; /* F = I + H */
+    F[4] += 1;
+    F[8] += 1;
+}
+
+/* Pass 1 of the force, the rotation stabilisation of sample s (see MODEL): adds its stress
+   to P (divided by the volume), sets *D (the divergence D = Y : F / 2, with Y = sum_k Z_k
+   over the pairs of frames without unseen rotations, Dall over all) and returns its
+   energy (J). With linearize, stores the data K v needs (p_stab per pair: the frames with
+   unseen rotations m_k = N omega_k + g D grad w_k, the others t_k = sum_j f_j x z_kj; Y
+   and D per sample). The frame-own torques and T_k: frm_pass1_stab_pair. */
+FRM_HOSTDEV static inline double frm_pass1_stab_force(const frm_view *w, int s, const frm_real H[9],
+                                                      const frm_real F[9], frm_real P[9], int linearize, frm_real *Dout)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, i;
+    frm_real v = w->s_volume[s], c = w->s_mu[s] * v, g = w->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
+    frm_real sD, Z[9];
+    double energy = 0;
+    for (r = 0; r < 9; r++) Dall[r] = 0;
+    for (k = 0; k < n; k++) { /* Z_k: Y over the plain pairs, Dall over the others */
+        i = w->p_frame[b + k];
+        frm_stab_direction(w->relm + 9 * i, w->p_grad + 3 * (size_t)(b + k), Z);
+        for (r = 0; r < 9; r++) {
+            if (w->f_stab_on[i]) Dall[r] += Z[r];
+            else Y[r] += Z[r];
+        }
+    }
+    for (r = 0; r < 9; r++) Dall[r] += Y[r];
+    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
+                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
+    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
+    sD = (frm_real)0.5 * c * g * D;
+    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
+    for (k = 0; k < n; k++) {
+        const frm_real *gk = w->p_grad + 3 * (size_t)(b + k);
+        i = w->p_frame[b + k];
+        if (w->f_stab_on[i]) {
+            const frm_real *N = w->f_stab + 6 * i;
+            frm_real om[3], mk[3], T[9];
+            frm_pair_stab_omega(H, w->relm + 9 * i, om);
+            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
+            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+            frm_stab_stress(c, w->relm + 9 * i, mk, T);
+            for (r = 0; r < 9; r++) P[r] += T[r] / v;
+            if (linearize)
+                for (r = 0; r < 3; r++) w->p_stab[3 * (size_t)(b + k) + r] = mk[r];
+        } else if (linearize) {
+            frm_real t[3];
+            frm_stab_direction(w->relm + 9 * i, gk, Z);
+            frm_column_cross_sum(F, Z, t);
+            for (r = 0; r < 3; r++) w->p_stab[3 * (size_t)(b + k) + r] = t[r];
+        }
+    }
+    if (linearize) {
+        for (r = 0; r < 9; r++) w->s_stabY[9 * (size_t)s + r] = Y[r];
+        w->s_stabD[s] = D;
+    }
+    *Dout = D;
+    return energy;
+}
+
+/* Pass 1 of the force, the stabilisation's T_k (9) and frame-own torque (3) of slot k of
+   sample s, given the sample's D (frm_pass1_stab_force computed the same values). */
+FRM_HOSTDEV static inline void frm_pass1_stab_pair(const frm_view *w, int s, int k, const frm_real H[9],
+                                                   const frm_real F[9], frm_real D, frm_real T[9], frm_real stq[3])
+{
+    int b = w->s_start[s], i = w->p_frame[b + k], r;
+    frm_real v = w->s_volume[s], c = w->s_mu[s] * v, g = w->s_hstab[s];
+    const frm_real *gk = w->p_grad + 3 * (size_t)(b + k);
+    if (w->f_stab_on[i]) {
+        const frm_real *N = w->f_stab + 6 * i;
+        frm_real om[3], mk[3];
+        frm_pair_stab_omega(H, w->relm + 9 * i, om);
+        mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
+        mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
+        mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
+        for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
+        frm_stab_stress(c, w->relm + 9 * i, mk, T);
+        frm_column_cross_sum(F, T, stq);
+    } else {
+        frm_real t[3], sD = (frm_real)0.5 * c * g * D;
+        frm_stab_direction(w->relm + 9 * i, gk, T);
+        frm_column_cross_sum(F, T, t);
+        for (r = 0; r < 3; r++) stq[r] = sD * t[r];
+        for (r = 0; r < 9; r++) T[r] *= sD;
+    }
+}
+
+/* Pass 1 of the force, the pairs of sample s for its final stress P (the law's, plus the
+   stabilisation's; D from frm_pass1_stab_force, unused without it): each pair's partial
+   force into p_out (eq. 3.52; the stabilisation's frame-own torque and the coupling
+   term's forces added), the coupling term's energy added to *energy; with linearize, the
+   pairs' lever a, G and Hs (the frame-own terms of the stabilisation and the coupling
+   included) and the coupling's g. */
+FRM_HOSTDEV static inline void frm_pass1_force_pairs(const frm_view *w, int s, const frm_real H[9],
+                                                     const frm_real F[9], const frm_real P[9], frm_real D,
+                                                     int linearize, double *energy)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, stab = w->s_stab[s];
+    frm_real v = w->s_volume[s];
+    for (k = 0; k < n; k++) {
+        int p = b + k, i = w->p_frame[p];
+        frm_real lever[3], T[9], stq[3], *out = w->p_out + 6 * (size_t)p;
+        frm_pass_lever(w, p, lever);
+        frm_pair_force(v, P, w->p_grad + 3 * (size_t)p, w->p_weight[p], lever, w->rel + 9 * i, out);
+        if (stab) {
+            frm_pass1_stab_pair(w, s, k, H, F, D, T, stq);
+            for (r = 0; r < 3; r++) out[3 + r] += stq[r];
+        }
+        if (linearize) {
+            frm_real *Hs = w->p_H + 6 * (size_t)p;
+            for (r = 0; r < 3; r++) w->p_A[3 * (size_t)p + r] = lever[r];
+            frm_pair_linearize(v, P, w->p_grad + 3 * (size_t)p, w->p_weight[p], lever, w->rel + 9 * i,
+                               w->p_G + 9 * (size_t)p, Hs);
+            if (stab) frm_pair_stab_rotation(F, T, Hs);
+        }
+    }
+    if (w->s_couple[s] != 0) {
+        frm_real lever[3 * FRM_MAX_NEIGHBORS], offset[3 * FRM_MAX_NEIGHBORS], Hc[9];
+        frm_sample_deformation(n, w->p_frame + b, w->p_weight + b, w->p_grad + 3 * (size_t)b, w->p_rlev + 3 * (size_t)b,
+                               w->s_rest + 3 * (size_t)s, w->disp, w->relm, Hc, lever, offset, NULL);
+        *energy += (double)frm_sample_coupling_force(n, w->p_weight + b, lever, offset, w->s_couple[s],
+                                                     w->p_out + 6 * (size_t)b, linearize ? w->p_C + 3 * (size_t)b : NULL);
+        if (linearize)
+            for (k = 0; k < n; k++)
+                frm_pair_coupling_rotation(w->p_C + 3 * (size_t)(b + k), lever + 3 * k, w->p_H + 6 * (size_t)(b + k));
+    }
+}
+
+/* Pass 1 of K v (pair mode), first part: dF of sample s from its neighbours' v (6 per
+   frame: translation, rotation) through the linearisation's G (eq. 3.43). */
+FRM_HOSTDEV static inline void frm_pass1_apply_dF(const frm_view *w, int s, const frm_real *v, frm_real dF[9])
+{
+    int b = w->s_start[s], e = w->s_start[s + 1], k;
+    for (k = 0; k < 9; k++) dF[k] = 0;
+    for (k = b; k < e; k++) frm_pair_dF(v + 6 * w->p_frame[k], w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, dF);
+}
+
+/* Pass 1 of K v, the pairs of sample s for its dF and the law's dP (dP receives the
+   stabilisation's stress-like part): each pair's v_s B^T vec(dP) (plus the stabilisation's
+   frame-own torque and the coupling's Gauss-Newton part) into p_out. definite: the
+   linearisation is K's positive-definite part (the stabilisation's Gauss-Newton part
+   only). The stabilisation (see frm_pair_stab_apply): dD = Y : dF / 2 + sum over the pairs
+   of frames with unseen rotations g_k . domega_k - sum over the others dtheta_k . t_k / 2;
+   its torques wait in p_out's rotational half until dP is complete. */
+FRM_HOSTDEV static inline void frm_pass1_apply_pairs(const frm_view *w, int s, const frm_real *v, const frm_real dF[9],
+                                                     frm_real dP[9], int definite)
+{
+    int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, i, stab = w->s_stab[s];
+    frm_real vol = w->s_volume[s];
+    if (stab) {
+        const frm_real *F = w->lin_F + 9 * (size_t)s, *Y = w->s_stabY + 9 * (size_t)s;
+        frm_real c = w->s_mu[s] * w->s_volume[s], g = w->s_hstab[s], D = w->s_stabD[s], dD, s1, s2, dPx[9];
+        dD = (frm_real)0.5 * (Y[0] * dF[0] + Y[1] * dF[1] + Y[2] * dF[2] + Y[3] * dF[3] + Y[4] * dF[4] + Y[5] * dF[5] +
+                              Y[6] * dF[6] + Y[7] * dF[7] + Y[8] * dF[8]);
+        for (k = 0; k < n; k++) {
+            const frm_real *t = w->p_stab + 3 * (size_t)(b + k), *gk = w->p_grad + 3 * (size_t)(b + k);
+            const frm_real *th = v + 6 * w->p_frame[b + k] + 3;
+            i = w->p_frame[b + k];
+            if (w->f_stab_on[i]) {
+                frm_real om[3];
+                frm_pair_stab_domega(F, dF, w->relm + 9 * i, th, om);
+                dD += gk[0] * om[0] + gk[1] * om[1] + gk[2] * om[2];
+            } else
+                dD -= (frm_real)0.5 * (th[0] * t[0] + th[1] * t[1] + th[2] * t[2]);
+        }
+        s1 = (frm_real)0.5 * c * g * dD;
+        s2 = (frm_real)0.5 * c * g * D;
+        for (r = 0; r < 9; r++) dPx[r] = s1 * Y[r];
+        for (k = 0; k < n; k++) {
+            const frm_real *t = w->p_stab + 3 * (size_t)(b + k), *gk = w->p_grad + 3 * (size_t)(b + k);
+            const frm_real *th = v + 6 * w->p_frame[b + k] + 3;
+            frm_real *stq = w->p_out + 6 * (size_t)(b + k) + 3;
+            i = w->p_frame[b + k];
+            if (w->f_stab_on[i]) {
+                const frm_real *N = w->f_stab + 6 * i;
+                frm_real o[3], u[3], d[9];
+                frm_pair_stab_domega(F, dF, w->relm + 9 * i, th, o);
+                u[0] = N[0] * o[0] + N[5] * o[1] + N[4] * o[2] + g * dD * gk[0];
+                u[1] = N[5] * o[0] + N[1] * o[1] + N[3] * o[2] + g * dD * gk[1];
+                u[2] = N[4] * o[0] + N[3] * o[1] + N[2] * o[2] + g * dD * gk[2];
+                frm_pair_stab_apply(F, dF, w->relm + 9 * i, c, u, t, th, definite, d, stq);
+                for (r = 0; r < 9; r++) dPx[r] += d[r];
+                continue;
+            }
+            for (r = 0; r < 3; r++) stq[r] = -s1 * t[r];
+            if (!definite && s2 != 0) {
+                frm_real Z[9], x[3];
+                frm_stab_direction(w->relm + 9 * i, gk, Z);
+                frm_column_cross_sum(dF, Z, x);
+                for (r = 0; r < 3; r++) stq[r] -= s2 * x[r];
+                for (r = 0; r < 3; r++) { /* dPx += [dtheta]x T_k, column r */
+                    dPx[r] += s2 * (th[1] * Z[6 + r] - th[2] * Z[3 + r]);
+                    dPx[3 + r] += s2 * (th[2] * Z[r] - th[0] * Z[6 + r]);
+                    dPx[6 + r] += s2 * (th[0] * Z[3 + r] - th[1] * Z[r]);
+                }
+            }
+        }
+        for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
+        for (k = b; k < b + n; k++) { /* the pairs' products, the waiting torques added (the same sum) */
+            frm_real y[6], *out = w->p_out + 6 * (size_t)k;
+            frm_pair_apply(vol, dP, w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, y);
+            for (r = 0; r < 3; r++) {
+                out[r] = y[r];
+                out[3 + r] = y[3 + r] + out[3 + r];
+            }
+        }
+    } else
+        for (k = b; k < b + n; k++)
+            frm_pair_apply(vol, dP, w->p_grad + 3 * (size_t)k, w->p_G + 9 * (size_t)k, w->p_out + 6 * (size_t)k);
+    if (w->s_couple[s] != 0)
+        frm_sample_coupling_apply(n, w->p_frame + b, w->p_weight + b, w->p_A + 3 * (size_t)b, w->s_couple[s], v,
+                                  w->p_out + 6 * (size_t)b);
+}
+
+/* Pass 2 of frame i: dst (6) = the sum of src (6 per pair) over its pairs in pair order
+   through the reverse table, in double; scale (may be NULL) = the sum of their |src|^2. */
+FRM_HOSTDEV static inline void frm_pass2_gather(const frm_view *w, int i, const frm_real *src, frm_real *dst,
+                                                double *scale)
+{
+    double sum[6] = {0, 0, 0, 0, 0, 0}, sq = 0;
+    int e, k;
+    for (e = w->rev_start[i]; e < w->rev_start[i + 1]; e++) {
+        const frm_real *x = src + 6 * (size_t)w->rev_pair[e];
+        for (k = 0; k < 6; k++) sum[k] += (double)x[k];
+        if (scale)
+            for (k = 0; k < 6; k++) sq += (double)x[k] * x[k];
+    }
+    for (k = 0; k < 6; k++) dst[6 * i + k] = (frm_real)sum[k];
+    if (scale) scale[i] = sq;
+}
+
+/* Pass 2 of K v (pair mode), after the gather: the frame-own rotational term of frame i
+   (the pairs' Hs and gravity, lin_hrot) applied to v's rotation, added to out (6 per frame). */
+FRM_HOSTDEV static inline void frm_pass2_rotational(const frm_view *w, int i, const frm_real *v, frm_real *out)
+{
+    const frm_real *h = w->lin_hrot + 6 * i, *t = v + 6 * i + 3;
+    out[6 * i + 3] += h[0] * t[0] + h[5] * t[1] + h[4] * t[2];
+    out[6 * i + 4] += h[5] * t[0] + h[1] * t[1] + h[3] * t[2];
+    out[6 * i + 5] += h[4] * t[0] + h[3] * t[1] + h[2] * t[2];
+}
+
 #endif /* FRAMES_KERNELS */
 
 /* ======================================================================================
@@ -3305,6 +3698,7 @@ struct frm_model {
     int lin_predict; /* the next linear solve's iterations, predicted: max(last, previous prediction / 2) (-1: none yet) */
     int lin_definite; /* the linearisation holds the positive-definite part of K (see SOLVERS) */
     frm_stats stats;
+    frm_view view; /* the passes' arrays (frm__fill_view, after the layout) */
 };
 
 /* >>math ------------------------------------------------------------------------------- */
@@ -4939,6 +5333,59 @@ static int frm__create_precompute(frm_model *m, const frm_desc *d, frm__create_t
     return FRM_OK;
 }
 
+/* The view the passes run on (frm_view): pointers into the block, set once. */
+static void frm__fill_view(frm_model *m)
+{
+    frm_view *w = &m->view;
+    w->frame_count = m->frame_count;
+    w->sample_count = m->sample_count;
+    w->pair_count = m->pair_count;
+    w->law_cache = m->law_cache;
+    w->disp = m->disp;
+    w->rel = m->rel;
+    w->relm = m->relm;
+    w->f_stab = m->f_stab;
+    w->f_stab_on = m->f_stab_on;
+    w->rev_start = m->rev_start;
+    w->rev_pair = m->rev_pair;
+    w->lin_hrot = m->lin_hrot;
+    w->s_start = m->s_start;
+    w->s_rest = m->s_rest;
+    w->s_volume = m->s_volume;
+    w->s_couple = m->s_couple;
+    w->s_mu = m->s_mu;
+    w->s_hstab = m->s_hstab;
+    w->s_law = m->s_law;
+    w->s_stab = m->s_stab;
+    w->s_law_params = m->s_law_params;
+    w->s_stabY = m->s_stabY;
+    w->s_stabD = m->s_stabD;
+    w->lin_F = m->lin_F;
+    w->lin_S = m->lin_S;
+    w->lin_cache = m->lin_cache;
+    w->s_pos = m->s_pos;
+    w->p_frame = m->p_frame;
+    w->p_weight = m->p_weight;
+    w->p_grad = m->p_grad;
+    w->p_rlev = m->p_rlev;
+    w->p_G = m->p_G;
+    w->p_H = m->p_H;
+    w->p_A = m->p_A;
+    w->p_C = m->p_C;
+    w->p_stab = m->p_stab;
+    w->p_out = m->p_out;
+    w->quat = m->quat;
+    w->rest_quat = m->rest_quat;
+    w->vel = m->vel;
+    w->ext = m->ext;
+    w->state = m->state;
+    w->axes = m->axes;
+    w->mass_local = m->mass_local;
+    w->grav_local = m->grav_local;
+    w->kdiag_rest = m->kdiag_rest;
+    w->volumetric = m->vol_mode;
+}
+
 static int frm__btd_model_check(const frm_model *m, const frm_desc *d);
 FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
 {
@@ -4955,6 +5402,7 @@ FRMDEF int frm_model_create(const frm_desc *d, frm_model **out)
     err = frm__create_size(d, &tmp, &tables);
     if (err) return err;
     err = frm__create_layout(d, &tmp, &m);
+    if (!err) frm__fill_view(m); /* the precomputation runs passes */
     if (!err) err = frm__create_precompute(m, d, &tables);
     if (!err && m->linear_solver == FRM_LINEAR_SOLVER_BTD) err = frm__btd_model_check(m, d);
     frm__create_free_tables(d, &tables);
@@ -4998,66 +5446,7 @@ static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
     for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
 }
 
-/* The rotation stabilisation of sample s (see MODEL): its energy (returned), its stress
-   added to P (divided by the volume), each pair's T_k into T (9 n, for the frame-own
-   second-order term) and the frame-own torques into stq (3 n). With D = sum_k grad w_k .
-   omega_k = Y : F / 2, Y = sum_k Z_k: pairs of frames without unseen rotations have
-   T_k = c g D / 2 Z_k (no omega_k needed); those with them the general
-   T_k = c/2 Q_k [N_k omega_k + g D grad w_k]x. With linearize, the data K v needs. */
-static double frm__stab_sample_force(frm_model *m, int s, const frm_real H[9], const frm_real F[9], frm_real P[9],
-                                     frm_real *T, frm_real *stq, int linearize)
-{
-    int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r, i;
-    frm_real v = m->s_volume[s], c = m->s_mu[s] * v, g = m->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
-    frm_real sD;
-    double energy = 0;
-    for (r = 0; r < 9; r++) Dall[r] = 0;
-    for (k = 0; k < n; k++) { /* Z_k into T, Y over the plain pairs, Dall over the others */
-        const frm_real *gk = m->p_grad + 3 * (size_t)(b + k);
-        i = m->p_frame[b + k];
-        frm_stab_direction(m->relm + 9 * i, gk, T + 9 * k);
-        for (r = 0; r < 9; r++) {
-            if (m->f_stab_on[i]) Dall[r] += T[9 * k + r];
-            else Y[r] += T[9 * k + r];
-        }
-    }
-    for (r = 0; r < 9; r++) Dall[r] += Y[r];
-    D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
-                         Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
-    energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
-    sD = (frm_real)0.5 * c * g * D;
-    for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
-    for (k = 0; k < n; k++) {
-        i = m->p_frame[b + k];
-        if (m->f_stab_on[i]) {
-            const frm_real *N = m->f_stab + 6 * i, *gk = m->p_grad + 3 * (size_t)(b + k);
-            frm_real om[3], mk[3];
-            frm_pair_stab_omega(H, m->relm + 9 * i, om);
-            mk[0] = N[0] * om[0] + N[5] * om[1] + N[4] * om[2];
-            mk[1] = N[5] * om[0] + N[1] * om[1] + N[3] * om[2];
-            mk[2] = N[4] * om[0] + N[3] * om[1] + N[2] * om[2];
-            energy += 0.5 * (double)c * (double)(om[0] * mk[0] + om[1] * mk[1] + om[2] * mk[2]);
-            for (r = 0; r < 3; r++) mk[r] += g * D * gk[r];
-            frm_stab_stress(c, m->relm + 9 * i, mk, T + 9 * k);
-            frm_column_cross_sum(F, T + 9 * k, stq + 3 * k);
-            for (r = 0; r < 9; r++) P[r] += T[9 * k + r] / v;
-            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), mk, sizeof mk);
-        } else {
-            frm_real t[3];
-            frm_column_cross_sum(F, T + 9 * k, t);
-            for (r = 0; r < 3; r++) stq[3 * k + r] = sD * t[r];
-            for (r = 0; r < 9; r++) T[9 * k + r] *= sD;
-            if (linearize) memcpy(m->p_stab + 3 * (size_t)(b + k), t, sizeof t);
-        }
-    }
-    if (linearize) {
-        memcpy(m->s_stabY + 9 * (size_t)s, Y, sizeof Y);
-        m->s_stabD[s] = D;
-    }
-    return energy;
-}
-
-/* The stabilisation's part of K v for sample s (see frm__stab_sample_force): for the
+/* The stabilisation's part of K v for sample s (see frm_pass1_stab_force), for the assembly: for the
    sample's dF and each pair's frame rotation dth[k] (NULL: zero), the stress-like sum
    dPx (absolute: divide by the volume) and each pair's frame-own torque row stq (3 n).
    dD = Y : dF / 2 - sum_k dtheta_k . t_k / 2 (+ g_k . domega_k for the general pairs), the
@@ -5283,23 +5672,17 @@ static void frm__force_chunks(void *vctx, int begin, int end)
 {
     frm__force_ctx *ctx = (frm__force_ctx *)vctx;
     frm_model *m = ctx->m;
+    const frm_view *w = &m->view;
     int c;
     for (c = begin; c < end; c++) {
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s, err = 0;
         double energy = m->vol_mode ? m->chunk_energy[c] : 0; /* volumetric: the law's energy of stage 3 */
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r, stab = m->s_stab[s];
-            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, lever[3 * FRM_MAX_NEIGHBORS], v = m->s_volume[s];
-            frm_real offset[3 * FRM_MAX_NEIGHBORS], sT[9 * FRM_MAX_NEIGHBORS], stq[3 * FRM_MAX_NEIGHBORS];
-            frm_sample_deformation(n, m->p_frame + b, m->p_weight + b, m->p_grad + 3 * b, m->p_rlev + 3 * b,
-                                   m->s_rest + 3 * s, m->disp, m->relm, H, lever, offset,
-                                   ctx->outputs ? m->s_pos + 3 * s : NULL);
+            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, e, r;
+            frm_real F[9], H[9], S[6], P[9], cache[FRM__LAW_CACHE_MAX], psi, D = 0, v = m->s_volume[s];
             const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
-            memcpy(F, H, sizeof F);
-            F[0] += 1; /* F = I + H */
-            F[4] += 1;
-            F[8] += 1;
+            frm_pass1_deform(w, s, H, F, ctx->outputs ? m->s_pos + 3 * s : NULL);
             if (m->vol_mode) { /* P = alpha P_bar + beta F^-T (the law ran in stage 3) */
                 frm_real Fi[9], J = 1 + m->v_jm1[s], al = 1 + m->v_am1[s], be = m->v_beta[s];
                 const frm_real *Pb = m->v_Pbar + 9 * (size_t)s;
@@ -5328,20 +5711,10 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 continue;
             }
             energy += (double)v * (double)psi; /* volumetric: 0 here, the law's energy came from stage 3 */
-            if (stab) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
-                energy += frm__stab_sample_force(m, s, H, F, P, sT, stq, ctx->linearize);
-            for (k = 0; k < n; k++)
-                frm_pair_force(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
-                               m->rel + 9 * m->p_frame[b + k], m->p_out + 6 * (size_t)(b + k));
-            if (stab)
-                for (k = 0; k < n; k++)
-                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
-            if (m->s_couple[s] != 0)
-                energy += (double)frm_sample_coupling_force(n, m->p_weight + b, lever, offset, m->s_couple[s],
-                                                            m->p_out + 6 * (size_t)b,
-                                                            ctx->linearize ? m->p_C + 3 * (size_t)b : NULL);
+            if (m->s_stab[s]) /* the rotation stabilisation: T / v joins P, the frame's own torque apart */
+                energy += frm_pass1_stab_force(w, s, H, F, P, ctx->linearize, &D);
+            frm_pass1_force_pairs(w, s, H, F, P, D, ctx->linearize, &energy);
             if (ctx->linearize) {
-                memcpy(m->p_A + 3 * (size_t)b, lever, sizeof(frm_real) * 3 * (size_t)n);
                 memcpy(m->lin_F + 9 * (size_t)s, F, sizeof F);
                 if (m->vol_mode) { /* the law's data at F_bar were stored in stage 3 */
                 } else if (ctx->linearize == 2) { /* definite: the geometric term with the positive part of S, the
@@ -5355,13 +5728,6 @@ static void frm__force_chunks(void *vctx, int begin, int end)
                 if (!m->vol_mode) {
                     memcpy(m->lin_S + 6 * (size_t)s, S, sizeof S);
                     memcpy(m->lin_cache + (size_t)m->law_cache * s, cache, sizeof(frm_real) * (size_t)m->law_cache);
-                }
-                for (k = 0; k < n; k++) {
-                    frm_real *Hs = m->p_H + 6 * (size_t)(b + k);
-                    frm_pair_linearize(v, P, m->p_grad + 3 * (b + k), m->p_weight[b + k], lever + 3 * k,
-                                       m->rel + 9 * m->p_frame[b + k], m->p_G + 9 * (size_t)(b + k), Hs);
-                    if (stab) frm_pair_stab_rotation(F, sT + 9 * k, Hs);
-                    if (m->s_couple[s] != 0) frm_pair_coupling_rotation(m->p_C + 3 * (size_t)(b + k), lever + 3 * k, Hs);
                 }
             }
         }
@@ -5388,18 +5754,7 @@ static void frm__gather_chunks(void *vctx, int begin, int end)
     for (c = begin; c < end; c++) {
         int i0 = c * FRM__FRAME_CHUNK, i1 = i0 + FRM__FRAME_CHUNK, i;
         if (i1 > m->frame_count) i1 = m->frame_count;
-        for (i = i0; i < i1; i++) {
-            double sum[6] = {0, 0, 0, 0, 0, 0}, sq = 0;
-            int e, k;
-            for (e = m->rev_start[i]; e < m->rev_start[i + 1]; e++) {
-                const frm_real *src = ctx->src + 6 * (size_t)m->rev_pair[e];
-                for (k = 0; k < 6; k++) sum[k] += (double)src[k];
-                if (ctx->scale)
-                    for (k = 0; k < 6; k++) sq += (double)src[k] * src[k];
-            }
-            for (k = 0; k < 6; k++) ctx->dst[6 * i + k] = (frm_real)sum[k];
-            if (ctx->scale) ctx->scale[i] = sq;
-        }
+        for (i = i0; i < i1; i++) frm_pass2_gather(&m->view, i, ctx->src, ctx->dst, ctx->scale);
     }
 }
 
@@ -5655,20 +6010,19 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
 {
     frm__apply_ctx *ctx = (frm__apply_ctx *)vctx;
     const frm_model *m = ctx->m;
+    const frm_view *w = &m->view;
     const frm_real *v = ctx->v;
     int c;
     for (c = begin; c < end; c++) {
         int s0 = c * FRM__SAMPLE_CHUNK, s1 = s0 + FRM__SAMPLE_CHUNK, s;
         if (s1 > m->sample_count) s1 = m->sample_count;
         for (s = s0; s < s1; s++) {
-            int b = m->s_start[s], n = m->s_start[s + 1] - b, k, r;
-            frm_real dF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, dP[9], vol = m->s_volume[s], stq[3 * FRM_MAX_NEIGHBORS];
+            frm_real dF[9], dP[9];
             if (m->vol_mode) frm__vol_sample_dP(m, s, dF, dP);
             else {
-                for (k = b; k < b + n; k++) frm_pair_dF(v + 6 * m->p_frame[k], m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, dF);
-            {
                 int law = m->s_law[s];
                 const frm_real *prm = m->s_law_params + FRM_LAW_PARAMS * (size_t)s;
+                frm_pass1_apply_dF(w, s, v, dF);
                 if (frm__laws[law].fast_path)
                     frm_sample_dP(law, prm[0], prm[1], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
                                   m->lin_S + 6 * (size_t)s, dF, dP);
@@ -5676,22 +6030,7 @@ static void frm__apply_chunks(void *vctx, int begin, int end)
                     frm__law_dP(law, prm, m->s_user[s], m->lin_cache + (size_t)m->law_cache * s, m->lin_F + 9 * (size_t)s,
                                 m->lin_S + 6 * (size_t)s, dF, dP);
             }
-            }
-            if (m->s_stab[s]) {
-                frm_real dPx[9];
-                const frm_real *dth[FRM_MAX_NEIGHBORS];
-                for (k = 0; k < n; k++) dth[k] = v + 6 * m->p_frame[b + k] + 3;
-                frm__stab_sample_apply(m, s, dF, dth, m->lin_definite, dPx, stq);
-                for (r = 0; r < 9; r++) dP[r] += dPx[r] / vol;
-            }
-            for (k = b; k < b + n; k++)
-                frm_pair_apply(vol, dP, m->p_grad + 3 * k, m->p_G + 9 * (size_t)k, m->p_out + 6 * (size_t)k);
-            if (m->s_stab[s])
-                for (k = 0; k < n; k++)
-                    for (r = 0; r < 3; r++) m->p_out[6 * (size_t)(b + k) + 3 + r] += stq[3 * k + r];
-            if (m->s_couple[s] != 0)
-                frm_sample_coupling_apply(n, m->p_frame + b, m->p_weight + b, m->p_A + 3 * (size_t)b, m->s_couple[s], v,
-                                          m->p_out + 6 * (size_t)b);
+            frm_pass1_apply_pairs(w, s, v, dF, dP, m->lin_definite);
         }
     }
 }
@@ -5762,12 +6101,7 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
         if (m->vol_mode) frm__vol_apply_stages(m, v);
         frm__run(m, m->sample_chunks, frm__apply_chunks, &a);
         frm__gather(m, m->p_out, out, NULL);
-        for (i = 0; i < m->frame_count; i++) { /* the frame-own rotational term (pairs' Hs + gravity) */
-            const frm_real *h = m->lin_hrot + 6 * i, *t = v + 6 * i + 3;
-            out[6 * i + 3] += h[0] * t[0] + h[5] * t[1] + h[4] * t[2];
-            out[6 * i + 4] += h[5] * t[0] + h[1] * t[1] + h[3] * t[2];
-            out[6 * i + 5] += h[4] * t[0] + h[3] * t[1] + h[2] * t[2];
-        }
+        for (i = 0; i < m->frame_count; i++) frm_pass2_rotational(&m->view, i, v, out); /* pairs' Hs + gravity */
     }
     if (m->anchor_probe) frm__anchor_product(m, v, out);
     if (exact)
@@ -7786,6 +8120,19 @@ FRMDEF int frm_model_mass_block(const frm_model *m, int i, frm_real out[36])
 
 FRMDEF size_t frm_model_memory_bytes(const frm_model *m) { return m ? m->block_bytes : 0; }
 FRMDEF int frm_model_stabilized_frames(const frm_model *m) { return m ? m->stab_frames : 0; }
+FRMDEF int frm_model_view(const frm_model *m, frm_view *out)
+{
+    int r;
+    if (!m || !out) return FRM_ERR_ARG;
+    *out = m->view;
+    for (r = 0; r < 3; r++) out->gravity[r] = m->gravity[r]; /* the settings as they are now */
+    out->time_step = m->time_step;
+    out->mass_damping = m->mass_damping;
+    out->stiffness_damping = m->stiffness_damping;
+    out->cg_tolerance = m->cg_tolerance;
+    out->cg_max_iterations = m->cg_max_iterations;
+    return FRM_OK;
+}
 
 /* >>stiffness-api ---------------------------------------------------------------------- */
 

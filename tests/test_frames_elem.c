@@ -83,7 +83,7 @@ static void test_float_renames(void)
         NAME(frm_model_velocities), NAME(frm_model_set_poses), NAME(frm_model_set_velocities),
         NAME(frm_model_sample_positions), NAME(frm_model_deformation_gradients), NAME(frm_model_forces),
         NAME(frm_model_total_forces), NAME(frm_model_energy), NAME(frm_model_last_stats), NAME(frm_model_mass_block),
-        NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_prepare_stiffness),
+        NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_view), NAME(frm_model_prepare_stiffness),
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
         NAME(frm_model_set_damping), NAME(frm_model_set_integrator), NAME(frm_model_displacements), NAME(frm_model_rest_positions),
@@ -630,6 +630,69 @@ static int tet_beam(frm_sampling *s, frm_model **m, int k, double gamma)
     for (i = 0; i < s->frame_count; i++)
         if (s->frame_positions[3 * i] == 0) frm_model_fix_frame(*m, i);
     return 0;
+}
+
+/* Issue 16: the public view and pass functions are a backend of their own. A serial loop
+   in this test over frm_model_view's arrays (frm_pass1_deform, the kernels' law, the
+   stabilisation, frm_pass1_force_pairs, frm_pass2_gather; frm_pass1_apply_dF, frm_sample_dP,
+   frm_pass1_apply_pairs, frm_pass2_gather and _rotational) gives the model's own forces and
+   K v bit for bit (the same expressions in the same order: exact equality is the claim),
+   on the tetrahedral R3 beam one cell across (frames with unseen rotations: both kinds of
+   stabilisation pairs) in a deformed state, the default law. */
+static void test_view_passes(void)
+{
+    frm_sampling s;
+    frm_model *m = NULL;
+    frm_view w;
+    const frm_real *f;
+    frm_real g[3] = {0, 3, -200}, *buf, *v, *kv, *mine;
+    int i, k, n, same_f = 1, same_kv = 1;
+    REQUIRE(tet_beam(&s, &m, 1, 4) == 0);
+    frm_sampling_free(&s);
+    CHECK_INT(0, frm_model_set_stiffness_mode(m, FRM_STIFFNESS_PAIRS));
+    CHECK_INT(FRM_ERR_ARG, frm_model_view(m, NULL));
+    CHECK_INT(0, frm_model_view(m, &w));
+    CHECK_INT(frm_model_frame_count(m), w.frame_count);
+    CHECK_INT(frm_model_pair_count(m), w.pair_count);
+    CHECK(frm_model_stabilized_frames(m) > 0);
+    frm_model_set_gravity(m, g);
+    for (i = 0; i < 3; i++) CHECK_INT(0, frm_model_step(m));
+    n = 6 * w.frame_count;
+    buf = alloc_reals(3 * n);
+    v = buf, kv = buf + n, mine = buf + 2 * n;
+    CHECK_INT(0, frm_model_forces(m, &f));
+    for (i = 0; i < w.sample_count; i++) { /* pass 1 of the force, as frames_cuda.cu runs it */
+        frm_real H[9], F[9], S[6], P[9], cache[FRM_LAW_CACHE], psi, D = 0;
+        const frm_real *prm = w.s_law_params + FRM_LAW_PARAMS * (size_t)i;
+        double e = 0;
+        frm_pass1_deform(&w, i, H, F, NULL);
+        REQUIRE(frm_material_stress(w.s_law[i], prm[0], prm[1], H, S, &psi, cache) == 0);
+        frm_first_piola(F, S, P);
+        if (w.s_stab[i]) e += frm_pass1_stab_force(&w, i, H, F, P, 0, &D);
+        frm_pass1_force_pairs(&w, i, H, F, P, D, 0, &e);
+    }
+    for (i = 0; i < w.frame_count; i++) frm_pass2_gather(&w, i, w.p_out, mine, NULL);
+    for (k = 0; k < n; k++) same_f &= mine[k] == f[k];
+    CHECK(same_f);
+    for (k = 0; k < n; k++) v[k] = (frm_real)(1e-3 * ((k * 37) % 11 - 5));
+    CHECK_INT(0, frm_model_prepare_stiffness(m));
+    CHECK_INT(0, frm_model_apply_stiffness(m, v, kv, 1));
+    for (i = 0; i < w.sample_count; i++) {
+        frm_real dF[9], dP[9];
+        const frm_real *prm = w.s_law_params + FRM_LAW_PARAMS * (size_t)i;
+        frm_pass1_apply_dF(&w, i, v, dF);
+        frm_sample_dP(w.s_law[i], prm[0], prm[1], w.lin_cache + (size_t)w.law_cache * i, w.lin_F + 9 * (size_t)i,
+                      w.lin_S + 6 * (size_t)i, dF, dP);
+        frm_pass1_apply_pairs(&w, i, v, dF, dP, 0);
+    }
+    for (i = 0; i < w.frame_count; i++) {
+        frm_pass2_gather(&w, i, w.p_out, mine, NULL);
+        frm_pass2_rotational(&w, i, v, mine);
+    }
+    for (k = 0; k < n; k++) same_kv &= mine[k] == kv[k];
+    CHECK(same_kv);
+    free(buf);
+    frm_model_destroy(m);
 }
 
 /* Modes below `limit` Hz (not counting those at or below zero: none on a clamped beam)
@@ -2382,6 +2445,7 @@ static void test_vol_poisson_beam(void)
 static const test_case cases[] = {
     TEST(test_garbage_descriptions),
     TEST(test_float_renames),
+    TEST(test_view_passes),
     TEST(test_shape_refusals),
     TEST(test_svk_mirrored_compression),
     TEST(test_svk_mirrored_step),
