@@ -11,16 +11,19 @@
 # The matrix: gcc -std=c99, g++ (the same test sources compiled as C++) and clang -std=c99,
 # each in double and in float; gcc with -fopenmp run with OMP_NUM_THREADS=2; gcc under
 # AddressSanitizer + UndefinedBehaviorSanitizer. All with -Wall -Wextra -pedantic -Werror.
-# Compiling the headers dominates the time of `make test` (about 5 s per program and
+# Compiling the headers dominates the time of `make test` (about 4 to 6 s per program and
 # configuration), so: gcc in double and the OpenMP build compile at -O2 (the optimiser's
 # warnings, the speed the library ships at), the other configurations at -O1 (the same
 # warnings and assertions, about 40 % less compile time); the full-size convergence studies
-# run with gcc (double, float, OpenMP), while g++, clang and the sanitizer build run every
-# assertion on the reduced sizes of TEST_QUICK (tests/test.h); the OpenMP build runs only
-# the programs whose headers have parallel loops; the sanitizer build skips the two
+# run with gcc (double, float), while clang float and the sanitizer build run every
+# assertion on the reduced sizes of TEST_QUICK (tests/test.h); g++ (double, float) and clang
+# double build one program per header plus the compile-only programs (each header alone and
+# all three together compile in every configuration); the OpenMP build runs, on the reduced
+# sizes, the programs whose headers have parallel loops; the sanitizer build skips the two
 # compile-only programs (their code is the same headers the other programs exercise) and
 # keeps line tables only (-g1: its reports still name file and line; full -g tripled the
-# sanitizer build's compile time, 45 s for test_frames alone); test_compile_all (the three
+# sanitizer build's compile time, 45 s for test_frames alone) at -Og (test_frames: 12 s to
+# compile and 34 s to run, against 23 s and 35 s at -O1, 8.5 s and 73 s at -O0); test_compile_all (the three
 # headers in one translation unit) runs in gcc double, g++ double and clang float, and
 # test_compile_static (the same with *_STATIC) in gcc float, g++ float and clang double.
 # Each PASS line in build/<configuration>/<program>.log gives the case's CPU time.
@@ -33,27 +36,24 @@ HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/tes
            tests/fixtures.h
 FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
 
-CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double \
-           simd-double simd-float
+CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
 
-CC_gcc-double   := gcc -std=c99 -O2
-CC_gcc-float    := gcc -std=c99 -O1 $(FLOAT)
+# gcc builds for this machine (-march=native): the headers' vector paths (intrinsics and
+# vector extensions behind compile-time checks of the target, issues 15 and 21) exist only
+# when the target has them, so gcc double, gcc float and the OpenMP build run them (heml's
+# test_vector_paths_match_scalar compares them with the scalar path bit for bit; the
+# OpenMP build's thread-count determinism and allocation tests run them with 2 threads),
+# while g++, clang and the sanitizer build (generic x86-64) run the portable scalar code.
+# ISO C mode keeps -ffp-contract=off: no fused multiply-adds appear from -march alone.
+CC_gcc-double   := gcc -std=c99 -O2 -march=native
+CC_gcc-float    := gcc -std=c99 -O1 -march=native $(FLOAT)
 CC_gxx-double   := g++ -std=c++11 -O1 -x c++ -DTEST_QUICK
 CC_gxx-float    := g++ -std=c++11 -O1 -x c++ $(FLOAT) -DTEST_QUICK
 CC_clang-double := clang -std=c99 -O1 -DTEST_QUICK
 CC_clang-float  := clang -std=c99 -O1 $(FLOAT) -DTEST_QUICK
-CC_omp-double   := gcc -std=c99 -O2 -fopenmp
-CC_asan-double  := gcc -std=c99 -O1 -g1 -fno-omit-frame-pointer -fsanitize=address,undefined \
+CC_omp-double   := gcc -std=c99 -O2 -march=native -fopenmp -DTEST_QUICK
+CC_asan-double  := gcc -std=c99 -Og -g1 -fno-omit-frame-pointer -fsanitize=address,undefined \
                    -fno-sanitize-recover=all -DTEST_QUICK
-# The headers' vector paths (intrinsics behind compile-time checks of the target, issue 21)
-# exist only when the target has them: these two build for this machine (-march=native;
-# on a machine without AVX they test the scalar path again) and run the programs of the
-# headers that have such paths (heml.h: test_heml, whose test_vector_paths_match_scalar
-# compares them with the scalar path bit for bit; in double also test_heml_sim, whose
-# thread-count determinism and allocation tests then run the vector paths), on the
-# TEST_QUICK sizes, double with 2 OpenMP threads.
-CC_simd-double  := gcc -std=c99 -O2 -march=native -fopenmp -DTEST_QUICK
-CC_simd-float   := gcc -std=c99 -O2 -march=native $(FLOAT) -DTEST_QUICK
 
 # Passive waiting: libgomp's idle threads otherwise spin (about 300,000 polls, 0.1 to 1 ms)
 # at every barrier before they sleep. On a machine whose other core is busy the spinning
@@ -61,7 +61,6 @@ CC_simd-float   := gcc -std=c99 -O2 -march=native $(FLOAT) -DTEST_QUICK
 # thread, 141 s on 2, 1.3 s on 2 passive (issue 18), and `make test` 37 minutes instead of
 # 4. Passive: idle threads sleep at once; the tests check results, not speed.
 ENV_omp-double := OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive
-ENV_simd-double := OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive
 
 TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 COMPILE_ONLY := test_compile_all test_compile_static
@@ -69,16 +68,20 @@ COMPILE_ONLY := test_compile_all test_compile_static
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
 TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
-TESTS_simd-double := test_heml test_heml_sim
-TESTS_simd-float := test_heml
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
 # part of its own test programs)
 TESTS_gcc-float := $(filter-out test_compile_all,$(TESTS))
-TESTS_gxx-float := $(filter-out test_compile_all,$(TESTS))
-TESTS_clang-double := $(filter-out test_compile_all,$(TESTS))
 TESTS_gcc-double := $(filter-out test_compile_static,$(TESTS))
-TESTS_gxx-double := $(filter-out test_compile_static,$(TESTS))
+# g++ (double and float) and clang in double build one program per header (each header
+# alone, with its implementation: the compile check of that combination) and the compile
+# programs; every assertion runs under gcc (double, float), clang float and the sanitizers
+# (compiling a program costs about 4 s of CPU per configuration: the whole matrix of every
+# program took make test to 8 minutes on two idle cores after issues 13-16 and 21)
+PER_HEADER := test_tensormass_qs test_heml_time test_frames_chain
+TESTS_gxx-double := $(PER_HEADER) test_compile_all
+TESTS_gxx-float := $(PER_HEADER) test_compile_static
+TESTS_clang-double := $(PER_HEADER) test_compile_static
 TESTS_clang-float := $(filter-out test_compile_static,$(TESTS))
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a

@@ -9468,8 +9468,8 @@ FRMDEF int frm_parts_combine(frm_assembly *out, const frm_part *parts, int part_
     long long samples = 0, pairs = 0, cells = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, size = 0, tol;
     int k, i, j, r, s0 = 0, p0 = 0, c0 = 0, err = FRM_OK, first = 1, pass, all_cells = 1;
-    int *given;
-    unsigned char *rigid;
+    int *given = NULL;
+    unsigned char *rigid = NULL;
     frm_allocator al;
     frm__carver c;
     if (!out) return FRM_ERR_ARG;
