@@ -15,11 +15,11 @@
 # configuration), so: gcc in double and the OpenMP build compile at -O2 (the optimiser's
 # warnings, the speed the library ships at), the other configurations at -O1 (the same
 # warnings and assertions, about 40 % less compile time); the full-size convergence studies
-# run with gcc (double, float), while clang float and the sanitizer build run every
-# assertion on the reduced sizes of TEST_QUICK (tests/test.h); g++ (double, float) and clang
-# double build one program per header plus the compile-only programs (each header alone and
+# run with gcc (double, float), while the sanitizer build runs every assertion on the
+# reduced sizes of TEST_QUICK (tests/test.h); g++ and clang (double, float) build one
+# program per header plus the compile-only programs (each header alone and
 # all three together compile in every configuration); the OpenMP build runs, on the reduced
-# sizes, the programs whose headers have parallel loops; the sanitizer build skips the two
+# sizes, the programs with the three headers' thread-count determinism tests; the sanitizer build skips the two
 # compile-only programs (their code is the same headers the other programs exercise) and
 # keeps line tables only (-g1: its reports still name file and line; full -g tripled the
 # sanitizer build's compile time, 45 s for test_frames alone) at -Og (test_frames: 12 s to
@@ -66,23 +66,23 @@ TESTS := $(basename $(notdir $(wildcard tests/test_*.c)))
 COMPILE_ONLY := test_compile_all test_compile_static
 # the programs each configuration builds and runs (all of them unless listed here)
 $(foreach c,$(CONFIGS),$(eval TESTS_$(c) := $(TESTS)))
-TESTS_omp-double := test_frames test_heml test_heml_sim test_heml_solve test_heml_time test_tensormass test_tensormass_qs
+TESTS_omp-double := test_frames test_heml test_heml_sim test_tensormass
 TESTS_asan-double := $(filter-out $(COMPILE_ONLY),$(TESTS))
 # each compile-only program in three configurations that together cover C and C++, gcc and
 # clang, double and float (every header also compiles alone in every configuration, as
 # part of its own test programs)
 TESTS_gcc-float := $(filter-out test_compile_all,$(TESTS))
 TESTS_gcc-double := $(filter-out test_compile_static,$(TESTS))
-# g++ (double and float) and clang in double build one program per header (each header
+# g++ and clang (double and float) build one program per header (each header
 # alone, with its implementation: the compile check of that combination) and the compile
-# programs; every assertion runs under gcc (double, float), clang float and the sanitizers
+# programs; every assertion runs under gcc (double, float) and the sanitizers
 # (compiling a program costs about 4 s of CPU per configuration: the whole matrix of every
 # program took make test to 8 minutes on two idle cores after issues 13-16 and 21)
 PER_HEADER := test_tensormass_qs test_heml_time test_frames_chain
 TESTS_gxx-double := $(PER_HEADER) test_compile_all
 TESTS_gxx-float := $(PER_HEADER) test_compile_static
 TESTS_clang-double := $(PER_HEADER) test_compile_static
-TESTS_clang-float := $(filter-out test_compile_static,$(TESTS))
+TESTS_clang-float := $(PER_HEADER) test_compile_all
 EXAMPLES := $(basename $(notdir $(wildcard examples/*.c)))
 # the examples' argument and write-error behaviour (tests/test_examples.sh), counted like a
 # test program of a configuration named "examples"
