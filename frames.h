@@ -3489,6 +3489,41 @@ FRM_HOSTDEV static inline void frm_pass2_gather(const frm_view *w, int i, const 
     if (scale) scale[i] = sq;
 }
 
+/* One frame's world mass data from its rest-axes data ml (m, cbar, Jbar: 10 numbers) and
+   its rotation R: m, c = R cbar, J = R Jbar R^T (symmetrised). frm__mass_update and the
+   CUDA companion call it. */
+FRM_HOSTDEV static inline void frm_pass_mass_world(const double *ml, const frm_real *R, frm_real *mw)
+{
+    double J[9], RJ[9], W[9];
+    int r, k, l;
+    J[0] = ml[4];
+    J[4] = ml[5];
+    J[8] = ml[6];
+    J[5] = J[7] = ml[7];
+    J[2] = J[6] = ml[8];
+    J[1] = J[3] = ml[9];
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) {
+            double t = 0;
+            for (l = 0; l < 3; l++) t += (double)R[3 * r + l] * J[3 * l + k];
+            RJ[3 * r + k] = t;
+        }
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) {
+            double t = 0;
+            for (l = 0; l < 3; l++) t += RJ[3 * r + l] * (double)R[3 * k + l];
+            W[3 * r + k] = t;
+        }
+    mw[0] = (frm_real)ml[0];
+    for (r = 0; r < 3; r++) mw[1 + r] = (frm_real)(R[3 * r] * ml[1] + R[3 * r + 1] * ml[2] + R[3 * r + 2] * ml[3]);
+    mw[4] = (frm_real)W[0];
+    mw[5] = (frm_real)W[4];
+    mw[6] = (frm_real)W[8];
+    mw[7] = (frm_real)(0.5 * (W[5] + W[7]));
+    mw[8] = (frm_real)(0.5 * (W[2] + W[6]));
+    mw[9] = (frm_real)(0.5 * (W[1] + W[3]));
+}
+
 /* Pass 2 of K v (pair mode), after the gather: the frame-own rotational term of frame i
    (the pairs' Hs and gravity, lin_hrot) applied to v's rotation, added to out (6 per frame). */
 FRM_HOSTDEV static inline void frm_pass2_rotational(const frm_view *w, int i, const frm_real *v, frm_real *out)
@@ -6326,42 +6361,13 @@ static void frm__prepare_mode(frm_model *m, int mode)
     if (m->anchor_probe) frm__anchor_diagonal(m);
 }
 
-/* World mass data (m, c = R cbar, J = R Jbar R^T) of every frame at its current pose. */
+/* World mass data (m, c = R cbar, J = R Jbar R^T) of every frame at its current pose
+   (frm_pass_mass_world, shared with the CUDA companion). */
 static void frm__mass_update(frm_model *m)
 {
-    int i, r, k, l;
-    for (i = 0; i < m->frame_count; i++) {
-        const double *ml = m->mass_local + 10 * (size_t)i;
-        const frm_real *R = m->rot + 9 * i;
-        frm_real *mw = m->mass_world + 10 * (size_t)i;
-        double J[9], RJ[9], W[9];
-        J[0] = ml[4];
-        J[4] = ml[5];
-        J[8] = ml[6];
-        J[5] = J[7] = ml[7];
-        J[2] = J[6] = ml[8];
-        J[1] = J[3] = ml[9];
-        for (r = 0; r < 3; r++)
-            for (k = 0; k < 3; k++) {
-                double t = 0;
-                for (l = 0; l < 3; l++) t += (double)R[3 * r + l] * J[3 * l + k];
-                RJ[3 * r + k] = t;
-            }
-        for (r = 0; r < 3; r++)
-            for (k = 0; k < 3; k++) {
-                double t = 0;
-                for (l = 0; l < 3; l++) t += RJ[3 * r + l] * (double)R[3 * k + l];
-                W[3 * r + k] = t;
-            }
-        mw[0] = (frm_real)ml[0];
-        for (r = 0; r < 3; r++) mw[1 + r] = (frm_real)(R[3 * r] * ml[1] + R[3 * r + 1] * ml[2] + R[3 * r + 2] * ml[3]);
-        mw[4] = (frm_real)W[0];
-        mw[5] = (frm_real)W[4];
-        mw[6] = (frm_real)W[8];
-        mw[7] = (frm_real)(0.5 * (W[5] + W[7]));
-        mw[8] = (frm_real)(0.5 * (W[2] + W[6]));
-        mw[9] = (frm_real)(0.5 * (W[1] + W[3]));
-    }
+    int i;
+    for (i = 0; i < m->frame_count; i++)
+        frm_pass_mass_world(m->mass_local + 10 * (size_t)i, m->rot + 9 * i, m->mass_world + 10 * (size_t)i);
 }
 
 /* The 6x6 mass block of frame i from mass_world: [m I, -[c]x; [c]x, J]. */

@@ -76,42 +76,6 @@ __global__ static void fcu_update_frames(frm_view w, frm_real *rot, frm_real *re
     frm_frame_rotations(w.quat + 4 * i, w.rest_quat + 4 * i, rot + 9 * i, rel + 9 * i, relm + 9 * i);
 }
 
-/* frm__mass_update for frame i. */
-__device__ static void fcu_mass_update(const frm_view *w, int i, const frm_real *rot, frm_real *mass_world)
-{
-    const double *ml = w->mass_local + 10 * (size_t)i;
-    const frm_real *R = rot + 9 * i;
-    frm_real *mw = mass_world + 10 * (size_t)i;
-    double J[9], RJ[9], W[9];
-    int r, k, l;
-    J[0] = ml[4];
-    J[4] = ml[5];
-    J[8] = ml[6];
-    J[5] = J[7] = ml[7];
-    J[2] = J[6] = ml[8];
-    J[1] = J[3] = ml[9];
-    for (r = 0; r < 3; r++)
-        for (k = 0; k < 3; k++) {
-            double t = 0;
-            for (l = 0; l < 3; l++) t += (double)R[3 * r + l] * J[3 * l + k];
-            RJ[3 * r + k] = t;
-        }
-    for (r = 0; r < 3; r++)
-        for (k = 0; k < 3; k++) {
-            double t = 0;
-            for (l = 0; l < 3; l++) t += RJ[3 * r + l] * (double)R[3 * k + l];
-            W[3 * r + k] = t;
-        }
-    mw[0] = (frm_real)ml[0];
-    for (r = 0; r < 3; r++) mw[1 + r] = (frm_real)(R[3 * r] * ml[1] + R[3 * r + 1] * ml[2] + R[3 * r + 2] * ml[3]);
-    mw[4] = (frm_real)W[0];
-    mw[5] = (frm_real)W[4];
-    mw[6] = (frm_real)W[8];
-    mw[7] = (frm_real)(0.5 * (W[5] + W[7]));
-    mw[8] = (frm_real)(0.5 * (W[2] + W[6]));
-    mw[9] = (frm_real)(0.5 * (W[1] + W[3]));
-}
-
 /* frm__mass_matrix. */
 __device__ static void fcu_mass_matrix(const frm_real *w, double M[36])
 {
@@ -302,7 +266,7 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
         K[22] += Hr[5];
         K[27] += Hr[5];
     }
-    fcu_mass_update(&w, i, rot, mass_world);
+    frm_pass_mass_world(w.mass_local + 10 * (size_t)i, rot + 9 * i, mass_world + 10 * (size_t)i);
     mg = (frm_real)w.grav_local[4 * (size_t)i];
     for (r = 0; r < 3; r++) { /* frm__total_force */
         total[6 * i + r] = force[6 * i + r] + mg * w.gravity[r] + w.ext[6 * i + r];
