@@ -4270,8 +4270,12 @@ static void heml__nodal_weights(heml_model *m, const heml_desc *d, double *acc)
    stiffness of the rest state on the free degrees of freedom (assembled from 3x3 node
    blocks, dense, Cholesky-factored in double; a mode that pins make singular is dropped).
    Slender bodies bend as their aggregates rotate, which is what Jacobi alone resolves
-   slowest: on the steel cantilever R1 it cuts the CG iterations by about ten. A_c is
-   rebuilt when the pinned axes change. */
+   slowest: on the steel cantilever R1 it cuts the CG iterations by about ten. The anchors
+   (heml_set_anchors) add P^T k P on their nodes: a body held only by anchors keeps its
+   rigid modes in the coarse space (without them those modes were singular and dropped:
+   the glued R1 half of tests/test_frames_coupling.c took about 900 CG iterations a
+   Newton solve instead of 120). A_c is rebuilt when the pinned axes change and after
+   heml_set_anchors. */
 #define HEML__MAX_AGG 64
 #define HEML__MIN_AGG_NODES 24 /* nodes per aggregate at least (fewer aggregates otherwise) */
 
@@ -4399,6 +4403,13 @@ static void heml__coarse_build(heml_model *m)
                     }
             }
         }
+    }
+    for (i = 0; i < m->anchor_count; i++) { /* the anchors' k I on their nodes: P^T k P */
+        double P[3][6], ka = (double)m->anchor_k[i];
+        double *blockp = Ac + (size_t)(6 * m->node_agg[m->anchor_nodes[i]]) * D + 6 * m->node_agg[m->anchor_nodes[i]];
+        heml__node_modes(m, m->anchor_nodes[i], P);
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) blockp[(size_t)a * D + b] += ka * (P[0][a] * P[0][b] + P[1][a] * P[1][b] + P[2][a] * P[2][b]);
     }
     for (i = 0; i < D; i++) dg[i] = Ac[(size_t)i * D + i];
     for (k = 0; k < D; k++) {
@@ -5860,6 +5871,7 @@ HEMLDEF int heml_set_anchors(heml_model *m, int count, const int *nodes, const h
     m->anchor_nodes = count ? nodes : NULL;
     m->anchor_k = count ? stiffness : NULL;
     m->anchor_target = count ? targets : NULL;
+    m->coarse_version = m->pin_version - 1; /* the coarse space holds the anchors' k */
     return HEML_OK;
 }
 
