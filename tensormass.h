@@ -54,7 +54,7 @@
        TMASS_REAL      float or double (default double). Creation computes the tensors in
                        double and stores them in TMASS_REAL. In float builds every public
                        function is renamed (tmass_step -> tmass_step_f32, and so on for all
-                       82), so mixing float and double translation units fails at link
+                       84), so mixing float and double translation units fails at link
                        time, not at run time (a test lists them all).
        TMASS_MALLOC(size, user) / TMASS_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
@@ -66,7 +66,8 @@
        2. tmass_create(&d, &m) validates everything and allocates all memory once.
        3. Boundary conditions: tmass_fix_node (pinned where it is), tmass_set_displacement
           (pinned at rest + u, e.g. driven by a tool), tmass_release_node, gravity,
-          tmass_set_external_force.
+          tmass_set_external_force, tmass_set_anchors (springs to targets: gluing to
+          another model, see ANCHORS).
        4. tmass_step(m) (desc integrator and time step) or tmass_step_ex(m, dt, integrator);
           tmass_solve_static(m) for the equilibrium.
        5. Read tmass_positions / tmass_velocities / tmass_displacements /
@@ -397,6 +398,42 @@
    reported through desc.log). Cutting and tearing apply to the dynamic part; connection
    nodes left without a dynamic tetrahedron stop coupling.
 
+   ANCHORS (tmass_set_anchors, issue 14; the same hook, arguments and semantics as
+       heml_set_anchors and frm_model_set_anchors): zero-length springs from chosen nodes to
+       target points, energy sum_a k_a / 2 |x_a - t_a|^2, part of the model from the call
+       on: forces (-k (x - t), formed in double as (rest - t) + u), the stiffness (k I on
+       the node: in every K product, so tmass_apply_stiffness, the CG products, the Jacobi
+       diagonal and the modal analysis include it), every integrator (explicit ones through
+       the force; implicit Euler, its linearised form and BDF2 through force and
+       operator; the springs' Newton through residual, tangent and incremental potential),
+       the static solves (the springs' saddle check too); tmass_energy's elastic part
+       includes them. They belong to K, so stiffness damping (beta > 0) damps them like
+       the rest of K (force -beta k v: frames.h's Rayleigh damping does the same; heml.h
+       has none); a glued node's damping then acts on its absolute velocity, so keep beta
+       small in glued scenes. The arrays are the caller's (kept by pointer, read at every
+       evaluation). Off by default: without the call every result is bit-identical. One
+       serial loop over the anchors per pass (in order: deterministic), no allocation.
+       They are the hook for gluing a mesh to another model without either header
+       including the other: the targets are the other model's points (frames.h: mapped
+       points of a probe), updated between solves, and the springs' stiffness is inside
+       each implicit and static solve (frames.h COUPLING; tests/test_frames_coupling.c
+       glues a tensormass.h half of R1 to a frames half: 6 coupling iterations, tip +0.10 %
+       of Timoshenko, float -0.09 %; examples/glue.h itself holds a heml.h mesh and shows
+       the full scheme). The precomputed quasi-static model refuses an anchored model
+       (tmass_qs_create, tmass_qs_load: TMASS_ERR_ANCHORED): its compliance C = K^-1 and
+       preload are fixed at creation, while the anchors' targets move with the other model
+       (a moving target is a load on the anchored node, k (t - X), which the precomputed
+       preload cannot follow unless every anchored node were a contact node, and k would
+       change C). A hybrid model's precomputed part is made inside tmass_hybrid_create and
+       never sees anchors; its dynamic part (tmass_hybrid_dynamic_part) is a model like any
+       and takes them in its steps and static solve (not tested). Tested
+       (tests/test_tensormass.c): force = -grad energy and K d = -df by central
+       differences with anchors on both kinds (below 1e-10 relative in double, 3e-6 float); a bar
+       held only by anchors of k = 1e4 E h at one end equals the clamped bar statically
+       (tip 3.1e-7 m off against a bound of 7.2e-7 m from k and the reactions) and through
+       20 implicit steps of each implicit integrator; every integrator keeps the anchored
+       equilibrium; bad input refused; no allocation in steps.
+
    PERFORMANCE: a force evaluation is one pass over the live edges. Per edge it reads two
    int node indices and one 3x3 tensor (8 + 72 = 80 bytes in double, 8 + 36 = 44 in
    float) and the displacements of both ends, and updates the forces of both ends; per
@@ -484,6 +521,10 @@
          with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       unreleased (issue 14) tmass_set_anchors (springs from nodes to caller-owned targets,
+             as heml.h and frames.h), tmass_apply_stiffness (the public K v),
+             TMASS_ERR_ANCHORED (the quasi-static precomputation of an anchored model).
+             Results without anchors bit-identical.
        unreleased (issue 19) TMASS_BDF2 (second-order implicit, the implicit Euler
              minimisation reused); the model block grows by 2 vectors of 3n reals (BDF2's
              history, 48 bytes per node in double). Modal analysis (tmass_modal_*), point

@@ -37,6 +37,7 @@ typedef struct glue {
     frm_probe *p;
     int n, iterations; /* glued nodes; the last solve's iterations */
     int robin_frames;  /* 0: the mesh carries the springs, 1: the frames (glue_map) */
+    int springs_on;    /* the side that last carried them: 0 none yet, 1 the mesh, 2 the frames */
     int depth;         /* Anderson mixing's depth (<= GLUE_DEPTH; 0: plain iteration) */
     double gz;         /* gravity along z, m/s^2 (the staggered scheme's weight of the glued nodes) */
     double mesh_seconds, frames_seconds; /* CPU time in each model's solves (clock), summed */
@@ -102,10 +103,13 @@ static inline int glue_map(glue *gl, double dt, const double *x, double *g)
         heml_set_velocities(gl->h, gl->hv);
     }
     if (!gl->robin_frames) {
-        static const heml_real zero[3] = {0, 0, 0};
-        if ((err = frm_model_set_anchors(gl->f, NULL, NULL, NULL)) != 0) return err;
-        for (i = 0; i < gl->n; i++)
-            if ((err = heml_set_external_force(gl->h, gl->nodes[i], zero)) != 0) return 1000 + err;
+        if (gl->springs_on == 2) { /* they were on the frames: remove them and their forces */
+            static const heml_real zero[3] = {0, 0, 0};
+            if ((err = frm_model_set_anchors(gl->f, NULL, NULL, NULL)) != 0) return err;
+            for (i = 0; i < gl->n; i++)
+                if ((err = heml_set_external_force(gl->h, gl->nodes[i], zero)) != 0) return 1000 + err;
+        }
+        gl->springs_on = 1;
         for (i = 0; i < 3 * gl->n; i++) gl->ht[i] = (heml_real)x[i];
         if ((err = heml_set_anchors(gl->h, gl->n, gl->nodes, gl->hk, gl->ht)) != 0) return 1000 + err;
         t0 = clock();
@@ -129,8 +133,11 @@ static inline int glue_map(glue *gl, double dt, const double *x, double *g)
         for (i = 0; i < 3 * gl->n; i++) g[i] = (double)gl->mp[i];
         return 0;
     }
-    if ((err = heml_set_anchors(gl->h, 0, NULL, NULL, NULL)) != 0) return 1000 + err;
-    frm_model_clear_external(gl->f);
+    if (gl->springs_on == 1) { /* they were on the mesh: remove them and their loads */
+        if ((err = heml_set_anchors(gl->h, 0, NULL, NULL, NULL)) != 0) return 1000 + err;
+        frm_model_clear_external(gl->f);
+    }
+    gl->springs_on = 2;
     for (i = 0; i < 3 * gl->n; i++) gl->ft[i] = (frm_real)x[i];
     if (dt > 0) {
         frm_model_set_poses(gl->f, gl->fp, gl->fq);
