@@ -1265,9 +1265,11 @@ static void cook_smooth(const tetmesh *mesh, const double *p, double *out)
    difference between the computed nodal pressure and the model's own (nod_p, internal; 0
    without nodal pressure) over the pressure's standard deviation, [4] the indicator of the
    P1 element pressures U'(J_e) averaged to the nodes, [5] of the displacement u_y (an
-   hourglass pattern would show there) */
+   hourglass pattern would show there), [6] of the nodal pressure smoothed three times;
+   with smoothed (2 (N + 1)^2 values), that thrice-smoothed pressure (NAN on the nodes
+   nearer the clamped edge) */
 static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *krylov, double *jump,
-                   double checker[6])
+                   double checker[7], double *smoothed)
 {
     tetmesh mesh;
     heml_desc d = heml_default_desc();
@@ -1348,6 +1350,10 @@ static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *kr
         checker[2] = checkerboard(&mesh, ps);
         for (i = 0; i < mesh.node_count; i++) ps[i] = (double)heml_displacements(m)[3 * i + 1];
         checker[5] = checkerboard(&mesh, ps);
+        cook_smooth(&mesh, pe, ps);
+        cook_smooth(&mesh, ps, pe);
+        checker[6] = checkerboard(&mesh, pe);
+        for (i = 0; smoothed && i < mesh.node_count; i++) smoothed[i] = mesh.nodes[3 * i] >= 8 ? pe[i] : NAN;
         checker[3] = 0;
         if (nodal && m->nod_p) {
             double mean = 0, var = 0;
@@ -1395,22 +1401,40 @@ static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *kr
        plain P1 (option off), nodal J_a     1.17 1.21 1.22 (five)   0.51 0.58 0.67 (six)
        the same smoothed once               0.64 0.85 0.82 (five)   0.27 0.24 0.27 (six)
        displacement u_y, option on          about the floor (no hourglass in u)
-   So the issue's requirement does NOT hold: the average nodal pressure tetrahedron's
-   pressure is checkerboarded (P1 displacements with nodal pressures do not satisfy the
-   inf-sup condition), at every N and for both splits, and one pass of element averaging
-   (p_e, what the README suggested reading) does not remove it; the static tolerance is
-   not the cause (1e-10 instead of 1e-9 changed no figure). Averaging the two planes of
-   this one-cell-thick slab, z = 0 and 1, lowers the five-tetrahedron indicator to 0.38,
-   0.25, 0.21 (part of its pattern is through the thickness), not the six's (0.80, 0.85,
-   0.81). The checks below assert that state (LIMITS), so that a stabilised pressure
-   (e.g. a pressure projection or a stabilisation term in heml.h) turns them red: then
-   invert them to "below 2x the floor". The displacement has no hourglass pattern: its
-   indicator stays below 2.5 times the smooth field's (asserted; measured 0.15 / 0.21 at
-   N = 8 against floors 0.10 / 0.21; a weak check: u_y's spread is large, a pattern under
-   about a tenth of it would pass). */
+   So the issue's requirement does NOT hold for the raw field: the average nodal pressure
+   tetrahedron's pressure is checkerboarded (P1 displacements with nodal pressures do not
+   satisfy the inf-sup condition), at every N and for both splits, and one pass of element
+   averaging (p_e) does not remove it; the static tolerance is not the cause (1e-10
+   instead of 1e-9 changed no figure). Averaging the two planes of this one-cell-thick
+   slab, z = 0 and 1, lowers the five-tetrahedron indicator to 0.38, 0.25, 0.21 (part of
+   its pattern is through the thickness), not the six's (0.80, 0.85, 0.81). Three passes
+   of the element-mean smoothing (cook_smooth) do: 0.31 0.17 0.058 (five), 0.31 0.13 0.039
+   (six) at N = 4, 8, 16, under 2.5 times the (unsmoothed) smooth field's floor, and the
+   two splits' thrice-smoothed pressures then converge to one field: their RMS difference
+   is 0.27, 0.23, 0.084 of its spread at N = 4, 8, 16 (the raw fields differ by 25 to 37
+   times that spread). The checks below assert that state: the raw field checkerboarded
+   (LIMITS; a stabilised pressure in heml.h would turn them red: then invert them to
+   "below 2x the floor"), the thrice-smoothed one smooth and split-independent to 0.35 of
+   its spread at N = 8. The displacement has no hourglass pattern: its indicator stays
+   below 2.5 times the smooth field's (measured 0.15 / 0.21 at N = 8 against floors
+   0.10 / 0.21; a weak check: u_y's spread is large, a pattern under about a tenth of it
+   would pass). */
+static double cook_split_difference(const double *a, const double *b, int n)
+{
+    double mean = 0, var = 0, diff = 0;
+    int i, k = 0;
+    for (i = 0; i < n; i++)
+        if (b[i] == b[i]) mean += b[i], k++;
+    mean /= k;
+    for (i = 0; i < n; i++)
+        if (b[i] == b[i]) var += (b[i] - mean) * (b[i] - mean), diff += (a[i] - b[i]) * (a[i] - b[i]);
+    return sqrt(diff / var);
+}
+
 static void test_nodal_pressure_cook(void)
 {
-    double u5, u6, u6p, u54 = 0, u64 = 0, jump, c5[6], c6[6], c6p[6], c[6];
+    double u5, u6, u6p, u54 = 0, u64 = 0, jump, c5[7], c6[7], c6p[7], c[7], d8 = 0;
+    double s5[2 * 81], s6[2 * 81]; /* the thrice-smoothed pressures at N = 8 */
     int it5, it6, it6p, it;
     const int N = TEST_IS_QUICK ? 6 : 8; /* (6: u_y 3.54 mm with, 2.16 without) */
     /* P_a computed here vs nod_p, over the spread of p: double, round-off (measured 1e-12
@@ -1420,34 +1444,41 @@ static void test_nodal_pressure_cook(void)
     if (TEST_IS_QUICK) { /* (the reduced builds: the six-tetrahedron split only, 6 x 6) */
         u5 = 0;
     } else {
-        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT5, 1, 400942, &u54, &it, &jump, c));
-        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT6, 1, 400942, &u64, &it, &jump, c));
-        CHECK_INT(HEML_OK, cook_ex(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump, c5));
+        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT5, 1, 400942, &u54, &it, &jump, c, NULL));
+        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT6, 1, 400942, &u64, &it, &jump, c, NULL));
+        CHECK_INT(HEML_OK, cook_ex(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump, c5, s5));
         printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f, checkerboard %.2f (smoothed "
-               "%.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u5, it5, jump, c5[0], c5[1], c5[2], c5[5], c5[3]);
+               "once %.2f, thrice %.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u5, it5, jump, c5[0], c5[1], c5[6],
+               c5[2], c5[5], c5[3]);
     }
-    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump, c6));
+    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump, c6, TEST_IS_QUICK ? NULL : s6));
     printf("    split 6, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f, checkerboard %.2f (smoothed "
-           "%.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u6, it6, jump, c6[0], c6[1], c6[2], c6[5], c6[3]);
-    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump, c6p));
-    printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov, checkerboard %.2f (smoothed %.2f)\n", u6p, it6p,
-           c6p[0], c6p[1]);
+           "once %.2f, thrice %.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u6, it6, jump, c6[0], c6[1], c6[6], c6[2],
+           c6[5], c6[3]);
+    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump, c6p, NULL));
+    printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov, checkerboard %.2f (smoothed once %.2f)\n", u6p,
+           it6p, c6p[0], c6p[1]);
     if (!TEST_IS_QUICK) {
-        printf("    splits at N = 4: %.4f and %.4f mm (%.1f %% apart), at N = 8 %.1f %% apart\n", u54, u64,
-               100 * fabs(u54 - u64) / u64, 100 * fabs(u5 - u6) / u6);
+        d8 = cook_split_difference(s5, s6, 2 * 81);
+        printf("    splits at N = 4: %.4f and %.4f mm (%.1f %% apart), at N = 8 %.1f %% apart; thrice-smoothed "
+               "pressures %.2f of their spread apart\n", u54, u64, 100 * fabs(u54 - u64) / u64,
+               100 * fabs(u5 - u6) / u6, d8);
         CHECK(fabs(u5 - u6) <= 0.05 * u6);
         CHECK(fabs(u5 - u6) / u6 <= 0.6 * fabs(u54 - u64) / u64);
         CHECK(c5[3] <= agree);
         CHECK(c5[2] <= 0.3);                /* the floor: a smooth field reads smooth */
         CHECK(c5[0] >= 3 * c5[2]);          /* LIMITS: checkerboarded (measured 1.24 / 0.10) */
         CHECK(c5[1] >= 3 * c5[2]);          /* and smoothing once leaves it (1.15 / 0.10) */
+        CHECK(c5[6] <= 2.5 * c5[2]);        /* three times removes it (0.17 / 0.10) */
         CHECK(c5[5] <= 2.5 * c5[2]);        /* no hourglass in the displacement */
+        CHECK(d8 <= 0.35);                  /* split-independent (measured 0.23) */
     }
     CHECK(u6 >= (TEST_IS_QUICK ? 1.5 : 1.8) * u6p);
     CHECK(u5 <= 6.9 * 1.02 && u6 <= 6.9 * 1.02);
     CHECK(c6[3] <= agree);
     CHECK(c6[2] <= 0.3);
     CHECK(c6[0] >= 3 * c6[2]);              /* LIMITS (measured 1.22 / 0.21) */
+    CHECK(c6[6] <= 2.5 * c6[2]);            /* (0.13 / 0.21) */
     CHECK(c6[5] <= 2.5 * c6[2]);
 }
 
