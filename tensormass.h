@@ -118,7 +118,7 @@
          (selected by desc.linear_solver); tmass__linear_solvers[] (section >>solver) gets
          a row {name, solve, solve_block}. solve(m, diag, c, b, x) solves
          (diag + c K) x = b on the free degrees of freedom (K applied by tmass__matvec,
-         including a hybrid's coupling block), x holding the initial guess; solve_block
+         including a hybrid's coupling block and the anchors), x holding the initial guess; solve_block
          solves K X = B for TMASS__RHS interleaved columns (the quasi-static
          precomputation). Both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (cap reached or a
          direction of non-positive curvature) or TMASS_ERR_NOT_FINITE, add to stats
@@ -3082,6 +3082,15 @@ static double tmass__roundoff_floor2(const tmass_model *m, const tmass_real *u, 
         double a = (diag ? (double)diag[i] : 0.0) + (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)];
         double e = eps * fabs((double)u[i]) * a * m->free_mask[i];
         s += e * e;
+    }
+    for (i = 0; i < m->anchor_count; i++) { /* the anchors' k (in the tangent's scale) */
+        int r, j;
+        for (r = 0; r < 3; r++) {
+            double e;
+            j = 3 * m->anchor_nodes[i] + r;
+            e = eps * fabs((double)u[j]) * m->anchor_scale * (double)m->anchor_k[i] * m->free_mask[j];
+            s += e * e;
+        }
     }
     return s;
 }
