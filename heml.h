@@ -147,7 +147,9 @@
    heml_create only. Pointers returned by heml_positions and friends point into the model
    and stay valid until heml_destroy. Meshes of 96 nodes or more also hold the static
    solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
-   24, at most 64: up to 1.2 MB). The stiffness cache (desc.stiffness_cache = 1, the
+   24, at most 64: up to 1.2 MB), and for the implicit steps' coarse correction two more
+   (the unfactored P^T K0 P and the step's factor: up to 2.4 MB more; none with
+   desc.implicit_coarse = -1). The stiffness cache (desc.stiffness_cache = 1, the
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
@@ -420,9 +422,11 @@
                              desc.newton_iterations, default 20) to desc.newton_tolerance
                              (default 1e-6, float 1e-4) on the residual relative to its
                              largest force term, each solving (M (1 + dt alpha) / dt^2 -
-                             df/du) delta = R by Jacobi-preconditioned CG with the exact
-                             force differential applied matrix-free (an Eisenstat-Walker
-                             tolerance), then an energy line search (backtracking until the
+                             df/du) delta = R by CG with the exact force differential
+                             applied matrix-free (an Eisenstat-Walker tolerance;
+                             preconditioned by Jacobi, plus the static solve's coarse
+                             correction where it pays: IMPLICIT COARSE CORRECTION below),
+                             then an energy line search (backtracking until the
                              potential decreases; with a Prony series the force has no
                              potential and the residual must decrease instead). Where CG
                              meets negative curvature (stats.negative_curvature) a
@@ -582,6 +586,55 @@
        tetrahedron listing the tetrahedra whose bounding box overlaps it (a point outside
        or on the surface scans all tetrahedra; the answer is the same as a full scan's). Then position, displacement and velocity are the P1 interpolation
        of the four nodes' values (exact for affine fields), 3 per point, no allocation.
+
+   IMPLICIT COARSE CORRECTION (issue 21; desc.implicit_coarse): the implicit steps'
+       Krylov solves (HEML_IMPLICIT_EULER and HEML_BDF2 Newton solves, the linearised
+       step's solve, CG and its MINRES fallback) solve (D + c K) x = b, D = M (1 + h alpha)
+       / h^2 (c = 1; the linearised step: D = M (1 + dt alpha), c = dt^2). Jacobi alone
+       is good while D dominates (small dt, soft bodies) and needs hundreds of iterations
+       once c K does on slender bodies (their bending modes are what Jacobi resolves
+       slowest). The static solve's two-level preconditioner is reused with the step's
+       operator: Jacobi of D + c diag K0 plus P A_c^-1 P^T, A_c = P^T (D + c K0) P on the
+       same aggregates and rigid modes (>>coarse), K0 the rest state's small-strain
+       stiffness (assembled once per set of pinned axes, shared with the static solve),
+       D's projection 6 x 6 per aggregate. The factor (dense Cholesky of 6 A unknowns,
+       double) is kept with its key (c, P^T D P bit for bit, the pins) and reused while
+       the key holds: a step's Newton iterations, and every step of one dt, share one
+       factorisation (frames.h rebuilds its coarse matrix at every Newton iteration from
+       the tangent; here K0 is constant, so the step's first factor serves until dt, the
+       masses or the pins change; BDF2 has two keys: its implicit Euler start and h =
+       2 dt / 3). The preconditioner is inexact (K0, not the tangent); CG checks the
+       answer as before, so results change only within the solve tolerances. Modes:
+       0 (default) automatic: Jacobi alone until an implicit step's solves needed
+       HEML_COARSE_MIN_ITERATIONS (20) CG iterations each on average, the coarse
+       correction from the next step on (never switched off again); 1 always; -1 never
+       (and its arrays are not allocated: MEMORY). stats.coarse_solves counts the solves
+       that used it, stats.coarse_factors its factorisations in the step. Why 20: a coarse
+       correction costs about 0.6 of a stiffness product per iteration on the bench beam
+       (two node passes and two triangular solves) plus one node pass per solve for the
+       key; on R3 (40 x 4 x 4 cells, 1025 nodes, 15 aggregates) at dt = 1 ms it loses
+       below about 15 Jacobi iterations a solve (E = 1 MPa, 11 a solve: x1.19 the time
+       over 20 steps; E = 2 MPa, 15: x1.02; E = 3 MPa, 19: x0.95; E = 10 MPa, 32: x0.69).
+       Measured (`build/bench/bench --parts coarse`, bench.c >>coarse, Neo-Hookean beams
+       clamped at x = 0, 6 implicit Euler steps from rest, Zen 5, 2 vCPUs, loaded; CG
+       iterations per step Jacobi only -> always, and the time ratio always / never,
+       best of 3 interleaved repeats in one run; the bench now runs 2):
+                              dt = 1 ms         10 ms           0.1 s            1 s
+           R3, E = 1 kPa      2 -> 4   x7.3 *   8 -> 9   x1.67  81 -> 30  x0.68  274 -> 38 x0.24
+           R3, E = 1 MPa     25 -> 19  x1.27  206 -> 34  x0.26 423 -> 53  x0.21  341 -> 51 x0.24
+           R3, E = 10 MPa    81 -> 30  x0.64  274 -> 38  x0.24 401 -> 57  x0.52  210 -> 36 x0.32
+           R1, steel        356 -> 30  x0.17  808 -> 46  x0.14 1007 -> 66 x0.13  364 -> 31 x0.19
+       (R3: 1 x 0.1 x 0.1 m, 40 x 4 x 4 cells, 3075 dof, load g = 0.01 E / 1 MPa; R1: 16 x
+       0.5 x 0.5 m, 64 x 2 x 2 cells, 1755 dof, its own weight. * the first step assembles
+       P^T K0 P, about 2 ms, once per model: in 6 steps of a fraction of a millisecond it
+       is the whole difference; the automatic mode stays Jacobi there. Rows under a few
+       ms a step vary by +-25 % between runs on this loaded machine.)
+       BDF2 gives the same picture (bench rows). The automatic mode matches "always" from
+       its second step on where Jacobi needed 20 iterations a solve, and stays Jacobi
+       where it did not (the 1 kPa rows at 1-10 ms, 1 MPa at 1 ms). Tests:
+       tests/test_heml_sim.c test_implicit_coarse_correction (same states as Jacobi only
+       to 1e-6 of the displacement, 7.1 times fewer iterations, one factorisation per
+       coefficient).
 
    MODAL ANALYSIS (heml_modal_*): the lowest `count` natural frequencies and M-orthonormal
        mode shapes of K x = lambda M x about the current state (K = -df/du, the exact
@@ -845,9 +898,14 @@
          compression or inversion CG meets negative curvature and MINRES takes over
          (slower); a solve capped by cg_max_iterations fails the step rather than return an
          unconverged one.
-       - The implicit step's CG is Jacobi-preconditioned only (the coarse space serves the
-         static solve): slender stiff bodies at large time steps need hundreds of
-         iterations per step (R3 at 40 x 4 x 4 cells, dt = T/100: about 20 ms a step).
+       - The implicit steps' coarse correction (IMPLICIT COARSE CORRECTION) uses the rest
+         state's small-strain stiffness K0, not the tangent: under large rotations or
+         strains it helps less (never wrongly: CG checks its answer). Its automatic mode
+         turns it on after one Jacobi-only step that needed HEML_COARSE_MIN_ITERATIONS
+         iterations a solve and keeps it on (a later, much smaller dt keeps paying its
+         cost per iteration: set implicit_coarse = -1 for such runs); meshes under 96 nodes
+         have none. tensormass.h's implicit steps have no coarse correction (README,
+         issue 21).
        - St Venant-Kirchhoff softens in compression (the stress falls to zero as a
          tetrahedron flattens, sec. 4.2); the J0 guard keeps it from settling inverted, but
          a homogeneous uniaxial compression is unstable in the law itself beyond about
@@ -3737,10 +3795,13 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->agg_centre, double, 3 * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse_rhs, double, 6 * (size_t)m->agg_count);
-    HEML__CARVE(c, m->coarse_k, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
-    HEML__CARVE(c, m->coarse_step, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
-    HEML__CARVE(c, m->coarse_pdp, double, 36 * (size_t)m->agg_count);
-    HEML__CARVE(c, m->coarse_pdp_new, double, 36 * (size_t)m->agg_count);
+    {
+        size_t A = m->implicit_coarse >= 0 ? (size_t)m->agg_count : 0; /* the implicit steps' */
+        HEML__CARVE(c, m->coarse_k, double, 36 * A * A);
+        HEML__CARVE(c, m->coarse_step, double, 36 * A * A);
+        HEML__CARVE(c, m->coarse_pdp, double, 36 * A);
+        HEML__CARVE(c, m->coarse_pdp_new, double, 36 * A);
+    }
     {
         size_t nn = m->nodal ? n : 0;
         HEML__CARVE(c, m->nod_w, heml_real, nn * M);
@@ -4387,13 +4448,10 @@ static void heml__node_modes(const heml_model *m, int i, double P[3][6])
             for (k = 0; k < 6; k++) P[r][k] = 0.0;
 }
 
-/* coarse_k = P^T K0 P on the free degrees of freedom (unfactored), when the pins changed
-   since its last assembly. */
-static void heml__coarse_assemble(heml_model *m)
+/* Ac = P^T K0 P on the free degrees of freedom (unfactored, (6 A)^2 doubles). */
+static void heml__coarse_assemble(const heml_model *m, double *Ac)
 {
     int A = m->agg_count, D = 6 * A, c, blk, k, i, j, r, s, a, b;
-    double *Ac = m->coarse_k;
-    if (m->coarse_k_version == m->pin_version) return;
     memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
     for (c = 0; c < m->chunk_count; c++) {
         const heml__mat *mt = m->mats + m->chunk_material[c];
@@ -4425,6 +4483,14 @@ static void heml__coarse_assemble(heml_model *m)
             }
         }
     }
+}
+
+/* coarse_k = P^T K0 P, when the pins changed since its last assembly (implicit_coarse >= 0:
+   the static solve and the implicit steps share it). */
+static void heml__coarse_k_update(heml_model *m)
+{
+    if (m->coarse_k_version == m->pin_version) return;
+    heml__coarse_assemble(m, m->coarse_k);
     m->coarse_k_version = m->pin_version;
 }
 
@@ -4453,13 +4519,17 @@ static void heml__coarse_factor(double *Ac, int D, double *dg)
 }
 
 /* The static solve's A_c = P^T K0 P, Cholesky-factored into `coarse`, when the pins
-   changed since. */
+   changed since (assembled into coarse_k first, which the implicit steps share, unless
+   implicit_coarse = -1 left it out). */
 static void heml__coarse_build(heml_model *m)
 {
     size_t D = 6 * (size_t)m->agg_count;
     if (!m->agg_count || m->coarse_version == m->pin_version) return;
-    heml__coarse_assemble(m);
-    memcpy(m->coarse, m->coarse_k, sizeof(double) * D * D);
+    if (m->implicit_coarse < 0) heml__coarse_assemble(m, m->coarse); /* (no coarse_k) */
+    else {
+        heml__coarse_k_update(m);
+        memcpy(m->coarse, m->coarse_k, sizeof(double) * D * D);
+    }
     heml__coarse_factor(m->coarse, (int)D, m->coarse_rhs);
     m->coarse_version = m->pin_version;
 }
@@ -4493,7 +4563,7 @@ static void heml__coarse_step_build(heml_model *m, const heml_real *diag, double
     if (m->coarse_step_version == m->pin_version && m->coarse_step_c == c &&
         !memcmp(pdp, m->coarse_pdp, sizeof(double) * 36 * (size_t)A))
         return;
-    heml__coarse_assemble(m);
+    heml__coarse_k_update(m);
     for (i = 0; i < D * D; i++) Ac[i] = c * m->coarse_k[i];
     for (i = 0; i < A; i++)
         for (a = 0; a < 6; a++)
@@ -4726,6 +4796,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
     }
+    tmp->implicit_coarse = d->implicit_coarse; /* (-1: the step's coarse arrays are not carved) */
     return HEML_OK;
 }
 

@@ -424,7 +424,7 @@ static int hm_kernel(void *v, int kernel)
    10 MPa, loaded by g = 0.01 E / (1 MPa) m/s^2 (the time part's R3 load: a 1.5 mm tip
    deflection, so the steps stay near-linear and the Krylov solves are what is compared),
    and R1's steel beam (16 x 0.5 x 0.5 m, 64 x 2 x 2 cells; 32 x 1 x 1 quick; E = 200 GPa,
-   its own weight); dt = 1 ms, 10 ms, 0.1 s and 1 s; implicit Euler and BDF2; `steps`
+   its own weight); dt = 1 ms, 10 ms, 0.1 s and 1 s; implicit Euler and BDF2; `steps` (6; 2 quick)
    steps from rest, each mode (-1 never, 0 automatic, 1 always) on its own model, the modes
    interleaved, best of `repeats` for the time. */
 static int hm_coarse_run(const bench_body *b, int integrator, double dt, int mode, int steps, double (*clock_s)(void),
@@ -463,7 +463,7 @@ int BENCH_COARSE_ROWS(int quick, double (*clock_s)(void), bench_coarse_row *rows
 {
     static const double youngs[3] = {1e3, 1e6, 1e7}, dts[4] = {1e-3, 1e-2, 0.1, 1.0};
     static const int integrators[2] = {HEML_IMPLICIT_EULER, HEML_BDF2};
-    int scene, e, d, it, mode, rep, n = 0, k = quick ? 1 : 2, steps = quick ? 2 : 6, repeats = quick ? 1 : 3;
+    int scene, e, d, it, mode, rep, n = 0, k = quick ? 1 : 2, steps = quick ? 2 : 6, repeats = quick ? 1 : 2;
     for (scene = 0; scene < 2; scene++)
         for (e = 0; e < (scene ? 1 : 3); e++)
             for (d = 0; d < 4; d++)

@@ -1221,6 +1221,8 @@ static void test_validation_errors(void)
     d = base; d.integrator = (heml_integrator)9;     CHECK_INT(HEML_ERR_INTEGRATOR, try_create(&d));
     d = base; d.cg_tolerance = 0;                    CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
     d = base; d.cg_max_iterations = 0;               CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
+    d = base; d.implicit_coarse = 2;                 CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
+    d = base; d.implicit_coarse = -2;                CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
     d = base; d.newton_iterations = 0;               CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
     d = base; d.static_max_iterations = 0;           CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
     d = base; d.static_tolerance = (heml_real)NAN;   CHECK_INT(HEML_ERR_SOLVER, try_create(&d));
