@@ -1305,6 +1305,8 @@ typedef FRM_REAL frm_real;
 #define frm_sampling_hexes frm_sampling_hexes_f32
 #define frm_sampling_tets frm_sampling_tets_f32
 #define frm_sampling_meshless frm_sampling_meshless_f32
+#define frm_sampling_curve frm_sampling_curve_f32
+#define frm_material_thin frm_material_thin_f32
 #define frm_sampling_box frm_sampling_box_f32
 #define frm_sampling_surface frm_sampling_surface_f32
 #define frm_sampling_apply frm_sampling_apply_f32
@@ -1926,6 +1928,38 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
 FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_count, const int *tets,
                              int tet_count, int points, const frm_real *barycentric,
                              const frm_allocator *allocator);
+/* Mesh-based, a curve (issue 14, thin parts): a rod of constant cross-section along the
+   open polyline of node_count >= 2 nodes (3 each, m; consecutive nodes distinct), a frame
+   at every node. Each segment (length l, unit tangent t) gets one station at its midpoint
+   with 4 samples of volume l A / 4 in its cross-section, weights 1/2 and gradients -+ t / l
+   (linear along the curve, the frames' rotations carry the section): a rectangle
+   section[0] x section[1] (section[1] along the height axis `up`, made normal to t per
+   segment; NULL: world z, or world y for a segment within 45 degrees of z) at the 2 x 2
+   Gauss points +-w / (2 sqrt 3), +-h / (2 sqrt 3), or, with section[1] = 0, a disk of
+   radius section[0] at 4 points r / sqrt 2 off the axis: both integrate a bending strain
+   linear across the section exactly. One station a segment is the reduced axial rule that
+   keeps the rod's shear from locking (two Gauss stations: 67 % too stiff at 16 segments,
+   see LIMITS, thin parts). The sections are rigid (the frames carry them): give the
+   material through frm_material_thin(.., 1). sample_cells holds the segment. FRM_ERR_ARG
+   for missing or non-finite arguments, FRM_ERR_SAMPLING for a section not > 0, a repeated
+   node or an `up` along a segment. */
+FRMDEF int frm_sampling_curve(frm_sampling *out, const frm_real *nodes, int node_count, const frm_real section[2],
+                              const frm_real up[3], const frm_allocator *allocator);
+/* Material constants for thin parts whose thickness the frames do not resolve (issue 14;
+   St Venant-Kirchhoff and Neo-Hookean, whose small-strain moduli are E and nu): replaces
+   m->young_modulus and m->poisson_ratio by those of the isotropic law with the same shear
+   modulus mu whose response under the thin part's kinematic constraint is the thin
+   continuum's. dimensions = 1, a curve of frames (frm_sampling_curve: rigid sections,
+   eps_yy = eps_zz = 0): lambda' = E nu / (1 + nu), so that lambda' + 2 mu = E (uniaxial
+   stress); nu' = nu / (1 + 2 nu), E' = E (1 + 3 nu) / ((1 + nu) (1 + 2 nu)). dimensions =
+   2, a layer one element thick whose through-thickness strain is constant (tetrahedral
+   frames, 4 Gauss points: the bending's Poisson strain across the layer is not
+   representable): lambda' = 2 mu lambda / (lambda + 2 mu), the plane-stress modulus;
+   nu' = nu / (1 + nu), E' = E (1 + 2 nu) / (1 + nu)^2. Exact for bending; a membrane
+   state whose thickness is free is then 5 % soft in E at nu = 0.3 (keep the true material
+   for membranes). FRM_ERR_ARG for another law, dimensions or a NULL m;
+   FRM_ERR_MATERIAL for E or nu out of range. */
+FRMDEF int frm_material_thin(frm_material *m, int dimensions);
 /* Meshless: the given frames and samples (3 coordinates each), total volume (m^3) split
    evenly over the samples, neighbours and weights from the shape description (NULL: the
    default one). */
@@ -8756,6 +8790,101 @@ FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_
         }
     }
     out->neighbor_start[s] = 4 * s;
+    return FRM_OK;
+}
+
+FRMDEF int frm_sampling_curve(frm_sampling *out, const frm_real *nodes, int node_count, const frm_real section[2],
+                              const frm_real up[3], const frm_allocator *allocator)
+{
+    double w, h, cy[4], cz[4];
+    int err, e, k, r;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!nodes || !section || node_count < 2 || node_count > 100000000) return FRM_ERR_ARG;
+    if (!frm__all_finite(nodes, 3 * (size_t)node_count) || !frm__all_finite(section, 2) ||
+        (up && !frm__all_finite(up, 3)))
+        return FRM_ERR_ARG;
+    w = (double)section[0];
+    h = (double)section[1];
+    if (!(w > 0) || h < 0) return FRM_ERR_SAMPLING;
+    for (k = 0; k < 4; k++) { /* section points: rectangle 2 x 2 Gauss, or a disk at r / sqrt 2 */
+        double sy = (k & 1) ? 1.0 : -1.0, sz = (k & 2) ? 1.0 : -1.0;
+        if (h > 0) {
+            cy[k] = sy * w / (2.0 * sqrt(3.0));
+            cz[k] = sz * h / (2.0 * sqrt(3.0));
+        } else {
+            cy[k] = sy * w / 2.0;
+            cz[k] = sz * w / 2.0;
+        }
+    }
+    err = frm__sampling_alloc(out, node_count, 4 * (node_count - 1), 8 * (node_count - 1), node_count - 1, allocator);
+    if (err) return err;
+    memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
+    for (e = 0; e < node_count - 1; e++) {
+        double t[3], n[3], b[3], u[3] = {0, 0, 1}, len = 0, un = 0, d, area = h > 0 ? w * h : 3.14159265358979324 * w * w;
+        for (r = 0; r < 3; r++) {
+            t[r] = (double)nodes[3 * (e + 1) + r] - (double)nodes[3 * e + r];
+            len += t[r] * t[r];
+        }
+        len = sqrt(len);
+        if (!(len > 0)) {
+            frm_sampling_free(out);
+            return FRM_ERR_SAMPLING;
+        }
+        for (r = 0; r < 3; r++) t[r] /= len;
+        if (up)
+            for (r = 0; r < 3; r++) u[r] = (double)up[r];
+        else if (fabs(t[2]) > 0.70710678118654752) {
+            u[1] = 1;
+            u[2] = 0;
+        }
+        d = frm__dot3d(u, t);
+        for (r = 0; r < 3; r++) {
+            n[r] = u[r] - d * t[r];
+            un += u[r] * u[r];
+        }
+        d = sqrt(frm__dot3d(n, n));
+        if (!(d > 1e-3 * sqrt(un))) {
+            frm_sampling_free(out);
+            return FRM_ERR_SAMPLING;
+        }
+        for (r = 0; r < 3; r++) n[r] /= d;
+        frm__cross3d(t, n, b);
+        for (k = 0; k < 4; k++) {
+            int s = 4 * e + k, q = 2 * s;
+            out->neighbor_start[s] = q;
+            out->sample_cells[s] = e;
+            out->sample_volumes[s] = (frm_real)(len * area / 4.0);
+            for (r = 0; r < 3; r++)
+                out->sample_positions[3 * s + r] =
+                    (frm_real)(0.5 * ((double)nodes[3 * e + r] + (double)nodes[3 * (e + 1) + r]) + cy[k] * b[r] + cz[k] * n[r]);
+            out->neighbor_frames[q] = e;
+            out->neighbor_frames[q + 1] = e + 1;
+            out->neighbor_weights[q] = (frm_real)0.5;
+            out->neighbor_weights[q + 1] = (frm_real)0.5;
+            for (r = 0; r < 3; r++) {
+                out->neighbor_gradients[3 * q + r] = (frm_real)(-t[r] / len);
+                out->neighbor_gradients[3 * (q + 1) + r] = (frm_real)(t[r] / len);
+            }
+        }
+    }
+    out->neighbor_start[4 * (node_count - 1)] = 8 * (node_count - 1);
+    return FRM_OK;
+}
+
+FRMDEF int frm_material_thin(frm_material *m, int dimensions)
+{
+    double E, nu, mu, lambda;
+    if (!m || (dimensions != 1 && dimensions != 2) || (m->law != FRM_LAW_SVK && m->law != FRM_LAW_NEO_HOOKEAN))
+        return FRM_ERR_ARG;
+    E = (double)m->young_modulus;
+    nu = (double)m->poisson_ratio;
+    if (!(frm__finite(E) && E > 0 && nu > -1 && nu < 0.5)) return FRM_ERR_MATERIAL;
+    mu = E / (2 * (1 + nu));
+    lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    lambda = dimensions == 1 ? E - 2 * mu : 2 * mu * lambda / (lambda + 2 * mu);
+    m->poisson_ratio = (frm_real)(lambda / (2 * (lambda + mu)));
+    m->young_modulus = (frm_real)(mu * (3 * lambda + 2 * mu) / (lambda + mu));
     return FRM_OK;
 }
 
