@@ -89,8 +89,10 @@
 
    STEP BY STEP
        1. Frames, samples and the neighbour table: frm_sampling_hexes / _tets (mesh-based),
-          frm_sampling_meshless (given points), frm_sampling_box / _surface (Poisson disks);
-          or fill the table yourself (any weights that sum to one, gradients to zero).
+          frm_sampling_curve (a rod: frames along a polyline), frm_sampling_meshless (given
+          points), frm_sampling_box / _surface (Poisson disks); or fill the table yourself
+          (any weights that sum to one, gradients to zero). Thin parts (a layer one element
+          thick, a curve): frm_material_thin (LIMITS, thin parts).
           Several parts (own sampling, material, density) sharing frames, and rigid bodies:
           frm_parts_combine, then frm_assembly_apply instead of frm_sampling_apply (COUPLING).
        2. frm_desc d = frm_model_default_desc(); frm_sampling_apply(&s, &d); set the
@@ -647,6 +649,17 @@
        binned by their xy boxes, shared edges counted once), frames from a coarser
        distance than samples, the volume split evenly; the k nearest frames or all within
        a radius (a grid search). The same seed gives the same points everywhere.
+       Curves (frm_sampling_curve, issue 14): frames at the nodes of a polyline, weights
+       linear along each segment (1/2 each at its midpoint, gradients -+ t / l), one
+       station a segment (the reduced rule: two Gauss stations lock the rod's shear) with
+       4 samples across the section (2 x 2 Gauss points of a rectangle, or a disk's 4
+       points at r / sqrt 2): an off-axis sample sees its frames' rotations through the
+       lever, so bending strain linear across the section is integrated exactly. The
+       frames carry rigid sections (no lateral contraction): frm_material_thin(m, 1) gives
+       the law whose lambda' + 2 mu = E with mu kept, so the rod bends with E and shears
+       with G. frm_material_thin(m, 2) gives a layer one element thick the plane-stress
+       modulus (lambda' = 2 mu lambda / (lambda + 2 mu)) its constant through-thickness
+       strain cannot give it. Measured: LIMITS, thin parts.
 
    PERFORMANCE
        Bytes each kernel streams per (sample, neighbour) pair, double (float about half):
@@ -743,12 +756,53 @@
          21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
          Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
          test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
-       - Thin parts (issue 14): a plate one cell thick of hexahedral frames solves static and
-         implicit problems and converges under refinement (tests/test_frames.c
-         test_i14_thin_plate: 1 x 1 x 0.05 m cantilever plate under its own weight, 5.85,
-         6.12, 6.20 mm at 4, 8, 16 cells a side, beam theory 5.89 mm); tetrahedral frames
-         one cell thick (one sample each) solve but do not converge in sight (2.87, 5.47,
-         7.54 mm). A thin slab loaded in its plane can buckle: Cook's membrane one element
+       - Thin parts (issue 14). Measured with tests/test_frames.c (gcc -O2, double; the
+         plate: 1 x 1 x 0.05 m, E = 1 GPa, nu = 0.3, Neo-Hookean, clamped along x = 0,
+         its own weight; beam theory 5.89 mm, the 3D answer 5.54 mm by hexahedral frames
+         4 cells thick, 16 x 16 x 4: 5.524, 32 x 32 x 4: 5.544 mm):
+           hexahedral frames one cell thick, 2^3 sub-cell samples (test_i14_thin_plate):
+             5.85, 6.12, 6.20, 6.22 mm at 4, 8, 16, 32 cells a side: converges, to +12 %
+             of the 3D answer (+6 % of beam theory; at nu = 0 +31 %: 7.85 mm against
+             5.98): the sub-cell rule under-integrates the layer and is soft;
+           tetrahedral frames one cell thick (6 a cube), one sample each: 2.87, 5.47,
+             7.54, 11.0, 13.3 mm at 4 to 64 cells: no limit (a centroid sees the layer's
+             bending only through its offset from the mid-plane; refinement adds rotation
+             modes it does not see). Use instead:
+           tetrahedral frames one cell thick, 4 Gauss points (frm_sampling_tets(.., 4,
+             NULL, ..)) and frm_material_thin(&material, 2) (test_i14_thin_tet): 1.43,
+             3.13, 4.42, 5.05, 5.37 mm at 4, 8, 16, 32, 64 cells (0.01, 0.1, 0.5, 2, 8 s
+             static on one core, Zen 5, loaded), monotone from below: the 4-point rule
+             integrates the blended field's energy exactly (a conforming model), and its
+             first-order extrapolation 2 t(n) - t(n/2) is 5.71, 5.69, 5.69 mm at n = 16,
+             32, 64 (+3 % of the 3D answer). With the true material the limit is 15 % stiff (1.37, 2.90,
+             3.96, 4.39, 4.58 mm): the layer's through-thickness strain is constant (a
+             rotated vertical lever moves sideways only), so the bending's Poisson strain
+             is held. What is still missing: the convergence is first order while the
+             cells are wider than the layer is thick (at n = 16, -20 %; at 64, -3 % of the
+             3D answer): the tetrahedra's transverse shear locks (the blended field
+             bends with an O(h) shear strain costing about 12 G / E (h / t)^2 times the
+             bending energy). Reduced rules that avoid it are soft instead: two samples a
+             tetrahedron on the centroid's vertical at the layer's Gauss levels give
+             3.53, 5.31, 6.21, 6.42 mm (limit about 6.5, +17 %; +32 % at nu = 0), for
+             any rotation_divergence (measured 4, 16, 64); an assumed-strain treatment
+             of the shear is not done. Mean dilatation (FRM_VOLUMETRIC_CELLS) does not
+             remove the Poisson stiffening (it is not volumetric) and its solves are slow.
+           a curve of frames (frm_sampling_curve, 2 x 2 section points, frm_material_thin(
+             &material, 1); test_i14_curve) on REFERENCES R1: -6.33, -1.57, -0.40, -0.10 %
+             of the rod answer (Euler-Bernoulli plus a rigid section's uniform shear,
+             q L^4 / (8 E I) + q L^2 / (2 G A) = 0.150567 m) at 4, 8, 16, 32 segments,
+             second order; 3D's 0.150169 m is 0.26 % below the rod (the clamp holds the
+             section). Static solves in 3 Newton iterations, implicit steps keep the
+             static state. With the true material 25.8 % too stiff ((1 - nu) / ((1 + nu)
+             (1 - 2 nu)) = 1.346: the rigid sections hold the lateral contraction); with
+             two Gauss stations a segment the sag is 67 % short at 16 segments (shear
+             locking; measured with nu = 0).
+             The rigid, unwarped section makes the torsion stiffer than the continuum's
+             (a square's St Venant constant is 0.141 a^4, the rigid section's a^4 / 6:
+             +18 %; a disk's is exact); not measured in a test. Meshless Shepard frames on
+             a line stay inconsistent (zero-order weights: tip 0.65, 1.6, 3.1, 8.9 mm at
+             4 to 32 frames against 5.9 mm).
+         A thin slab loaded in its plane can buckle: Cook's membrane one element
          thick (48 x 44..60 x 1, E = 240.565 Pa, nu = 0.3) has no stable flat state beyond
          F = 2.05 N (hexahedral frames, 16 cells a side; 4.5 N at 4): at the usual F = 32 N
          the flat state is a saddle and, the load being symmetric about the mid-plane,
@@ -757,10 +811,7 @@
          "rotations the samples do not see" is then not the cause). Hold the out-of-plane
          axes for the plane problem (frm_model_set_frame_axes(m, i, 4, 3): test_i18_cook_membrane)
          or nudge it out of plane (1e-3 of the load) for the buckled one (corner u_y 7.8,
-         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations). Frames along a
-         curve (meshless Shepard frames on a line, samples in a thin tube) solve but are not
-         consistent: zero-order weights on a line give no convergent bending (tip 0.65,
-         1.6, 3.1, 8.9 mm at 4 to 32 frames against 5.9 mm); a rod model is not done.
+         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations).
        - Models with volumetric averaging (desc.volumetric, issue 13) solve with
          block-Jacobi alone: the coarse matrix's per-sample pass does not know the cell
          averages (not measured; to do).
@@ -1938,8 +1989,8 @@ FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_
    Gauss points +-w / (2 sqrt 3), +-h / (2 sqrt 3), or, with section[1] = 0, a disk of
    radius section[0] at 4 points r / sqrt 2 off the axis: both integrate a bending strain
    linear across the section exactly. One station a segment is the reduced axial rule that
-   keeps the rod's shear from locking (two Gauss stations: 67 % too stiff at 16 segments,
-   see LIMITS, thin parts). The sections are rigid (the frames carry them): give the
+   keeps the rod's shear from locking (two Gauss stations: the sag 67 % short at 16
+   segments, see LIMITS, thin parts). The sections are rigid (the frames carry them): give the
    material through frm_material_thin(.., 1). sample_cells holds the segment. FRM_ERR_ARG
    for missing or non-finite arguments, FRM_ERR_SAMPLING for a section not > 0, a repeated
    node or an `up` along a segment. */
