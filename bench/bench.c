@@ -1781,6 +1781,7 @@ static int kernel_models(const options *o, const bench_model *const *models, int
             for (i = 0; i < pc && n < 256; i++) out[n++] = peers + i;
     }
 #else
+    (void)o;
     printf("Bullet rows skipped: install Debian's libbullet-dev (apt-get install libbullet-dev) and rebuild the "
            "bench (make build/bench/bench) to time Bullet's Neo-Hookean and corotated forces and implicit step\n");
 #endif
@@ -1982,7 +1983,7 @@ int main(int argc, char **argv)
     options o;
     static const bench_model *models[256], *variants[64];
     int i, count = 0, variant_count = 0;
-    double t0 = now();
+    double t0 = now(), tp, part_time[5] = {0, 0, 0, 0, 0}; /* trade, stability, sweep, time, kernels */
     memset(&o, 0, sizeof o);
     o.repeats = 3;
     o.threads = 2;
@@ -2027,9 +2028,10 @@ int main(int argc, char **argv)
 #endif
     }
     set_threads(1);
-    if (o.parts & 1) run_trade(&o, models, count);
+    tp = now();
+    if (o.parts & 1) run_trade(&o, models, count), part_time[0] = now() - tp, tp = now();
     set_threads(1);
-    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
+    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count), part_time[1] = now() - tp, tp = now();
     set_threads(1);
     if (o.parts & 8) { /* the primary = -1 entries too (issue 13's options near nu = 0.5), not in --quick */
         static const bench_model *all[256];
@@ -2037,9 +2039,10 @@ int main(int argc, char **argv)
         for (i = 0; i < count && n < 256; i++) all[n++] = models[i];
         for (i = 0; i < variant_count && n < 256 && !o.quick; i++) all[n++] = variants[i];
         run_sweep(&o, all, n);
+        part_time[2] = now() - tp, tp = now();
     }
     set_threads(1);
-    if (o.parts & 16) run_time(&o, models, count);
+    if (o.parts & 16) run_time(&o, models, count), part_time[3] = now() - tp, tp = now();
     if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */
         static const bench_model *all[256];
         int n = 0;
@@ -2047,7 +2050,8 @@ int main(int argc, char **argv)
         for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
         run_kernels(&o, all, n);
     }
-    if (o.parts & 4) run_chain(&o);
-    printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
+    if (o.parts & 4) run_chain(&o), part_time[4] = now() - tp;
+    printf("\nbench: done in %.0f s (trade %.0f, stability %.0f, sweep %.0f, time %.0f, kernels %.0f); results in "
+           "%s/\n", now() - t0, part_time[0], part_time[1], part_time[2], part_time[3], part_time[4], o.out);
     return 0;
 }
