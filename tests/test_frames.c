@@ -4135,7 +4135,11 @@ static void test_i14_thin_tet(void)
    the extrapolation within 0.02 % (float 0.1 %); 3D's 0.150169 m is 0.26 % off the rod
    (the clamp holds the section). Implicit Euler from the static state keeps it (gravity
    on, dt = 10 ms: the tip moves by under 1e-6 of the sag; float 1e-3), and released it
-   swings back up. 128 samples at most: milliseconds. Also the sampling's contract:
+   swings back up. The same rod along (0.6, 0.8, 0) sags the same (the Newton tolerance,
+   1e-6; float 1e-4). R3's beam as a rod of 16 segments swings at 0.5082 Hz under implicit
+   Euler (200 steps a period, as test_beam_frequency_r3), -0.18 % of the 3D 0.5091 Hz:
+   within 1 % (the rod's discretisation +0.2 %, implicit Euler -0.13 %, the rod against the
+   3D solid a few tenths; the true material would give +16 %). 0.1 s. Also the sampling's contract:
    weights 1/2, gradients -+ t / l, volume L A, the disk's points at r / sqrt 2, errors. */
 static void test_i14_curve(void)
 {
@@ -4194,6 +4198,67 @@ static void test_i14_curve(void)
     for (l = 1; l < 4; l++) CHECK(err[l - 1] / err[l] > 3 && err[l - 1] / err[l] < 5);
     CHECK_REL(rod, tip[3], 2.5e-3);
     CHECK_REL(rod, tip[3] + (tip[3] - tip[2]) / 3, IS_FLOAT ? 1e-3 : 2e-4);
+    { /* the same rod along (0.6, 0.8, 0) (sections built from t x up): the same sag */
+        scene sc;
+        frm_real x[3 * 9];
+        int i;
+        memset(&sc, 0, sizeof sc);
+        for (i = 0; i <= 8; i++) {
+            x[3 * i] = (frm_real)(0.6 * L * i / 8);
+            x[3 * i + 1] = (frm_real)(0.8 * L * i / 8);
+            x[3 * i + 2] = 0;
+        }
+        REQUIRE(frm_sampling_curve(&sc.s, x, 9, sec, NULL, NULL) == FRM_OK);
+        REQUIRE(scene_create(&sc, FRM_LAW_NEO_HOOKEAN, (double)mat.young_modulus, (double)mat.poisson_ratio, rho,
+                             FRM_STIFFNESS_AUTO) == FRM_OK);
+        REQUIRE(frm_model_fix_frame(sc.m, 0) == FRM_OK);
+        CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+        printf("    the rod along (0.6, 0.8, 0), 8 segments: tip %.9f m (along x %.9f m)\n",
+               -(double)frm_model_positions(sc.m)[3 * 8 + 2], tip[1]);
+        CHECK_REL(tip[1], -(double)frm_model_positions(sc.m)[3 * 8 + 2], IS_FLOAT ? 1e-4 : 1e-6);
+        scene_free(&sc);
+    }
+    { /* R3's beam (1 x 0.1 x 0.1 m, E = 1 MPa, nu = 0.3, 1000 kg/m^3) as a rod of 16
+         segments swinging after release from a small sag, implicit Euler at 200 steps a
+         period, as test_beam_frequency_r3: the frequency from the zero crossings */
+        scene sc;
+        frm_material r3 = mat;
+        frm_real x[3 * 17], s3[2] = {(frm_real)0.1, (frm_real)0.1}, gs[3] = {0, 0, (frm_real)-9.81e-4};
+        double f_timoshenko = 0.5069, dt = 1 / f_timoshenko / 200, prev, cross[3], f;
+        int i, step, nc = 0;
+        memset(&sc, 0, sizeof sc);
+        memset(x, 0, sizeof x);
+        for (i = 0; i <= 16; i++) x[3 * i] = (frm_real)(i / 16.0);
+        r3.law = FRM_LAW_SVK;
+        r3.young_modulus = (frm_real)1e6;
+        r3.poisson_ratio = (frm_real)0.3;
+        REQUIRE(frm_material_thin(&r3, 1) == FRM_OK);
+        REQUIRE(frm_sampling_curve(&sc.s, x, 17, s3, NULL, NULL) == FRM_OK);
+        REQUIRE(scene_create(&sc, FRM_LAW_SVK, (double)r3.young_modulus, (double)r3.poisson_ratio, 1000,
+                             FRM_STIFFNESS_AUTO) == FRM_OK);
+        REQUIRE(frm_model_fix_frame(sc.m, 0) == FRM_OK);
+        REQUIRE(frm_model_set_gravity(sc.m, gs) == FRM_OK);
+        REQUIRE(frm_model_set_solver(sc.m, (frm_real)(IS_FLOAT ? 1e-5 : 1e-8), 2000, (frm_real)(IS_FLOAT ? 1e-4 : 1e-8),
+                                     30) == FRM_OK);
+        CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
+        REQUIRE(frm_model_set_gravity(sc.m, zero) == FRM_OK);
+        prev = (double)frm_model_positions(sc.m)[3 * 16 + 2];
+        for (step = 1; step <= 700 && nc < 3; step++) {
+            double z;
+            int e = frm_model_step_ex(sc.m, (frm_real)dt);
+            CHECK_INT(FRM_OK, e);
+            if (e) break;
+            z = (double)frm_model_positions(sc.m)[3 * 16 + 2];
+            if ((prev < 0) != (z < 0)) cross[nc++] = (step - 1) * dt + dt * prev / (prev - z);
+            prev = z;
+        }
+        REQUIRE(nc >= 3);
+        f = 1 / (cross[2] - cross[0]);
+        printf("    R3 as a rod of 16 segments: f1 = %.4f Hz (Timoshenko %.4f, 3D 0.5091 Hz: %+.2f %%), %d steps\n", f,
+               f_timoshenko, 100 * (f / 0.5091 - 1), step - 1);
+        CHECK_REL(0.5091, f, 0.01);
+        scene_free(&sc);
+    }
     { /* the sampling's contract, and a disk on a vertical segment (default up: world y) */
         frm_sampling s;
         frm_real v[6] = {1, 2, 3, 1, 2, 5}, disk[2] = {(frm_real)0.1, 0}, bad[2] = {0, 1}, upz[3] = {0, 0, 1};
