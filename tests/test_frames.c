@@ -4135,8 +4135,8 @@ static void test_i14_thin_tet(void)
    the extrapolation within 0.02 % (float 0.1 %); 3D's 0.150169 m is 0.26 % off the rod
    (the clamp holds the section). Implicit Euler from the static state keeps it (gravity
    on, dt = 10 ms: the tip moves by under 1e-6 of the sag; float 1e-3), and released it
-   swings back up. The same rod along (0.6, 0.8, 0) sags the same (the Newton tolerance,
-   1e-6; float 1e-4). R3's beam as a rod of 16 segments swings at 0.5082 Hz under implicit
+   swings back up. The same rod along (0.6, 0.8, 0) sags the same (to 1e-6; float 2e-3,
+   where Newton stops at 1e-4 on the residual). R3's beam as a rod of 16 segments swings at 0.5082 Hz under implicit
    Euler (200 steps a period, as test_beam_frequency_r3), -0.18 % of the 3D 0.5091 Hz:
    within 1 % (the rod's discretisation +0.2 %, implicit Euler -0.13 %, the rod against the
    3D solid a few tenths; the true material would give +16 %). 0.1 s. Also the sampling's contract:
@@ -4215,7 +4215,9 @@ static void test_i14_curve(void)
         CHECK_INT(FRM_OK, frm_model_solve_static(sc.m));
         printf("    the rod along (0.6, 0.8, 0), 8 segments: tip %.9f m (along x %.9f m)\n",
                -(double)frm_model_positions(sc.m)[3 * 8 + 2], tip[1]);
-        CHECK_REL(tip[1], -(double)frm_model_positions(sc.m)[3 * 8 + 2], IS_FLOAT ? 1e-4 : 1e-6);
+        /* float: its Newton stops at 1e-4 on the residual, which left the rod along x 6e-4
+           short of double's tip (measured 0.148112 against 0.148199 m along x, 0.148199 m slanted) */
+        CHECK_REL(tip[1], -(double)frm_model_positions(sc.m)[3 * 8 + 2], IS_FLOAT ? 2e-3 : 1e-6);
         scene_free(&sc);
     }
     { /* R3's beam (1 x 0.1 x 0.1 m, E = 1 MPa, nu = 0.3, 1000 kg/m^3) as a rod of 16
