@@ -1590,10 +1590,6 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
-#define HEML__SAD 13        /* n vectors of the saddle-point solves (m->sad, nodal pressure only) */
-#define HEML__SAD_C 11      /* (m->sad: the node pass's dP_a per unit q_a, heml__saddle_setup) */
-#define HEML__SAD_D0 12     /* (m->sad: the share d0_a of d_a kept in the displacement block) */
-#define HEML__SAD_ALPHA (getenv("ANP_ALPHA") ? atof(getenv("ANP_ALPHA")) : 0.0)
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__NODE_CHUNK 1024 /* nodes per work item of the nodal pressure's node pass */
 #define HEML__MAX_TETS 100000000
@@ -1773,16 +1769,6 @@ struct heml_model {
     heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
     double *nod_energy;
     int nod_chunks;
-    /* the nodal pressure's saddle-point solves (heml__saddle_minres): kdev 1 while a solve
-       runs on the deviatoric pieces (the node pass writes dP_a = sad_q_a sad[C]_a, 0 when
-       sad_q is NULL; Jacobi reads diag_dev, the coarse space is built from the deviatoric
-       small-strain stiffness, coarse_dev says which one is factored); sad_d non-NULL: the
-       node pass records d_a = dP_a / dj_a there; sad[]: HEML__SAD vectors of n (the
-       MINRES pressure parts, then e, sigma, the pressure preconditioner and the coefficient
-       c); diag_dev: the deviatoric small-strain stiffness diagonal (3n) */
-    int kdev, coarse_dev;
-    const heml_real *sad_q;
-    heml_real *sad_d, *diag_dev, *sad[HEML__SAD];
 
     heml_stats stats;
 };
@@ -3456,12 +3442,7 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
             for (k = 0; k < valid; k++) {
                 heml_real inv = m->nod_inv[a + k];
                 m->nod_p[a + k] = P[k] * inv;
-                if (cx->diff) {
-                    if (m->sad_d) m->sad_d[a + k] = Q[k] * inv * inv;
-                    m->nod_dp[a + k] = !m->kdev ? Q[k] * inv * inv * m->nod_dj[a + k]
-                                       : m->sad[HEML__SAD_D0][a + k] * m->nod_dj[a + k] +
-                                             (m->sad_q ? m->sad_q[a + k] * m->sad[HEML__SAD_C][a + k] : 0);
-                }
+                if (cx->diff) m->nod_dp[a + k] = Q[k] * inv * inv * m->nod_dj[a + k];
             }
         }
         m->nod_energy[c] = energy;
@@ -3691,7 +3672,6 @@ static void heml__layout(heml_model *m, heml__carver *c)
 {
     size_t n = (size_t)m->node_count, s = (size_t)m->slot_count, B = (size_t)m->block_count;
     size_t C = (size_t)m->chunk_count, P = (size_t)m->prony_total, M = (size_t)m->material_count;
-    int i;
     HEML__CARVE(c, m->rest, heml_real, 3 * n);
     HEML__CARVE(c, m->pos, heml_real, 3 * n);
     HEML__CARVE(c, m->disp, heml_real, 3 * n);
@@ -3747,11 +3727,8 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_p, heml_real, nn);
         HEML__CARVE(c, m->nod_dp, heml_real, nn);
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
-        HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
-        for (i = 0; i < HEML__SAD; i++) HEML__CARVE(c, m->sad[i], heml_real, nn);
     }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? HEML__NC * s : 0);
-    if (!m->nodal) m->diag_dev = NULL;
     if (!m->has_springs) m->blk_spring = NULL;
     if (!m->has_dc) m->dc = NULL;
 }
@@ -4197,7 +4174,6 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
     double noise2 = 0.0;
     memset(mass_acc, 0, sizeof(double) * (size_t)m->node_count);
     memset(diag_acc, 0, sizeof(double) * 3 * (size_t)m->node_count);
-    if (m->diag_dev) memset(m->diag_dev, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (s = 0; s < m->slot_count; s++) {
         int t = m->slot_tet[s], *idx;
         heml_real *R;
@@ -4231,13 +4207,9 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             for (j = 0; j < 4; j++) {
                 double gg = g[j][0] * g[j][0] + g[j][1] * g[j][1] + g[j][2] * g[j][2];
                 mass_acc[q[j]] += mt->density * vol / 4.0;
-                for (r = 0; r < 3; r++) {
+                for (r = 0; r < 3; r++)
                     diag_acc[3 * q[j] + r] +=
                         vol * ((mt->small_lambda + mt->small_mu) * g[j][r] * g[j][r] + mt->small_mu * gg);
-                    if (m->diag_dev) /* lambda - kappa = -2 mu / 3: the law minus its dilation energy */
-                        m->diag_dev[3 * q[j] + r] +=
-                            (heml_real)(vol * ((HEML__SAD_ALPHA + 1.0 / 3.0) * mt->small_mu * g[j][r] * g[j][r] + mt->small_mu * gg));
-                }
             }
             if (mt->kind == HEML__K_SPRING) {
                 for (l = 0; l < 6; l++) {
@@ -4396,11 +4368,11 @@ static void heml__coarse_build(heml_model *m)
 {
     int A = m->agg_count, D = 6 * A, c, blk, k, i, j, r, s, a, b;
     double *Ac = m->coarse, *dg = m->coarse_rhs;
-    if (!A || (m->coarse_version == m->pin_version && m->coarse_dev == m->kdev)) return;
+    if (!A || m->coarse_version == m->pin_version) return;
     memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
     for (c = 0; c < m->chunk_count; c++) {
         const heml__mat *mt = m->mats + m->chunk_material[c];
-        double mu = mt->small_mu, lam = m->kdev ? (HEML__SAD_ALPHA - 2.0 / 3.0) * mt->small_mu : mt->small_lambda;
+        double mu = mt->small_mu, lam = mt->small_lambda;
         for (blk = m->chunk_begin[c]; blk < m->chunk_end[c]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
@@ -4445,7 +4417,6 @@ static void heml__coarse_build(heml_model *m)
         }
     }
     m->coarse_version = m->pin_version;
-    m->coarse_dev = m->kdev;
 }
 
 /* z += P A_c^-1 P^T r on the free degrees of freedom. */
@@ -4832,9 +4803,8 @@ static void heml__cg_apply(heml_model *m, const heml_real *diag, double c, const
 static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, heml_real *pinv)
 {
     int i, n3 = 3 * m->node_count;
-    const heml_real *kd = m->kdev ? m->diag_dev : m->diag;
     for (i = 0; i < n3; i++) {
-        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)kd[i];
+        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)m->diag[i];
         pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
     }
     if (m->anchor_count) { /* the anchors' k joins the diagonal of the nodes they hold */
@@ -4848,7 +4818,7 @@ static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, h
                 double dgl;
                 j = 3 * m->anchor_nodes[a] + r;
                 if (pinv[j] < 0) continue;
-                dgl = (diag ? (double)diag[j] : 0.0) + c * ((double)kd[j] + (double)pinv[j]);
+                dgl = (diag ? (double)diag[j] : 0.0) + c * ((double)m->diag[j] + (double)pinv[j]);
                 pinv[j] = (heml_real)(m->free_mask[j] > 0 && dgl > 0 ? -1.0 / dgl : -0.0);
             }
         for (a = 0; a < m->anchor_count; a++)
@@ -5012,174 +4982,6 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     return phibar <= tol ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
 }
 
-/* >>saddle: the nodal pressure's static solves as a saddle-point problem (NEAR-
-   INCOMPRESSIBLE BODIES, "Solvers"). With the average nodal pressure the differential is
-       A = D + c K,   K = K_dev + s G^T Dn G,
-   K_dev the element pass with the nodal dP_a held at 0 (the law minus its element
-   dilation energy, the deviatoric part at small strain), G du = (sum Vol_e dJ_e / 4)_a the
-   nodal volume change, Dn = diag(d_a), d_a = sum_mat W U''_mat(J_a) / V_a^2, s the Prony
-   factor (the same for every material, else not used). With e_a = sqrt(c s |d_a|) and
-   sigma_a = sign d_a (+1 at 0), A du = b is the first row of
-       [D + c K_dev   G^T E] [du]   [b]
-       [E G        -Sigma ] [ q] = [0],
-   since q = Sigma E G du gives G^T E Sigma E G = c s G^T Dn G: the same du, exactly. The
-   system is symmetric and indefinite, its entries of the size of mu (not of the bulk
-   modulus), and MINRES with the block-diagonal SPD preconditioner diag(P_dev, S^-1) needs
-   a number of iterations that barely grows with kappa / mu: P_dev the Jacobi of the
-   deviatoric small-strain stiffness plus the coarse space built from it, S_a = 1 + s |d_a|
-   V_a / (HEML__SAD_BETA mu_a) (the Schur complement sigma + E G (c K_dev)^-1 G^T E with
-   G K_dev^-1 G^T replaced by the lumped pressure mass V_a / (beta mu_a)). */
-#define HEML__SAD_X 7   /* (m->sad: MINRES's pressure parts 0..7, then:) */
-#define HEML__SAD_E 8   /* e_a */
-#define HEML__SAD_SIG 9 /* sigma_a */
-#define HEML__SAD_PQ 10 /* 1 / S_a */
-#define HEML__SAD_BETA (getenv("ANP_BETA") ? atof(getenv("ANP_BETA")) : 1.0)
-#define HEML__SADDLE_NA 2 /* private result of heml__saddle_minres: the form does not apply */
-
-/* e, sigma, 1 / S and the node pass's coefficient C = e / (c s) at x_lin (one sums pass
-   and one node pass, s[0] as scratch). Returns 0 where the form does not apply (Prony
-   factors that differ between materials, c <= 0). */
-static int heml__saddle_setup(heml_model *m, const heml_real *x_lin, double c, heml_real *zero)
-{
-    int i, a, n = m->node_count;
-    double s = 0.0;
-    heml_real *e = m->sad[HEML__SAD_E], *sig = m->sad[HEML__SAD_SIG], *pq = m->sad[HEML__SAD_PQ];
-    heml_real *cc = m->sad[HEML__SAD_C], *d0 = m->sad[HEML__SAD_D0];
-    for (i = 0; i < m->material_count; i++) {
-        double sp = m->mats[i].prony_count ? (double)m->prony_s[i] : 1.0;
-        if (i == 0) s = sp;
-        else if (sp != s) return 0;
-    }
-    if (!(s > 0) || !(c > 0)) return 0;
-    memset(zero, 0, sizeof(heml_real) * 3 * (size_t)n);
-    m->sad_d = e;
-    heml__nodal_prepare(m, HEML__DIFF, x_lin, zero);
-    m->sad_d = NULL;
-    for (a = 0; a < n; a++) {
-        double d = (double)e[a], inv = (double)m->nod_inv[a], mu = 0.0, ea, dd0;
-        for (i = 0; i < m->material_count; i++) mu += (double)m->nod_w[(size_t)i * (size_t)n + (size_t)a] * m->mats[i].small_mu;
-        mu *= inv;
-        dd0 = HEML__SAD_ALPHA * mu * inv;
-        if (!(d > dd0)) dd0 = d > 0 ? d : 0.0;
-        d0[a] = (heml_real)dd0;
-        d -= (double)d0[a];
-        ea = sqrt(c * s * fabs(d));
-        e[a] = (heml_real)ea;
-        sig[a] = (heml_real)(d < 0 ? -1 : 1);
-        cc[a] = (heml_real)(ea / (c * s));
-        pq[a] = (heml_real)(inv > 0 && mu > 0 ? 1.0 / (1.0 + s * fabs(d) / (inv * HEML__SAD_BETA * mu + s * dd0)) : 1.0);
-    }
-    return 1;
-}
-
-/* [yu; yq] = the saddle matrix times [vu; vq] (yu on the free degrees of freedom). */
-static void heml__saddle_apply(heml_model *m, const heml_real *diag, double c, const heml_real *vu,
-                               const heml_real *vq, heml_real *yu, heml_real *yq)
-{
-    const heml_real *e = m->sad[HEML__SAD_E], *sig = m->sad[HEML__SAD_SIG];
-    int a;
-    m->sad_q = vq;
-    heml__cg_apply(m, diag, c, vu, yu);
-    m->sad_q = NULL;
-    for (a = 0; a < m->node_count; a++) yq[a] = e[a] * m->nod_dj[a] - sig[a] * vq[a];
-}
-
-/* heml__minres on the saddle-point form: solves (D - c df/dx(x_lin)) x = b on the free
-   degrees of freedom from x = 0, to a preconditioned residual below rtol times its initial
-   value (as heml__minres). Workspace s[0..7] (3n) and m->sad[0..7] (n). Returns HEML_OK,
-   HEML_ERR_NO_CONVERGENCE, HEML_ERR_NOT_FINITE or HEML__SADDLE_NA. */
-static int heml__saddle_minres(heml_model *m, const heml_real *x_lin, const heml_real *diag, double c,
-                               const heml_real *b, heml_real *x, double rtol, int coarse, heml_real **s)
-{
-    heml_real *r1 = s[0], *r2 = s[1], *y = s[2], *v = s[3], *w = s[4], *w1 = s[5], *w2 = s[6], *pinv = s[7];
-    heml_real *r1q = m->sad[0], *r2q = m->sad[1], *yq = m->sad[2], *vq = m->sad[3], *wq = m->sad[4];
-    heml_real *w1q = m->sad[5], *w2q = m->sad[6], *xq = m->sad[HEML__SAD_X], *pq = m->sad[HEML__SAD_PQ];
-    int n = m->node_count, n3 = 3 * n, i, it, err;
-    double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol;
-    m->lin_x = x_lin;
-    heml__dc_invalidate(m);
-    if (!heml__saddle_setup(m, x_lin, c, r1)) return HEML__SADDLE_NA;
-    m->kdev = 1;
-    coarse = coarse && m->agg_count;
-    if (coarse) heml__coarse_build(m);
-    heml__jacobi(m, diag, c, pinv);
-    for (i = 0; i < n3; i++) {
-        x[i] = w[i] = w2[i] = 0;
-        r1[i] = r2[i] = b[i] * m->free_mask[i];
-    }
-    for (i = 0; i < n; i++) xq[i] = wq[i] = w2q[i] = r1q[i] = r2q[i] = 0;
-    heml__precond(m, pinv, r1, y, coarse);
-    for (i = 0; i < n; i++) yq[i] = 0;
-    beta1 = heml__dot(r1, y, n3);
-    m->stats.cg_residual = 0;
-    err = HEML_OK;
-    if (!heml__finite(beta1)) err = HEML_ERR_NOT_FINITE;
-    if (err || !(beta1 > 0.0)) {
-        m->kdev = 0;
-        return err;
-    }
-    beta1 = sqrt(beta1);
-    beta = phibar = beta1;
-    tol = rtol * beta1;
-    for (it = 0; it < m->cg_max_iterations && phibar > tol; it++) {
-        double alfa, oldeps, delta, gbar, gamma, phi, sb = 1.0 / beta;
-        for (i = 0; i < n3; i++) v[i] = (heml_real)(sb * y[i]);
-        for (i = 0; i < n; i++) vq[i] = (heml_real)(sb * yq[i]);
-        heml__saddle_apply(m, diag, c, v, vq, y, yq);
-        if (it > 0) {
-            for (i = 0; i < n3; i++) y[i] -= (heml_real)(beta / oldb) * r1[i];
-            for (i = 0; i < n; i++) yq[i] -= (heml_real)(beta / oldb) * r1q[i];
-        }
-        alfa = heml__dot(v, y, n3) + heml__dot(vq, yq, n);
-        for (i = 0; i < n3; i++) {
-            y[i] -= (heml_real)(alfa / beta) * r2[i];
-            r1[i] = r2[i];
-            r2[i] = y[i];
-        }
-        for (i = 0; i < n; i++) {
-            yq[i] -= (heml_real)(alfa / beta) * r2q[i];
-            r1q[i] = r2q[i];
-            r2q[i] = yq[i];
-        }
-        heml__precond(m, pinv, r2, y, coarse);
-        for (i = 0; i < n; i++) yq[i] = pq[i] * r2q[i];
-        oldb = beta;
-        beta = heml__dot(r2, y, n3) + heml__dot(r2q, yq, n);
-        beta = beta > 0 ? sqrt(beta) : 0.0;
-        oldeps = epsln;
-        delta = cs * dbar + sn * alfa;
-        gbar = sn * dbar - cs * alfa;
-        epsln = sn * beta;
-        dbar = -cs * beta;
-        gamma = sqrt(gbar * gbar + beta * beta);
-        if (gamma < 1e-300) gamma = 1e-300;
-        cs = gbar / gamma;
-        sn = beta / gamma;
-        phi = cs * phibar;
-        phibar = sn * phibar;
-        for (i = 0; i < n3; i++) {
-            heml_real t = w2[i];
-            w2[i] = w[i];
-            w1[i] = t;
-            w[i] = (heml_real)(((double)v[i] - oldeps * (double)w1[i] - delta * (double)w2[i]) / gamma);
-            x[i] += (heml_real)phi * w[i];
-        }
-        for (i = 0; i < n; i++) {
-            heml_real t = w2q[i];
-            w2q[i] = wq[i];
-            w1q[i] = t;
-            wq[i] = (heml_real)(((double)vq[i] - oldeps * (double)w1q[i] - delta * (double)w2q[i]) / gamma);
-            xq[i] += (heml_real)phi * wq[i];
-        }
-        if (beta == 0.0) break; /* invariant subspace: exact */
-    }
-    m->kdev = 0;
-    m->stats.cg_iterations += it;
-    m->stats.cg_residual = (heml_real)(phibar / beta1);
-    if (!heml__finite(phibar)) return HEML_ERR_NOT_FINITE;
-    return phibar <= tol ? HEML_OK : HEML_ERR_NO_CONVERGENCE;
-}
-
 /* >>linear-solvers: one row per heml_linear_solver, indexed by it (see HOW TO EXTEND).
    `solve` is for systems expected to be positive definite, `solve_indefinite` for
    symmetric indefinite ones. Both solve (D - c df/dx(x_lin)) x = b on the free degrees of
@@ -5210,7 +5012,6 @@ typedef char heml__linear_solvers_has_a_row_per_solver
 
 #define HEML__SPD 0
 #define HEML__INDEFINITE 1
-#define HEML__PROBE 2 /* the saddle probe's solve: positive definite, and CG must see its curvature */
 
 /* Every linear solve of the library goes through here, to the model's linear solver. */
 static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, const heml_real *diag, double c,
@@ -5219,22 +5020,8 @@ static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, c
     const heml__linear_solver_ops *ops = heml__linear_solvers + m->linear_solver;
     int err;
     heml__dc_invalidate(m); /* (x_lin's contents may be new: the stiffness cache refills) */
-    if (m->nodal && coarse && kind != HEML__PROBE && getenv("ANP_SAD")) {
-        /* the saddle-point form (>>saddle); its answer is taken where it descends (b . x > 0),
-           else CG below decides (negative curvature, the Levenberg-Marquardt shift) */
-        int it0 = m->stats.cg_iterations;
-        err = heml__saddle_minres(m, x_lin, diag, c, b, x, rtol, coarse, m->krylov);
-        heml__dc_invalidate(m);
-        if (getenv("ANP_DBG")) fprintf(stderr, "sad err %d its %d rtol %.2g slope %.3g\n", err, m->stats.cg_iterations - it0, rtol, heml__dot(b, x, 3 * m->node_count));
-        if (err == HEML_ERR_NOT_FINITE) return err;
-        if ((err == HEML_OK || err == HEML_ERR_NO_CONVERGENCE) && heml__dot(b, x, 3 * m->node_count) > 0.0)
-            return err;
-    }
-    if (kind == HEML__PROBE) kind = HEML__SPD;
-    {int it0 = m->stats.cg_iterations;
     err = (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
                                                                            m->krylov);
-    if (getenv("ANP_DBG")) fprintf(stderr, "cg kind %d err %d its %d rtol %.2g\n", kind, err, m->stats.cg_iterations - it0, rtol);}
     heml__dc_invalidate(m);
     return err;
 }
@@ -5536,7 +5323,7 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
         b[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
         x[i] = 0;
     }
-    kerr = heml__linear_solve(m, HEML__PROBE, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
+    kerr = heml__linear_solve(m, HEML__SPD, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
     if (kerr == HEML_ERR_NOT_FINITE) return kerr;
     if (kerr != HEML__NEGATIVE_CURVATURE) return HEML_OK;
     /* the solve's last direction p and K p, its preconditioner, and two free vectors */
