@@ -357,7 +357,8 @@
        before the filter, so it relaxes with the rest of the stress. Inversion: the
        continued U is restoring below J0 at the nodes; a single tetrahedron's own
        resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
-       the bulk part. Memory: 6 reals per node plus one per node and material.
+       the bulk part. Memory: 9 reals per node (3 of them the deviatoric diagonal of the
+       probe below) plus one per node and material.
        Measured (tests/test_heml_solve.c, Cook's membrane R10, nu = 0.4999, corner u_y in
        mm at N x N x 1 cells, N = 4, 8, 16, 32; converged about 6.9):
            six tetrahedra per cell   plain 2.15 2.17 2.22 2.38   nodal 2.65 4.38 5.99 6.61
@@ -374,7 +375,8 @@
            beam 40x4x4    111 (2)    455 (3)     933 (3)    2,228 (3)
        (bench/heml_nodal_krylov.c; before the K_dev probe below, at nu = 0.49, 0.499,
        0.4999: Cook N = 8 814, 2,701, 7,262, N = 16 1,658, 4,350, 20,692, the beam 458,
-       1,357, 3,653; the answers the same to every printed digit), so
+       1,357, 3,653; the answers the same to every printed digit; time at 0.4999, best of
+       2 or 3 interleaved runs: Cook N = 8 0.76 -> 0.64 s, the beam 3.9 -> 2.3 s), so
        still 12 to 38 times the nu = 0.3 count at 0.4999. The probe on K_dev: the saddle
        probe (heml__saddle_escape) solves K x = b to 1e-10 after Newton converged, and with
        the nodal pressure K = K_dev + s G^T Dn G (K_dev the tangent with the nodal dP_a held
@@ -384,13 +386,13 @@
        small-strain diagonal and a coarse space built from the deviatoric small-strain
        stiffness, lambda -> -2 mu / 3) there is none on K either; otherwise the full probe
        runs as before. Its conditioning is that of mu: 169 iterations on Cook N = 8 at
-       every nu, against 155 (nu = 0.3) to 1,706 (0.4999) for the full probe, 3,744 on
-       Cook N = 16; dearer than the full probe at small bulk-to-shear ratios, so it runs
+       every nu, against 155 (nu = 0.3) to 1,706 (0.4999) for the full probe (3,744 on
+       Cook N = 16 at 0.4999); dearer than the full probe at small bulk-to-shear ratios, so it runs
        only where every material's kappa >= 20 mu (nu >= 0.476). Tested: K_dev against
        closed forms at rest (a dilation gives 0, an isochoric shear gives K v), symmetric
-       and below K at a deformed state, the same Cook answer bit for bit, a buckled
-       column's saddle still caught. Tried, and
-       not kept (git history of branch i-anp, commit 84d59f2, reverted): the textbook
+       and below K at a deformed state, the same Cook answer bit for bit, a compressed
+       column's saddle still caught (in double; in float the static solve accepts that
+       saddle with or without the shortcut). Tried, and not kept (git history of branch i-anp, commit 84d59f2, reverted): the textbook
        kappa-robust route, the equivalent saddle-point system [D + c K_dev, G^T E; E G,
        -Sigma] (K_dev the element pass with dP_a = 0, G du = sum Vol dJ / 4, E =
        sqrt(c s |d_a|), d_a = sum W U'' / V_a^2: eliminating the pressure gives exactly
