@@ -372,14 +372,17 @@
        Krylov iterations in total (Newton iterations), for nu = 0.3, 0.49, 0.499, 0.4999 at
        mu fixed, the bulk modulus from nu; Cook six tetrahedra per cell; the beam 1 x 0.1 x
        0.1, 40 x 4 x 4 cells of five, clamped, tip load, linear range):
-           Cook N = 8     490 (4)    743 (5)   2,256 (9)    5,729 (11)
-           Cook N = 16    449 (5)  1,484 (9)   3,430 (10)  17,103 (16)
-           beam 40x4x4    111 (2)    455 (3)     933 (3)    2,228 (3)
-       (bench/heml_nodal_krylov.c; before the K_dev probe below, at nu = 0.49, 0.499,
-       0.4999: Cook N = 8 814, 2,701, 7,262, N = 16 1,658, 4,350, 20,692, the beam 458,
-       1,357, 3,653; the answers the same to every printed digit; time at 0.4999, best of
-       2 or 3 interleaved runs: Cook N = 8 0.76 -> 0.64 s, the beam 3.9 -> 2.3 s), so
-       still 12 to 38 times the nu = 0.3 count at 0.4999. The probe on K_dev: the saddle
+           Cook N = 8     490 (4)    745 (5)   2,243 (9)    5,738 (11)
+           Cook N = 16    449 (5)  1,480 (9)   3,434 (10)  13,446 (13)
+           beam 40x4x4    111 (2)    455 (3)     933 (3)    2,223 (3)
+       (bench/heml_nodal_krylov.c. Before the K_dev probe below, on the code before issue
+       21's coarse changes, at nu = 0.49, 0.499, 0.4999: Cook N = 8 814, 2,701, 7,262,
+       N = 16 1,658, 4,350, 20,692 (16), the beam 458, 1,357, 3,653; with it, on that code,
+       743, 2,256, 5,729, 1,484, 3,430, 17,103 (16), 455, 933, 2,228: the round-off of the
+       coarse correction moves Newton's path at 0.4999, by up to a fifth of the count. The
+       answers the same to every printed digit; time at 0.4999, best of 2 or 3 interleaved
+       runs: Cook N = 8 0.76 -> 0.64 s, the beam 3.9 -> 2.3 s), so still 12 to 30 times the
+       nu = 0.3 count at 0.4999. The probe on K_dev: the saddle
        probe (heml__saddle_escape) solves K x = b to 1e-10 after Newton converged, and with
        the nodal pressure K = K_dev + s G^T Dn G (K_dev the tangent with the nodal dP_a held
        at 0, G du = (sum Vol dJ / 4)_a, Dn = diag(d_a), d_a = sum_mat W U''_mat(J_a) / V_a^2,
@@ -916,7 +919,7 @@
          desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
          BODIES), which removes the volumetric locking, not the bending one.
        - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
-         shear ratio (12 to 38 times more at nu = 0.4999 than at nu = 0.3; the saddle
+         shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
          probe's share is cut by running it on the deviatoric stiffness first, but a
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
          robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
