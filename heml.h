@@ -419,8 +419,13 @@
        0.02: no gain.
        The nodal pressure field also oscillates between neighbouring nodes
        near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
-       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
-       smoothed, e.g. as the element means p_e, not node by node. The bench's Poisson beam
+       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): a checkerboard, as
+       linear displacements with nodal pressures are not an inf-sup stable pair. One pass of
+       smoothing (element means p_e spread back to the nodes) is not enough (a neighbour
+       indicator of 0.5 to 1.15 against a smooth field's 0.04 to 0.4); three passes give a
+       smooth field that both tetrahedral splits agree on (tests/test_heml_solve.c
+       test_nodal_pressure_cook): read pressures smoothed three times, never node by node.
+       A stabilised pressure is not done (issue 13 open). The bench's Poisson beam
        (1 x 0.1 x 0.1 m, 30 x 3 x 3 cells of five tetrahedra, tip against Timoshenko): 14.4,
        18.9, 22.5, 25.9 % off at nu = 0.3, 0.45, 0.49, 0.499 (plain 18.5, 22.4, 26.6,
        30.2 %); of six tetrahedra per cell at nu = 0.499 the tip is 0.0071 m instead of
@@ -923,8 +928,8 @@
          probe's share is cut by running it on the deviatoric stiffness first, but a
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
          robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
-         oscillates between neighbouring nodes near nu = 0.5 (smooth the pressure before
-         reading it); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read it smoothed
+         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
