@@ -163,7 +163,7 @@ int BENCH_GLUE_ROWS(int quick, double *v)
     frm_model_set_solver(f, (frm_real)1e-9, 20000, (frm_real)1e-6, 50);
     heml_set_solver(h, (heml_real)1e-9, 20000);
     nodes = glue_face(10, 2, &n);
-    if (glue_init(&gl, h, f, &pd, nodes, n, 0.3 * 1e6 * 0.05)) return -1;
+    if (glue_init_heml(&gl, h, f, &pd, nodes, n, 0.3 * 1e6 * 0.05)) return -1;
     gl.depth = GLUE_DEPTH;
     t0 = glue_now();
     for (step = 0; step < 20 && !err; step++) {
@@ -192,7 +192,7 @@ int BENCH_GLUE_ROWS(int quick, double *v)
     heml_destroy(h);
     if (glue_frames(nx, 2, 8, 0.5, 2e11, rho, &f, &pd, &hexes) || glue_heml(nx, 2, 8, 8, 0.5, 2e11, rho, &h)) return -1;
     nodes = glue_face(nx, 2, &n);
-    if (glue_init(&gl, h, f, &pd, nodes, n, 0.3 * 2e11 * 0.25)) return -1;
+    if (glue_init_heml(&gl, h, f, &pd, nodes, n, 0.3 * 2e11 * 0.25)) return -1;
     gl.depth = GLUE_DEPTH;
     err = glue_solve(&gl, 0, 1e-6, 30);
     v[4] = 100 * (glue_sag(h, NULL, NULL, 16, 0.5) / timo - 1);

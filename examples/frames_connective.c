@@ -176,7 +176,7 @@ int main(int argc, char **argv)
         if (x[2] > 0.0499) glued[ng++] = i; /* the top face: glued to the layer */
         if (x[2] < 1e-9 && fabs(x[0] - 0.05) <= 0.026 && fabs(x[1] - 0.05) <= 0.026) pushed[np++] = i;
     }
-    err = glue_init(&gl, h, f, &pd, glued, ng, 0.3 * 1e4 * (0.1 / NX));
+    err = glue_init_heml(&gl, h, f, &pd, glued, ng, 0.3 * 1e4 * (0.1 / NX));
     if (err) {
         fprintf(stderr, "frames_connective: glue: %s\n", frm_error_string(err));
         return 1;
