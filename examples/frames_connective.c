@@ -198,7 +198,7 @@ int main(int argc, char **argv)
         total += (double)(clock() - t0) / CLOCKS_PER_SEC;
         if (err) {
             fprintf(stderr, "frames_connective: step %d: %s\n", step,
-                    err == -1 ? "coupling did not converge" : err > 500 ? heml_error_string(err - 1000) : frm_error_string(err));
+                    glue_error_string(&gl, err));
             return 1;
         }
         iterations += gl.iterations;

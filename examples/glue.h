@@ -5,8 +5,8 @@
    compiled (on its guard macro, HEML_H or TENSORMASS_H), glue_init_heml / glue_init_tmass.
    Used by tests/test_frames_coupling.c, examples/frames_connective.c and
    bench/model_glue.c; frames.h's COUPLING section explains the schemes and their measured
-   limits. Everything is static; errors: 0, a frames.h code, 1000 + the mesh header's code
-   (glue_error_string names either), or -1 (glue_solve at its cap). Allocation: the
+   limits. Everything is static; errors: 0, a frames.h code, 1000 + the mesh header's code,
+   or GLUE_ERR_NOT_CONVERGED (glue_solve at its cap); glue_error_string names each. Allocation: the
    glue_init_* functions only. The glue owns the frames' external loads and the glued
    nodes' external forces (the coupling writes and clears them). */
 #ifndef GLUE_H
@@ -35,6 +35,7 @@
    frames as loads (J^T f), once a step. Steps: implicit Euler in the mesh (HEML_ /
    TMASS_IMPLICIT_EULER), the frames model's own integrator (frm_model_step_ex). */
 #define GLUE_DEPTH 6
+#define GLUE_ERR_NOT_CONVERGED (-1000) /* glue_solve at max_iterations (not a header's code) */
 typedef struct glue glue;
 
 /* What the glue asks of a mesh: one table per mesh header (the adapters below). The
@@ -265,6 +266,7 @@ static inline int glue_init_tmass(glue *gl, tmass_model *t, frm_model *f, const 
 /* The name of a glue code: the mesh header's for 1000 + its code, else frames.h's. */
 static inline const char *glue_error_string(const glue *gl, int err)
 {
+    if (err == GLUE_ERR_NOT_CONVERGED) return "the coupling iteration did not converge within max_iterations";
     return err > 500 ? gl->ops->error_string(err - 1000) : frm_error_string(err);
 }
 
@@ -382,7 +384,8 @@ static inline void glue_lsq(const double *dR, int N, int m, const double *r, dou
 
 /* The coupled step (dt > 0) or static solve (dt = 0), stiff coupling: Gauss-Seidel with
    Anderson mixing until max |g - x| <= tol (m), at most max_iterations maps. Returns 0, a
-   model's code (both models back at the start state for a step) or -1 at the cap. */
+   model's code or GLUE_ERR_NOT_CONVERGED at the cap (both models back at the start state
+   for a step). */
 static inline int glue_solve(glue *gl, double dt, double tol, int max_iterations)
 {
     int N = 3 * gl->n, it, i, m = 0, head = 0, err = 0, nf = frm_model_frame_count(gl->f);
@@ -432,7 +435,7 @@ static inline int glue_solve(glue *gl, double dt, double tol, int max_iterations
         } else
             memcpy(gl->x, gl->g, sizeof(double) * (size_t)N);
     }
-    if (!err) err = -1;
+    if (!err) err = GLUE_ERR_NOT_CONVERGED;
     if (dt > 0) { /* failed: both back at the step's start */
         gl->ops->state(gl, 1);
         frm_model_set_poses(gl->f, gl->fp, gl->fq);

@@ -1502,7 +1502,11 @@ static void test_glue_steel_cantilever(void)
    of the first period, 2 s; the mesh's implicit Euler): every step converges, the tip
    never falls more than 2.2 times the static sag (a body released from rest overshoots to
    twice its sag at most; 10 % for the nonlinearity) and reaches a fifth of it (it falls),
-   within 30 iterations a step. */
+   within 30 iterations a step. Measured (double): static sags 0.1661 m (heml.h) and
+   0.1599 m (tensormass.h), peaks 0.1138 and 0.1141 m at the last step (after 0.5 s the
+   tip is still approaching the sag: mass damping 2/s and implicit Euler's own damping),
+   at most 9 and 7 iterations a step. The tensormass.h half steps with the springs on the
+   frames' side (robin_frames = 1, as float does), so both sides of glue_map run. */
 static double mesh_tip_sag(heml_model *h, tmass_model *t, double x, double b);
 static int tmass_box(int nx, int ny, int nz, double x0, double sx, double sy, double sz, double E, double rho,
                      tmass_model **m);
@@ -1573,7 +1577,7 @@ static void soft_implicit_run(int tm)
        either side (its residual stalls at float's round-off above that); at 1e-3 every
        step converges and the trajectory is double's to the printed digits (heml.h: peak
        and end 0.1138 m in both). */
-    if (IS_FLOAT) gl.robin_frames = 1;
+    if (IS_FLOAT || tm) gl.robin_frames = 1; /* tensormass.h: so both sides of glue_map run in double too */
     frm_model_set_solver(f, (frm_real)(IS_FLOAT ? 1e-5 : 1e-9), 20000, (frm_real)(IS_FLOAT ? 1e-3 : 1e-6), 50);
     for (step = 0; step < (TEST_IS_QUICK ? 30 : 50); step++) {
         int err = glue_solve(&gl, dt, IS_FLOAT ? 1e-5 : 1e-7, 30);
