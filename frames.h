@@ -1078,8 +1078,8 @@
    the factor stores D_i^-1 and E_i^T, so the solve is two sweeps of 6x6 products: forward
    y_i = b_i - E_{i-1} y_{i-1} (and z_i = D_i^-1 y_i off the chain), backward
    x_i = z_i - E_i^T x_{i+1} (each 6x6 product as two partial sums, so a block adds three
-   multiply-adds and an add to a sweep's dependency chain instead of six multiply-adds:
-   solve 22.8 -> 20.2 us for 1,000 blocks, -O3 -march=native, best of 50). D_i^-1, E_i and D_{i+1} come from one symmetric sweep
+   multiply-adds and an add to a sweep's dependency chain instead of six multiply-adds).
+   D_i^-1, E_i and D_{i+1} come from one symmetric sweep
    (Gauss-Jordan) of the 12 x 12 window [D_i B_i^T; B_i A(i + 1, i + 1)] over its first six
    pivots: each pivot costs one division, and the next pivot is formed from it by one
    multiply-add, so the sequential chain of the whole factorisation is 6 (division +
@@ -1104,6 +1104,14 @@
    solve is not met: the sweep is bound by its row updates' throughput (about 650
    multiply-adds a block on 6-wide rows) more than by the division chain (about 100 cycles
    a block); the bench's btd rows give the timings under the bench's load.
+   Kept since (issue 15's speed item, second pass): in double builds with vector rows the
+   factor stores D_i^-1 and E_i^T straight from the registers instead of staging them
+   through arrays, and the solve's 6x6 products are two partial sums each. Measured
+   (AMD EPYC Zen 5, family 26, 2 vCPUs shared with other builds, gcc -O3 -march=native,
+   1,000 blocks, best of 50, the two versions run interleaved, 10 times each):
+   factor + solve 109.3 + 23.1 = 132.9 us before, 96.8 + 20.2 = 117.3 us after; plain
+   gcc -O2: 217.0 + 42.8 = 260.5 us before, 228.1 + 41.2 = 269.7 us after (the factor
+   within the noise). The 50 us goal is still not met.
    Tried for the goal and not kept (AMD EPYC Zen 5, family 26, AVX-512, about 3.6 GHz by a
    multiply-add latency loop, 2 vCPUs shared with other builds, load average 7-9; gcc 12-14
    -O3 -march=native, best of 50, 1,000 blocks, factor / solve in us; the original 107 /
@@ -10783,6 +10791,20 @@ FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, fr
         FRM__BTD_PIVOT(3);
         FRM__BTD_PIVOT(4);
         FRM__BTD_PIVOT(5);
+#if defined(FRM__BTD_VECTOR) && !FRM__CAT(FRM__IS_, FRM_REAL)
+        { /* double: rows stored straight from the registers (factor 109 -> 97 us for 1,000
+             blocks against staging them through arrays, -O3 -march=native, best of 50) */
+            frm__v8 acc = U[0], d;
+            for (a = 0; a < 6; a++) {
+#define FRM__BTD_OUT(P) d.P = -T[a].P, acc.P = a ? acc.P + U[a].P : acc.P;
+                FRM__BTD_PARTS(FRM__BTD_OUT)
+#undef FRM__BTD_OUT
+                FRM__BTD_STORE(Dout + 6 * a, d);
+                FRM__BTD_STORE(Eout + 6 * a, U[a]);
+            }
+            for (b = 0; b < 6; b++) usum += FRM__BTD_LANE(acc, b);
+        }
+#else
         for (a = 0; a < 6; a++) {
             FRM__BTD_STORE(t[a], T[a]);
             FRM__BTD_STORE(u[a], U[a]);
@@ -10792,6 +10814,7 @@ FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, fr
                 usum += u[a][b];
             }
         }
+#endif
         if (!frm__finite(usum)) {
             if (failed_block) *failed_block = i;
             return FRM_ERR_NOT_FINITE;
