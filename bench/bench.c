@@ -9,7 +9,8 @@
    --budget: a refinement series stops at the first level whose answer takes longer
    (default 2 s; law variants get a quarter). Raise it to see finer levels.
 
-   1. trade: scenes with known answers (REFERENCES.md R1-R5 and a cutting scene; R1 and R3
+   1. trade: scenes with known answers (REFERENCES.md R1-R5, a cutting scene and NI, a
+      near-incompressible cantilever against Timoshenko (issue 13); R1 and R3
       against the converged 3D solid, R3's frequency corrected for the integrator's phase
       error, see integrator_frequency; beam tips read at the free face's centre through
       the models' point probes, tip_deflection), for every
@@ -683,6 +684,51 @@ static void trade_cut(const bench_model *m, const options *o)
     }
 }
 
+/* NI: near-incompressible tissue (issue 13). The Poisson rows' cantilever (1 x 0.1 x
+   0.1 m, E = 1 MPa, nu = 0.499, its own weight scaled for a tip deflection of about 1 cm:
+   strains below 1e-3, where every law is linear elasticity) refined as 10k x k x k cells,
+   static, against Timoshenko's tip deflection with shear (timoshenko_tip, kappa = 10 (1 +
+   nu) / (12 + 11 nu)): an analytic answer valid as nu -> 0.5, independent of every model.
+   How far beam theory is from the 3D solid at this slenderness (the clamped face restrains
+   the section's warping and its lateral contraction) bounds what the table's 1 % row can
+   mean: see the README's figures. Every entry with a static solver runs it, the option
+   entries (primary -1: heml nodal-p, frames vol=) included, at the full budget (they are
+   what the scene is for); law variants (primary 0) do not (at 1e-3 strain a law is a law),
+   nor float entries (locking is not a matter of precision; floats doubled the scene's time
+   and a float frames tet4 solve at k = 6 ran 79 s to fail). Levels from k = 2: one cell
+   across cannot bend a near-incompressible section, its errors are accidents of
+   cancellation (frames svk tet4 measured 2.4 % at k = 1, 15.5 % at k = 2); to k = 6: k = 8
+   took 3 to 5 s an entry and no entry reached 10 % there that had not at k = 6 (plain P1
+   10.8 %), which kept the scene near 40 s. */
+static void trade_ni(const bench_model *m, const options *o)
+{
+    static const int levels[] = {2, 3, 4, 6};
+    int l, n = o->quick ? 1 : 4;
+    if (!(m->integrators & BIT(BENCH_STATIC)) || !m->primary || strcmp(m->precision, "double")) return;
+    for (l = 0; l < n; l++) {
+        int k = levels[l];
+        bench_body b = make_body(1, 0.1, 0.1, 10 * k, k, k, 1e6, 0.499, 1000);
+        void *sim = NULL;
+        trade_row *r = new_row("NI", m, "static nu=0.499", k);
+        if (!r) return;
+        b.gravity[2] = -0.01 / 1.5e5 * b.young;
+        r->reference = timoshenko_tip(1, 0.1, b.young, b.poisson, b.density, -b.gravity[2]);
+        r->status = timed_static(m, &b, o->repeats, &sim, r);
+        if (!r->status) {
+            r->value = tip_deflection(m, sim, &b);
+            r->error = relative_error(r->value, r->reference);
+        }
+        if (sim) m->destroy(sim);
+        print_row(r);
+        /* past the budget, or predicted (seconds growing at least as the cells, k^3) to
+           take over twice the budget at the next level: frames svk tet4's k = 6 took 8 s
+           on the loaded Zen 5 for 9.3 % */
+        if (r->answer_s > o->budget || (r->status && l > 0) ||
+            (l + 1 < n && r->answer_s * pow((double)levels[l + 1] / k, 3) > 2 * o->budget))
+            break;
+    }
+}
+
 typedef struct scene {
     const char *name, *title;
     void (*run)(const bench_model *m, const options *o);
@@ -695,6 +741,7 @@ static const scene scenes[] = {
     {"R4", "R4 uniaxial stretch, St Venant-Kirchhoff P_zz", trade_r4},
     {"R5", "R5 uniaxial stretch, Neo-Hookean P_zz", trade_r5},
     {"cut", "cutting a notch vs rebuilding the mesh without it", trade_cut},
+    {"NI", "NI near-incompressible cantilever (nu = 0.499), static tip vs Timoshenko", trade_ni},
 };
 
 static void series_name(const trade_row *r, char *out, size_t size)
@@ -789,7 +836,8 @@ static void print_cheapest(void)
         }
 }
 
-static void run_trade(const options *o, const bench_model *const *models, int count)
+static void run_trade(const options *o, const bench_model *const *models, int count,
+                      const bench_model *const *variants, int variant_count)
 {
     FILE *f;
     int s, i;
@@ -803,6 +851,8 @@ static void run_trade(const options *o, const bench_model *const *models, int co
                    "schemes w = tan(w_h dt) / dt, semi-implicit Euler w = 2 sin(w_h dt / 2) / dt; \"measured\" is "
                    "the uncorrected one)\n");
         for (i = 0; i < count; i++) scenes[s].run(models[i], o);
+        if (scenes[s].run == trade_ni) /* the options against locking (primary -1) too */
+            for (i = 0; i < variant_count; i++) scenes[s].run(variants[i], o);
         printf("  (%s: %.1f s)\n", scenes[s].name, now() - t0);
     }
     finish_r2();
@@ -1781,6 +1831,7 @@ static int kernel_models(const options *o, const bench_model *const *models, int
             for (i = 0; i < pc && n < 256; i++) out[n++] = peers + i;
     }
 #else
+    (void)o;
     printf("Bullet rows skipped: install Debian's libbullet-dev (apt-get install libbullet-dev) and rebuild the "
            "bench (make build/bench/bench) to time Bullet's Neo-Hookean and corotated forces and implicit step\n");
 #endif
@@ -1982,7 +2033,7 @@ int main(int argc, char **argv)
     options o;
     static const bench_model *models[256], *variants[64];
     int i, count = 0, variant_count = 0;
-    double t0 = now();
+    double t0 = now(), tp, part_time[5] = {0, 0, 0, 0, 0}; /* trade, stability, sweep, time, kernels */
     memset(&o, 0, sizeof o);
     o.repeats = 3;
     o.threads = 2;
@@ -2027,9 +2078,10 @@ int main(int argc, char **argv)
 #endif
     }
     set_threads(1);
-    if (o.parts & 1) run_trade(&o, models, count);
+    tp = now();
+    if (o.parts & 1) run_trade(&o, models, count, variants, variant_count), part_time[0] = now() - tp, tp = now();
     set_threads(1);
-    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count);
+    if (o.parts & 2) run_stability(&o, models, count, variants, variant_count), part_time[1] = now() - tp, tp = now();
     set_threads(1);
     if (o.parts & 8) { /* the primary = -1 entries too (issue 13's options near nu = 0.5), not in --quick */
         static const bench_model *all[256];
@@ -2037,9 +2089,10 @@ int main(int argc, char **argv)
         for (i = 0; i < count && n < 256; i++) all[n++] = models[i];
         for (i = 0; i < variant_count && n < 256 && !o.quick; i++) all[n++] = variants[i];
         run_sweep(&o, all, n);
+        part_time[2] = now() - tp, tp = now();
     }
     set_threads(1);
-    if (o.parts & 16) run_time(&o, models, count);
+    if (o.parts & 16) run_time(&o, models, count), part_time[3] = now() - tp, tp = now();
     if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */
         static const bench_model *all[256];
         int n = 0;
@@ -2047,7 +2100,8 @@ int main(int argc, char **argv)
         for (i = 0; i < variant_count && n < 256; i++) all[n++] = variants[i];
         run_kernels(&o, all, n);
     }
-    if (o.parts & 4) run_chain(&o);
-    printf("\nbench: done in %.0f s; results in %s/\n", now() - t0, o.out);
+    if (o.parts & 4) run_chain(&o), part_time[4] = now() - tp;
+    printf("\nbench: done in %.0f s (trade %.0f, stability %.0f, sweep %.0f, time %.0f, kernels %.0f); results in "
+           "%s/\n", now() - t0, part_time[0], part_time[1], part_time[2], part_time[3], part_time[4], o.out);
     return 0;
 }

@@ -1150,14 +1150,126 @@ static void test_stress_sweep(void)
 
 /* ---- average nodal pressure (NEAR-INCOMPRESSIBLE BODIES) --------------------------- */
 
+/* The checkerboard indicator of a nodal field p on the nodes 8 mm or more from Cook's
+   clamped edge (its corners are singular): the RMS over those nodes of p_a minus the mean
+   of p over a's neighbours (the nodes sharing a tetrahedron with a, each counted once per
+   shared tetrahedron, among those nodes), over the standard deviation of p there. A smooth
+   field leaves only its gradient times the neighbourhood's off-centring (O(h / L)) and its
+   curvature (O(h^2 / L^2)); a node-to-node oscillation of amplitude A leaves about A. */
+static double checkerboard(const tetmesh *mesh, const double *p)
+{
+    double *sum = (double *)calloc((size_t)mesh->node_count, sizeof(double)), mean = 0, var = 0, res = 0;
+    int *cnt = (int *)calloc((size_t)mesh->node_count, sizeof(int)), t, a, b, i, n = 0;
+    if (!sum || !cnt) {
+        free(sum), free(cnt);
+        return HUGE_VAL;
+    }
+    for (t = 0; t < mesh->tet_count; t++)
+        for (a = 0; a < 4; a++)
+            for (b = 0; b < 4; b++) {
+                int na = mesh->tets[4 * t + a], nb = mesh->tets[4 * t + b];
+                if (a == b || mesh->nodes[3 * na] < 8 || mesh->nodes[3 * nb] < 8) continue;
+                sum[na] += p[nb];
+                cnt[na]++;
+            }
+    for (i = 0; i < mesh->node_count; i++)
+        if (cnt[i]) mean += p[i], n++;
+    mean /= n;
+    for (i = 0; i < mesh->node_count; i++)
+        if (cnt[i]) {
+            double r = p[i] - sum[i] / cnt[i];
+            var += (p[i] - mean) * (p[i] - mean);
+            res += r * r;
+        }
+    free(sum), free(cnt);
+    return sqrt(res / var);
+}
+
+/* The nodal pressure of a Neo-Hookean body computed here from the positions and the mesh
+   alone (heml.h's definition, NEAR-INCOMPRESSIBLE BODIES): J_a = the current volume of
+   the tetrahedra around node a over their rest volume (sum Vol_e J_e / sum Vol_e), and
+   P_a = U'(J_a), U(J) = w(J^(1/3) I) = mu/2 (3 J^(2/3) - 3) - mu ln J + lambda/2 ln^2 J.
+   Also the element-wise pressures averaged to the nodes the same way (the P1 element's
+   own pressure U'(J_e), volume-weighted), into pe. */
+static void cook_nodal_pressure(const tetmesh *mesh, const heml_real *u, double mu, double lambda, double *p,
+                                double *pe)
+{
+    int t, a, k, i;
+    double *v0 = (double *)calloc((size_t)mesh->node_count, sizeof(double));
+    double *v1 = (double *)calloc((size_t)mesh->node_count, sizeof(double));
+    for (i = 0; i < mesh->node_count; i++) p[i] = pe[i] = 0;
+    if (!v0 || !v1) {
+        free(v0), free(v1);
+        return;
+    }
+    for (t = 0; t < mesh->tet_count; t++) {
+        double e0[3][3], e1[3][3], V0, V1, J;
+        const int *n = mesh->tets + 4 * t;
+        for (a = 0; a < 3; a++)
+            for (k = 0; k < 3; k++) {
+                e0[a][k] = mesh->nodes[3 * n[a + 1] + k] - mesh->nodes[3 * n[0] + k];
+                e1[a][k] = e0[a][k] + (double)u[3 * n[a + 1] + k] - (double)u[3 * n[0] + k];
+            }
+        V0 = (e0[0][0] * (e0[1][1] * e0[2][2] - e0[1][2] * e0[2][1]) - e0[0][1] * (e0[1][0] * e0[2][2] - e0[1][2] * e0[2][0]) +
+              e0[0][2] * (e0[1][0] * e0[2][1] - e0[1][1] * e0[2][0])) / 6;
+        V1 = (e1[0][0] * (e1[1][1] * e1[2][2] - e1[1][2] * e1[2][1]) - e1[0][1] * (e1[1][0] * e1[2][2] - e1[1][2] * e1[2][0]) +
+              e1[0][2] * (e1[1][0] * e1[2][1] - e1[1][1] * e1[2][0])) / 6;
+        J = V1 / V0;
+        for (a = 0; a < 4; a++) {
+            v0[n[a]] += V0;
+            v1[n[a]] += V1;
+            pe[n[a]] += V0 * (mu * pow(J, -1.0 / 3) - mu / J + lambda * log(J) / J);
+        }
+    }
+    for (i = 0; i < mesh->node_count; i++) {
+        double J = v1[i] / v0[i];
+        p[i] = mu * pow(J, -1.0 / 3) - mu / J + lambda * log(J) / J;
+        pe[i] /= v0[i];
+    }
+    free(v0), free(v1);
+}
+
+/* One smoothing pass of a nodal field: each tetrahedron's mean of its four nodes' values
+   (the p_e the element itself sees), averaged back to the nodes weighted by rest volume. */
+static void cook_smooth(const tetmesh *mesh, const double *p, double *out)
+{
+    double *w = (double *)calloc((size_t)mesh->node_count, sizeof(double));
+    int t, a, k, i;
+    for (i = 0; i < mesh->node_count; i++) out[i] = 0;
+    if (!w) return;
+    for (t = 0; t < mesh->tet_count; t++) {
+        const int *n = mesh->tets + 4 * t;
+        double e[3][3], V, pm = (p[n[0]] + p[n[1]] + p[n[2]] + p[n[3]]) / 4;
+        for (a = 0; a < 3; a++)
+            for (k = 0; k < 3; k++) e[a][k] = mesh->nodes[3 * n[a + 1] + k] - mesh->nodes[3 * n[0] + k];
+        V = fabs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]));
+        for (a = 0; a < 4; a++) out[n[a]] += V * pm, w[n[a]] += V;
+    }
+    for (i = 0; i < mesh->node_count; i++) out[i] /= w[i];
+    free(w);
+}
+
 /* Cook's membrane (REFERENCES R10) on an N x N x 1 hexahedral mesh of the tapered panel,
    1 mm thick, each hexahedron cut by `split` (TETMESH_SPLIT5 or TETMESH_SPLIT6): left edge
    clamped, u_z = 0 everywhere (plane strain), 100 N per mm of thickness in y on the right
    edge (trapezoid-rule node shares), mm, N, MPa. Returns the static solve's code; the
    corner (48, 60)'s vertical displacement, the Krylov iterations and the largest jump of
    the nodal pressure between neighbouring nodes of the midplane relative to the pressure's
-   range go to the outputs. */
-static int cook(int N, int split, int nodal, double bulk, double *uy, int *krylov, double *jump)
+   range go to the outputs; with checker (checkerboard(), on the nodes 8 mm or more from
+   the clamped edge):
+   [0] the indicator of the nodal pressure computed from the positions
+   (cook_nodal_pressure), [1] of that pressure smoothed once (cook_smooth: the element
+   means p_e the force uses, back to the nodes), [2] of a smooth field on the same nodes
+   (sin(pi x / 96) (y / 60)^2: the indicator's floor on this mesh), [3] the largest
+   difference between the computed nodal pressure and the model's own (nod_p, internal; 0
+   without nodal pressure) over the pressure's standard deviation, [4] the indicator of the
+   P1 element pressures U'(J_e) averaged to the nodes, [5] of the displacement u_y (an
+   hourglass pattern would show there), [6] of the nodal pressure smoothed three times;
+   with smoothed (2 (N + 1)^2 values), that thrice-smoothed pressure (NAN on the nodes
+   nearer the clamped edge) */
+static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *krylov, double *jump,
+                   double checker[7], double *smoothed)
 {
     tetmesh mesh;
     heml_desc d = heml_default_desc();
@@ -1220,6 +1332,46 @@ static int cook(int N, int split, int nodal, double bulk, double *uy, int *krylo
                 }
         *jump = worst / (pmax - pmin);
     }
+    if (checker) {
+        double *p = (double *)malloc(sizeof(double) * 3 * (size_t)mesh.node_count), *pe = p + mesh.node_count,
+               *ps = pe + mesh.node_count, worst = 0, sd;
+        if (!p) {
+            heml_destroy(m);
+            tetmesh_free(&mesh);
+            return HEML_ERR_ALLOC;
+        }
+        cook_nodal_pressure(&mesh, heml_displacements(m), mu, bulk - 2.0 / 3.0 * mu, p, pe);
+        for (i = 0; i < mesh.node_count; i++)
+            ps[i] = sin(3.14159265358979 * mesh.nodes[3 * i] / 96) * pow(mesh.nodes[3 * i + 1] / 60, 2);
+        checker[0] = checkerboard(&mesh, p);
+        checker[4] = checkerboard(&mesh, pe);
+        cook_smooth(&mesh, p, pe);
+        checker[1] = checkerboard(&mesh, pe);
+        checker[2] = checkerboard(&mesh, ps);
+        for (i = 0; i < mesh.node_count; i++) ps[i] = (double)heml_displacements(m)[3 * i + 1];
+        checker[5] = checkerboard(&mesh, ps);
+        cook_smooth(&mesh, pe, ps);
+        cook_smooth(&mesh, ps, pe);
+        checker[6] = checkerboard(&mesh, pe);
+        for (i = 0; smoothed && i < mesh.node_count; i++) smoothed[i] = mesh.nodes[3 * i] >= 8 ? pe[i] : NAN;
+        checker[3] = 0;
+        if (nodal && m->nod_p) {
+            double mean = 0, var = 0;
+            int n = 0;
+            for (i = 0; i < mesh.node_count; i++)
+                if (mesh.nodes[3 * i] >= 8) mean += p[i], n++;
+            mean /= n;
+            for (i = 0; i < mesh.node_count; i++)
+                if (mesh.nodes[3 * i] >= 8) {
+                    double d = fabs(p[i] - (double)m->nod_p[i]);
+                    var += (p[i] - mean) * (p[i] - mean);
+                    worst = d > worst ? d : worst;
+                }
+            sd = sqrt(var / n);
+            checker[3] = worst / sd;
+        }
+        free(p);
+    }
     heml_destroy(m);
     tetmesh_free(&mesh);
     return err;
@@ -1230,29 +1382,104 @@ static int cook(int N, int split, int nodal, double bulk, double *uy, int *krylo
    tetrahedra 2.65, 4.38, 5.99, 6.61 mm with nodal_pressure, 2.15, 2.17, 2.22, 2.38 mm
    without; into five 2.46, 4.23, 6.13, 6.68 mm with, 2.26, 3.19, 5.20, 6.33 mm without;
    approaching about 6.9 mm as O(h)). Here: both splits agree within 5 % with nodal
-   pressure (they differ by a factor 1.5 without), the locked six-tetrahedron split moves
-   at least 1.8 times further with it, and no answer exceeds the converged 6.9 mm by more
-   than 2 % (P1 displacements converge from below). The nodal pressure is not free of
-   oscillation: its largest jump between neighbouring nodes away from the clamped edge
-   is 0.8 to 1.0 of its range there (printed, not asserted; see LIMITS). */
+   pressure (they differ by a factor 1.5 without), their difference shrinks under
+   refinement (7.4 % at N = 4, 3.5 % at 8: asserted below 0.6 times, O(h) would give 0.5),
+   the locked six-tetrahedron split moves at least 1.8 times further with it, and no answer
+   exceeds the converged 6.9 mm by more than 2 % (P1 displacements converge from below).
+
+   The nodal pressure (issue 13: "no checkerboard or hourglass pattern in the nodal
+   pressure"), by the indicator of checkerboard(): the RMS of p_a minus its neighbours'
+   mean over p's standard deviation, on the nodes 8 mm or more from the clamped edge. Its
+   floor on these meshes, a smooth field's value, is 0.25 / 0.42 (five / six tetrahedra a
+   cell) at N = 4, 0.10 / 0.21 at 8, 0.035 / 0.10 at 16: O(h) (the neighbourhoods are off
+   centre); a node-to-node oscillation as large as the field gives about 1 or more.
+   Measured (gcc -O2, double; the pressure computed here from the positions and the mesh,
+   J_a = current over rest volume of a's tetrahedra, P_a = U'(J_a), which equals the
+   model's own nod_p to 1e-11 of its spread):
+       nodal pressure, option on     N = 4, 8, 16: 1.25 1.24 1.23 (five)   1.21 1.22 1.21 (six)
+       the same smoothed once               1.13 1.15 0.96 (five)   0.95 0.83 0.51 (six)
+       plain P1 (option off), nodal J_a     1.17 1.21 1.22 (five)   0.51 0.58 0.67 (six)
+       the same smoothed once               0.64 0.85 0.82 (five)   0.27 0.24 0.27 (six)
+       displacement u_y, option on          about the floor (no hourglass in u)
+   So the issue's requirement does NOT hold for the raw field: the average nodal pressure
+   tetrahedron's pressure is checkerboarded (P1 displacements with nodal pressures do not
+   satisfy the inf-sup condition), at every N and for both splits, and one pass of element
+   averaging (p_e) does not remove it; the static tolerance is not the cause (1e-10
+   instead of 1e-9 changed no figure). Averaging the two planes of this one-cell-thick
+   slab, z = 0 and 1, lowers the five-tetrahedron indicator to 0.38, 0.25, 0.21 (part of
+   its pattern is through the thickness), not the six's (0.80, 0.85, 0.81). Three passes
+   of the element-mean smoothing (cook_smooth) do: 0.31 0.17 0.058 (five), 0.31 0.13 0.039
+   (six) at N = 4, 8, 16, under 2.5 times the (unsmoothed) smooth field's floor, and the
+   two splits' thrice-smoothed pressures then converge to one field: their RMS difference
+   is 0.27, 0.23, 0.084 of its spread at N = 4, 8, 16 (the raw fields differ by 25 to 37
+   times that spread). The checks below assert that state: the raw field checkerboarded
+   (LIMITS; a stabilised pressure in heml.h would turn them red: then invert them to
+   "below 2x the floor"), the thrice-smoothed one smooth and split-independent to 0.35 of
+   its spread at N = 8. The displacement has no hourglass pattern: its indicator stays
+   below 2.5 times the smooth field's (measured 0.15 / 0.21 at N = 8 against floors
+   0.10 / 0.21; a weak check: u_y's spread is large, a pattern under about a tenth of it
+   would pass). */
+static double cook_split_difference(const double *a, const double *b, int n)
+{
+    double mean = 0, var = 0, diff = 0;
+    int i, k = 0;
+    for (i = 0; i < n; i++)
+        if (b[i] == b[i]) mean += b[i], k++;
+    mean /= k;
+    for (i = 0; i < n; i++)
+        if (b[i] == b[i]) var += (b[i] - mean) * (b[i] - mean), diff += (a[i] - b[i]) * (a[i] - b[i]);
+    return sqrt(diff / var);
+}
+
 static void test_nodal_pressure_cook(void)
 {
-    double u5, u6, u6p, jump;
-    int it5, it6, it6p;
+    double u5, u6, u6p, u54 = 0, u64 = 0, jump, c5[7], c6[7], c6p[7], c[7], d8 = 0;
+    double s5[2 * 81], s6[2 * 81]; /* the thrice-smoothed pressures at N = 8 */
+    int it5, it6, it6p, it;
     const int N = TEST_IS_QUICK ? 6 : 8; /* (6: u_y 3.54 mm with, 2.16 without) */
+    /* P_a computed here vs nod_p, over the spread of p: double, round-off (measured 1e-12
+       to 3e-12); float, the library's J - 1 (about 1e-4) from float positions (measured
+       3e-5 to 7e-5) */
+    const double agree = IS_FLOAT ? 1e-3 : 1e-8;
     if (TEST_IS_QUICK) { /* (the reduced builds: the six-tetrahedron split only, 6 x 6) */
         u5 = 0;
     } else {
-        CHECK_INT(HEML_OK, cook(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump));
-        printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u5, it5, jump);
+        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT5, 1, 400942, &u54, &it, &jump, c, NULL));
+        CHECK_INT(HEML_OK, cook_ex(4, TETMESH_SPLIT6, 1, 400942, &u64, &it, &jump, c, NULL));
+        CHECK_INT(HEML_OK, cook_ex(8, TETMESH_SPLIT5, 1, 400942, &u5, &it5, &jump, c5, s5));
+        printf("    split 5, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f, checkerboard %.2f (smoothed "
+               "once %.2f, thrice %.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u5, it5, jump, c5[0], c5[1], c5[6],
+               c5[2], c5[5], c5[3]);
     }
-    CHECK_INT(HEML_OK, cook(N, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump));
-    printf("    split 6, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f\n", u6, it6, jump);
-    CHECK_INT(HEML_OK, cook(N, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump));
-    printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov\n", u6p, it6p);
-    if (!TEST_IS_QUICK) CHECK(fabs(u5 - u6) <= 0.05 * u6);
+    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 1, 400942, &u6, &it6, &jump, c6, TEST_IS_QUICK ? NULL : s6));
+    printf("    split 6, nodal pressure: u_y %.4f mm, %d Krylov, pressure jump %.2f, checkerboard %.2f (smoothed "
+           "once %.2f, thrice %.2f, floor %.2f, u_y %.2f), vs nod_p %.2g\n", u6, it6, jump, c6[0], c6[1], c6[6], c6[2],
+           c6[5], c6[3]);
+    CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 0, 400942, &u6p, &it6p, &jump, c6p, NULL));
+    printf("    split 6, plain P1:       u_y %.4f mm, %d Krylov, checkerboard %.2f (smoothed once %.2f)\n", u6p,
+           it6p, c6p[0], c6p[1]);
+    if (!TEST_IS_QUICK) {
+        d8 = cook_split_difference(s5, s6, 2 * 81);
+        printf("    splits at N = 4: %.4f and %.4f mm (%.1f %% apart), at N = 8 %.1f %% apart; thrice-smoothed "
+               "pressures %.2f of their spread apart\n", u54, u64, 100 * fabs(u54 - u64) / u64,
+               100 * fabs(u5 - u6) / u6, d8);
+        CHECK(fabs(u5 - u6) <= 0.05 * u6);
+        CHECK(fabs(u5 - u6) / u6 <= 0.6 * fabs(u54 - u64) / u64);
+        CHECK(c5[3] <= agree);
+        CHECK(c5[2] <= 0.3);                /* the floor: a smooth field reads smooth */
+        CHECK(c5[0] >= 3 * c5[2]);          /* LIMITS: checkerboarded (measured 1.24 / 0.10) */
+        CHECK(c5[1] >= 3 * c5[2]);          /* and smoothing once leaves it (1.15 / 0.10) */
+        CHECK(c5[6] <= 2.5 * c5[2]);        /* three times removes it (0.17 / 0.10) */
+        CHECK(c5[5] <= 2.5 * c5[2]);        /* no hourglass in the displacement */
+        CHECK(d8 <= 0.35);                  /* split-independent (measured 0.23) */
+    }
     CHECK(u6 >= (TEST_IS_QUICK ? 1.5 : 1.8) * u6p);
     CHECK(u5 <= 6.9 * 1.02 && u6 <= 6.9 * 1.02);
+    CHECK(c6[3] <= agree);
+    CHECK(c6[2] <= 0.3);
+    CHECK(c6[0] >= 3 * c6[2]);              /* LIMITS (measured 1.22 / 0.21) */
+    CHECK(c6[6] <= 2.5 * c6[2]);            /* (0.13 / 0.21) */
+    CHECK(c6[5] <= 2.5 * c6[2]);
 }
 
 /* A nearly incompressible cube (1 m, 2 x 2 x 2 cells of five tetrahedra, Neo-Hookean
