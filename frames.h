@@ -89,8 +89,10 @@
 
    STEP BY STEP
        1. Frames, samples and the neighbour table: frm_sampling_hexes / _tets (mesh-based),
-          frm_sampling_meshless (given points), frm_sampling_box / _surface (Poisson disks);
-          or fill the table yourself (any weights that sum to one, gradients to zero).
+          frm_sampling_curve (a rod: frames along a polyline), frm_sampling_meshless (given
+          points), frm_sampling_box / _surface (Poisson disks); or fill the table yourself
+          (any weights that sum to one, gradients to zero). Thin parts (a layer one element
+          thick, a curve): frm_material_thin (LIMITS, thin parts).
           Several parts (own sampling, material, density) sharing frames, and rigid bodies:
           frm_parts_combine, then frm_assembly_apply instead of frm_sampling_apply (COUPLING).
        2. frm_desc d = frm_model_default_desc(); frm_sampling_apply(&s, &d); set the
@@ -649,6 +651,17 @@
        binned by their xy boxes, shared edges counted once), frames from a coarser
        distance than samples, the volume split evenly; the k nearest frames or all within
        a radius (a grid search). The same seed gives the same points everywhere.
+       Curves (frm_sampling_curve, issue 14): frames at the nodes of a polyline, weights
+       linear along each segment (1/2 each at its midpoint, gradients -+ t / l), one
+       station a segment (the reduced rule: two Gauss stations lock the rod's shear) with
+       4 samples across the section (2 x 2 Gauss points of a rectangle, or a disk's 4
+       points at r / sqrt 2): an off-axis sample sees its frames' rotations through the
+       lever, so bending strain linear across the section is integrated exactly. The
+       frames carry rigid sections (no lateral contraction): frm_material_thin(m, 1) gives
+       the law whose lambda' + 2 mu = E with mu kept, so the rod bends with E and shears
+       with G. frm_material_thin(m, 2) gives a layer one element thick the plane-stress
+       modulus (lambda' = 2 mu lambda / (lambda + 2 mu)) its constant through-thickness
+       strain cannot give it. Measured: LIMITS, thin parts.
 
    PERFORMANCE
        Bytes each kernel streams per (sample, neighbour) pair, double (float about half):
@@ -745,12 +758,54 @@
          21 % less stress than REFERENCES R4 / R5 for s from 0.7 to 1.5 (18 % for St
          Venant-Kirchhoff at s = 1.1, 21 % for Neo-Hookean at s = 0.9; measured with
          test_i18_cube_uniaxial_load's cube_uniaxial in tests/test_frames.c).
-       - Thin parts (issue 14): a plate one cell thick of hexahedral frames solves static and
-         implicit problems and converges under refinement (tests/test_frames.c
-         test_i14_thin_plate: 1 x 1 x 0.05 m cantilever plate under its own weight, 5.85,
-         6.12, 6.20 mm at 4, 8, 16 cells a side, beam theory 5.89 mm); tetrahedral frames
-         one cell thick (one sample each) solve but do not converge in sight (2.87, 5.47,
-         7.54 mm). A thin slab loaded in its plane can buckle: Cook's membrane one element
+       - Thin parts (issue 14). Measured with tests/test_frames.c (gcc -O2, double; the
+         plate: 1 x 1 x 0.05 m, E = 1 GPa, nu = 0.3, Neo-Hookean, clamped along x = 0,
+         its own weight; beam theory 5.89 mm, the 3D answer 5.54 mm by hexahedral frames
+         4 cells thick, 16 x 16 x 4: 5.524, 32 x 32 x 4: 5.544 mm):
+           hexahedral frames one cell thick, 2^3 sub-cell samples (test_i14_thin_plate):
+             5.85, 6.12, 6.20, 6.22 mm at 4, 8, 16, 32 cells a side: converges, to +12 %
+             of the 3D answer (+6 % of beam theory; at nu = 0 +31 %: 7.85 mm against
+             5.98): the sub-cell rule under-integrates the layer and is soft;
+           tetrahedral frames one cell thick (6 a cube), one sample each: 2.87, 5.47,
+             7.54, 11.0, 13.3 mm at 4 to 64 cells: no limit (a centroid sees the layer's
+             bending only through its offset from the mid-plane; refinement adds rotation
+             modes it does not see). Use instead:
+           tetrahedral frames one cell thick, 4 Gauss points (frm_sampling_tets(.., 4,
+             NULL, ..)) and frm_material_thin(&material, 2) (test_i14_thin_tet): 1.43,
+             3.13, 4.42, 5.05, 5.37 mm at 4, 8, 16, 32, 64 cells (0.01, 0.1, 0.5, 2, 8 s
+             static on one core, Zen 5, loaded), monotone from below: the 4-point rule
+             integrates the blended field's energy exactly (a conforming model), and its
+             first-order extrapolation 2 t(n) - t(n/2) is 5.71, 5.69, 5.69 mm at n = 16,
+             32, 64 (+3 % of the 3D answer). With the true material the limit is 15 % stiff (1.37, 2.90,
+             3.96, 4.39, 4.58 mm): the layer's through-thickness strain is constant (a
+             rotated vertical lever moves sideways only), so the bending's Poisson strain
+             is held. What is still missing: the convergence is first order while the
+             cells are wider than the layer is thick (at n = 16, -20 %; at 64, -3 % of the
+             3D answer): the tetrahedra's transverse shear locks (the blended field
+             bends with an O(h) shear strain costing about 12 G / E (h / t)^2 times the
+             bending energy). Reduced rules that avoid it are soft instead: two samples a
+             tetrahedron on the centroid's vertical at the layer's Gauss levels give
+             3.53, 5.31, 6.21, 6.42 mm (limit about 6.5, +17 %; +32 % at nu = 0), for
+             any rotation_divergence (measured 4, 16, 64); an assumed-strain treatment
+             of the shear is not done. Mean dilatation (FRM_VOLUMETRIC_CELLS) does not
+             remove the Poisson stiffening (it is not volumetric) and its solves are slow.
+           a curve of frames (frm_sampling_curve, 2 x 2 section points, frm_material_thin(
+             &material, 1); test_i14_curve) on REFERENCES R1: -6.33, -1.57, -0.40, -0.10 %
+             of the rod answer (Euler-Bernoulli plus a rigid section's uniform shear,
+             q L^4 / (8 E I) + q L^2 / (2 G A) = 0.150567 m) at 4, 8, 16, 32 segments,
+             second order; 3D's 0.150169 m is 0.26 % below the rod (the clamp holds the
+             section). Static solves in 3 Newton iterations, implicit steps keep the
+             static state; R3's beam as a rod of 16 segments swings at 0.5082 Hz under
+             implicit Euler (-0.18 % of the 3D 0.5091 Hz). With the true material 25.8 % too stiff ((1 - nu) / ((1 + nu)
+             (1 - 2 nu)) = 1.346: the rigid sections hold the lateral contraction); with
+             two Gauss stations a segment the sag is 67 % short at 16 segments (shear
+             locking; measured with nu = 0).
+             The rigid, unwarped section makes the torsion stiffer than the continuum's
+             (a square's St Venant constant is 0.141 a^4, the rigid section's a^4 / 6:
+             +18 %; a disk's is exact); not measured in a test. Meshless Shepard frames on
+             a line stay inconsistent (zero-order weights: tip 0.65, 1.6, 3.1, 8.9 mm at
+             4 to 32 frames against 5.9 mm).
+         A thin slab loaded in its plane can buckle: Cook's membrane one element
          thick (48 x 44..60 x 1, E = 240.565 Pa, nu = 0.3) has no stable flat state beyond
          F = 2.05 N (hexahedral frames, 16 cells a side; 4.5 N at 4): at the usual F = 32 N
          the flat state is a saddle and, the load being symmetric about the mid-plane,
@@ -759,10 +814,7 @@
          "rotations the samples do not see" is then not the cause). Hold the out-of-plane
          axes for the plane problem (frm_model_set_frame_axes(m, i, 4, 3): test_i18_cook_membrane)
          or nudge it out of plane (1e-3 of the load) for the buckled one (corner u_y 7.8,
-         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations). Frames along a
-         curve (meshless Shepard frames on a line, samples in a thin tube) solve but are not
-         consistent: zero-order weights on a line give no convergent bending (tip 0.65,
-         1.6, 3.1, 8.9 mm at 4 to 32 frames against 5.9 mm); a rod model is not done.
+         11.8, 13.1 mm at 4, 8, 16 cells; 136 to 305 Newton iterations).
        - Models with volumetric averaging (desc.volumetric, issue 13) solve with
          block-Jacobi alone: the coarse matrix's per-sample pass does not know the cell
          averages (not measured; to do).
@@ -1348,6 +1400,8 @@ typedef FRM_REAL frm_real;
 #define frm_sampling_hexes frm_sampling_hexes_f32
 #define frm_sampling_tets frm_sampling_tets_f32
 #define frm_sampling_meshless frm_sampling_meshless_f32
+#define frm_sampling_curve frm_sampling_curve_f32
+#define frm_material_thin frm_material_thin_f32
 #define frm_sampling_box frm_sampling_box_f32
 #define frm_sampling_surface frm_sampling_surface_f32
 #define frm_sampling_apply frm_sampling_apply_f32
@@ -1978,6 +2032,38 @@ FRMDEF int frm_sampling_hexes(frm_sampling *out, const frm_real *nodes, int node
 FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_count, const int *tets,
                              int tet_count, int points, const frm_real *barycentric,
                              const frm_allocator *allocator);
+/* Mesh-based, a curve (issue 14, thin parts): a rod of constant cross-section along the
+   open polyline of node_count >= 2 nodes (3 each, m; consecutive nodes distinct), a frame
+   at every node. Each segment (length l, unit tangent t) gets one station at its midpoint
+   with 4 samples of volume l A / 4 in its cross-section, weights 1/2 and gradients -+ t / l
+   (linear along the curve, the frames' rotations carry the section): a rectangle
+   section[0] x section[1] (section[1] along the height axis `up`, made normal to t per
+   segment; NULL: world z, or world y for a segment within 45 degrees of z) at the 2 x 2
+   Gauss points +-w / (2 sqrt 3), +-h / (2 sqrt 3), or, with section[1] = 0, a disk of
+   radius section[0] at 4 points r / sqrt 2 off the axis: both integrate a bending strain
+   linear across the section exactly. One station a segment is the reduced axial rule that
+   keeps the rod's shear from locking (two Gauss stations: the sag 67 % short at 16
+   segments, see LIMITS, thin parts). The sections are rigid (the frames carry them): give the
+   material through frm_material_thin(.., 1). sample_cells holds the segment. FRM_ERR_ARG
+   for missing or non-finite arguments, FRM_ERR_SAMPLING for a section not > 0, a repeated
+   node or an `up` along a segment. */
+FRMDEF int frm_sampling_curve(frm_sampling *out, const frm_real *nodes, int node_count, const frm_real section[2],
+                              const frm_real up[3], const frm_allocator *allocator);
+/* Material constants for thin parts whose thickness the frames do not resolve (issue 14;
+   St Venant-Kirchhoff and Neo-Hookean, whose small-strain moduli are E and nu): replaces
+   m->young_modulus and m->poisson_ratio by those of the isotropic law with the same shear
+   modulus mu whose response under the thin part's kinematic constraint is the thin
+   continuum's. dimensions = 1, a curve of frames (frm_sampling_curve: rigid sections,
+   eps_yy = eps_zz = 0): lambda' = E nu / (1 + nu), so that lambda' + 2 mu = E (uniaxial
+   stress); nu' = nu / (1 + 2 nu), E' = E (1 + 3 nu) / ((1 + nu) (1 + 2 nu)). dimensions =
+   2, a layer one element thick whose through-thickness strain is constant (tetrahedral
+   frames, 4 Gauss points: the bending's Poisson strain across the layer is not
+   representable): lambda' = 2 mu lambda / (lambda + 2 mu), the plane-stress modulus;
+   nu' = nu / (1 + nu), E' = E (1 + 2 nu) / (1 + nu)^2. Exact for bending; a membrane
+   state whose thickness is free is then 5 % soft in E at nu = 0.3 (keep the true material
+   for membranes). FRM_ERR_ARG for another law, dimensions or a NULL m;
+   FRM_ERR_MATERIAL for E or nu out of range. */
+FRMDEF int frm_material_thin(frm_material *m, int dimensions);
 /* Meshless: the given frames and samples (3 coordinates each), total volume (m^3) split
    evenly over the samples, neighbours and weights from the shape description (NULL: the
    default one). */
@@ -8833,6 +8919,101 @@ FRMDEF int frm_sampling_tets(frm_sampling *out, const frm_real *nodes, int node_
         }
     }
     out->neighbor_start[s] = 4 * s;
+    return FRM_OK;
+}
+
+FRMDEF int frm_sampling_curve(frm_sampling *out, const frm_real *nodes, int node_count, const frm_real section[2],
+                              const frm_real up[3], const frm_allocator *allocator)
+{
+    double w, h, cy[4], cz[4];
+    int err, e, k, r;
+    if (!out) return FRM_ERR_ARG;
+    memset(out, 0, sizeof *out);
+    if (!nodes || !section || node_count < 2 || node_count > 100000000) return FRM_ERR_ARG;
+    if (!frm__all_finite(nodes, 3 * (size_t)node_count) || !frm__all_finite(section, 2) ||
+        (up && !frm__all_finite(up, 3)))
+        return FRM_ERR_ARG;
+    w = (double)section[0];
+    h = (double)section[1];
+    if (!(w > 0) || h < 0) return FRM_ERR_SAMPLING;
+    for (k = 0; k < 4; k++) { /* section points: rectangle 2 x 2 Gauss, or a disk at r / sqrt 2 */
+        double sy = (k & 1) ? 1.0 : -1.0, sz = (k & 2) ? 1.0 : -1.0;
+        if (h > 0) {
+            cy[k] = sy * w / (2.0 * sqrt(3.0));
+            cz[k] = sz * h / (2.0 * sqrt(3.0));
+        } else {
+            cy[k] = sy * w / 2.0;
+            cz[k] = sz * w / 2.0;
+        }
+    }
+    err = frm__sampling_alloc(out, node_count, 4 * (node_count - 1), 8 * (node_count - 1), node_count - 1, allocator);
+    if (err) return err;
+    memcpy(out->frame_positions, nodes, sizeof(frm_real) * 3 * (size_t)node_count);
+    for (e = 0; e < node_count - 1; e++) {
+        double t[3], n[3], b[3], u[3] = {0, 0, 1}, len = 0, un = 0, d, area = h > 0 ? w * h : 3.14159265358979324 * w * w;
+        for (r = 0; r < 3; r++) {
+            t[r] = (double)nodes[3 * (e + 1) + r] - (double)nodes[3 * e + r];
+            len += t[r] * t[r];
+        }
+        len = sqrt(len);
+        if (!(len > 0)) {
+            frm_sampling_free(out);
+            return FRM_ERR_SAMPLING;
+        }
+        for (r = 0; r < 3; r++) t[r] /= len;
+        if (up)
+            for (r = 0; r < 3; r++) u[r] = (double)up[r];
+        else if (fabs(t[2]) > 0.70710678118654752) {
+            u[1] = 1;
+            u[2] = 0;
+        }
+        d = frm__dot3d(u, t);
+        for (r = 0; r < 3; r++) {
+            n[r] = u[r] - d * t[r];
+            un += u[r] * u[r];
+        }
+        d = sqrt(frm__dot3d(n, n));
+        if (!(d > 1e-3 * sqrt(un))) {
+            frm_sampling_free(out);
+            return FRM_ERR_SAMPLING;
+        }
+        for (r = 0; r < 3; r++) n[r] /= d;
+        frm__cross3d(t, n, b);
+        for (k = 0; k < 4; k++) {
+            int s = 4 * e + k, q = 2 * s;
+            out->neighbor_start[s] = q;
+            out->sample_cells[s] = e;
+            out->sample_volumes[s] = (frm_real)(len * area / 4.0);
+            for (r = 0; r < 3; r++)
+                out->sample_positions[3 * s + r] =
+                    (frm_real)(0.5 * ((double)nodes[3 * e + r] + (double)nodes[3 * (e + 1) + r]) + cy[k] * b[r] + cz[k] * n[r]);
+            out->neighbor_frames[q] = e;
+            out->neighbor_frames[q + 1] = e + 1;
+            out->neighbor_weights[q] = (frm_real)0.5;
+            out->neighbor_weights[q + 1] = (frm_real)0.5;
+            for (r = 0; r < 3; r++) {
+                out->neighbor_gradients[3 * q + r] = (frm_real)(-t[r] / len);
+                out->neighbor_gradients[3 * (q + 1) + r] = (frm_real)(t[r] / len);
+            }
+        }
+    }
+    out->neighbor_start[4 * (node_count - 1)] = 8 * (node_count - 1);
+    return FRM_OK;
+}
+
+FRMDEF int frm_material_thin(frm_material *m, int dimensions)
+{
+    double E, nu, mu, lambda;
+    if (!m || (dimensions != 1 && dimensions != 2) || (m->law != FRM_LAW_SVK && m->law != FRM_LAW_NEO_HOOKEAN))
+        return FRM_ERR_ARG;
+    E = (double)m->young_modulus;
+    nu = (double)m->poisson_ratio;
+    if (!(frm__finite(E) && E > 0 && nu > -1 && nu < 0.5)) return FRM_ERR_MATERIAL;
+    mu = E / (2 * (1 + nu));
+    lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    lambda = dimensions == 1 ? E - 2 * mu : 2 * mu * lambda / (lambda + 2 * mu);
+    m->poisson_ratio = (frm_real)(lambda / (2 * (lambda + mu)));
+    m->young_modulus = (frm_real)(mu * (3 * lambda + 2 * mu) / (lambda + mu));
     return FRM_OK;
 }
 

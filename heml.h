@@ -147,7 +147,9 @@
    heml_create only. Pointers returned by heml_positions and friends point into the model
    and stay valid until heml_destroy. Meshes of 96 nodes or more also hold the static
    solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
-   24, at most 64: up to 1.2 MB). The stiffness cache (desc.stiffness_cache = 1, the
+   24, at most 64: up to 1.2 MB), and for the implicit steps' coarse correction two more
+   (the unfactored P^T K0 P and the step's factor: up to 2.4 MB more; none with
+   desc.implicit_coarse = -1). The stiffness cache (desc.stiffness_cache = 1, the
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
@@ -420,9 +422,11 @@
                              desc.newton_iterations, default 20) to desc.newton_tolerance
                              (default 1e-6, float 1e-4) on the residual relative to its
                              largest force term, each solving (M (1 + dt alpha) / dt^2 -
-                             df/du) delta = R by Jacobi-preconditioned CG with the exact
-                             force differential applied matrix-free (an Eisenstat-Walker
-                             tolerance), then an energy line search (backtracking until the
+                             df/du) delta = R by CG with the exact force differential
+                             applied matrix-free (an Eisenstat-Walker tolerance;
+                             preconditioned by Jacobi, plus the static solve's coarse
+                             correction where it pays: IMPLICIT COARSE CORRECTION below),
+                             then an energy line search (backtracking until the
                              potential decreases; with a Prony series the force has no
                              potential and the residual must decrease instead). Where CG
                              meets negative curvature (stats.negative_curvature) a
@@ -582,6 +586,55 @@
        tetrahedron listing the tetrahedra whose bounding box overlaps it (a point outside
        or on the surface scans all tetrahedra; the answer is the same as a full scan's). Then position, displacement and velocity are the P1 interpolation
        of the four nodes' values (exact for affine fields), 3 per point, no allocation.
+
+   IMPLICIT COARSE CORRECTION (issue 21; desc.implicit_coarse): the implicit steps'
+       Krylov solves (HEML_IMPLICIT_EULER and HEML_BDF2 Newton solves, the linearised
+       step's solve, CG and its MINRES fallback) solve (D + c K) x = b, D = M (1 + h alpha)
+       / h^2 (c = 1; the linearised step: D = M (1 + dt alpha), c = dt^2). Jacobi alone
+       is good while D dominates (small dt, soft bodies) and needs hundreds of iterations
+       once c K does on slender bodies (their bending modes are what Jacobi resolves
+       slowest). The static solve's two-level preconditioner is reused with the step's
+       operator: Jacobi of D + c diag K0 plus P A_c^-1 P^T, A_c = P^T (D + c K0) P on the
+       same aggregates and rigid modes (>>coarse), K0 the rest state's small-strain
+       stiffness (assembled once per set of pinned axes, shared with the static solve),
+       D's projection 6 x 6 per aggregate. The factor (dense Cholesky of 6 A unknowns,
+       double) is kept with its key (c, P^T D P bit for bit, the pins) and reused while
+       the key holds: a step's Newton iterations, and every step of one dt, share one
+       factorisation (frames.h rebuilds its coarse matrix at every Newton iteration from
+       the tangent; here K0 is constant, so the step's first factor serves until dt, the
+       masses or the pins change; BDF2 has two keys: its implicit Euler start and h =
+       2 dt / 3). The preconditioner is inexact (K0, not the tangent); CG checks the
+       answer as before, so results change only within the solve tolerances. Modes:
+       0 (default) automatic: Jacobi alone until an implicit step's solves needed
+       HEML_COARSE_MIN_ITERATIONS (20) CG iterations each on average, the coarse
+       correction from the next step on (never switched off again); 1 always; -1 never
+       (and its arrays are not allocated: MEMORY). stats.coarse_solves counts the solves
+       that used it, stats.coarse_factors its factorisations in the step. Why 20: a coarse
+       correction costs about 0.6 of a stiffness product per iteration on the bench beam
+       (two node passes and two triangular solves) plus one node pass per solve for the
+       key; on R3 (40 x 4 x 4 cells, 1025 nodes, 15 aggregates) at dt = 1 ms it loses
+       below about 15 Jacobi iterations a solve (E = 1 MPa, 11 a solve: x1.19 the time
+       over 20 steps; E = 2 MPa, 15: x1.02; E = 3 MPa, 19: x0.95; E = 10 MPa, 32: x0.69).
+       Measured (`build/bench/bench --parts coarse`, bench.c >>coarse, Neo-Hookean beams
+       clamped at x = 0, 6 implicit Euler steps from rest, Zen 5, 2 vCPUs, loaded; CG
+       iterations per step Jacobi only -> always, and the time ratio always / never,
+       best of 3 interleaved repeats in one run; the bench now runs 2):
+                              dt = 1 ms         10 ms           0.1 s            1 s
+           R3, E = 1 kPa      2 -> 4   x7.3 *   8 -> 9   x1.67  81 -> 30  x0.68  274 -> 38 x0.24
+           R3, E = 1 MPa     25 -> 19  x1.27  206 -> 34  x0.26 423 -> 53  x0.21  341 -> 51 x0.24
+           R3, E = 10 MPa    81 -> 30  x0.64  274 -> 38  x0.24 401 -> 57  x0.52  210 -> 36 x0.32
+           R1, steel        356 -> 30  x0.17  808 -> 46  x0.14 1007 -> 66 x0.13  364 -> 31 x0.19
+       (R3: 1 x 0.1 x 0.1 m, 40 x 4 x 4 cells, 3075 dof, load g = 0.01 E / 1 MPa; R1: 16 x
+       0.5 x 0.5 m, 64 x 2 x 2 cells, 1755 dof, its own weight. * the first step assembles
+       P^T K0 P, about 2 ms, once per model: in 6 steps of a fraction of a millisecond it
+       is the whole difference; the automatic mode stays Jacobi there. Rows under a few
+       ms a step vary by +-25 % between runs on this loaded machine.)
+       BDF2 gives the same picture (bench rows). The automatic mode matches "always" from
+       its second step on where Jacobi needed 20 iterations a solve, and stays Jacobi
+       where it did not (the 1 kPa rows at 1-10 ms, 1 MPa at 1 ms). Tests:
+       tests/test_heml_sim.c test_implicit_coarse_correction (same states as Jacobi only
+       to 1e-6 of the displacement, 7.1 times fewer iterations, one factorisation per
+       coefficient).
 
    MODAL ANALYSIS (heml_modal_*): the lowest `count` natural frequencies and M-orthonormal
        mode shapes of K x = lambda M x about the current state (K = -df/du, the exact
@@ -845,9 +898,14 @@
          compression or inversion CG meets negative curvature and MINRES takes over
          (slower); a solve capped by cg_max_iterations fails the step rather than return an
          unconverged one.
-       - The implicit step's CG is Jacobi-preconditioned only (the coarse space serves the
-         static solve): slender stiff bodies at large time steps need hundreds of
-         iterations per step (R3 at 40 x 4 x 4 cells, dt = T/100: about 20 ms a step).
+       - The implicit steps' coarse correction (IMPLICIT COARSE CORRECTION) uses the rest
+         state's small-strain stiffness K0, not the tangent: under large rotations or
+         strains it helps less (never wrongly: CG checks its answer). Its automatic mode
+         turns it on after one Jacobi-only step that needed HEML_COARSE_MIN_ITERATIONS
+         iterations a solve and keeps it on (a later, much smaller dt keeps paying its
+         cost per iteration: set implicit_coarse = -1 for such runs); meshes under 96 nodes
+         have none. tensormass.h's implicit steps have no coarse correction (README,
+         issue 21).
        - St Venant-Kirchhoff softens in compression (the stress falls to zero as a
          tetrahedron flattens, sec. 4.2); the J0 guard keeps it from settling inverted, but
          a homogeneous uniaxial compression is unstable in the law itself beyond about
@@ -895,6 +953,11 @@
          cancellation-free sums (and the rounding correction of ln J).
 
    HISTORY
+       unreleased (issue 21, solvers) the implicit steps' Krylov solves take the static
+             solve's coarse correction with the step's operator (desc.implicit_coarse,
+             default automatic; stats.coarse_solves, coarse_factors; IMPLICIT COARSE
+             CORRECTION): 3 to 15 times fewer CG iterations on slender bodies at large
+             dt, answers within the solve tolerances; up to 2.4 MB more per model.
        unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
              masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
              spring force 15x faster (no differential terms on an unset workspace) and its
@@ -1217,6 +1280,11 @@ typedef struct heml_desc {
     int cg_max_iterations;           /* Krylov iterations per linear solve, default 1000 */
     heml_linear_solver linear_solver; /* every linear solve (implicit steps, static solve and its
                                         saddle probe), default HEML_LINEAR_SOLVER_CG */
+    int implicit_coarse;             /* the implicit steps' Krylov solves (issue 21, SOLVERS): 0
+                                        (default) add the static solve's coarse correction when it
+                                        pays (once a step's Jacobi-only solves need
+                                        HEML_COARSE_MIN_ITERATIONS each), 1 always, -1 never (Jacobi
+                                        only); meshes under 96 nodes have no coarse space */
     int static_max_iterations;       /* Newton iterations of heml_solve_static per load step,
                                         default 50 */
     heml_real static_tolerance;      /* its residual relative to the larger of the loads and the
@@ -1271,6 +1339,10 @@ typedef struct heml_stats {
     int below_threshold;       /* tetrahedra with J < J0 at the last force evaluation: their
                                   stress is the J0 continuation's, not the law's (for St
                                   Venant-Kirchhoff: the inversion guard's; see LIMITS) */
+    int coarse_solves;         /* implicit steps: Krylov solves preconditioned with the coarse
+                                  correction (desc.implicit_coarse; SOLVERS) */
+    int coarse_factors;        /* implicit steps: factorisations of its coarse matrix (0 when the
+                                  last one was reused: same dt, mass and pins) */
 } heml_stats;
 
 /* Energies of the current state (heml_energy). */
@@ -1669,6 +1741,12 @@ struct heml_model {
     int simd;                              /* 1: the vector gather and scatter where compiled in
                                               (HEML__AVX); tests set 0 to compare with the scalar path */
     unsigned pin_version, coarse_version;  /* A_c is rebuilt when the pins change */
+    unsigned coarse_k_version, coarse_step_version; /* coarse_k's and coarse_step's pins */
+    int implicit_coarse;                   /* desc.implicit_coarse: -1 never, 0 when it pays, 1 always */
+    int coarse_plain;                      /* CG iterations per solve of the last implicit step
+                                              without the coarse correction (-1: none yet) */
+    int step_solves;                       /* Krylov solves of the running step */
+    double coarse_step_c;                  /* c of the factor in coarse_step */
     heml_integrator integrator;
     heml_linear_solver linear_solver;
     heml_real time_step, mass_damping, gravity[3], cg_tolerance, J0, jm1_0, static_tolerance;
@@ -1760,6 +1838,10 @@ struct heml_model {
     double *agg_centre; /* 3 per aggregate */
     double *coarse;     /* (6 A)^2: A_c, then its Cholesky factor */
     double *coarse_rhs; /* 6 A */
+    double *coarse_k;   /* (6 A)^2: P^T K0 P (unfactored; heml__coarse_assemble) */
+    double *coarse_step; /* (6 A)^2: the implicit steps' P^T (D + c K0) P, Cholesky-factored */
+    double *coarse_pdp, *coarse_pdp_new; /* 36 A each: P^T D P of coarse_step's factor, and of the
+                                            solve asking (its key, with c and the pins) */
 
     /* average nodal pressure (heml__nodal_prepare): per node the rest volume weights of
        each material, W[mat n + a] = sum Vol_e / 4 over the node's tetrahedra of that
@@ -3719,6 +3801,13 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->coarse, double, 36 * (size_t)m->agg_count * (size_t)m->agg_count);
     HEML__CARVE(c, m->coarse_rhs, double, 6 * (size_t)m->agg_count);
     {
+        size_t A = m->implicit_coarse >= 0 ? (size_t)m->agg_count : 0; /* the implicit steps' */
+        HEML__CARVE(c, m->coarse_k, double, 36 * A * A);
+        HEML__CARVE(c, m->coarse_step, double, 36 * A * A);
+        HEML__CARVE(c, m->coarse_pdp, double, 36 * A);
+        HEML__CARVE(c, m->coarse_pdp_new, double, 36 * A);
+    }
+    {
         size_t nn = m->nodal ? n : 0;
         HEML__CARVE(c, m->nod_w, heml_real, nn * M);
         HEML__CARVE(c, m->nod_inv, heml_real, nn);
@@ -3995,6 +4084,8 @@ static int heml__create_validate(const heml_desc *d)
         return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0 or 1");
     if (d->stiffness_cache != 0 && d->stiffness_cache != 1)
         return heml__fail(d, HEML_ERR_ARG, "stiffness_cache must be 0 or 1");
+    if (d->implicit_coarse < -1 || d->implicit_coarse > 1)
+        return heml__fail(d, HEML_ERR_SOLVER, "implicit_coarse must be -1, 0 or 1");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return heml__fail(d, HEML_ERR_ARG, "allocator needs both alloc and free");
     M = d->materials ? d->material_count : 1;
@@ -4362,13 +4453,10 @@ static void heml__node_modes(const heml_model *m, int i, double P[3][6])
             for (k = 0; k < 6; k++) P[r][k] = 0.0;
 }
 
-/* A_c = P^T K0 P, Cholesky-factored in place (lower triangle, row-major); a mode whose
-   pivot falls below 1e-10 of its diagonal is dropped (zero row and column of L). */
-static void heml__coarse_build(heml_model *m)
+/* Ac = P^T K0 P on the free degrees of freedom (unfactored, (6 A)^2 doubles). */
+static void heml__coarse_assemble(const heml_model *m, double *Ac)
 {
     int A = m->agg_count, D = 6 * A, c, blk, k, i, j, r, s, a, b;
-    double *Ac = m->coarse, *dg = m->coarse_rhs;
-    if (!A || m->coarse_version == m->pin_version) return;
     memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
     for (c = 0; c < m->chunk_count; c++) {
         const heml__mat *mt = m->mats + m->chunk_material[c];
@@ -4400,6 +4488,23 @@ static void heml__coarse_build(heml_model *m)
             }
         }
     }
+}
+
+/* coarse_k = P^T K0 P, when the pins changed since its last assembly (implicit_coarse >= 0:
+   the static solve and the implicit steps share it). */
+static void heml__coarse_k_update(heml_model *m)
+{
+    if (m->coarse_k_version == m->pin_version) return;
+    heml__coarse_assemble(m, m->coarse_k);
+    m->coarse_k_version = m->pin_version;
+}
+
+/* Cholesky factor of the D x D matrix Ac in place (lower triangle, row-major); a mode whose
+   pivot falls below 1e-10 of its diagonal is dropped (zero row and column of L). dg:
+   D doubles of scratch. */
+static void heml__coarse_factor(double *Ac, int D, double *dg)
+{
+    int i, j, k;
     for (i = 0; i < D; i++) dg[i] = Ac[(size_t)i * D + i];
     for (k = 0; k < D; k++) {
         double *Lk = Ac + (size_t)k * D, d = Lk[k];
@@ -4416,21 +4521,94 @@ static void heml__coarse_build(heml_model *m)
             Li[k] = t / d;
         }
     }
+}
+
+/* The static solve's A_c = P^T K0 P, Cholesky-factored into `coarse`, when the pins
+   changed since (assembled into coarse_k first, which the implicit steps share, unless
+   implicit_coarse = -1 left it out). */
+static void heml__coarse_build(heml_model *m)
+{
+    size_t D = 6 * (size_t)m->agg_count;
+    if (!m->agg_count || m->coarse_version == m->pin_version) return;
+    if (m->implicit_coarse < 0) heml__coarse_assemble(m, m->coarse); /* (no coarse_k) */
+    else {
+        heml__coarse_k_update(m);
+        memcpy(m->coarse, m->coarse_k, sizeof(double) * D * D);
+    }
+    heml__coarse_factor(m->coarse, (int)D, m->coarse_rhs);
     m->coarse_version = m->pin_version;
 }
 
-/* z += P A_c^-1 P^T r on the free degrees of freedom. */
-static void heml__coarse_apply(heml_model *m, const heml_real *rv, heml_real *z)
+/* The implicit steps' coarse matrix P^T (D + c K0) P (D the solve's diagonal, NULL: 0),
+   Cholesky-factored into coarse_step, unless the factor there already has this D's
+   projection P^T D P (compared bit for bit: 36 doubles per aggregate, one pass over the
+   nodes), this c and these pins: a step's Newton iterations, and the steps of one dt,
+   reuse one factor. K0 is the rest state's small-strain stiffness (the static solve's),
+   not the tangent at the iterate: the correction is a preconditioner, CG checks the
+   answer. */
+static void heml__coarse_step_build(heml_model *m, const heml_real *diag, double c)
 {
-    int A = m->agg_count, D = 6 * A, i, j, r, k;
-    double *y = m->coarse_rhs, *L = m->coarse;
+    int A = m->agg_count, D = 6 * A, i, r, a, b;
+    double *pdp = m->coarse_pdp_new, *Ac = m->coarse_step;
+    memset(pdp, 0, sizeof(double) * 36 * (size_t)A);
+    if (diag)
+        for (i = 0; i < m->node_count; i++) {
+            double P[3][6], *blk = pdp + 36 * (size_t)m->node_agg[i];
+            heml__node_modes(m, i, P);
+            for (r = 0; r < 3; r++) {
+                double d = (double)diag[3 * i + r];
+                if (d == 0.0) continue;
+                for (a = 0; a < 6; a++) {
+                    double pa = d * P[r][a];
+                    if (pa == 0.0) continue;
+                    for (b = 0; b < 6; b++) blk[6 * a + b] += pa * P[r][b];
+                }
+            }
+        }
+    if (m->coarse_step_version == m->pin_version && m->coarse_step_c == c &&
+        !memcmp(pdp, m->coarse_pdp, sizeof(double) * 36 * (size_t)A))
+        return;
+    heml__coarse_k_update(m);
+    for (i = 0; i < D * D; i++) Ac[i] = c * m->coarse_k[i];
+    for (i = 0; i < A; i++)
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) Ac[(size_t)(6 * i + a) * D + 6 * i + b] += pdp[36 * i + 6 * a + b];
+    heml__coarse_factor(Ac, D, m->coarse_rhs);
+    memcpy(m->coarse_pdp, pdp, sizeof(double) * 36 * (size_t)A);
+    m->coarse_step_c = c;
+    m->coarse_step_version = m->pin_version;
+    m->stats.coarse_factors++;
+}
+
+/* Which coarse correction a Krylov solve asked for (HEML__COARSE_*) gets: the static one
+   or the step's, built or reused here; 0 on a mesh without a coarse space. */
+#define HEML__COARSE_STATIC 1 /* P^T K0 P (the static solve, its saddle probe, the modal solve) */
+#define HEML__COARSE_STEP 2   /* P^T (D + c K0) P (the implicit steps) */
+static int heml__coarse_prepare(heml_model *m, int coarse, const heml_real *diag, double c)
+{
+    if (!coarse || !m->agg_count) return 0;
+    if (coarse == HEML__COARSE_STEP) heml__coarse_step_build(m, diag, c);
+    else heml__coarse_build(m);
+    return coarse;
+}
+
+/* z += P A_c^-1 P^T r on the free degrees of freedom. */
+static void heml__coarse_apply(heml_model *m, const double *L, const heml_real *rv, heml_real *z)
+{
+    int A = m->agg_count, D = 6 * A, i, j, r;
+    double *y = m->coarse_rhs;
     memset(y, 0, sizeof(double) * (size_t)D);
-    for (i = 0; i < m->node_count; i++) {
-        double P[3][6];
-        heml__node_modes(m, i, P);
-        for (k = 0; k < 6; k++)
-            y[6 * m->node_agg[i] + k] += P[0][k] * (double)rv[3 * i] + P[1][k] * (double)rv[3 * i + 1] +
-                                         P[2][k] * (double)rv[3 * i + 2];
+    for (i = 0; i < m->node_count; i++) { /* y += P^T r: per node (r, rho x r), rho = X - c (heml__node_modes) */
+        const double *c = m->agg_centre + 3 * m->node_agg[i];
+        double *ya = y + 6 * m->node_agg[i], rho[3], q[3];
+        for (r = 0; r < 3; r++) {
+            rho[r] = (double)m->rest[3 * i + r] - c[r];
+            q[r] = m->free_mask[3 * i + r] > 0 ? (double)rv[3 * i + r] : 0.0;
+            ya[r] += q[r];
+        }
+        ya[3] += rho[1] * q[2] - rho[2] * q[1];
+        ya[4] += rho[2] * q[0] - rho[0] * q[2];
+        ya[5] += rho[0] * q[1] - rho[1] * q[0];
     }
     for (i = 0; i < D; i++) { /* L y' = y */
         const double *Li = L + (size_t)i * D;
@@ -4451,13 +4629,15 @@ static void heml__coarse_apply(heml_model *m, const heml_real *rv, heml_real *z)
         for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
         y[i] = t / Lii;
     }
-    for (i = 0; i < m->node_count; i++) {
-        double P[3][6];
-        const double *ya = y + 6 * m->node_agg[i];
-        heml__node_modes(m, i, P);
+    for (i = 0; i < m->node_count; i++) { /* z += P y: per node t + w x rho on the free axes */
+        const double *c = m->agg_centre + 3 * m->node_agg[i], *ya = y + 6 * m->node_agg[i];
+        double rho[3], d[3];
+        for (r = 0; r < 3; r++) rho[r] = (double)m->rest[3 * i + r] - c[r];
+        d[0] = ya[0] + (ya[4] * rho[2] - ya[5] * rho[1]);
+        d[1] = ya[1] + (ya[5] * rho[0] - ya[3] * rho[2]);
+        d[2] = ya[2] + (ya[3] * rho[1] - ya[4] * rho[0]);
         for (r = 0; r < 3; r++)
-            z[3 * i + r] += (heml_real)(P[r][0] * ya[0] + P[r][1] * ya[1] + P[r][2] * ya[2] + P[r][3] * ya[3] +
-                                        P[r][4] * ya[4] + P[r][5] * ya[5]);
+            if (m->free_mask[3 * i + r] > 0) z[3 * i + r] += (heml_real)d[r];
     }
 }
 
@@ -4621,6 +4801,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
     }
+    tmp->implicit_coarse = d->implicit_coarse; /* (-1: the step's coarse arrays are not carved) */
     return HEML_OK;
 }
 
@@ -4659,6 +4840,7 @@ static int heml__create_layout(const heml_desc *d, const heml_model *sized, heml
     m->min_increment = d->min_increment;
     m->allow_inversion = d->allow_inversion;
     m->leave_saddles = d->leave_saddles;
+    m->implicit_coarse = d->implicit_coarse;
     m->precision_limit = d->precision_limit;
     m->J0 = d->inversion_threshold;
     m->jm1_0 = (heml_real)((double)d->inversion_threshold - 1.0);
@@ -4736,7 +4918,8 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
     heml__aggregate_centres(m);
     heml__colour_groups(m, w->stamp, w->colour_of, w->order);
     for (i = 0; i < m->node_count; i++) heml__set_masks(m, i);
-    m->coarse_version = m->pin_version - 1;
+    m->coarse_version = m->coarse_k_version = m->coarse_step_version = m->pin_version - 1;
+    m->coarse_plain = -1;
     heml__prony_coefficients(m, (double)m->time_step);
     m->h_min = heml__shortest_edge(d);
     m->stats.newton_iterations = 0;
@@ -4829,12 +5012,13 @@ static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, h
     }
 }
 
-/* z = pinv r, plus the coarse correction when `coarse` (static solves). */
+/* z = pinv r, plus the coarse correction `coarse` (HEML__COARSE_*, as heml__coarse_prepare
+   returned it; 0: none). */
 static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real *r, heml_real *z, int coarse)
 {
     int i, n3 = 3 * m->node_count;
     for (i = 0; i < n3; i++) z[i] = pinv[i] * r[i];
-    if (coarse) heml__coarse_apply(m, r, z);
+    if (coarse) heml__coarse_apply(m, coarse == HEML__COARSE_STEP ? m->coarse_step : m->coarse, r, z);
 }
 
 #define HEML__NEGATIVE_CURVATURE 1 /* private result of heml__cg */
@@ -4860,8 +5044,7 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
     double bb, rr, rz, tol2;
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
-    coarse = coarse && m->agg_count;
-    if (coarse) heml__coarse_build(m);
+    coarse = heml__coarse_prepare(m, coarse, diag, c);
     heml__jacobi(m, diag, c, pinv);
     for (i = 0; i < n3; i++) {
         x[i] *= m->free_mask[i];
@@ -4926,8 +5109,7 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol;
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
-    coarse = coarse && m->agg_count;
-    if (coarse) heml__coarse_build(m);
+    coarse = heml__coarse_prepare(m, coarse, diag, c);
     heml__jacobi(m, diag, c, pinv);
     for (i = 0; i < n3; i++) {
         x[i] = w[i] = w2[i] = 0;
@@ -5019,6 +5201,8 @@ static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, c
 {
     const heml__linear_solver_ops *ops = heml__linear_solvers + m->linear_solver;
     int err;
+    m->step_solves++;
+    if (coarse == HEML__COARSE_STEP && m->agg_count) m->stats.coarse_solves++;
     heml__dc_invalidate(m); /* (x_lin's contents may be new: the stiffness cache refills) */
     err = (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
                                                                            m->krylov);
@@ -5027,6 +5211,22 @@ static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, c
 }
 
 /* >>integrators ----------------------------------------------------------------------- */
+
+/* The implicit steps' coarse correction (desc.implicit_coarse, SOLVERS): HEML__COARSE_STEP
+   or 0. Automatic (0): on once an implicit step's Jacobi-only solves needed
+   HEML_COARSE_MIN_ITERATIONS CG iterations each on average (heml_step_ex records it in
+   coarse_plain), and from then on: below that the mass term dominates, Jacobi alone
+   converges in a few dozen iterations and the coarse correction's cost per iteration (two
+   triangular solves of 6 A unknowns and a pass over the nodes) and its factorisation
+   (once per dt) do not pay back (measured: SOLVERS). */
+#ifndef HEML_COARSE_MIN_ITERATIONS
+#define HEML_COARSE_MIN_ITERATIONS 20
+#endif
+static int heml__step_coarse(const heml_model *m)
+{
+    if (!m->agg_count || m->implicit_coarse < 0) return 0;
+    return m->implicit_coarse > 0 || m->coarse_plain >= HEML_COARSE_MIN_ITERATIONS ? HEML__COARSE_STEP : 0;
+}
 
 /* Working copies (u0, v0) of displacements and velocities with pinned axes moved to their
    targets over this step: v = (target - u) / dt, u = target. */
@@ -5161,7 +5361,7 @@ static int heml__semi_explicit(heml_model *m, heml_real dt, const heml_real *u0,
 static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_real *u0, const heml_real *v0,
                                      heml_real *u1, heml_real *v1)
 {
-    int i, r, err, n = m->node_count, n3 = 3 * n;
+    int i, r, err, coarse, n = m->node_count, n3 = 3 * n;
     heml_real *f = m->work_f, *dmass = m->lin_dmass, *du = m->lin_du, *rhs = m->lin_rhs;
     heml_real alpha = m->mass_damping;
     double dt2 = (double)dt * dt;
@@ -5176,9 +5376,10 @@ static int heml__implicit_linearized(heml_model *m, heml_real dt, const heml_rea
             du[j] = dt * (v0[j] + m->dv_prev[j]);
         }
     if (!heml__all_finite(rhs, (size_t)n3)) return HEML_ERR_NOT_FINITE;
-    err = heml__linear_solve(m, HEML__SPD, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
+    coarse = heml__step_coarse(m);
+    err = heml__linear_solve(m, HEML__SPD, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, coarse);
     if (err == HEML__NEGATIVE_CURVATURE)
-        err = heml__linear_solve(m, HEML__INDEFINITE, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, 0);
+        err = heml__linear_solve(m, HEML__INDEFINITE, u0, dmass, dt2, rhs, du, (double)m->cg_tolerance, coarse);
     if (err) return err;
     m->stats.newton_iterations = 1;
     for (i = 0; i < n3; i++) {
@@ -5542,6 +5743,7 @@ static int heml__incremental(heml_model *m, heml_real h, const heml_real *ubar, 
     ob.tol = (double)m->newton_tolerance;
     ob.max_iterations = m->newton_iterations;
     ob.energy_search = !m->has_prony; /* a Prony history's force has no potential */
+    ob.coarse = heml__step_coarse(m);
     memcpy(u1, start, sizeof(heml_real) * (size_t)n3);
     err = heml__newton(m, &ob, u1);
     if (err) return err;
@@ -5645,7 +5847,10 @@ HEMLDEF int heml_step_ex(heml_model *m, heml_real dt, heml_integrator integrator
         heml__history_reset(m);
         return HEML_ERR_PRECISION;
     }
+    m->step_solves = 0;
     err = ops->step(m, dt, u0, v0, u1, v1);
+    if (!m->stats.coarse_solves && m->step_solves > 0) /* Jacobi alone: its cost per solve (heml__step_coarse) */
+        m->coarse_plain = m->stats.cg_iterations / m->step_solves;
     if (!err && (!heml__all_finite(u1, n3) || !heml__all_finite(v1, n3))) err = HEML_ERR_NOT_FINITE;
     if (err) {
         memset(m->dv_prev, 0, sizeof(heml_real) * n3);

@@ -3,7 +3,7 @@
    make bench         the full run (under 10 minutes on 2 cores): bench/results/
    make bench-quick   the smallest sizes (under a minute): build/bench-quick/
 
-   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels]
+   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,coarse,kernels]
                      [--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
@@ -27,6 +27,9 @@
       from a static deflection, implicit Euler and BDF2 at dt = T/20 to T/400: period
       error, amplitude decay per period, seconds of computing per simulated second.
       time.csv.
+   3b. coarse (>>coarse, alone with --parts coarse): heml.h's implicit steps on the R3 and
+      R1 beams at E = 1 kPa to 10 MPa and dt = 1 ms to 1 s, with and without the coarse
+      correction (issue 21): iterations and time per step. coarse.csv.
    4. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
       the memory-bandwidth bound of the bytes each header says its kernel moves, with the
       bandwidth measured in the same run by a STREAM triad. kernels.csv.
@@ -65,6 +68,8 @@ const bench_model *bench_models_frames_double(int *count);
 const bench_model *bench_models_frames_float(int *count);
 int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
+/* heml.h's implicit steps with and without the coarse correction (issue 21): bench/model_heml.c */
+int bench_heml_coarse_rows_double(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max);
 /* the coupled scenes (issue 14): bench/model_glue.c, not a bench_model (two models glued) */
 int bench_glue_rows_double(int quick, double *v);
 int bench_glue_rows_float(int quick, double *v);
@@ -93,7 +98,7 @@ typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
     const char *scenes; /* --scenes: trade scenes to run (comma list of names; NULL: all) */
-    int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time */
+    int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time, 32 coarse */
     double budget; /* s: a configuration slower than this stops its refinement */
 } options;
 
@@ -1702,6 +1707,42 @@ static void run_time(const options *o, const bench_model *const *models, int cou
     printf("  time: %.1f s\n", now() - t0);
 }
 
+/* >>coarse: heml.h's implicit steps with and without the coarse correction of its static
+   solve (issue 21; desc.implicit_coarse, the scenes in bench/model_heml.c >>coarse-rows):
+   CG and Newton iterations, coarse factorisations and seconds per step, Jacobi only
+   ("never"), automatic (the default) and "always", the time ratios against "never" from
+   the same run (best of the repeats, the modes interleaved). coarse.csv. */
+static void run_coarse(const options *o)
+{
+    static const char *mode_name[3] = {"never", "auto", "always"};
+    static bench_coarse_row rows[128];
+    double t0 = now();
+    int n, i;
+    FILE *f;
+    if (o->filter && !strstr("heml coarse", o->filter)) return;
+    printf("\nheml.h implicit steps, coarse correction (issue 21): Neo-Hookean beams clamped at x = 0, steps from rest; "
+           "per step: CG and Newton iterations, coarse factorisations, ms (best of the repeats); time ratio against "
+           "Jacobi only (see bench.c >>coarse)\n");
+    f = open_csv(o, "coarse.csv", "scene,integrator,young,time_step,mode,dof,cg_per_step,newton_per_step,"
+                                  "factors_per_step,seconds_per_step,time_ratio_to_never,status");
+    n = bench_heml_coarse_rows_double(o->quick, now, rows, 128);
+    for (i = 0; i < n; i++) {
+        const bench_coarse_row *r = rows + i, *base = rows + i - (r->mode + 1);
+        double ratio = r->seconds_per_step / base->seconds_per_step;
+        printf("  %-8s %-14s E=%-6.0e dt=%-6g %-6s %5d dof: %7.1f CG %5.2f Newton %4.2f fact %9.3f ms  x%5.2f  code %d\n",
+               r->scene, r->integrator, r->young, r->dt, mode_name[r->mode + 1], r->dof, r->cg_per_step,
+               r->newton_per_step, r->factors_per_step, 1e3 * r->seconds_per_step, ratio, r->code);
+        if (f) {
+            csv_prefix(f);
+            fprintf(f, "%s,%s,%.6g,%.6g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", r->scene, r->integrator, r->young, r->dt,
+                    mode_name[r->mode + 1], r->dof, r->cg_per_step, r->newton_per_step, r->factors_per_step,
+                    r->seconds_per_step, ratio, r->code);
+        }
+    }
+    if (f) fclose(f);
+    printf("  coarse: %.1f s\n", now() - t0);
+}
+
 /* >>kernels */
 
 /* STREAM triad a = b + s c over three arrays of n doubles: best of five, GB/s (24 bytes
@@ -2023,7 +2064,7 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,kernels] [--filter TEXT] "
+    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,coarse,kernels] [--filter TEXT] "
                     "[--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]\n");
     exit(2);
 }
@@ -2033,12 +2074,12 @@ int main(int argc, char **argv)
     options o;
     static const bench_model *models[256], *variants[64];
     int i, count = 0, variant_count = 0;
-    double t0 = now(), tp, part_time[5] = {0, 0, 0, 0, 0}; /* trade, stability, sweep, time, kernels */
+    double t0 = now(), tp, part_time[6] = {0, 0, 0, 0, 0, 0}; /* trade, stability, sweep, time, kernels, coarse */
     memset(&o, 0, sizeof o);
     o.repeats = 3;
     o.threads = 2;
     o.out = "bench/results";
-    o.parts = 31;
+    o.parts = 63;
     o.budget = 2;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
@@ -2051,7 +2092,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--parts") && i + 1 < argc) {
             const char *p = argv[++i];
             o.parts = (strstr(p, "trade") ? 1 : 0) | (strstr(p, "stability") ? 2 | 8 : 0) | (strstr(p, "kernels") ? 4 : 0) |
-                      (strstr(p, "sweep") ? 8 : 0) | (strstr(p, "time") ? 16 : 0);
+                      (strstr(p, "sweep") ? 8 : 0) | (strstr(p, "time") ? 16 : 0) | (strstr(p, "coarse") ? 32 : 0);
         } else usage();
     }
     if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
@@ -2093,6 +2134,7 @@ int main(int argc, char **argv)
     }
     set_threads(1);
     if (o.parts & 16) run_time(&o, models, count), part_time[3] = now() - tp, tp = now();
+    if (o.parts & 32) run_coarse(&o), part_time[5] = now() - tp, tp = now();
     if (o.parts & 4) { /* the primary = -1 entries too (their two smallest sizes) */
         static const bench_model *all[256];
         int n = 0;
@@ -2101,7 +2143,8 @@ int main(int argc, char **argv)
         run_kernels(&o, all, n);
     }
     if (o.parts & 4) run_chain(&o), part_time[4] = now() - tp;
-    printf("\nbench: done in %.0f s (trade %.0f, stability %.0f, sweep %.0f, time %.0f, kernels %.0f); results in "
-           "%s/\n", now() - t0, part_time[0], part_time[1], part_time[2], part_time[3], part_time[4], o.out);
+    printf("\nbench: done in %.0f s (trade %.0f, stability %.0f, sweep %.0f, time %.0f, coarse %.0f, kernels %.0f); "
+           "results in %s/\n", now() - t0, part_time[0], part_time[1], part_time[2], part_time[3], part_time[5],
+           part_time[4], o.out);
     return 0;
 }

@@ -115,4 +115,16 @@ typedef struct bench_model {
 /* An adapter's table: *count entries. */
 typedef const bench_model *(*bench_models_fn)(int *count);
 
+/* One row of heml.h's implicit steps with and without the coarse correction (issue 21,
+   bench/model_heml.c bench_heml_coarse_rows_*): a beam, E, dt, integrator and
+   desc.implicit_coarse (-1 never, 0 automatic, 1 always); per step the CG iterations, the
+   Newton iterations, the coarse factorisations and the seconds (best of the repeats), and
+   the status of the run. */
+typedef struct bench_coarse_row {
+    const char *scene, *integrator;
+    double young, dt;
+    int mode, dof, code;
+    double cg_per_step, newton_per_step, factors_per_step, seconds_per_step;
+} bench_coarse_row;
+
 #endif

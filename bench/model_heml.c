@@ -418,6 +418,86 @@ static int hm_kernel(void *v, int kernel)
     return BENCH_UNSUPPORTED;
 }
 
+/* >>coarse-rows (issue 21): implicit steps with and without the coarse correction of the
+   static solve (desc.implicit_coarse). Beams clamped at x = 0: R3's soft beam (1 x 0.1 x
+   0.1 m, 40 x 4 x 4 cells; 20 x 2 x 2 quick; rho 1000, nu 0.3) at E = 1 kPa, 1 MPa and
+   10 MPa, loaded by g = 0.01 E / (1 MPa) m/s^2 (the time part's R3 load: a 1.5 mm tip
+   deflection, so the steps stay near-linear and the Krylov solves are what is compared),
+   and R1's steel beam (16 x 0.5 x 0.5 m, 64 x 2 x 2 cells; 32 x 1 x 1 quick; E = 200 GPa,
+   its own weight); dt = 1 ms, 10 ms, 0.1 s and 1 s; implicit Euler and BDF2; `steps` (6; 2 quick)
+   steps from rest, each mode (-1 never, 0 automatic, 1 always) on its own model, the modes
+   interleaved, best of `repeats` for the time. */
+static int hm_coarse_run(const bench_body *b, int integrator, double dt, int mode, int steps, double (*clock_s)(void),
+                         bench_coarse_row *row)
+{
+    void *v = NULL;
+    hm_sim *s;
+    double t0, cg = 0, nw = 0, fc = 0;
+    int k, err = hm_create(b, HEML_NEO_HOOKEAN, 0, &v);
+    if (err) return err;
+    s = (hm_sim *)v;
+    s->m->implicit_coarse = mode;
+    row->dof = 3 * s->nodes;
+    t0 = clock_s();
+    for (k = 0; k < steps && !err; k++) {
+        const heml_stats *st;
+        err = heml_step_ex(s->m, (heml_real)dt, integrator);
+        st = heml_last_stats(s->m);
+        cg += st->cg_iterations, nw += st->newton_iterations, fc += st->coarse_factors;
+    }
+    t0 = (clock_s() - t0) / steps;
+    if (row->seconds_per_step == 0 || t0 < row->seconds_per_step) row->seconds_per_step = t0;
+    row->cg_per_step = cg / steps, row->newton_per_step = nw / steps, row->factors_per_step = fc / steps;
+    row->code = err;
+    hm_destroy(v);
+    return 0;
+}
+
+#ifdef BENCH_FLOAT
+#define BENCH_COARSE_ROWS bench_heml_coarse_rows_float
+#else
+#define BENCH_COARSE_ROWS bench_heml_coarse_rows_double
+#endif
+int BENCH_COARSE_ROWS(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max);
+int BENCH_COARSE_ROWS(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max)
+{
+    static const double youngs[3] = {1e3, 1e6, 1e7}, dts[4] = {1e-3, 1e-2, 0.1, 1.0};
+    static const int integrators[2] = {HEML_IMPLICIT_EULER, HEML_BDF2};
+    int scene, e, d, it, mode, rep, n = 0, k = quick ? 1 : 2, steps = quick ? 2 : 6, repeats = quick ? 1 : 2;
+    for (scene = 0; scene < 2; scene++)
+        for (e = 0; e < (scene ? 1 : 3); e++)
+            for (d = 0; d < 4; d++)
+                for (it = 0; it < 2; it++) {
+                    bench_body b;
+                    if (n + 3 > max) return n;
+                    memset(&b, 0, sizeof b);
+                    b.clamp = 1;
+                    b.poisson = 0.3;
+                    if (scene) {
+                        b.size[0] = 16, b.size[1] = b.size[2] = 0.5;
+                        b.cells[0] = 32 * k, b.cells[1] = b.cells[2] = k;
+                        b.young = 200e9, b.density = 7800, b.gravity[2] = -9.81;
+                    } else {
+                        b.size[0] = 1, b.size[1] = b.size[2] = 0.1;
+                        b.cells[0] = 20 * k, b.cells[1] = b.cells[2] = 2 * k;
+                        b.young = youngs[e], b.density = 1000, b.gravity[2] = -0.01 * youngs[e] / 1e6;
+                    }
+                    for (mode = 0; mode < 3; mode++) {
+                        bench_coarse_row *r = rows + n + mode;
+                        memset(r, 0, sizeof *r);
+                        r->scene = scene ? "R1 steel" : "R3 beam";
+                        r->integrator = it ? "bdf2" : "implicit-euler";
+                        r->young = b.young, r->dt = dts[d], r->mode = mode - 1;
+                    }
+                    for (rep = 0; rep < repeats; rep++)
+                        for (mode = 0; mode < 3; mode++)
+                            if (hm_coarse_run(&b, integrators[it], dts[d], mode - 1, steps, clock_s, rows + n + mode))
+                                rows[n + mode].code = -1;
+                    n += 3;
+                }
+    return n;
+}
+
 #define HM_ALL ((1u << BENCH_SEMI_IMPLICIT_EULER) | (1u << BENCH_IMPLICIT_EULER) | (1u << BENCH_STATIC) | (1u << BENCH_BDF2))
 #define HM_FUNCTIONS                                                                                          \
     hm_destroy, hm_dof, hm_node_count, hm_rest, hm_position, hm_pin, hm_release, hm_set_gravity, hm_solve_static, \

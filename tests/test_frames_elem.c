@@ -72,6 +72,7 @@ static void test_float_renames(void)
     static const entry_name names[] = {
         NAME(frm_version), NAME(frm_error_string), NAME(frm_shape_tet), NAME(frm_shape_hex), NAME(frm_shape_shepard),
         NAME(frm_shape_mls), NAME(frm_sampling_hexes), NAME(frm_sampling_tets), NAME(frm_sampling_meshless),
+        NAME(frm_sampling_curve), NAME(frm_material_thin),
         NAME(frm_sampling_box), NAME(frm_sampling_surface), NAME(frm_sampling_apply), NAME(frm_sampling_free),
         NAME(frm_shape_default_desc), NAME(frm_poisson_default_desc), NAME(frm_model_default_desc),
         NAME(frm_model_create), NAME(frm_model_destroy), NAME(frm_model_fix_frame), NAME(frm_model_drive_frame),
