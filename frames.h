@@ -1184,8 +1184,14 @@
    FRM_LINEAR_SOLVER_AUTO, resolved at creation (frm_model_linear_solver tells which):
    FRM_LINEAR_SOLVER_BTD when the block pattern is a chain in frame order (every sample's
    frames within one index of each other, so frame i couples to i - 1 and i + 1 only; a
-   chain numbered in another order is not detected) and the blocks are assembled (not
-   stiffness_mode FRM_STIFFNESS_PAIRS, not volumetric), FRM_LINEAR_SOLVER_CG otherwise;
+   chain numbered in another order is not detected), the blocks are assembled (not
+   stiffness_mode FRM_STIFFNESS_PAIRS, not volumetric) and frm_real is double,
+   FRM_LINEAR_SOLVER_CG otherwise. Float builds keep CG under AUTO: the factor is stored in
+   float, and on slender rods (condition numbers near 1 / eps(float)) BTD's answers met the
+   residual test yet were less accurate than CG's (tests/test_frames.c test_i14_curve in
+   float: the 32-segment rod's tip 0.150560 m under BTD against 0.150410 m in double, and
+   implicit steps that stopped converging); an explicit FRM_LINEAR_SOLVER_BTD still works
+   in float;
    the BTD workspace (144 reals a frame) is allocated only then. Anchors
    (frm_model_set_anchors: J^T k J couples the frames of each anchor's point, outside the
    assembled blocks) switch a model where AUTO chose BTD to CG while they are set (an
@@ -1193,12 +1199,16 @@
    coarse_aggregates concern CG only. Explicit CG or BTD are kept (BTD on a pattern that is
    not a chain: FRM_ERR_SOLVER at creation). Measured: a 12-frame rod whose samples each see
    two neighbouring frames gets BTD under AUTO, with the static sag and ten implicit steps
-   equal to CG's within 1e-6 of the sag (float 1e-3); a 3D block of hexahedra gets CG
+   equal to CG's within 1e-6 of the sag, as does a 16-segment rod of frm_sampling_curve
+   (rods from frm_sampling_curve are chains); a 3D block of hexahedra gets CG
    (tests/test_frames_chain.c test_frames_btd_auto); the two-frame models of
    tests/test_frames.c's validation tests now solve with BTD. BTD assembles the blocks
    (block stiffness mode forced), makes held components identity rows, factors
    a_mass M + a_stiff K, checks |b - A x| <= tolerance |b| against the model's own product
-   (up to three steps of iterative refinement: float needs them), and reports a failed
+   (up to three steps of iterative refinement: float needs them; where they stall, as for
+   a slender rod whose condition number nears 1 / eps(float), CG goes on from BTD's answer:
+   a 16-segment frm_sampling_curve rod in float failed its static solve under BTD alone and
+   matches CG's sag with this), and reports a failed
    factorisation as negative curvature (the Newton loops then retry with K's
    positive-definite part, as after CG). The reduced chain below always uses BTD.
 
@@ -1298,9 +1308,10 @@
              reduced chain model with actuators and the inverse model (frm_chain_*,
              frm_actuator), error codes FRM_ERR_BTD_INDEFINITE .. FRM_ERR_QP_INDEFINITE;
              desc.linear_solver defaults to FRM_LINEAR_SOLVER_AUTO (-1; BTD for chain-pattern
-             models with assembled blocks, CG otherwise) and frm_model_linear_solver tells
-             the choice: results of chain-pattern models (two-frame models among them) change
-             within the solve tolerances, other models bit-identical.
+             models with assembled blocks in double builds, CG otherwise) and
+             frm_model_linear_solver tells the choice: results of chain-pattern models (rods
+             of frm_sampling_curve, two-frame models) change within the solve tolerances in
+             double, other models and float builds bit-identical.
        unreleased (issue 14): coupling: mapped points (frm_probe_jacobian,
              frm_probe_jacobian_transpose, frm_probe_add_external; frm_probe_desc.nodes,
              node_frames, node_count), several parts (frm_part, frm_parts_combine,
@@ -1650,8 +1661,9 @@ typedef enum frm_integrator {
 /* Linear solvers of every Newton iteration (static solve and implicit steps). */
 typedef enum frm_linear_solver {
     FRM_LINEAR_SOLVER_AUTO = -1, /* not a solver: the choice at creation (default): BTD when the model's
-                                    stiffness pattern is a chain in frame order and its blocks are
-                                    assembled, CG otherwise (see SOLVERS, BLOCK-TRIDIAGONAL SOLVER);
+                                    stiffness pattern is a chain in frame order, its blocks are
+                                    assembled and frm_real is double, CG otherwise (see
+                                    BLOCK-TRIDIAGONAL SOLVER);
                                     frm_model_linear_solver tells which */
     FRM_LINEAR_SOLVER_CG = 0,    /* conjugate gradients, block-Jacobi plus the coarse space */
     FRM_LINEAR_SOLVER_BTD = 1,   /* block-tridiagonal LDL^T (issue 15): models whose stiffness pattern is a
@@ -1808,7 +1820,8 @@ typedef struct frm_desc {
     int implicit_linearized;   /* the older spelling of integrator = FRM_IMPLICIT_EULER_LINEARIZED:
                                   0 (default) or 1, which selects the linearised integrator */
     frm_linear_solver linear_solver; /* default FRM_LINEAR_SOLVER_AUTO: BTD for a chain-pattern
-                                        model with assembled blocks, CG otherwise (resolved at
+                                        model with assembled blocks in double builds, CG
+                                        otherwise (resolved at
                                         creation; frm_model_linear_solver); CG or BTD to choose
                                         (BTD refused with FRM_ERR_SOLVER where the pattern is not
                                         a chain) */
@@ -5233,10 +5246,11 @@ static int frm__create_size(const frm_desc *d, frm_model *tmp, frm__create_table
             if (d->sample_cells[s] + 1 > tmp->vol_groups) tmp->vol_groups = d->sample_cells[s] + 1;
     }
     /* FRM_LINEAR_SOLVER_BTD carves its blocks; AUTO resolves here: BTD for assembled blocks
-       whose pattern (every sample's frames pairwise coupled) is a chain in frame order */
+       whose pattern (every sample's frames pairwise coupled) is a chain in frame order, in
+       double builds (float keeps CG: see BLOCK-TRIDIAGONAL SOLVER) */
     tmp->linear_solver = (int)d->linear_solver;
     if (d->linear_solver == FRM_LINEAR_SOLVER_AUTO) {
-        int chain = tmp->has_blocks;
+        int chain = tmp->has_blocks && !FRM__IS_FLOAT;
         for (s = 0; s < S && chain; s++) {
             int lo = n, hi = -1, e;
             for (e = d->neighbor_start[s]; e < d->neighbor_start[s + 1]; e++) {
@@ -11099,6 +11113,7 @@ static int frm__btd_model_check(const frm_model *m, const frm_desc *d)
     return FRM_OK;
 }
 
+static int frm__cg(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x);
 static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, double tolerance, frm_real *b, frm_real *x)
 {
     int n = m->frame_count, i, e, a, c, err, k;
@@ -11169,7 +11184,9 @@ static int frm__btd_model_solve(frm_model *m, double a_mass, double a_stiff, dou
         m->lin_iterations = k;
         if (!frm__finite(rr)) return FRM__CG_NOT_FINITE;
         if (rr <= tolerance * tolerance * bb) return FRM__CG_OK;
-        if (k == 3 || frm_btd_solve(n, F, 1, r)) return FRM__CG_CAP;
+        if (k == 3 || frm_btd_solve(n, F, 1, r)) /* refinement stalls (float, condition near
+                                                     1 / eps): CG goes on from this answer */
+            return frm__cg(m, a_mass, a_stiff, tolerance, b, x);
         frm__mask(m, r);
         for (j = 0; j < (int)n6; j++) x[j] += r[j];
     }

@@ -1082,7 +1082,9 @@ static void test_frames_btd_solver(void)
 
 /* FRM_LINEAR_SOLVER_AUTO (the default) chooses BTD for the chain-pattern rod, whose
    static sag and ten implicit steps then equal CG's to the same tolerances as above (the
-   two solvers' answers differ by their solve tolerances only); CG for the same rod with a
+   two solvers' answers differ by their solve tolerances only), and for a rod of
+   frm_sampling_curve (same check of the sag; in float, where AUTO keeps CG (see the
+   manual), with BTD chosen: its refinement stalls and CG finishes); CG for the same rod with a
    third, farther neighbour (not a chain), for the chain in the matrix-free pair mode (no
    assembled blocks), and for a 3D block of hexahedra; explicit choices are kept; anchors
    (not in BTD's assembled blocks) switch an AUTO model to CG while they are set, and the
@@ -1091,10 +1093,10 @@ static void test_frames_btd_auto(void)
 {
     frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1, 0), *b = rod_model(FRM_LINEAR_SOLVER_AUTO, 1, 0), *c;
     double sag, tol = IS_FLOAT ? 1e-3 : 1e-6;
-    int i, k;
+    int i, k, chosen = IS_FLOAT ? FRM_LINEAR_SOLVER_CG : FRM_LINEAR_SOLVER_BTD; /* AUTO on a chain */
     if (!a || !b) return;
     CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(a));
-    CHECK_INT(FRM_LINEAR_SOLVER_BTD, frm_model_linear_solver(b));
+    CHECK_INT(chosen, frm_model_linear_solver(b));
     CHECK_INT(FRM_LINEAR_SOLVER_AUTO, frm_model_default_desc().linear_solver);
     CHECK_INT(FRM_LINEAR_SOLVER_COUNT, frm_model_linear_solver(NULL));
     CHECK_INT(FRM_OK, frm_model_solve_static(a));
@@ -1132,7 +1134,7 @@ static void test_frames_btd_auto(void)
                 for (k = 0; k < 3; k++)
                     CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
             CHECK_INT(FRM_OK, frm_model_set_anchors(b, NULL, NULL, NULL));
-            CHECK_INT(FRM_LINEAR_SOLVER_BTD, frm_model_linear_solver(b));
+            CHECK_INT(chosen, frm_model_linear_solver(b));
             CHECK_INT(FRM_OK, frm_model_solve_static(b));
         } else
             CHECK(0);
@@ -1140,6 +1142,44 @@ static void test_frames_btd_auto(void)
         frm_model_destroy(a);
         frm_model_destroy(b);
         frm_model_destroy(c);
+    }
+    { /* a rod of frm_sampling_curve (16 segments along x, each station between its two
+         frames): BTD under AUTO, the same cantilever sag as CG (tolerances as above) */
+        frm_real x[3 * 17], sec[2] = {(frm_real)0.02, (frm_real)0.02};
+        frm_sampling cs;
+        frm_model *r[2] = {NULL, NULL};
+        memset(x, 0, sizeof x);
+        for (i = 0; i <= 16; i++) x[3 * i] = (frm_real)(0.05 * i);
+        CHECK_INT(FRM_OK, frm_sampling_curve(&cs, x, 17, sec, NULL, NULL));
+        for (k = 0; k < 2; k++) {
+            frm_desc d = frm_model_default_desc();
+            frm_sampling_apply(&cs, &d);
+            d.material.young_modulus = (frm_real)1e8;
+            d.material.density = 1000;
+            /* float: BTD chosen explicitly (AUTO keeps CG there), whose iterative refinement
+               stalls on this rod and hands over to CG (without that the static solve failed) */
+            d.linear_solver = k ? FRM_LINEAR_SOLVER_CG : IS_FLOAT ? FRM_LINEAR_SOLVER_BTD : FRM_LINEAR_SOLVER_AUTO;
+            d.newton_tolerance = (frm_real)(IS_FLOAT ? 1e-4 : 1e-10);
+            d.cg_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-12);
+            CHECK_INT(FRM_OK, frm_model_create(&d, &r[k]));
+            if (!r[k]) continue;
+            CHECK_INT(k ? FRM_LINEAR_SOLVER_CG : FRM_LINEAR_SOLVER_BTD, frm_model_linear_solver(r[k]));
+            CHECK_INT(FRM_OK, frm_model_fix_frame(r[k], 0));
+            CHECK_INT(FRM_OK, frm_model_solve_static(r[k]));
+        }
+        if (r[0] && r[1]) {
+            sag = fabs((double)frm_model_displacements(r[1])[3 * 16 + 2]);
+            CHECK(sag > 1e-4);
+            printf("    curve rod sag %.6e m (CG) and %.6e m (%s)\n", sag,
+                   fabs((double)frm_model_displacements(r[0])[3 * 16 + 2]), IS_FLOAT ? "BTD chosen" : "AUTO: BTD");
+            for (i = 0; i < 17; i++)
+                for (k = 0; k < 3; k++)
+                    CHECK_NEAR((double)frm_model_displacements(r[0])[3 * i + k], (double)frm_model_displacements(r[1])[3 * i + k],
+                               tol * sag);
+        }
+        frm_model_destroy(r[0]);
+        frm_model_destroy(r[1]);
+        frm_sampling_free(&cs);
     }
     a = rod_model(FRM_LINEAR_SOLVER_AUTO, 0, 0); /* not a chain */
     b = rod_model(FRM_LINEAR_SOLVER_AUTO, 1, 1); /* a chain, but no assembled blocks */
