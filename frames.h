@@ -927,15 +927,21 @@
          attached to a rigid body (the attached frames are no longer frames of the model).
        - At most 16 neighbours per sample. The CUDA companion runs a subset and has not run on a
          GPU yet (see CUDA).
-       - Coupling to heml.h meshes is by iteration between the models (tensormass.h: not yet)
+       - Coupling to heml.h and tensormass.h meshes is by iteration between the models
          (COUPLING), not one monolithic solve: each coupled step costs several steps of
          each model (7 to 9 measured), the staggered exchange has a small time-step limit,
          and the glue is a penalty (its compliance is a modelling error, about 1 / k per
          glued node). Assembled blocks (frm_model_stiffness_blocks) hold the anchors' own
-         rotational term on the diagonal but not J^T k J (the products add it). In float
-         builds the coupled beams of tests/test_frames_coupling.c fail (a model's solve
-         stops at its round-off before the interface settles; skipped there, not yet
-         investigated); the anchors' own finite-difference tests pass in float.
+         rotational term on the diagonal but not J^T k J (the products add it). Float: the
+         coupled beams of tests/test_frames_coupling.c run with tolerances float can reach
+         (they were skipped before, failing): heml.h's static solve of the glued R1 half
+         stalls at its round-off floor above float's default static_tolerance 1e-4
+         (HEML_ERR_ROUND_OFF in the first map; 1e-3 passes, R1 glued +3.40 % against
+         double's +3.57 %), the glue iterates to 1e-4 m; the soft beam's Newton steps of
+         the frames, under the springs' forces as loads, stop in their line search at
+         1e-4 (FRM_ERR_NO_CONVERGENCE at the first step): with the springs on the frames'
+         side (robin_frames = 1) and the frames' Newton tolerance 1e-3 every step converges
+         and the trajectory equals double's to 4 digits.
        - Reduced chain (issue 15): each link is linear in its proximal frame's axes (small
          strain, large rotations: the thesis's model), so a link bent by tens of degrees is
          inaccurate (its rotation measure 2 sin(theta/2) saturates); use more vertebrae.
@@ -1002,8 +1008,8 @@
        loads (constant through the following steps and solves: once per step for a
        staggered coupling). Measured cost: see README (bench kernels part, "frames mapped
        point").
-       Anchors (frm_model_set_anchors; heml_set_anchors is the same hook for nodes,
-       tensormass.h's is not written yet): zero-length springs from a probe's mapped points to targets, energy
+       Anchors (frm_model_set_anchors; heml_set_anchors and tmass_set_anchors are the same
+       hook for nodes): zero-length springs from a probe's mapped points to targets, energy
        sum_n k_n / 2 |p_n(q) - t_n|^2, part of the model (forces J^T (-k d), d = p - t; the
        stiffness J^T k J plus the levers' own term k w (a d^T - (a . d) I) per pair, whose
        antisymmetric half is the 1/2 [tau]x of every torque; energies; the block-Jacobi
@@ -1037,7 +1043,11 @@
        with 0.055 m to go); plain Robin-Neumann diverges on R1's interface modes; with
        Anderson mixing R1 (half frames 16 x 2 x 2 hexahedra clamped, half heml.h 16 x 2 x 2
        cells of P1 tetrahedra) converges in 7 iterations to +0.13 % of Timoshenko (frames
-       alone +3.49 %, heml alone -64.9 %: P1 locking, which the outer half feels 1/16 of),
+       alone +3.49 %, heml alone -64.9 %: P1 locking, which the outer half feels 1/16 of);
+       with the heml half refined until heml alone is within 5 % (6 x 6 x 128 cells of five
+       tetrahedra a half: -4.16 % alone) the glued tip is +3.57 % in 4 iterations; a
+       tensormass.h half (16 x 2 x 2 cells, tmass_set_anchors, the same iteration written
+       out in the test) +0.10 % in 6 (tensormass alone -64.9 %: the same P1 stiffness);
        and the soft beam above steps at dt = 10 ms with at most 9 iterations a step. k
        trades the glue's compliance against the iteration: k = 0.1, 0.3, 1, 3 E h (h the
        mesh's cell size across) gave +1.41, +0.13, -0.40, -0.57 % on R1 (the last not
@@ -2417,7 +2427,7 @@ FRMDEF int frm_probe_jacobian_transpose(const frm_probe *p, const frm_model *m, 
    per step with the points' current forces (a staggered coupling, a render mesh's
    contact). FRM_ERR_ARG as above, or a non-finite force (nothing added). */
 FRMDEF int frm_probe_add_external(const frm_probe *p, frm_model *m, const frm_real *f);
-/* Anchors (issue 14; the same hook as heml_set_anchors; tensormass.h's is planned): zero-length
+/* Anchors (issue 14; the same hook as heml_set_anchors and tmass_set_anchors): zero-length
    springs from each mapped point p_n of the probe to targets[3n..3n+2] (m) with stiffness
    stiffness[n] (N/m, >= 0), energy sum_n k_n / 2 |p_n(q) - t_n|^2. They are part of the
    model from then on: internal forces (frm_model_forces; J^T of -k (p - t)), energies,

@@ -359,27 +359,84 @@
        before the filter, so it relaxes with the rest of the stress. Inversion: the
        continued U is restoring below J0 at the nodes; a single tetrahedron's own
        resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
-       the bulk part. Memory: 6 reals per node plus one per node and material.
+       the bulk part. Memory: 9 reals per node (3 of them the deviatoric diagonal of the
+       probe below) plus one per node and material.
        Measured (tests/test_heml_solve.c, Cook's membrane R10, nu = 0.4999, corner u_y in
        mm at N x N x 1 cells, N = 4, 8, 16, 32; converged about 6.9):
            six tetrahedra per cell   plain 2.15 2.17 2.22 2.38   nodal 2.65 4.38 5.99 6.61
            five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
        so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
        it and converge (as O(h)) towards the published value. What it does not fix
-       (LIMITS): the static solve's Krylov iterations (Cook, N = 16: about 430 at nu = 0.3,
-       17,000 at nu = 0.4999, with or without nodal pressure: the conditioning is the
-       bulk-to-shear ratio, which the Jacobi and rigid-body coarse preconditioner does
-       not address; scaling the Jacobi diagonal's bulk share by 0.2 or 0.02 gave 14,300
-       to 21,600: the diagonal is not the cause, a volumetric (divergence-free) coarse
-       space or a block preconditioner would be), and the nodal pressure field oscillates between neighbouring nodes
+       (LIMITS): the static solve's Krylov iterations grow with the bulk-to-shear ratio.
+       Measured (Zen 5, 2 vCPUs, loaded; gcc -O2 -march=native, double; heml_solve_static,
+       Krylov iterations in total (Newton iterations), for nu = 0.3, 0.49, 0.499, 0.4999 at
+       mu fixed, the bulk modulus from nu; Cook six tetrahedra per cell; the beam 1 x 0.1 x
+       0.1, 40 x 4 x 4 cells of five, clamped, tip load, linear range):
+           Cook N = 8     490 (4)    745 (5)   2,243 (9)    5,738 (11)
+           Cook N = 16    449 (5)  1,480 (9)   3,434 (10)  13,446 (13)
+           beam 40x4x4    111 (2)    455 (3)     933 (3)    2,223 (3)
+       (bench/heml_nodal_krylov.c. Before the K_dev probe below, on the code before issue
+       21's coarse changes, at nu = 0.49, 0.499, 0.4999: Cook N = 8 814, 2,701, 7,262,
+       N = 16 1,658, 4,350, 20,692 (16), the beam 458, 1,357, 3,653; with it, on that code,
+       743, 2,256, 5,729, 1,484, 3,430, 17,103 (16), 455, 933, 2,228: the round-off of the
+       coarse correction moves Newton's path at 0.4999, by up to a fifth of the count. The
+       answers the same to every printed digit; time at 0.4999, best of 2 or 3 interleaved
+       runs: Cook N = 8 0.76 -> 0.64 s, the beam 3.9 -> 2.3 s), so still 12 to 30 times the
+       nu = 0.3 count at 0.4999. The probe on K_dev: the saddle
+       probe (heml__saddle_escape) solves K x = b to 1e-10 after Newton converged, and with
+       the nodal pressure K = K_dev + s G^T Dn G (K_dev the tangent with the nodal dP_a held
+       at 0, G du = (sum Vol dJ / 4)_a, Dn = diag(d_a), d_a = sum_mat W U''_mat(J_a) / V_a^2,
+       s the Prony factor): where every d_a >= 0 and all materials share s, K >= K_dev, so
+       when CG meets no negative curvature on K_dev (preconditioned by the deviatoric
+       small-strain diagonal and a coarse space built from the deviatoric small-strain
+       stiffness, lambda -> -2 mu / 3) there is none on K either; otherwise the full probe
+       runs as before. Its conditioning is that of mu: 169 iterations on Cook N = 8 at
+       every nu, against 155 (nu = 0.3) to 1,706 (0.4999) for the full probe (3,744 on
+       Cook N = 16 at 0.4999); dearer than the full probe at small bulk-to-shear ratios, so it runs
+       only where every material's kappa >= 20 mu (nu >= 0.476). Tested: K_dev against
+       closed forms at rest (a dilation gives 0, an isochoric shear gives K v), symmetric
+       and below K at a deformed state, the same Cook answer bit for bit, a compressed
+       column's saddle still caught (in double; in float the static solve accepts that
+       saddle with or without the shortcut). Tried, and not kept (git history of branch i-anp, commit 84d59f2, reverted): the textbook
+       kappa-robust route, the equivalent saddle-point system [D + c K_dev, G^T E; E G,
+       -Sigma] (K_dev the element pass with dP_a = 0, G du = sum Vol dJ / 4, E =
+       sqrt(c s |d_a|), d_a = sum W U'' / V_a^2: eliminating the pressure gives exactly
+       today's operator; the answers agreed to every printed digit) by MINRES with the
+       block-diagonal preconditioner diag(deviatoric Jacobi + deviatoric coarse space,
+       1 / (1 + s |d_a| V_a / (beta mu_a))): Cook N = 8: 798, 1,626, 5,076, 35,055
+       iterations; with a grad-div share alpha mu / V_a of d_a kept in the displacement
+       block (alpha = 20, beta = 3, the best of alpha 0..20, beta 0.1..10) 513, 1,077, 3,345,
+       7,152, and on Cook N = 16 130,685 at nu = 0.4999. The reason: this pair (P1
+       displacements, nodal pressures) is not inf-sup stable (the same cause as the
+       pressure's checkerboard below), so the Schur complement C + G K_dev^-1 G^T falls to
+       C = V / kappa on nearly spurious pressure modes, which no diagonal pressure
+       preconditioner sees; kappa-robustness needs a Schur approximation with G's own
+       sparsity (C + G diag(K_dev)^-1 G^T, applied by an inner solve) or a stabilised
+       formulation (which changes the answers): not done. Also tried: the coarse space built with a
+       smaller lambda (the deviatoric -2 mu / 3, mu, 10 mu, 100 mu): 30,638, 27,246,
+       22,080, 14,574 against 7,262 on Cook N = 8 at 0.4999 (the coarse space must carry
+       the bulk stiffness); earlier, scaling the Jacobi diagonal's bulk share by 0.2 or
+       0.02: no gain.
+       The nodal pressure field also oscillates between neighbouring nodes
        near incompressibility (its largest jump between neighbours is 0.8 to 1.0 of its
-       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): read pressures
-       smoothed, e.g. as the element means p_e, not node by node. The bench's Poisson beam
+       range on Cook's membrane at nu = 0.4999, 0.15 to 0.2 at nu = 0.3): a checkerboard, as
+       linear displacements with nodal pressures are not an inf-sup stable pair. One pass of
+       smoothing (element means p_e spread back to the nodes) is not enough (a neighbour
+       indicator of 0.5 to 1.15 against a smooth field's 0.04 to 0.4); three passes give a
+       smooth field that both tetrahedral splits agree on (tests/test_heml_solve.c
+       test_nodal_pressure_cook): read pressures smoothed three times, never node by node.
+       A stabilised pressure is not done (issue 13 open). The bench's Poisson beam
        (1 x 0.1 x 0.1 m, 30 x 3 x 3 cells of five tetrahedra, tip against Timoshenko): 14.4,
        18.9, 22.5, 25.9 % off at nu = 0.3, 0.45, 0.49, 0.499 (plain 18.5, 22.4, 26.6,
        30.2 %); of six tetrahedra per cell at nu = 0.499 the tip is 0.0071 m instead of
-       plain P1's 0.0004 m. The growth with nu that remains halves with h (13 % between
-       nu = 0.3 and 0.499 at 3 cells across, 6 % at 6): P1 bending error, not locking.
+       plain P1's 0.0004 m. The growth with nu that remains halves with h: P1 bending
+       error, not locking (the same beam, 10 N x N x N cells of five tetrahedra, fully
+       clamped, tip load, against Timoshenko: N = 3, 6, 9 cells across -14.2, -4.6, -2.5 %
+       at nu = 0.3, -21.1, -8.0, -4.9 % at 0.49, -23.8, -9.5, -5.9 % at 0.499: the gap to
+       nu = 0.3 is 9.6, 4.9, 3.4 points at 0.499, O(h), and the O(h) extrapolations from
+       N = 6 and 9 agree within half a point, +1.7, +1.3, +1.3 %). So the issue's 2-point
+       target on the bench's beam (3 cells across: 8.1 points at 0.49, 11.5 at 0.499) is
+       not met, and would be from about 15 cells across.
        Cost (callgrind, 2,592 tetrahedra, Neo-Hookean, gcc -O3 -mavx2 -mfma, instructions
        per tetrahedron and pass): force 643 against 229 on the vectorised kernel (284 on
        the general path it runs instead), differential 979 against 310 (431): the sums
@@ -498,12 +555,16 @@
                              T/50 or less for the modes that matter) and it needs a
                              constant dt (a change restarts it with one implicit Euler
                              step).
-   ANCHORS (heml_set_anchors, issue 14; the same hook as frm_model_set_anchors, and
-       tensormass.h's planned tmass_set_anchors): zero-length springs from chosen nodes to target points,
+   ANCHORS (heml_set_anchors, issue 14; the same hook as frm_model_set_anchors and
+       tensormass.h's tmass_set_anchors): zero-length springs from chosen nodes to target points,
        energy sum_a k_a / 2 |x_a - t_a|^2, part of the model's energy W from the call on:
        forces (-k (x - t)), the differential (-k dx, so heml_apply_stiffness is the public
        stiffness product of the model with its anchors), the Jacobi preconditioner (k on the
-       anchored diagonal), every integrator, the static solve, its saddle check and modal
+       anchored diagonal), the coarse spaces of static solves and implicit steps (P^T k P on
+       the anchored nodes' aggregates, rebuilt after each heml_set_anchors: a body held only by anchors keeps
+       its rigid modes there; the glued R1 half went from about 900 to 120 CG iterations
+       a Newton solve; a stiffness changed in place without the call keeps the old coarse
+       space, slower, not wrong), every integrator, the static solve, its saddle check and modal
        analysis; heml_energy's elastic part includes them. They are the hook for gluing a
        mesh to another model without either header including the other: the targets are
        the other model's points (frames.h: mapped points of a probe), updated between
@@ -867,10 +928,12 @@
          desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
          BODIES), which removes the volumetric locking, not the bending one.
        - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
-         shear ratio (about 40 times more at nu = 0.4999 than at nu = 0.3 on Cook's
-         membrane: no preconditioner for the volumetric part yet); the nodal pressure
-         oscillates between neighbouring nodes near nu = 0.5 (smooth the pressure before
-         reading it); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
+         probe's share is cut by running it on the deviatoric stiffness first, but a
+         saddle-point MINRES with a block-diagonal preconditioner was tried and is not
+         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
+         oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read it smoothed
+         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
@@ -1394,7 +1457,7 @@ HEMLDEF int heml_node_pinned(const heml_model *m, int i);
 HEMLDEF int heml_set_external_force(heml_model *m, int i, const heml_real f[3]);
 /* Sets every external force to zero. */
 HEMLDEF void heml_clear_external_forces(heml_model *m);
-/* Anchors (issue 14; the same hook as frm_model_set_anchors; tensormass.h's is planned): zero-
+/* Anchors (issue 14; the same hook as frm_model_set_anchors and tmass_set_anchors): zero-
    length springs from nodes[a] to the point targets[3a..3a+2] (m) with stiffness
    stiffness[a] (N/m, >= 0), energy sum_a k_a / 2 |x_nodes[a] - t_a|^2. They are part of the
    model from then on: every force, energy, stiffness product (heml_apply_stiffness, the
@@ -1662,6 +1725,9 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
+#define HEML__DEV_PROBE_RATIO 20.0 /* kappa / mu from which the probe runs on K_dev first (nu of
+                                      0.476; measured on Cook's membrane, 8 x 8: 169 iterations at
+                                      every nu, the full probe 155 at nu = 0.3, 236 at 0.49) */
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__NODE_CHUNK 1024 /* nodes per work item of the nodal pressure's node pass */
 #define HEML__MAX_TETS 100000000
@@ -1851,6 +1917,13 @@ struct heml_model {
     heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
     double *nod_energy;
     int nod_chunks;
+    /* the deviatoric probe (heml__dev_probe): kdev 1 while a solve runs on K_dev (the node
+       pass writes dP_a = 0; Jacobi reads diag_dev, the deviatoric small-strain stiffness
+       diagonal, 3n; the coarse space is built from the deviatoric small-strain stiffness,
+       coarse_dev says which one is factored), 2 for the node pass to write d_a = dP_a /
+       dj_a instead; dev_probe: the model's bulk-to-shear ratio makes it pay */
+    int kdev, coarse_dev, dev_probe;
+    heml_real *diag_dev;
 
     heml_stats stats;
 };
@@ -3524,7 +3597,8 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
             for (k = 0; k < valid; k++) {
                 heml_real inv = m->nod_inv[a + k];
                 m->nod_p[a + k] = P[k] * inv;
-                if (cx->diff) m->nod_dp[a + k] = Q[k] * inv * inv * m->nod_dj[a + k];
+                if (cx->diff) /* (kdev: heml__dev_probe) */
+                    m->nod_dp[a + k] = m->kdev == 1 ? 0 : Q[k] * inv * inv * (m->kdev ? 1 : m->nod_dj[a + k]);
             }
         }
         m->nod_energy[c] = energy;
@@ -3816,8 +3890,10 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_p, heml_real, nn);
         HEML__CARVE(c, m->nod_dp, heml_real, nn);
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
+        HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? HEML__NC * s : 0);
+    if (!m->nodal) m->diag_dev = NULL;
     if (!m->has_springs) m->blk_spring = NULL;
     if (!m->has_dc) m->dc = NULL;
 }
@@ -4265,6 +4341,7 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
     double noise2 = 0.0;
     memset(mass_acc, 0, sizeof(double) * (size_t)m->node_count);
     memset(diag_acc, 0, sizeof(double) * 3 * (size_t)m->node_count);
+    if (m->diag_dev) memset(m->diag_dev, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (s = 0; s < m->slot_count; s++) {
         int t = m->slot_tet[s], *idx;
         heml_real *R;
@@ -4298,9 +4375,13 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
             for (j = 0; j < 4; j++) {
                 double gg = g[j][0] * g[j][0] + g[j][1] * g[j][1] + g[j][2] * g[j][2];
                 mass_acc[q[j]] += mt->density * vol / 4.0;
-                for (r = 0; r < 3; r++)
+                for (r = 0; r < 3; r++) {
                     diag_acc[3 * q[j] + r] +=
                         vol * ((mt->small_lambda + mt->small_mu) * g[j][r] * g[j][r] + mt->small_mu * gg);
+                    if (m->diag_dev) /* lambda - kappa = -2 mu / 3: the law less its dilation energy */
+                        m->diag_dev[3 * q[j] + r] +=
+                            (heml_real)(vol * (mt->small_mu / 3.0 * g[j][r] * g[j][r] + mt->small_mu * gg));
+                }
             }
             if (mt->kind == HEML__K_SPRING) {
                 for (l = 0; l < 6; l++) {
@@ -4361,8 +4442,12 @@ static void heml__nodal_weights(heml_model *m, const heml_desc *d, double *acc)
    stiffness of the rest state on the free degrees of freedom (assembled from 3x3 node
    blocks, dense, Cholesky-factored in double; a mode that pins make singular is dropped).
    Slender bodies bend as their aggregates rotate, which is what Jacobi alone resolves
-   slowest: on the steel cantilever R1 it cuts the CG iterations by about ten. A_c is
-   rebuilt when the pinned axes change. */
+   slowest: on the steel cantilever R1 it cuts the CG iterations by about ten. The anchors
+   (heml_set_anchors) add P^T k P on their nodes: a body held only by anchors keeps its
+   rigid modes in the coarse space (without them those modes were singular and dropped:
+   the glued R1 half of tests/test_frames_coupling.c took about 900 CG iterations a
+   Newton solve instead of 120; the implicit steps' P^T (D + c K0) P holds them through
+   K0 too). A_c is rebuilt when the pinned axes change and after heml_set_anchors. */
 #define HEML__MAX_AGG 64
 #define HEML__MIN_AGG_NODES 24 /* nodes per aggregate at least (fewer aggregates otherwise) */
 
@@ -4453,14 +4538,15 @@ static void heml__node_modes(const heml_model *m, int i, double P[3][6])
             for (k = 0; k < 6; k++) P[r][k] = 0.0;
 }
 
-/* Ac = P^T K0 P on the free degrees of freedom (unfactored, (6 A)^2 doubles). */
-static void heml__coarse_assemble(const heml_model *m, double *Ac)
+/* Ac = P^T K0 P on the free degrees of freedom (unfactored, (6 A)^2 doubles); with dev,
+   of the deviatoric small-strain stiffness (lambda -> -2 mu / 3: heml__dev_probe). */
+static void heml__coarse_assemble(const heml_model *m, double *Ac, int dev)
 {
     int A = m->agg_count, D = 6 * A, c, blk, k, i, j, r, s, a, b;
     memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
     for (c = 0; c < m->chunk_count; c++) {
         const heml__mat *mt = m->mats + m->chunk_material[c];
-        double mu = mt->small_mu, lam = mt->small_lambda;
+        double mu = mt->small_mu, lam = dev ? -2.0 / 3.0 * mt->small_mu : mt->small_lambda;
         for (blk = m->chunk_begin[c]; blk < m->chunk_end[c]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
@@ -4488,6 +4574,13 @@ static void heml__coarse_assemble(const heml_model *m, double *Ac)
             }
         }
     }
+    for (i = 0; i < m->anchor_count; i++) { /* the anchors' k I on their nodes: P^T k P */
+        double P[3][6], ka = (double)m->anchor_k[i];
+        double *blockp = Ac + (size_t)(6 * m->node_agg[m->anchor_nodes[i]]) * D + 6 * m->node_agg[m->anchor_nodes[i]];
+        heml__node_modes(m, m->anchor_nodes[i], P);
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) blockp[(size_t)a * D + b] += ka * (P[0][a] * P[0][b] + P[1][a] * P[1][b] + P[2][a] * P[2][b]);
+    }
 }
 
 /* coarse_k = P^T K0 P, when the pins changed since its last assembly (implicit_coarse >= 0:
@@ -4495,7 +4588,7 @@ static void heml__coarse_assemble(const heml_model *m, double *Ac)
 static void heml__coarse_k_update(heml_model *m)
 {
     if (m->coarse_k_version == m->pin_version) return;
-    heml__coarse_assemble(m, m->coarse_k);
+    heml__coarse_assemble(m, m->coarse_k, 0);
     m->coarse_k_version = m->pin_version;
 }
 
@@ -4525,18 +4618,20 @@ static void heml__coarse_factor(double *Ac, int D, double *dg)
 
 /* The static solve's A_c = P^T K0 P, Cholesky-factored into `coarse`, when the pins
    changed since (assembled into coarse_k first, which the implicit steps share, unless
-   implicit_coarse = -1 left it out). */
+   implicit_coarse = -1 left it out); while kdev (heml__dev_probe), the deviatoric one
+   (coarse_dev says which one `coarse` holds). */
 static void heml__coarse_build(heml_model *m)
 {
     size_t D = 6 * (size_t)m->agg_count;
-    if (!m->agg_count || m->coarse_version == m->pin_version) return;
-    if (m->implicit_coarse < 0) heml__coarse_assemble(m, m->coarse); /* (no coarse_k) */
+    if (!m->agg_count || (m->coarse_version == m->pin_version && m->coarse_dev == m->kdev)) return;
+    if (m->implicit_coarse < 0 || m->kdev) heml__coarse_assemble(m, m->coarse, m->kdev != 0); /* (no coarse_k) */
     else {
         heml__coarse_k_update(m);
         memcpy(m->coarse, m->coarse_k, sizeof(double) * D * D);
     }
     heml__coarse_factor(m->coarse, (int)D, m->coarse_rhs);
     m->coarse_version = m->pin_version;
+    m->coarse_dev = m->kdev;
 }
 
 /* The implicit steps' coarse matrix P^T (D + c K0) P (D the solve's diagonal, NULL: 0),
@@ -4913,6 +5008,11 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
     }
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
     if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
+    m->dev_probe = m->nodal; /* where it pays: every material's bulk modulus at least
+                                HEML__DEV_PROBE_RATIO times its shear modulus (heml__dev_probe) */
+    for (i = 0; i < m->material_count; i++)
+        if (m->mats[i].small_lambda + 2.0 / 3.0 * m->mats[i].small_mu < HEML__DEV_PROBE_RATIO * m->mats[i].small_mu)
+            m->dev_probe = 0;
     heml__create_chunks(m, src, w);
     if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);
@@ -4986,8 +5086,9 @@ static void heml__cg_apply(heml_model *m, const heml_real *diag, double c, const
 static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, heml_real *pinv)
 {
     int i, n3 = 3 * m->node_count;
+    const heml_real *kd = m->kdev ? m->diag_dev : m->diag;
     for (i = 0; i < n3; i++) {
-        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)m->diag[i];
+        double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)kd[i];
         pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
     }
     if (m->anchor_count) { /* the anchors' k joins the diagonal of the nodes they hold */
@@ -5001,7 +5102,7 @@ static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, h
                 double dgl;
                 j = 3 * m->anchor_nodes[a] + r;
                 if (pinv[j] < 0) continue;
-                dgl = (diag ? (double)diag[j] : 0.0) + c * ((double)m->diag[j] + (double)pinv[j]);
+                dgl = (diag ? (double)diag[j] : 0.0) + c * ((double)kd[j] + (double)pinv[j]);
                 pinv[j] = (heml_real)(m->free_mask[j] > 0 && dgl > 0 ? -1.0 / dgl : -0.0);
             }
         for (a = 0; a < m->anchor_count; a++)
@@ -5194,6 +5295,45 @@ typedef char heml__linear_solvers_has_a_row_per_solver
 
 #define HEML__SPD 0
 #define HEML__INDEFINITE 1
+#define HEML__PROBE 2 /* the saddle probe's solve (positive definite; CG must see its curvature) */
+
+/* The saddle probe's solve on the deviatoric stiffness (NEAR-INCOMPRESSIBLE BODIES,
+   "Solvers"): with the nodal pressure the tangent is K = K_dev + s G^T Dn G (K_dev the
+   element pass with the nodal dP_a held at 0, G du = (sum Vol_e dJ_e / 4)_a, Dn =
+   diag(d_a), d_a = sum_mat W U''_mat(J_a) / V_a^2, s the Prony factor), so where every d_a
+   >= 0 and every material has the same factor s > 0, D + c K >= D + c K_dev: a probe that
+   meets no negative curvature of D + c K_dev has shown the same of D + c K, at the
+   conditioning of the shear modulus rather than the bulk modulus (Jacobi of the
+   deviatoric small-strain diagonal, the coarse space of the deviatoric small-strain
+   stiffness). Returns the CG's code (x as CG left it), or HEML__NEGATIVE_CURVATURE (x
+   reset to 0) where the full probe must decide: K_dev has negative curvature, the
+   conditions fail, or the model's bulk-to-shear ratio is too low for it to pay
+   (dev_probe 0). One more sums and node pass, d_a in nod_dp (scratch: krylov[0]). */
+static int heml__dev_probe(heml_model *m, const struct heml__linear_solver_ops *ops, const heml_real *x_lin,
+                           const heml_real *diag, double c, const heml_real *b, heml_real *x, double rtol, int coarse)
+{
+    int i, err, n3 = 3 * m->node_count;
+    double s = 0.0;
+    if (!m->dev_probe || !(c > 0)) return HEML__NEGATIVE_CURVATURE;
+    for (i = 0; i < m->material_count; i++) {
+        double sp = m->mats[i].prony_count ? (double)m->prony_s[i] : 1.0;
+        if (i == 0) s = sp;
+        else if (sp != s) return HEML__NEGATIVE_CURVATURE;
+    }
+    if (!(s > 0)) return HEML__NEGATIVE_CURVATURE;
+    memset(m->krylov[0], 0, sizeof(heml_real) * (size_t)n3);
+    m->kdev = 2;
+    heml__nodal_prepare(m, HEML__DIFF, x_lin, m->krylov[0]);
+    for (i = 0; i < m->node_count; i++)
+        if (!(m->nod_dp[i] >= 0)) break;
+    m->kdev = 1;
+    err = i < m->node_count ? HEML__NEGATIVE_CURVATURE
+                            : ops->solve(m, x_lin, diag, c, b, x, rtol, coarse, m->krylov);
+    m->kdev = 0;
+    heml__dc_invalidate(m);
+    if (err == HEML__NEGATIVE_CURVATURE) memset(x, 0, sizeof(heml_real) * (size_t)n3);
+    return err;
+}
 
 /* Every linear solve of the library goes through here, to the model's linear solver. */
 static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, const heml_real *diag, double c,
@@ -5204,6 +5344,11 @@ static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, c
     m->step_solves++;
     if (coarse == HEML__COARSE_STEP && m->agg_count) m->stats.coarse_solves++;
     heml__dc_invalidate(m); /* (x_lin's contents may be new: the stiffness cache refills) */
+    if (kind == HEML__PROBE) {
+        err = heml__dev_probe(m, ops, x_lin, diag, c, b, x, rtol, coarse);
+        if (err != HEML__NEGATIVE_CURVATURE) return err;
+        kind = HEML__SPD; /* the full probe decides */
+    }
     err = (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
                                                                            m->krylov);
     heml__dc_invalidate(m);
@@ -5524,7 +5669,7 @@ static int heml__saddle_escape(heml_model *m, const heml__objective *ob, heml_re
         b[i] = (heml_real)(((double)(h & 0xffffu) / 32768.0 - 1.0) * (double)m->free_mask[i]);
         x[i] = 0;
     }
-    kerr = heml__linear_solve(m, HEML__SPD, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
+    kerr = heml__linear_solve(m, HEML__PROBE, u, ob->dmass, 1.0, b, x, HEML__FLOAT ? 1e-5 : 1e-10, ob->coarse);
     if (kerr == HEML_ERR_NOT_FINITE) return kerr;
     if (kerr != HEML__NEGATIVE_CURVATURE) return HEML_OK;
     /* the solve's last direction p and K p, its preconditioner, and two free vectors */
@@ -6065,6 +6210,7 @@ HEMLDEF int heml_set_anchors(heml_model *m, int count, const int *nodes, const h
     m->anchor_nodes = count ? nodes : NULL;
     m->anchor_k = count ? stiffness : NULL;
     m->anchor_target = count ? targets : NULL;
+    m->coarse_version = m->coarse_k_version = m->coarse_step_version = m->pin_version - 1; /* the coarse spaces hold the anchors' k */
     return HEML_OK;
 }
 

@@ -54,7 +54,7 @@
        TMASS_REAL      float or double (default double). Creation computes the tensors in
                        double and stores them in TMASS_REAL. In float builds every public
                        function is renamed (tmass_step -> tmass_step_f32, and so on for all
-                       82), so mixing float and double translation units fails at link
+                       84), so mixing float and double translation units fails at link
                        time, not at run time (a test lists them all).
        TMASS_MALLOC(size, user) / TMASS_FREE(ptr, user)
                        default allocator (malloc/free) when the desc gives none.
@@ -66,7 +66,8 @@
        2. tmass_create(&d, &m) validates everything and allocates all memory once.
        3. Boundary conditions: tmass_fix_node (pinned where it is), tmass_set_displacement
           (pinned at rest + u, e.g. driven by a tool), tmass_release_node, gravity,
-          tmass_set_external_force.
+          tmass_set_external_force, tmass_set_anchors (springs to targets: gluing to
+          another model, see ANCHORS).
        4. tmass_step(m) (desc integrator and time step) or tmass_step_ex(m, dt, integrator);
           tmass_solve_static(m) for the equilibrium.
        5. Read tmass_positions / tmass_velocities / tmass_displacements /
@@ -117,7 +118,7 @@
          (selected by desc.linear_solver); tmass__linear_solvers[] (section >>solver) gets
          a row {name, solve, solve_block}. solve(m, diag, c, b, x) solves
          (diag + c K) x = b on the free degrees of freedom (K applied by tmass__matvec,
-         including a hybrid's coupling block), x holding the initial guess; solve_block
+         including a hybrid's coupling block and the anchors), x holding the initial guess; solve_block
          solves K X = B for TMASS__RHS interleaved columns (the quasi-static
          precomputation). Both return TMASS_OK, TMASS_ERR_NO_CONVERGENCE (cap reached or a
          direction of non-positive curvature) or TMASS_ERR_NOT_FINITE, add to stats
@@ -397,6 +398,42 @@
    reported through desc.log). Cutting and tearing apply to the dynamic part; connection
    nodes left without a dynamic tetrahedron stop coupling.
 
+   ANCHORS (tmass_set_anchors, issue 14; the same hook, arguments and semantics as
+       heml_set_anchors and frm_model_set_anchors): zero-length springs from chosen nodes to
+       target points, energy sum_a k_a / 2 |x_a - t_a|^2, part of the model from the call
+       on: forces (-k (x - t), formed in double as (rest - t) + u), the stiffness (k I on
+       the node: in every K product, so tmass_apply_stiffness, the CG products, the Jacobi
+       diagonal and the modal analysis include it), every integrator (explicit ones through
+       the force; implicit Euler, its linearised form and BDF2 through force and
+       operator; the springs' Newton through residual, tangent and incremental potential),
+       the static solves (the springs' saddle check too); tmass_energy's elastic part
+       includes them. They belong to K, so stiffness damping (beta > 0) damps them like
+       the rest of K (force -beta k v: frames.h's Rayleigh damping does the same; heml.h
+       has none); a glued node's damping then acts on its absolute velocity, so keep beta
+       small in glued scenes. The arrays are the caller's (kept by pointer, read at every
+       evaluation). Off by default: without the call every result is bit-identical. One
+       serial loop over the anchors per pass (in order: deterministic), no allocation.
+       They are the hook for gluing a mesh to another model without either header
+       including the other: the targets are the other model's points (frames.h: mapped
+       points of a probe), updated between solves, and the springs' stiffness is inside
+       each implicit and static solve (frames.h COUPLING; tests/test_frames_coupling.c
+       glues a tensormass.h half of R1 to a frames half: 6 coupling iterations, tip +0.10 %
+       of Timoshenko, float -0.09 %; examples/glue.h itself holds a heml.h mesh and shows
+       the full scheme). The precomputed quasi-static model refuses an anchored model
+       (tmass_qs_create, tmass_qs_load: TMASS_ERR_ANCHORED): its compliance C = K^-1 and
+       preload are fixed at creation, while the anchors' targets move with the other model
+       (a moving target is a load on the anchored node, k (t - X), which the precomputed
+       preload cannot follow unless every anchored node were a contact node, and k would
+       change C). A hybrid model's precomputed part is made inside tmass_hybrid_create and
+       never sees anchors; its dynamic part (tmass_hybrid_dynamic_part) is a model like any
+       and takes them in its steps and static solve (not tested). Tested
+       (tests/test_tensormass.c): force = -grad energy and K d = -df by central
+       differences with anchors on both kinds (below 1e-10 relative in double, 3e-6 float); a bar
+       held only by anchors of k = 1e4 E h at one end equals the clamped bar statically
+       (tip 3.1e-7 m off against a bound of 7.2e-7 m from k and the reactions) and through
+       20 implicit steps of each implicit integrator; every integrator keeps the anchored
+       equilibrium; bad input refused; no allocation in steps.
+
    PERFORMANCE: a force evaluation is one pass over the live edges. Per edge it reads two
    int node indices and one 3x3 tensor (8 + 72 = 80 bytes in double, 8 + 36 = 44 in
    float) and the displacements of both ends, and updates the forces of both ends; per
@@ -484,6 +521,10 @@
          with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       unreleased (issue 14) tmass_set_anchors (springs from nodes to caller-owned targets,
+             as heml.h and frames.h), tmass_apply_stiffness (the public K v),
+             TMASS_ERR_ANCHORED (the quasi-static precomputation of an anchored model).
+             Results without anchors bit-identical.
        unreleased (issue 19) TMASS_BDF2 (second-order implicit, the implicit Euler
              minimisation reused); the model block grows by 2 vectors of 3n reals (BDF2's
              history, 48 bytes per node in double). Modal analysis (tmass_modal_*), point
@@ -562,6 +603,8 @@ typedef TMASS_REAL tmass_real;
 #define tmass_set_gravity tmass_set_gravity_f32
 #define tmass_set_damping tmass_set_damping_f32
 #define tmass_set_solver tmass_set_solver_f32
+#define tmass_set_anchors tmass_set_anchors_f32
+#define tmass_apply_stiffness tmass_apply_stiffness_f32
 #define tmass_step tmass_step_f32
 #define tmass_step_ex tmass_step_ex_f32
 #define tmass_solve_static tmass_solve_static_f32
@@ -690,13 +733,14 @@ typedef TMASS_REAL tmass_real;
     X(TMASS_ERR_DIVERGED, -38, "explicit step diverged (an edge stretched past divergence_strain); the last valid state was kept") \
     X(TMASS_ERR_PRECISION, -39, "displacements too large for the precision of tmass_real relative to the smallest edge; the last valid state was kept") \
     X(TMASS_ERR_UNSTABLE, -40, "static solve (spring model) converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); the last valid state was kept") \
-    X(TMASS_ERR_PROBE_OUTSIDE, -41, "probe point outside every tetrahedron of the mesh (or its tetrahedron was cut away)")
+    X(TMASS_ERR_PROBE_OUTSIDE, -41, "probe point outside every tetrahedron of the mesh (or its tetrahedron was cut away)") \
+    X(TMASS_ERR_ANCHORED, -42, "a model with anchors (tmass_set_anchors) cannot be precomputed: the quasi-static compliance and preload are fixed at creation, the anchors' targets move")
 
 enum {
 #define TMASS__ENUM(name, value, text) name = value,
     TMASS_ERROR_LIST(TMASS__ENUM)
 #undef TMASS__ENUM
-    TMASS_ERR_LAST_ = -42
+    TMASS_ERR_LAST_ = -43
 };
 
 typedef enum tmass_model_kind {
@@ -863,6 +907,27 @@ TMASSDEF int tmass_set_gravity(tmass_model *m, const tmass_real g[3]);
 TMASSDEF int tmass_set_damping(tmass_model *m, tmass_real mass_damping, tmass_real stiffness_damping);
 /* CG tolerance (relative residual, > 0) and iteration cap (>= 1) for later solves. */
 TMASSDEF int tmass_set_solver(tmass_model *m, tmass_real tolerance, int max_iterations);
+/* Anchors (issue 14; the same hook, arguments and semantics as heml_set_anchors and
+   frm_model_set_anchors): zero-length springs from nodes[a] to the point targets[3a..3a+2]
+   (m) with stiffness stiffness[a] (N/m, >= 0), energy sum_a k_a / 2 |x_nodes[a] - t_a|^2.
+   They are part of the model from then on, exactly (force -k (x - t), stiffness k I on the
+   node): every force (tmass_forces, the integrators' accelerations), energy (tmass_energy's
+   elastic part), stiffness product (tmass_apply_stiffness, the CG products and its Jacobi
+   preconditioner), static solve, step of every integrator and modal analysis. They belong
+   to K, so stiffness damping (beta > 0) damps them like the rest of K (force -beta k v, as
+   in frames.h; heml.h has no stiffness damping). This is how a mesh is glued to another
+   model (frames.h COUPLING: the targets are the other model's mapped points, updated
+   between solves). The three arrays are the caller's: kept by pointer and read at every
+   evaluation until the next call, so they must outlive the model's use of them (update
+   targets or stiffnesses in place, or call again). count = 0 removes every anchor (the
+   arrays may then be NULL); default none (results bit-identical to a model without the
+   call). A node may carry several anchors (they add). No allocation. The precomputed
+   quasi-static model refuses an anchored model (tmass_qs_create, tmass_qs_load:
+   TMASS_ERR_ANCHORED; see ANCHORS). Errors (nothing kept): TMASS_ERR_ARG (NULL model or
+   array, count < 0, a stiffness negative or not finite, a target not finite),
+   TMASS_ERR_NODE_RANGE (a node index). */
+TMASSDEF int tmass_set_anchors(tmass_model *m, int count, const int *nodes, const tmass_real *stiffness,
+                               const tmass_real *targets);
 
 /* ---- simulation ---- */
 
@@ -904,6 +969,14 @@ TMASSDEF const tmass_real *tmass_forces(tmass_model *m);
    to start from a deformed state. Values must be finite. */
 TMASSDEF int tmass_set_positions(tmass_model *m, const tmass_real *positions);
 TMASSDEF int tmass_set_velocities(tmass_model *m, const tmass_real *velocities);
+/* The stiffness product at the current state: out = K dx = -(df/dx) dx (3n values each,
+   N for dx in m; out overwritten, caller-owned), every node included (pinned or not).
+   Tensor-mass: the constant K; springs: the full tangent at the current displacement
+   (compressed springs' negative geometric term included; it overwrites the tensors the
+   solvers rebuild anyway). Anchors included. Stiffness damping plays no part. Sign as
+   frm_model_apply_stiffness (K v); heml_apply_stiffness returns the force differential
+   (df/dx) dx, the opposite sign. One pass over the edges, no allocation. */
+TMASSDEF int tmass_apply_stiffness(tmass_model *m, const tmass_real *dx, tmass_real *out);
 /* Statistics of the last step or static solve. */
 TMASSDEF const tmass_stats *tmass_last_stats(const tmass_model *m);
 /* Energies of the current state. Costs one force evaluation. */
@@ -1313,6 +1386,14 @@ struct tmass_model {
     double *coupling_x;  /* 2 * 3c scratch */
     void *coupling_block;
     size_t coupling_bytes;
+
+    /* anchors (tmass_set_anchors, issue 14): the caller's arrays, read at every evaluation */
+    int anchor_count;
+    const int *anchor_nodes;
+    const tmass_real *anchor_k, *anchor_target;
+    double anchor_scale; /* the anchors' weight in the operator the edge tensors hold: 1 for
+                            the tensor model (K itself), the springs' tangent scale kx + kv
+                            beta while their tensors hold kx K + kv D (tmass__spring_forces) */
 };
 
 /* >>math ------------------------------------------------------------------------------ */
@@ -2075,6 +2156,7 @@ static void tmass__create_settings(const tmass_desc *d, tmass_model *m)
     m->newton_tolerance = (double)d->newton_tolerance;
     m->newton_iterations = d->newton_iterations;
     m->load_scale = 1.0;
+    m->anchor_scale = 1.0;
     m->precision_limit = (double)d->precision_limit;
     m->density = (double)d->density;
     m->parallel_for = d->parallel_for;
@@ -2259,7 +2341,9 @@ static void tmass__coupling_matvec(const tmass_model *m, const tmass_real *p, tm
         for (j = 0; j < 3; j++) out[3 * m->coupling_nodes[i] + j] += (tmass_real)y[3 * i + j];
 }
 
-static void tmass__matvec(const tmass_model *m, const tmass_real *p, tmass_real *out)
+/* out = K p over the edge tensors and a hybrid's coupling block, without the anchors (the
+   force passes add the anchors' own force, formed in double: tmass__anchor_force). */
+static void tmass__matvec_elastic(const tmass_model *m, const tmass_real *p, tmass_real *out)
 {
     tmass__matvec_ctx c;
     c.m = m;
@@ -2270,6 +2354,41 @@ static void tmass__matvec(const tmass_model *m, const tmass_real *p, tmass_real 
         tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
                    tmass__matvec_chunks, &c);
     if (m->coupling_count) tmass__coupling_matvec(m, p, out);
+}
+
+/* The anchors' part of a force pass (tmass_set_anchors): per anchor a on node n,
+   d = x_n - t_a (rest + u - t, formed in double as (rest - t) + u), energy k |d|^2 / 2
+   (returned), force -k (d + beta v) added to out when out is given (v may be NULL: no
+   damping term). Anchors in order, serial: deterministic. */
+static double tmass__anchor_force(const tmass_model *m, const tmass_real *u, const tmass_real *v, double beta,
+                                  tmass_real *out)
+{
+    double energy = 0.0;
+    int a, r;
+    for (a = 0; a < m->anchor_count; a++) {
+        int n = m->anchor_nodes[a];
+        double k = (double)m->anchor_k[a];
+        for (r = 0; r < 3; r++) {
+            int j = 3 * n + r;
+            double d = ((double)m->rest[j] - (double)m->anchor_target[3 * a + r]) + (double)u[j];
+            energy += 0.5 * k * d * d;
+            if (out) out[j] = (tmass_real)((double)out[j] - k * (d + (v ? beta * (double)v[j] : 0.0)));
+        }
+    }
+    return energy;
+}
+
+/* out = K p, K the operator the solvers use: the edge tensors, a hybrid's coupling block
+   and the anchors' k I on their nodes (times m->anchor_scale). */
+static void tmass__matvec(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    int a, r;
+    tmass__matvec_elastic(m, p, out);
+    for (a = 0; a < m->anchor_count; a++) {
+        int j = 3 * m->anchor_nodes[a];
+        double k = m->anchor_scale * (double)m->anchor_k[a];
+        for (r = 0; r < 3; r++) out[j + r] = (tmass_real)((double)out[j + r] + k * (double)p[j + r]);
+    }
 }
 
 /* Spring forces (eq. 7) with axial damping, into out (overwritten):
@@ -2438,6 +2557,17 @@ static void tmass__spring_forces(tmass_model *m, const tmass_real *u, const tmas
     for (c.colour = 0; c.colour < m->colour_count; c.colour++)
         tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
                    tmass__spring_chunks, &c);
+    if (m->anchor_count) { /* the anchors: force, their k in the tangent's scale, K v */
+        int a, r;
+        tmass__anchor_force(m, u, v, (double)m->stiffness_damping, out);
+        if (tangent_kx > 0) m->anchor_scale = tangent_kx + tangent_kv * (double)m->stiffness_damping;
+        if (kv_out)
+            for (a = 0; a < m->anchor_count; a++)
+                for (r = 0; r < 3; r++) {
+                    int j = 3 * m->anchor_nodes[a] + r;
+                    kv_out[j] = (tmass_real)((double)kv_out[j] + (double)m->anchor_k[a] * (double)v_kv[j]);
+                }
+    }
     m->stats.force_evaluations++;
 }
 
@@ -2459,11 +2589,12 @@ static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass
     if (v && m->stiffness_damping != 0) {
         tmass_real beta = m->stiffness_damping;
         for (i = 0; i < n3; i++) w[i] = u[i] + beta * v[i];
-        tmass__matvec(m, w, out);
+        tmass__matvec_elastic(m, w, out);
     } else {
-        tmass__matvec(m, u, out);
+        tmass__matvec_elastic(m, u, out);
     }
     for (i = 0; i < n3; i++) out[i] = -out[i];
+    if (m->anchor_count) tmass__anchor_force(m, u, v, (double)m->stiffness_damping, out);
     m->stats.force_evaluations++;
 }
 
@@ -2473,14 +2604,16 @@ static void tmass__internal_force(tmass_model *m, const tmass_real *u, const tma
     tmass__kinds[m->kind].force(m, u, v, out, w);
 }
 
-/* 1/2 u^T K u = -1/2 u . f (f into m->force) */
+/* 1/2 u^T K u (K u into m->force as work, without the anchors), plus the
+   anchors' energy */
 static double tmass__tensor_energy(tmass_model *m, const tmass_real *u)
 {
     int i, n3 = 3 * m->node_count;
     double elastic = 0.0;
-    tmass__tensor_force(m, u, NULL, m->force, m->force_work);
-    for (i = 0; i < n3; i++) elastic -= 0.5 * (double)u[i] * (double)m->force[i];
-    return elastic;
+    tmass__matvec_elastic(m, u, m->force);
+    for (i = 0; i < n3; i++) elastic += 0.5 * (double)u[i] * (double)m->force[i];
+    m->stats.force_evaluations++;
+    return elastic + (m->anchor_count ? tmass__anchor_force(m, u, NULL, 0.0, NULL) : 0.0);
 }
 
 /* Acceleration of the free nodes (zero elsewhere):
@@ -2590,6 +2723,37 @@ static double tmass__sum_partials(const tmass_model *m, int offset)
     return s;
 }
 
+/* The anchors' k (times m->anchor_scale) joins the Jacobi diagonal of the nodes they
+   hold: pinv first holds each anchored entry's sum of k (several anchors on a node add),
+   then its inverse stored negated (each entry once), then the sign is restored. A node of
+   a hybrid's coupling block also keeps its block's diagonal entry. */
+static void tmass__anchor_jacobi(const tmass_model *m, const tmass_real *diag, double c, tmass_real *pinv)
+{
+    int a, r, j, i;
+    for (a = 0; a < m->anchor_count; a++)
+        for (r = 0; r < 3; r++) pinv[3 * m->anchor_nodes[a] + r] = 0;
+    for (a = 0; a < m->anchor_count; a++)
+        for (r = 0; r < 3; r++) pinv[3 * m->anchor_nodes[a] + r] += m->anchor_k[a];
+    for (a = 0; a < m->anchor_count; a++)
+        for (r = 0; r < 3; r++) {
+            int v = m->anchor_nodes[a];
+            double dgl, coupled = 0.0;
+            j = 3 * v + r;
+            if (pinv[j] < 0) continue;
+            for (i = 0; i < m->coupling_count; i++)
+                if (m->coupling_nodes[i] == v)
+                    coupled = m->coupling[(size_t)(3 * i + r) * (size_t)(3 * m->coupling_count) + 3 * i + r];
+            dgl = (diag ? (double)diag[j] : 0.0) +
+                  c * ((double)m->vertex_tensor[9 * v + 4 * r] + coupled + m->anchor_scale * (double)pinv[j]);
+            pinv[j] = (tmass_real)(m->free_mask[j] > 0 && dgl > 0 ? -1.0 / dgl : -0.0);
+        }
+    for (a = 0; a < m->anchor_count; a++)
+        for (r = 0; r < 3; r++) {
+            j = 3 * m->anchor_nodes[a] + r;
+            pinv[j] = pinv[j] < 0 ? -pinv[j] : 0;
+        }
+}
+
 /* Solves (D + c K) x = b on the free degrees of freedom by Jacobi-preconditioned CG
    (diag: D per degree of freedom, or NULL). x holds the initial guess; pinned and
    inactive entries are held at 0. Stops when |r| <= cg_tolerance |b| or after
@@ -2631,6 +2795,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
             pinv[dof] = (tmass_real)(m->free_mask[dof] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
         }
     }
+    if (m->anchor_count) tmass__anchor_jacobi(m, diag, c, pinv);
     m->stats.cg_residual = 0;
     m->cg_indefinite = 0;
     m->cg_last_iterations = 0;
@@ -2843,8 +3008,9 @@ static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tm
     int i, n3 = 3 * m->node_count;
     tmass_real *w = m->force_work, beta = m->stiffness_damping;
     for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
-    tmass__matvec(m, w, f);
+    tmass__matvec_elastic(m, w, f);
     for (i = 0; i < n3; i++) f[i] = -f[i];
+    if (m->anchor_count) tmass__anchor_force(m, w, NULL, 0.0, f); /* -k ((rest - t) + w) */
     m->stats.force_evaluations++;
     return (double)dt * dt + (double)dt * m->stiffness_damping;
 }
@@ -2916,6 +3082,15 @@ static double tmass__roundoff_floor2(const tmass_model *m, const tmass_real *u, 
         double a = (diag ? (double)diag[i] : 0.0) + (double)m->vertex_tensor[9 * (i / 3) + 4 * (i % 3)];
         double e = eps * fabs((double)u[i]) * a * m->free_mask[i];
         s += e * e;
+    }
+    for (i = 0; i < m->anchor_count; i++) { /* the anchors' k (in the tangent's scale) */
+        int r, j;
+        for (r = 0; r < 3; r++) {
+            double e;
+            j = 3 * m->anchor_nodes[i] + r;
+            e = eps * fabs((double)u[j]) * m->anchor_scale * (double)m->anchor_k[i] * m->free_mask[j];
+            s += e * e;
+        }
     }
     return s;
 }
@@ -3198,7 +3373,7 @@ static double tmass__spring_energy(const tmass_model *m, const tmass_real *u)
             stretch = l + l0 > 0 ? dl2 / (l + l0) : 0;
             elastic += 0.5 * (double)m->edge_stiffness[s] * stretch * stretch;
         }
-    return elastic;
+    return elastic + (m->anchor_count ? tmass__anchor_force(m, u, NULL, 0.0, NULL) : 0.0);
 }
 
 /* Total potential of the spring model at x: elastic energy minus the work of gravity and
@@ -3691,6 +3866,23 @@ TMASSDEF int tmass_set_external_force(tmass_model *m, int i, const tmass_real f[
     return TMASS_OK;
 }
 
+TMASSDEF int tmass_set_anchors(tmass_model *m, int count, const int *nodes, const tmass_real *stiffness,
+                               const tmass_real *targets)
+{
+    int a;
+    if (!m || count < 0 || (count > 0 && (!nodes || !stiffness || !targets))) return TMASS_ERR_ARG;
+    for (a = 0; a < count; a++) {
+        if (nodes[a] < 0 || nodes[a] >= m->node_count) return TMASS_ERR_NODE_RANGE;
+        if (!(tmass__finite((double)stiffness[a]) && stiffness[a] >= 0) || !tmass__vec3_finite(targets + 3 * a))
+            return TMASS_ERR_ARG;
+    }
+    m->anchor_count = count;
+    m->anchor_nodes = count ? nodes : NULL;
+    m->anchor_k = count ? stiffness : NULL;
+    m->anchor_target = count ? targets : NULL;
+    return TMASS_OK;
+}
+
 TMASSDEF void tmass_clear_external_forces(tmass_model *m)
 {
     if (m) memset(m->ext, 0, sizeof(tmass_real) * 3 * (size_t)m->node_count);
@@ -3744,6 +3936,15 @@ TMASSDEF const tmass_real *tmass_forces(tmass_model *m)
     if (!m) return NULL;
     tmass__internal_force(m, m->disp, NULL, m->force, m->force_work);
     return m->force;
+}
+
+TMASSDEF int tmass_apply_stiffness(tmass_model *m, const tmass_real *dx, tmass_real *out)
+{
+    if (!m || !dx || !out) return TMASS_ERR_ARG;
+    if (tmass__kinds[m->kind].tangent) tmass__kinds[m->kind].tangent(m, m->disp);
+    tmass__matvec(m, dx, out);
+    m->stats.stiffness_products++;
+    return TMASS_OK;
 }
 
 TMASSDEF int tmass_set_positions(tmass_model *m, const tmass_real *positions)
@@ -4774,6 +4975,7 @@ TMASSDEF int tmass_qs_create(tmass_model *m, const tmass_qs_desc *d, tmass_qs **
     if (!out) return TMASS_ERR_ARG;
     *out = NULL;
     if (m && m->coupling_count) return TMASS_ERR_ARG; /* a hybrid's dynamic part */
+    if (m && m->anchor_count) return TMASS_ERR_ANCHORED; /* ANCHORS: targets move, C is fixed */
     err = tmass__qs_prepare(m, d, &q);
     if (err) return err;
     n3 = 3 * m->node_count;
@@ -5001,6 +5203,7 @@ TMASSDEF int tmass_qs_load_memory(const tmass_model *m, const tmass_qs_desc *d, 
     if (!out) return TMASS_ERR_ARG;
     *out = NULL;
     if (!buffer) return TMASS_ERR_ARG;
+    if (m && m->anchor_count) return TMASS_ERR_ANCHORED;
     if (size < 8) return TMASS_ERR_FILE_TRUNCATED;
     if (memcmp(p, "TMASSQS", 8) != 0) return TMASS_ERR_FILE_FORMAT;
     if (size < TMASS__QS_HEADER_BYTES) return TMASS_ERR_FILE_TRUNCATED;
@@ -5087,6 +5290,7 @@ TMASSDEF int tmass_qs_load(const tmass_model *m, const tmass_qs_desc *d, const c
     tmass_allocator a;
     if (!out) return TMASS_ERR_ARG;
     *out = NULL;
+    if (m && m->anchor_count) return TMASS_ERR_ANCHORED;
     if (!path || !d) return TMASS_ERR_ARG;
     a = d->allocator;
     f = fopen(path, "rb");

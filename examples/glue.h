@@ -4,7 +4,8 @@
    file. Used by tests/test_frames_coupling.c and examples/frames_connective.c; frames.h's
    COUPLING section explains the schemes and their measured limits. Everything is static;
    errors: 0, a frames.h code, 1000 + a heml.h code, or -1 (glue_solve at its cap).
-   Allocation: glue_init only. */
+   Allocation: glue_init only. The glue owns the frames' external loads and the glued
+   nodes' external forces (the coupling writes and clears them). */
 #ifndef GLUE_H
 #define GLUE_H
 
@@ -36,6 +37,7 @@ typedef struct glue {
     frm_probe *p;
     int n, iterations; /* glued nodes; the last solve's iterations */
     int robin_frames;  /* 0: the mesh carries the springs, 1: the frames (glue_map) */
+    int springs_on;    /* the side that last carried them: 0 none yet, 1 the mesh, 2 the frames */
     int depth;         /* Anderson mixing's depth (<= GLUE_DEPTH; 0: plain iteration) */
     double gz;         /* gravity along z, m/s^2 (the staggered scheme's weight of the glued nodes) */
     double mesh_seconds, frames_seconds; /* CPU time in each model's solves (clock), summed */
@@ -88,7 +90,10 @@ static inline void glue_free(glue *gl)
    mapped points), the frames take J^T F (J at their latest iterate, so exact at
    convergence); 1: the frames carry them (x = the glued nodes), the mesh takes F at its
    nodes. dt > 0: steps of dt from the saved start state; dt = 0: static solves from the
-   current state. Returns a model's code (heml codes as 1000 + code). */
+   current state. The springs live on one side only: each map removes the other side's
+   (its anchors; the mesh's glued nodes' external forces, which the glue owns, as it owns
+   the frames' external loads), so robin_frames may change between solves. Returns a
+   model's code (heml codes as 1000 + code). */
 static inline int glue_map(glue *gl, double dt, const double *x, double *g)
 {
     int i, r, err, nf = frm_model_frame_count(gl->f);
@@ -98,6 +103,13 @@ static inline int glue_map(glue *gl, double dt, const double *x, double *g)
         heml_set_velocities(gl->h, gl->hv);
     }
     if (!gl->robin_frames) {
+        if (gl->springs_on == 2) { /* they were on the frames: remove them and their forces */
+            static const heml_real zero[3] = {0, 0, 0};
+            if ((err = frm_model_set_anchors(gl->f, NULL, NULL, NULL)) != 0) return err;
+            for (i = 0; i < gl->n; i++)
+                if ((err = heml_set_external_force(gl->h, gl->nodes[i], zero)) != 0) return 1000 + err;
+        }
+        gl->springs_on = 1;
         for (i = 0; i < 3 * gl->n; i++) gl->ht[i] = (heml_real)x[i];
         if ((err = heml_set_anchors(gl->h, gl->n, gl->nodes, gl->hk, gl->ht)) != 0) return 1000 + err;
         t0 = clock();
@@ -121,6 +133,11 @@ static inline int glue_map(glue *gl, double dt, const double *x, double *g)
         for (i = 0; i < 3 * gl->n; i++) g[i] = (double)gl->mp[i];
         return 0;
     }
+    if (gl->springs_on == 1) { /* they were on the mesh: remove them and their loads */
+        if ((err = heml_set_anchors(gl->h, 0, NULL, NULL, NULL)) != 0) return 1000 + err;
+        frm_model_clear_external(gl->f);
+    }
+    gl->springs_on = 2;
     for (i = 0; i < 3 * gl->n; i++) gl->ft[i] = (frm_real)x[i];
     if (dt > 0) {
         frm_model_set_poses(gl->f, gl->fp, gl->fq);

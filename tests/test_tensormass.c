@@ -1112,10 +1112,12 @@ static void test_no_allocation_after_create(void)
     tmass_model *m;
     counting_allocator c = {0, 0, 0, 0};
     tmass_real *x;
-    int allocs, i, kind, list[2] = {3, 4};
+    int allocs, i, kind, list[2] = {3, 4}, anchor_nodes[2] = {5, 7};
+    tmass_real anchor_k[2] = {1e4, 2e4}, anchor_t[6] = {0.5, 0, 0, 0.5, 0.5, 0}, *anchor_kx;
     tmass_tear_criteria tc = tmass_default_tear_criteria();
     box_mesh(&mesh, 3, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
     x = to_real(mesh.nodes, 3 * mesh.node_count);
+    anchor_kx = alloc_reals(3 * mesh.node_count);
     for (kind = 0; kind < 2; kind++) {
         d.rest_positions = x;
         d.node_count = mesh.node_count;
@@ -1129,6 +1131,8 @@ static void test_no_allocation_after_create(void)
         CHECK(tmass_memory_bytes(m) > 0);
         allocs = c.allocs;
         tmass_fix_node(m, 0);
+        REQUIRE(tmass_set_anchors(m, 2, anchor_nodes, anchor_k, anchor_t) == TMASS_OK); /* issue 14 */
+        tmass_apply_stiffness(m, x, anchor_kx);
         for (i = 0; i < TMASS_INTEGRATOR_COUNT; i++) tmass_step_ex(m, (tmass_real)1e-3, (tmass_integrator)i);
         for (i = 0; i < 3; i++) tmass_step_ex(m, (tmass_real)1e-3, TMASS_BDF2); /* with history */
         tmass_solve_static(m);
@@ -1143,6 +1147,7 @@ static void test_no_allocation_after_create(void)
         CHECK_INT(0, (long long)c.live);
     }
     free(x);
+    free(anchor_kx);
     tetmesh_free(&mesh);
 }
 
@@ -1504,7 +1509,7 @@ static void test_float_renames_every_entry_point(void)
         N(tmass_version), N(tmass_error_string), N(tmass_default_desc), N(tmass_create),
         N(tmass_destroy), N(tmass_fix_node), N(tmass_set_displacement), N(tmass_release_node),
         N(tmass_node_pinned), N(tmass_set_external_force), N(tmass_clear_external_forces),
-        N(tmass_set_gravity), N(tmass_set_damping), N(tmass_set_solver), N(tmass_step), N(tmass_step_ex),
+        N(tmass_set_gravity), N(tmass_set_damping), N(tmass_set_solver), N(tmass_set_anchors), N(tmass_apply_stiffness), N(tmass_step), N(tmass_step_ex),
         N(tmass_solve_static), N(tmass_node_count), N(tmass_tet_count), N(tmass_live_tet_count),
         N(tmass_edge_count), N(tmass_positions), N(tmass_displacements), N(tmass_probe_create),
         N(tmass_probe_positions), N(tmass_probe_displacements), N(tmass_probe_velocities),
@@ -2533,6 +2538,260 @@ static void test_extension_enums_validated(void)
     }
 }
 
+/* ---- anchors (tmass_set_anchors, issue 14) ------------------------------------------ */
+
+/* Sets the displacements u (3n, double) through tmass_set_positions and returns the ones
+   the model holds (rounded to tmass_real) in got. */
+static void set_disp(tmass_model *m, const double *u, double *got)
+{
+    int i, n3 = 3 * tmass_node_count(m);
+    tmass_real *x = alloc_reals(n3);
+    for (i = 0; i < n3; i++) x[i] = (tmass_real)((double)tmass_rest_positions(m)[i] + u[i]);
+    tmass_set_positions(m, x);
+    for (i = 0; i < n3; i++) got[i] = (double)tmass_displacements(m)[i];
+    free(x);
+}
+
+/* Anchors in the force, energy and stiffness product of both kinds: on a 2 x 1 x 1 box in a
+   random state, five anchors (one node twice) of random stiffness (10 to 25 E h) to random
+   targets, against central differences along random directions d of the whole model's
+   energy (force = -dE/dx) and force (K d = -(f(u + eps d) - f(u - eps d)) / 2 eps, K from
+   tmass_apply_stiffness). The finite-difference direction is the one the model holds
+   after rounding (float). Tolerances: the tensor model is quadratic, so central
+   differences are exact but for round-off, 1e-9 relative in double; the springs' terms are
+   smooth at curvature scale 1 / l (l = 0.5 m), eps = 1e-5 m gives (eps / l)^2 = 4e-10:
+   1e-7. Float: eps 1e-3 m, round-off eps_f |f| / (eps k) about 1e-3: 2e-2. */
+static void test_anchors_finite_differences(void)
+{
+    tetmesh mesh;
+    int kind, trial, i, n, n3, nodes[5] = {0, 3, 7, 11, 3};
+    double eps = IS_FLOAT ? 1e-3 : 1e-5, tol = IS_FLOAT ? 2e-2 : 1e-7;
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
+    n = mesh.node_count;
+    n3 = 3 * n;
+    for (kind = 0; kind < 2; kind++) {
+        tmass_model *m = make_model(&mesh, (tmass_model_kind)kind, 1e5, 0.3, 1000);
+        unsigned seed = 11u + (unsigned)kind;
+        tmass_real k[5], t[15], *dr = alloc_reals(n3), *Kd = alloc_reals(n3);
+        double *u = (double *)malloc(sizeof(double) * n3), *up = (double *)malloc(sizeof(double) * n3),
+               *um = (double *)malloc(sizeof(double) * n3), *fp = (double *)malloc(sizeof(double) * n3),
+               *f0 = (double *)malloc(sizeof(double) * n3), worst_f = 0, worst_k = 0;
+        REQUIRE(m != NULL);
+        for (i = 0; i < 5; i++) {
+            int r;
+            k[i] = (tmass_real)(1e5 * 0.5 * (17.5 + 7.5 * rnd(&seed)));
+            for (r = 0; r < 3; r++) t[3 * i + r] = (tmass_real)(mesh.nodes[3 * nodes[i] + r] + 0.05 * rnd(&seed));
+        }
+        for (i = 0; i < n3; i++) u[i] = 0.03 * rnd(&seed);
+        REQUIRE(tmass_set_anchors(m, 5, nodes, k, t) == TMASS_OK);
+        for (trial = 0; trial < 3; trial++) {
+            tmass_energies ep, em;
+            double fd_e, fw = 0, scale = 0, kd = 0, ks = 0;
+            for (i = 0; i < n3; i++) up[i] = u[i] + eps * rnd(&seed);
+            for (i = 0; i < n3; i++) um[i] = 2 * u[i] - up[i];
+            set_disp(m, up, up);
+            REQUIRE(tmass_energy(m, &ep) == TMASS_OK);
+            for (i = 0; i < n3; i++) fp[i] = (double)tmass_forces(m)[i];
+            set_disp(m, um, um);
+            REQUIRE(tmass_energy(m, &em) == TMASS_OK);
+            for (i = 0; i < n3; i++) f0[i] = (double)tmass_forces(m)[i];
+            /* the centre state and the direction the model actually moved along */
+            for (i = 0; i < n3; i++) u[i] = 0.5 * (up[i] + um[i]), dr[i] = (tmass_real)((up[i] - um[i]) / 2);
+            {
+                double *uc = (double *)malloc(sizeof(double) * n3);
+                set_disp(m, u, uc);
+                free(uc);
+            }
+            REQUIRE(tmass_apply_stiffness(m, dr, Kd) == TMASS_OK);
+            for (i = 0; i < n3; i++) { /* force = -grad E: -(E+ - E-) / 2 = f . dr */
+                double fc = (double)tmass_forces(m)[i];
+                fw += fc * (double)dr[i];
+                scale += fabs(fc * (double)dr[i]);
+            }
+            fd_e = -(ep.elastic - em.elastic) / 2;
+            if (fabs(fd_e - fw) / scale > worst_f) worst_f = fabs(fd_e - fw) / scale;
+            for (i = 0; i < n3; i++) { /* K dr = -(f+ - f-) / 2 */
+                double fd = -(fp[i] - f0[i]) / 2;
+                if (fabs(fd - (double)Kd[i]) > kd) kd = fabs(fd - (double)Kd[i]);
+                if (fabs((double)Kd[i]) > ks) ks = fabs((double)Kd[i]);
+            }
+            if (kd / ks > worst_k) worst_k = kd / ks;
+        }
+        printf("    %s with anchors: force against -dE/dx %.1e, K d against -df/dx d %.1e (relative)\n",
+               kind ? "springs" : "tensor-mass", worst_f, worst_k);
+        CHECK(worst_f < tol);
+        CHECK(worst_k < tol);
+        free(dr), free(Kd), free(u), free(up), free(um), free(fp), free(f0);
+        tmass_destroy(m);
+    }
+    tetmesh_free(&mesh);
+}
+
+/* Refusals of tmass_set_anchors (nothing kept), count 0 removing them, and the precomputed
+   model refusing an anchored one (TMASS_ERR_ANCHORED: its compliance and preload are
+   fixed at creation, the targets move). */
+static void test_anchors_refused(void)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    tmass_qs *qs = NULL;
+    tmass_qs_desc qd = tmass_qs_default_desc();
+    int nodes[2] = {1, 2}, bad_nodes[2] = {1, 0};
+    tmass_real k[2] = {1e3, 1e3}, t[6] = {0, 0, 0, 0, 0, 0}, f0, f1;
+    box_mesh(&mesh, 2, 1, 1, 1, 0.5, 0.5, TETMESH_SPLIT6);
+    m = make_model(&mesh, TMASS_TENSOR_MASS, 1e5, 0.3, 1000);
+    REQUIRE(m != NULL);
+    bad_nodes[1] = mesh.node_count;
+    f0 = tmass_forces(m)[3];
+    CHECK_INT(TMASS_ERR_NODE_RANGE, tmass_set_anchors(m, 2, bad_nodes, k, t));
+    bad_nodes[1] = -1;
+    CHECK_INT(TMASS_ERR_NODE_RANGE, tmass_set_anchors(m, 2, bad_nodes, k, t));
+    k[1] = -1;
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, 2, nodes, k, t));
+    k[1] = (tmass_real)NAN;
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, 2, nodes, k, t));
+    k[1] = (tmass_real)INFINITY;
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, 2, nodes, k, t));
+    k[1] = 1e3;
+    t[4] = (tmass_real)INFINITY;
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, 2, nodes, k, t));
+    t[4] = 0;
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, 2, nodes, NULL, t));
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(m, -1, NULL, NULL, NULL));
+    CHECK_INT(TMASS_ERR_ARG, tmass_set_anchors(NULL, 0, NULL, NULL, NULL));
+    CHECK(tmass_forces(m)[3] == f0); /* nothing kept */
+    REQUIRE(tmass_set_anchors(m, 2, nodes, k, t) == TMASS_OK);
+    f1 = tmass_forces(m)[3]; /* node 1 at x = 0.5 pulled to the origin: -k 0.5 */
+    CHECK_NEAR(-0.5e3, (double)f1 - (double)f0, 1e-9 * 0.5e3 + (IS_FLOAT ? 1e-3 : 0));
+    tmass_fix_node(m, 0);
+    tmass_fix_node(m, 6);
+    tmass_fix_node(m, 12);
+    CHECK_INT(TMASS_ERR_ANCHORED, tmass_qs_create(m, &qd, &qs));
+    CHECK(qs == NULL);
+    REQUIRE(tmass_set_anchors(m, 0, NULL, NULL, NULL) == TMASS_OK);
+    CHECK(tmass_forces(m)[3] == f0);
+    tmass_destroy(m);
+    tetmesh_free(&mesh);
+}
+
+/* The bar of test_anchors_bar_equals_clamped: 1 x 0.2 x 0.2 m, 5 x 1 x 1 cells, E = 10 MPa,
+   its face x = 0 either pinned (k = 0) or held only by anchors of stiffness k to the
+   nodes' rest positions. */
+static tmass_model *anchor_bar(tmass_model_kind kind, double k, int **nodes_out, tmass_real **targets,
+                               tmass_real **ks, int *count)
+{
+    tetmesh mesh;
+    tmass_model *m;
+    int i, c = 0;
+    box_mesh(&mesh, 5, 1, 1, 1, 0.2, 0.2, TETMESH_SPLIT6);
+    m = make_model(&mesh, kind, 1e7, 0.3, 1000);
+    if (m) tmass_set_solver(m, (tmass_real)(IS_FLOAT ? 1e-6 : 1e-12), 20000);
+    *nodes_out = (int *)malloc(sizeof(int) * 4);
+    *targets = alloc_reals(12);
+    *ks = alloc_reals(4);
+    for (i = 0; i < mesh.node_count; i++)
+        if (mesh.nodes[3 * i] == 0.0) {
+            (*nodes_out)[c] = i;
+            (*ks)[c] = (tmass_real)k;
+            memcpy(*targets + 3 * c, tmass_rest_positions(m) + 3 * i, 3 * sizeof(tmass_real));
+            if (k == 0) tmass_fix_node(m, i);
+            c++;
+        }
+    *count = c;
+    if (k > 0) tmass_set_anchors(m, c, *nodes_out, *ks, *targets);
+    tetmesh_free(&mesh);
+    return m;
+}
+
+/* A bar held only by stiff anchors at one end equals the same bar with those nodes fixed:
+   statically and through 20 implicit steps (implicit Euler, its linearised form, BDF2)
+   under gravity, for both kinds. Tolerance from k: each anchored node sits |R_n| / k from
+   its target (R_n the clamped bar's reaction there, measured), delta = max |R_n| / k; a
+   face moved by delta (translated, tilted about its 0.2 m width b) moves the tip by at most
+   delta (1 + 2 L / b) = 11 delta; twice that is the bound (plus 1e-6 of the tip's sag in
+   double, 1e-3 in float for round-off). With k = 1e4 E h the static difference is about
+   1e-5 of the sag; a weaker k (1e2 E h) is checked to be outside the bound at 1e4 E h's
+   delta (the comparison can fail). Every integrator keeps the anchored static
+   equilibrium: one step of each from it has a mean acceleration |v1| / dt below 1e-3 g
+   (float 0.1 g: the static solve's CG residual, 1e-12 and 1e-6 of the load, over a node's
+   mass, and float's rounding of forces of 1e5 N); without the anchors' force in its
+   acceleration an anchored node would accelerate at R / m, tens of g. */
+static void test_anchors_bar_equals_clamped(void)
+{
+    int kind;
+    for (kind = 0; kind < 2; kind++) {
+        int *nodes, *nodes_a, *nodes_w, count, i, r, step, it;
+        tmass_real *t, *t_a, *t_w, *k, *k_a, *k_w;
+        double E = 1e7, h = 0.2, ka = 1e4 * E * h, rmax = 0, delta, tip_c, tip_a, tip_w, bound, worst = 0, sag,
+               rel = IS_FLOAT ? 1e-3 : 1e-6;
+        tmass_model *mc = anchor_bar((tmass_model_kind)kind, 0, &nodes, &t, &k, &count);
+        tmass_model *ma = anchor_bar((tmass_model_kind)kind, ka, &nodes_a, &t_a, &k_a, &count);
+        tmass_model *mw = anchor_bar((tmass_model_kind)kind, 1e2 * E * h, &nodes_w, &t_w, &k_w, &count);
+        int tip = tmass_node_count(mc) - 1; /* (5, 1, 1): a corner of the free end */
+        REQUIRE(mc && ma && mw);
+        REQUIRE(tmass_solve_static(mc) == TMASS_OK);
+        REQUIRE(tmass_solve_static(ma) == TMASS_OK);
+        REQUIRE(tmass_solve_static(mw) == TMASS_OK);
+        for (i = 0; i < count; i++) { /* reactions of the clamped bar: -(f_el + m g) */
+            double R2 = 0;
+            for (r = 0; r < 3; r++) {
+                double R = (double)tmass_forces(mc)[3 * nodes[i] + r] + (r == 2 ? -9.81 * (double)tmass_masses(mc)[nodes[i]] : 0);
+                R2 += R * R;
+            }
+            if (sqrt(R2) > rmax) rmax = sqrt(R2);
+        }
+        delta = rmax / ka;
+        tip_c = (double)tmass_displacements(mc)[3 * tip + 2];
+        tip_a = (double)tmass_displacements(ma)[3 * tip + 2];
+        tip_w = (double)tmass_displacements(mw)[3 * tip + 2];
+        sag = fabs(tip_c);
+        bound = 2 * 11 * delta + rel * sag;
+        printf("    %s static tip sag: clamped %.6e m, anchored (k = 1e4 E h) %+.2e m off (bound %.2e), k = 1e2 E h %+.2e "
+               "off\n", kind ? "springs" : "tensor-mass", tip_c, tip_a - tip_c, bound, tip_w - tip_c);
+        CHECK(fabs(tip_a - tip_c) <= bound);
+        CHECK(fabs(tip_w - tip_c) > 2 * 11 * delta); /* the comparison can fail */
+        /* every integrator keeps the anchored equilibrium: the mean acceleration of a step
+           from it, |v1| / dt, stays at round-off */
+        for (it = 0; it < TMASS_INTEGRATOR_COUNT; it++) {
+            double dt = it < 3 ? 1e-6 : 1e-3, accel = 0;
+            /* back to the equilibrium by a static solve (velocities zero): restoring saved
+               positions would round u = x - X to float's eps |x| at the anchored nodes */
+            REQUIRE(tmass_solve_static(ma) == TMASS_OK);
+            REQUIRE(tmass_step_ex(ma, (tmass_real)dt, (tmass_integrator)it) == TMASS_OK);
+            for (i = 0; i < 3 * tmass_node_count(ma); i++)
+                if (fabs((double)tmass_velocities(ma)[i]) / dt > accel) accel = fabs((double)tmass_velocities(ma)[i]) / dt;
+            if (accel > worst) worst = accel;
+        }
+        printf("      one step of each integrator from the anchored equilibrium: |v1| / dt <= %.1e m/s^2\n", worst);
+        CHECK(worst <= (IS_FLOAT ? 1e-1 : 1e-3) * 9.81);
+        /* implicit steps from rest: anchored against clamped */
+        for (it = TMASS_IMPLICIT_EULER; it <= TMASS_BDF2; it++) {
+            double diff = 0, peak = 0;
+            tmass_real *zero = alloc_reals(3 * tmass_node_count(ma));
+            tmass_set_positions(mc, tmass_rest_positions(mc)), tmass_set_velocities(mc, zero);
+            tmass_set_positions(ma, tmass_rest_positions(ma)), tmass_set_velocities(ma, zero);
+            for (step = 0; step < 20; step++) {
+                REQUIRE(tmass_step_ex(mc, (tmass_real)0.01, (tmass_integrator)it) == TMASS_OK);
+                REQUIRE(tmass_step_ex(ma, (tmass_real)0.01, (tmass_integrator)it) == TMASS_OK);
+                tip_c = (double)tmass_displacements(mc)[3 * tip + 2];
+                tip_a = (double)tmass_displacements(ma)[3 * tip + 2];
+                if (fabs(tip_a - tip_c) > diff) diff = fabs(tip_a - tip_c);
+                if (fabs(tip_c) > peak) peak = fabs(tip_c);
+            }
+            printf("      20 steps of %s at 10 ms: tip within %.1e m of the clamped bar's (peak sag %.2e m)\n",
+                   it == TMASS_BDF2 ? "BDF2" : it == TMASS_IMPLICIT_EULER ? "implicit Euler" : "linearised implicit Euler",
+                   diff, peak);
+            /* the dynamic reactions stay below twice the static ones (from rest, overshoot
+               to twice the sag at most) */
+            CHECK(diff <= 2 * bound + 2 * rel * peak);
+            CHECK(peak > 0.5 * sag);
+            free(zero);
+        }
+        free(nodes), free(t), free(k), free(nodes_a), free(t_a), free(k_a), free(nodes_w), free(t_w), free(k_w);
+        tmass_destroy(mc), tmass_destroy(ma), tmass_destroy(mw);
+    }
+}
+
 static const test_case cases[] = {
     TEST(test_stiffness_equals_p1_fem),
     TEST(test_float_ill_conditioned_beam),
@@ -2564,6 +2823,9 @@ static const test_case cases[] = {
     TEST(test_duplicate_tet_refused),
     TEST(test_explicit_divergence_caught),
     TEST(test_float_renames_every_entry_point),
+    TEST(test_anchors_finite_differences),
+    TEST(test_anchors_refused),
+    TEST(test_anchors_bar_equals_clamped),
     TEST(test_precision_far_from_origin),
     TEST(test_stats_filled),
     TEST(test_springs_static_continuation),
