@@ -1007,7 +1007,7 @@ static void test_chain_no_allocation(void)
    static sag under gravity and ten implicit Euler steps with FRM_LINEAR_SOLVER_BTD equal
    CG's (both to a Newton tolerance of 1e-10: 1e-6 of the sag; float 1e-4: 1e-3); a model
    that is not a chain is refused at creation with FRM_ERR_SOLVER. */
-static frm_model *rod_model(frm_linear_solver solver, int chain)
+static frm_model *rod_model(frm_linear_solver solver, int chain, int pairs)
 {
     enum { NF = 12, PER = 4 };
     frm_real fp[3 * NF], sp[3 * NF * PER], vol[NF * PER], w[3 * NF * PER], g[9 * NF * PER];
@@ -1043,17 +1043,18 @@ static frm_model *rod_model(frm_linear_solver solver, int chain)
     d.material.young_modulus = (frm_real)1e8;
     d.material.density = 1000;
     d.linear_solver = solver;
+    if (pairs) d.stiffness_mode = FRM_STIFFNESS_PAIRS;
     d.newton_tolerance = (frm_real)(IS_FLOAT ? 1e-4 : 1e-10);
     d.cg_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-12);
     d.time_step = (frm_real)0.01;
-    CHECK_INT(chain || solver == FRM_LINEAR_SOLVER_CG ? FRM_OK : FRM_ERR_SOLVER, frm_model_create(&d, &m));
+    CHECK_INT(chain || solver != FRM_LINEAR_SOLVER_BTD ? FRM_OK : FRM_ERR_SOLVER, frm_model_create(&d, &m));
     if (m) frm_model_fix_frame(m, 0);
     return m;
 }
 
 static void test_frames_btd_solver(void)
 {
-    frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1), *b = rod_model(FRM_LINEAR_SOLVER_BTD, 1);
+    frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1, 0), *b = rod_model(FRM_LINEAR_SOLVER_BTD, 1, 0);
     double sag, tol = IS_FLOAT ? 1e-3 : 1e-6;
     int i, k;
     if (!a || !b) return;
@@ -1075,8 +1076,121 @@ static void test_frames_btd_solver(void)
             CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
     frm_model_destroy(a);
     frm_model_destroy(b);
-    a = rod_model(FRM_LINEAR_SOLVER_BTD, 0);
+    a = rod_model(FRM_LINEAR_SOLVER_BTD, 0, 0);
     CHECK(a == NULL);
+}
+
+/* FRM_LINEAR_SOLVER_AUTO (the default) chooses BTD for the chain-pattern rod, whose
+   static sag and ten implicit steps then equal CG's to the same tolerances as above (the
+   two solvers' answers differ by their solve tolerances only), and for a rod of
+   frm_sampling_curve (same check of the sag; in float, where AUTO keeps CG (see the
+   manual), with BTD chosen: its refinement stalls and CG finishes); CG for the same rod with a
+   third, farther neighbour (not a chain), for the chain in the matrix-free pair mode (no
+   assembled blocks), and for a 3D block of hexahedra; explicit choices are kept; anchors
+   (not in BTD's assembled blocks) switch an AUTO model to CG while they are set, and the
+   anchored answer equals CG's. */
+static void test_frames_btd_auto(void)
+{
+    frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1, 0), *b = rod_model(FRM_LINEAR_SOLVER_AUTO, 1, 0), *c;
+    double sag, tol = IS_FLOAT ? 1e-3 : 1e-6;
+    int i, k, chosen = IS_FLOAT ? FRM_LINEAR_SOLVER_CG : FRM_LINEAR_SOLVER_BTD; /* AUTO on a chain */
+    if (!a || !b) return;
+    CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(a));
+    CHECK_INT(chosen, frm_model_linear_solver(b));
+    CHECK_INT(FRM_LINEAR_SOLVER_AUTO, frm_model_default_desc().linear_solver);
+    CHECK_INT(FRM_LINEAR_SOLVER_COUNT, frm_model_linear_solver(NULL));
+    CHECK_INT(FRM_OK, frm_model_solve_static(a));
+    CHECK_INT(FRM_OK, frm_model_solve_static(b));
+    sag = fabs((double)frm_model_displacements(a)[3 * 11 + 2]);
+    CHECK(sag > 1e-4);
+    for (i = 0; i < 12; i++)
+        for (k = 0; k < 3; k++)
+            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    for (i = 0; i < 10; i++) {
+        CHECK_INT(FRM_OK, frm_model_step(a));
+        CHECK_INT(FRM_OK, frm_model_step(b));
+    }
+    for (i = 0; i < 12; i++)
+        for (k = 0; k < 3; k++)
+            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    frm_model_destroy(a);
+    frm_model_destroy(b);
+    { /* anchors: the rod's tip pulled toward a point 1 cm up, AUTO's model against CG's */
+        frm_probe_desc pd = frm_probe_default_desc();
+        frm_probe *p = NULL;
+        frm_real pt[3] = {(frm_real)1.1, 0, 0}, target[3] = {(frm_real)1.1, 0, (frm_real)0.01}, ks = (frm_real)1e3;
+        a = rod_model(FRM_LINEAR_SOLVER_CG, 1, 0), b = rod_model(FRM_LINEAR_SOLVER_AUTO, 1, 0);
+        c = rod_model(FRM_LINEAR_SOLVER_BTD, 1, 0);
+        if (a && b && c && frm_probe_create(b, &pd, pt, 1, &p) == FRM_OK) {
+            CHECK_INT(FRM_ERR_ARG, frm_model_set_anchors(c, p, &ks, target)); /* chosen BTD: refused */
+            CHECK_INT(FRM_LINEAR_SOLVER_BTD, frm_model_linear_solver(c));
+            CHECK_INT(FRM_OK, frm_model_set_anchors(a, p, &ks, target));
+            CHECK_INT(FRM_OK, frm_model_set_anchors(b, p, &ks, target));
+            CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(b));
+            CHECK_INT(FRM_OK, frm_model_solve_static(a));
+            CHECK_INT(FRM_OK, frm_model_solve_static(b));
+            sag = fabs((double)frm_model_displacements(a)[3 * 11 + 2]);
+            for (i = 0; i < 12; i++)
+                for (k = 0; k < 3; k++)
+                    CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+            CHECK_INT(FRM_OK, frm_model_set_anchors(b, NULL, NULL, NULL));
+            CHECK_INT(chosen, frm_model_linear_solver(b));
+            CHECK_INT(FRM_OK, frm_model_solve_static(b));
+        } else
+            CHECK(0);
+        frm_probe_destroy(p);
+        frm_model_destroy(a);
+        frm_model_destroy(b);
+        frm_model_destroy(c);
+    }
+    { /* a rod of frm_sampling_curve (16 segments along x, each station between its two
+         frames): BTD under AUTO, the same cantilever sag as CG (tolerances as above) */
+        frm_real x[3 * 17], sec[2] = {(frm_real)0.02, (frm_real)0.02};
+        frm_sampling cs;
+        frm_model *r[2] = {NULL, NULL};
+        memset(x, 0, sizeof x);
+        for (i = 0; i <= 16; i++) x[3 * i] = (frm_real)(0.05 * i);
+        CHECK_INT(FRM_OK, frm_sampling_curve(&cs, x, 17, sec, NULL, NULL));
+        for (k = 0; k < 2; k++) {
+            frm_desc d = frm_model_default_desc();
+            frm_sampling_apply(&cs, &d);
+            d.material.young_modulus = (frm_real)1e8;
+            d.material.density = 1000;
+            /* float: BTD chosen explicitly (AUTO keeps CG there), whose iterative refinement
+               stalls on this rod and hands over to CG (without that the static solve failed) */
+            d.linear_solver = k ? FRM_LINEAR_SOLVER_CG : IS_FLOAT ? FRM_LINEAR_SOLVER_BTD : FRM_LINEAR_SOLVER_AUTO;
+            d.newton_tolerance = (frm_real)(IS_FLOAT ? 1e-4 : 1e-10);
+            d.cg_tolerance = (frm_real)(IS_FLOAT ? 1e-5 : 1e-12);
+            CHECK_INT(FRM_OK, frm_model_create(&d, &r[k]));
+            if (!r[k]) continue;
+            CHECK_INT(k ? FRM_LINEAR_SOLVER_CG : FRM_LINEAR_SOLVER_BTD, frm_model_linear_solver(r[k]));
+            CHECK_INT(FRM_OK, frm_model_fix_frame(r[k], 0));
+            CHECK_INT(FRM_OK, frm_model_solve_static(r[k]));
+        }
+        if (r[0] && r[1]) {
+            sag = fabs((double)frm_model_displacements(r[1])[3 * 16 + 2]);
+            CHECK(sag > 1e-4);
+            printf("    curve rod sag %.6e m (CG) and %.6e m (%s)\n", sag,
+                   fabs((double)frm_model_displacements(r[0])[3 * 16 + 2]), IS_FLOAT ? "BTD chosen" : "AUTO: BTD");
+            for (i = 0; i < 17; i++)
+                for (k = 0; k < 3; k++)
+                    CHECK_NEAR((double)frm_model_displacements(r[0])[3 * i + k], (double)frm_model_displacements(r[1])[3 * i + k],
+                               tol * sag);
+        }
+        frm_model_destroy(r[0]);
+        frm_model_destroy(r[1]);
+        frm_sampling_free(&cs);
+    }
+    a = rod_model(FRM_LINEAR_SOLVER_AUTO, 0, 0); /* not a chain */
+    b = rod_model(FRM_LINEAR_SOLVER_AUTO, 1, 1); /* a chain, but no assembled blocks */
+    c = box_beam(4, 0.4, 0.1, 1e7);              /* default desc: AUTO; 3D */
+    CHECK(a && b && c);
+    if (a) CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(a));
+    if (b) CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(b));
+    if (c) CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(c));
+    frm_model_destroy(a);
+    frm_model_destroy(b);
+    frm_model_destroy(c);
 }
 
 static const test_case cases[] = {
@@ -1098,6 +1212,7 @@ static const test_case cases[] = {
     TEST(test_chain_vs_frames_cylinder),
     TEST(test_chain_no_allocation),
     TEST(test_frames_btd_solver),
+    TEST(test_frames_btd_auto),
 };
 
 int main(int argc, char **argv) { return TEST_MAIN(argc, argv, cases); }

@@ -83,7 +83,7 @@ static void test_float_renames(void)
         NAME(frm_model_pair_count), NAME(frm_model_positions), NAME(frm_model_orientations),
         NAME(frm_model_velocities), NAME(frm_model_set_poses), NAME(frm_model_set_velocities),
         NAME(frm_model_sample_positions), NAME(frm_model_deformation_gradients), NAME(frm_model_forces),
-        NAME(frm_model_total_forces), NAME(frm_model_energy), NAME(frm_model_last_stats), NAME(frm_model_mass_block),
+        NAME(frm_model_total_forces), NAME(frm_model_energy), NAME(frm_model_last_stats), NAME(frm_model_linear_solver), NAME(frm_model_mass_block),
         NAME(frm_model_memory_bytes), NAME(frm_model_stabilized_frames), NAME(frm_model_view), NAME(frm_model_prepare_stiffness),
         NAME(frm_model_apply_stiffness), NAME(frm_model_assemble_stiffness), NAME(frm_model_stiffness_blocks),
         NAME(frm_model_stiffness_block), NAME(frm_model_set_frame_axes), NAME(frm_model_frame_axes),
@@ -1372,8 +1372,15 @@ static void test_integrator_choice(void)
         d.integrator = FRM_IMPLICIT_EULER;
         d.linear_solver = FRM_LINEAR_SOLVER_COUNT;
         CHECK_INT(FRM_ERR_SOLVER, frm_model_create(&d, &m));
+        d.linear_solver = (frm_linear_solver)-2; /* below FRM_LINEAR_SOLVER_AUTO (-1) */
+        CHECK_INT(FRM_ERR_SOLVER, frm_model_create(&d, &m));
         d.linear_solver = FRM_LINEAR_SOLVER_CG;
         CHECK_INT(FRM_OK, frm_model_create(&d, &m));
+        CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(m));
+        frm_model_destroy(m);
+        d.linear_solver = FRM_LINEAR_SOLVER_AUTO;
+        CHECK_INT(FRM_OK, frm_model_create(&d, &m));
+        CHECK_INT(FRM_LINEAR_SOLVER_CG, frm_model_linear_solver(m)); /* a 3D sampling: not a chain */
         frm_model_destroy(m);
     }
     frm_sampling_free(&s);
