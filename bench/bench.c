@@ -326,11 +326,18 @@ static double relative_error(double value, double reference) { return fabs(value
    entries, a quarter of it for their law variants (they repeat the primary's mesh). */
 static double budget_of(const bench_model *m, const options *o) { return m->primary ? o->budget : o->budget / 4; }
 
-/* A refinement series stops past the budget, or at a failure other than on the coarsest
-   level (a mesh one cell across can defeat a model that converges on the next one). */
-static int series_done(const trade_row *r, int level_index, const bench_model *m, const options *o)
+/* A refinement series stops past the budget, at a failure other than on the coarsest
+   level (a mesh one cell across can defeat a model that converges on the next one), or
+   when the next level is predicted to take over twice the budget: seconds grow at least
+   as the cells, (k_next / k)^3 (the solves' iterations grow too, so this underestimates);
+   before this rule a float frames R1 solve at L6 ran 55 s after 0.4 s at L4. levels: the
+   scene's refinement levels, n of them, level_index the one just run. */
+static int series_done(const trade_row *r, int level_index, const bench_model *m, const options *o,
+                       const int *levels, int n)
 {
-    return r->answer_s > budget_of(m, o) || (r->status && level_index > 0);
+    double growth = level_index + 1 < n ? pow((double)levels[level_index + 1] / levels[level_index], 3) : 0;
+    return r->answer_s > budget_of(m, o) || (r->status && level_index > 0) ||
+           r->answer_s * growth > 2 * budget_of(m, o);
 }
 
 /* R1: the steel cantilever 16 x 0.5 x 0.5 m under its own weight, static. */
@@ -354,7 +361,7 @@ static void trade_r1(const bench_model *m, const options *o)
         }
         if (sim) m->destroy(sim);
         print_row(r);
-        if (series_done(r, l, m, o)) break;
+        if (series_done(r, l, m, o, levels, n)) break;
     }
 }
 
@@ -375,7 +382,7 @@ static void trade_r2(const bench_model *m, const options *o)
         if (!r->status) r->value = tip_deflection(m, sim, &b);
         if (sim) m->destroy(sim);
         print_row(r);
-        if (series_done(r, l, m, o)) break;
+        if (series_done(r, l, m, o, levels, n)) break;
     }
 }
 
@@ -518,7 +525,7 @@ static void trade_r3(const bench_model *m, const options *o)
                 r->status = err;
                 if (sim) m->destroy(sim);
                 print_row(r);
-                if (series_done(r, l, m, o)) break;
+                if (series_done(r, l, m, o, levels, n)) break;
             }
     }
 }
@@ -613,7 +620,7 @@ static void trade_uniaxial(const bench_model *m, const options *o, int neo_hooke
             r->status = err;
             m->destroy(sim);
             print_row(r);
-            if (series_done(r, l, m, o)) break;
+            if (series_done(r, l, m, o, levels, n)) break;
         }
 }
 
