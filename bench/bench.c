@@ -733,12 +733,9 @@ static void trade_ni(const bench_model *m, const options *o)
         }
         if (sim) m->destroy(sim);
         print_row(r);
-        /* past the budget, or predicted (seconds growing at least as the cells, k^3) to
-           take over twice the budget at the next level: frames svk tet4's k = 6 took 8 s
-           on the loaded Zen 5 for 9.3 % */
-        if (r->answer_s > o->budget || (r->status && l > 0) ||
-            (l + 1 < n && r->answer_s * pow((double)levels[l + 1] / k, 3) > 2 * o->budget))
-            break;
+        /* (the predicted stop first cut frames svk tet4's k = 6 here: 8 s on the loaded
+           Zen 5 for 9.3 %) */
+        if (series_done(r, l, m, o, levels, n)) break;
     }
 }
 
