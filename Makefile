@@ -39,7 +39,9 @@ HEADERS := $(wildcard tensormass.h heml.h frames.h) examples/tetmesh.h tests/tes
            tests/fixtures.h
 FLOAT := -DTMASS_REAL=float -DHEML_REAL=float -DFRM_REAL=float
 
-CONFIGS := gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double asan-double
+# The sanitizer build first: its programs take longest to build and run (test_frames: 22 s
+# and 44 s of CPU), so they start first instead of running alone at the end.
+CONFIGS := asan-double gcc-double gcc-float gxx-double gxx-float clang-double clang-float omp-double
 
 # gcc builds for this machine (-march=native): the headers' vector paths (intrinsics and
 # vector extensions behind compile-time checks of the target, issues 15 and 21) exist only
@@ -141,7 +143,8 @@ build/$(1)/header_alone.result: $(HEADERS)
 	     $$(CC_$(1)) $(WARN) -fsyntax-only -I. -x $(if $(findstring gxx,$(1)),c++,c) - \
 	     >> build/$(1)/header_alone.log 2>&1; \
 	  then pass=$$$$((pass + 1)); else fail=$$$$((fail + 1)); echo "FAIL $$$${h%%:*}.h alone" >> build/$(1)/header_alone.log; fi; \
-	done; echo "RESULT $$$$pass $$$$fail" > $$@
+	done; echo "RESULT $$$$pass $$$$fail" > $$@; \
+	if [ $$$$fail -eq 0 ]; then echo 0; else echo 1; fi > build/$(1)/header_alone.status
 endef
 $(foreach c,$(ALONE_CONFIGS),$(eval $(call ALONE_RULE,$(c))))
 
