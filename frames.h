@@ -3658,6 +3658,47 @@ FRM_HOSTDEV static inline void frm_pass2_gather(const frm_view *w, int i, const 
     if (scale) scale[i] = sq;
 }
 
+/* Adds a frame-own rotational term H (6: xx yy zz yz xz xy) to the rotation block of a
+   6x6 block D. */
+FRM_HOSTDEV static inline void frm__add_rotational(const frm_real *H, frm_real *D)
+{
+    D[21] += H[0];
+    D[28] += H[1];
+    D[35] += H[2];
+    D[29] += H[3];
+    D[34] += H[3];
+    D[23] += H[4];
+    D[33] += H[4];
+    D[22] += H[5];
+    D[27] += H[5];
+}
+
+/* One frame's pair-mode block-Jacobi block: the rest block K0 turned with the frame,
+   T K0 T^T with T = diag(Q, Q), plus the frame-own rotational term H (6). frm__prepare_mode
+   and the CUDA companion call it. */
+FRM_HOSTDEV static inline void frm_pass_precond_block(const frm_real *Q, const frm_real *K0, const frm_real *H,
+                                                      frm_real *K)
+{
+    double T[36], KT[36];
+    int r, k, l;
+    for (k = 0; k < 36; k++) T[k] = 0;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) T[6 * r + k] = T[6 * (r + 3) + k + 3] = Q[3 * r + k];
+    for (r = 0; r < 6; r++)
+        for (k = 0; k < 6; k++) {
+            double t = 0;
+            for (l = 0; l < 6; l++) t += (double)K0[6 * r + l] * T[6 * k + l];
+            KT[6 * r + k] = t; /* K0 T^T */
+        }
+    for (r = 0; r < 6; r++)
+        for (k = 0; k < 6; k++) {
+            double t = 0;
+            for (l = 0; l < 6; l++) t += T[6 * r + l] * KT[6 * l + k];
+            K[6 * r + k] = (frm_real)t;
+        }
+    frm__add_rotational(H, K);
+}
+
 /* One frame's world mass data from its rest-axes data ml (m, cbar, Jbar: 10 numbers) and
    its rotation R: m, c = R cbar, J = R Jbar R^T (symmetrised). frm__mass_update and the
    CUDA companion call it. */
@@ -6335,18 +6376,6 @@ static void frm__stiffness_product(frm_model *m, const frm_real *v, frm_real *ou
 }
 
 /* Adds the symmetric Hs (6) to the rotational block of a 6x6 row-major block. */
-static void frm__add_rotational(const frm_real *H, frm_real *D)
-{
-    D[21] += H[0];
-    D[28] += H[1];
-    D[35] += H[2];
-    D[29] += H[3];
-    D[34] += H[3];
-    D[23] += H[4];
-    D[33] += H[4];
-    D[22] += H[5];
-    D[27] += H[5];
-}
 
 /* The stabilisation's part of the tangent columns of slot a of sample s (assembly): for
    each unit dq_c of slot a's frame, adds dPx / v to cols[c] and writes the torque row of
@@ -6507,7 +6536,7 @@ static int frm__choose_mode(const frm_model *m)
 static void frm__prepare_mode(frm_model *m, int mode)
 {
     frm__gather_ctx g;
-    int i, r, k, l;
+    int i;
     g.m = m;
     g.src = NULL;
     g.dst = NULL;
@@ -6523,27 +6552,9 @@ static void frm__prepare_mode(frm_model *m, int mode)
        T K_rest T^T with T = diag(Q, Q), plus the current frame-own rotational term (its
        pairs' Hs and gravity): exact for a rigid motion of the rest state, an approximation
        under strain (the preconditioner only) */
-    for (i = 0; i < m->frame_count; i++) {
-        const frm_real *Q = m->rel + 9 * i, *K0 = m->kdiag_rest + 36 * (size_t)i;
-        frm_real *K = m->kdiag + 36 * (size_t)i;
-        double T[36], KT[36];
-        memset(T, 0, sizeof T);
-        for (r = 0; r < 3; r++)
-            for (k = 0; k < 3; k++) T[6 * r + k] = T[6 * (r + 3) + k + 3] = Q[3 * r + k];
-        for (r = 0; r < 6; r++)
-            for (k = 0; k < 6; k++) {
-                double t = 0;
-                for (l = 0; l < 6; l++) t += (double)K0[6 * r + l] * T[6 * k + l];
-                KT[6 * r + k] = t; /* K0 T^T */
-            }
-        for (r = 0; r < 6; r++)
-            for (k = 0; k < 6; k++) {
-                double t = 0;
-                for (l = 0; l < 6; l++) t += T[6 * r + l] * KT[6 * l + k];
-                K[6 * r + k] = (frm_real)t;
-            }
-        frm__add_rotational(m->lin_hrot + 6 * (size_t)i, K);
-    }
+    for (i = 0; i < m->frame_count; i++)
+        frm_pass_precond_block(m->rel + 9 * i, m->kdiag_rest + 36 * (size_t)i, m->lin_hrot + 6 * (size_t)i,
+                               m->kdiag + 36 * (size_t)i);
     if (m->anchor_probe) frm__anchor_diagonal(m);
 }
 

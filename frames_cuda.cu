@@ -213,9 +213,9 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
                                             frm_real *lin_gravity, double a_mass, double a_stiff, int *err)
 {
     int i = blockIdx.x * blockDim.x + threadIdx.x, r, k, l;
-    const frm_real *R, *Q, *K0;
-    frm_real cg[3], tg[3], *K, mg;
-    double Kg[9], h[6], T[36], KT[36], A[36], M[36], inv[36], cgd;
+    const frm_real *R, *K;
+    frm_real cg[3], tg[3], mg;
+    double Kg[9], h[6], A[36], M[36], inv[36], cgd;
     const frm_real *gv = w.gravity;
     if (i >= w.frame_count) return;
     frm_pass2_gather(&w, i, w.p_out, force, NULL);
@@ -236,36 +236,8 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
         for (r = 0; r < 6; r++) w.lin_hrot[6 * i + r] = (frm_real)h[r];
     }
     /* frm__prepare_mode, pair mode: T K_rest T^T + the frame-own rotational term */
-    Q = w.rel + 9 * i;
-    K0 = w.kdiag_rest + 36 * (size_t)i;
     K = kdiag + 36 * (size_t)i;
-    for (k = 0; k < 36; k++) T[k] = 0;
-    for (r = 0; r < 3; r++)
-        for (k = 0; k < 3; k++) T[6 * r + k] = T[6 * (r + 3) + k + 3] = Q[3 * r + k];
-    for (r = 0; r < 6; r++)
-        for (k = 0; k < 6; k++) {
-            double t = 0;
-            for (l = 0; l < 6; l++) t += (double)K0[6 * r + l] * T[6 * k + l];
-            KT[6 * r + k] = t;
-        }
-    for (r = 0; r < 6; r++)
-        for (k = 0; k < 6; k++) {
-            double t = 0;
-            for (l = 0; l < 6; l++) t += T[6 * r + l] * KT[6 * l + k];
-            K[6 * r + k] = (frm_real)t;
-        }
-    {
-        const frm_real *Hr = w.lin_hrot + 6 * i;
-        K[21] += Hr[0];
-        K[28] += Hr[1];
-        K[35] += Hr[2];
-        K[29] += Hr[3];
-        K[34] += Hr[3];
-        K[23] += Hr[4];
-        K[33] += Hr[4];
-        K[22] += Hr[5];
-        K[27] += Hr[5];
-    }
+    frm_pass_precond_block(w.rel + 9 * i, w.kdiag_rest + 36 * (size_t)i, w.lin_hrot + 6 * i, kdiag + 36 * (size_t)i);
     frm_pass_mass_world(w.mass_local + 10 * (size_t)i, rot + 9 * i, mass_world + 10 * (size_t)i);
     mg = (frm_real)w.grav_local[4 * (size_t)i];
     for (r = 0; r < 3; r++) { /* frm__total_force */
