@@ -1003,6 +1003,14 @@ static void test_chain_no_allocation(void)
 
 /* ---- FRM_LINEAR_SOLVER_BTD in the frames solvers ------------------------------------------ */
 
+/* The displacements of n frames of models a and b agree within tol (m). */
+static void check_same_displacements(const frm_model *a, const frm_model *b, int n, double tol)
+{
+    int i;
+    for (i = 0; i < 3 * n; i++)
+        CHECK_NEAR((double)frm_model_displacements(a)[i], (double)frm_model_displacements(b)[i], tol);
+}
+
 /* A rod of frames whose samples each see two consecutive frames (a chain pattern): the
    static sag under gravity and ten implicit Euler steps with FRM_LINEAR_SOLVER_BTD equal
    CG's (both to a Newton tolerance of 1e-10: 1e-6 of the sag; float 1e-4: 1e-3); a model
@@ -1056,24 +1064,20 @@ static void test_frames_btd_solver(void)
 {
     frm_model *a = rod_model(FRM_LINEAR_SOLVER_CG, 1, 0), *b = rod_model(FRM_LINEAR_SOLVER_BTD, 1, 0);
     double sag, tol = IS_FLOAT ? 1e-3 : 1e-6;
-    int i, k;
+    int i;
     if (!a || !b) return;
     CHECK_INT(FRM_OK, frm_model_solve_static(a));
     CHECK_INT(FRM_OK, frm_model_solve_static(b));
     sag = fabs((double)frm_model_displacements(a)[3 * 11 + 2]);
     CHECK(sag > 1e-4);
-    for (i = 0; i < 12; i++)
-        for (k = 0; k < 3; k++)
-            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    check_same_displacements(a, b, 12, tol * sag);
     printf("    rod sag %.6e m (CG) and %.6e m (BTD); BTD's last static solve: %d CG iterations\n", sag,
            fabs((double)frm_model_displacements(b)[3 * 11 + 2]), frm_model_last_stats(b)->cg_iterations);
     for (i = 0; i < 10; i++) {
         CHECK_INT(FRM_OK, frm_model_step(a));
         CHECK_INT(FRM_OK, frm_model_step(b));
     }
-    for (i = 0; i < 12; i++)
-        for (k = 0; k < 3; k++)
-            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    check_same_displacements(a, b, 12, tol * sag);
     frm_model_destroy(a);
     frm_model_destroy(b);
     a = rod_model(FRM_LINEAR_SOLVER_BTD, 0, 0);
@@ -1103,16 +1107,12 @@ static void test_frames_btd_auto(void)
     CHECK_INT(FRM_OK, frm_model_solve_static(b));
     sag = fabs((double)frm_model_displacements(a)[3 * 11 + 2]);
     CHECK(sag > 1e-4);
-    for (i = 0; i < 12; i++)
-        for (k = 0; k < 3; k++)
-            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    check_same_displacements(a, b, 12, tol * sag);
     for (i = 0; i < 10; i++) {
         CHECK_INT(FRM_OK, frm_model_step(a));
         CHECK_INT(FRM_OK, frm_model_step(b));
     }
-    for (i = 0; i < 12; i++)
-        for (k = 0; k < 3; k++)
-            CHECK_NEAR((double)frm_model_displacements(a)[3 * i + k], (double)frm_model_displacements(b)[3 * i + k], tol * sag);
+    check_same_displacements(a, b, 12, tol * sag);
     frm_model_destroy(a);
     frm_model_destroy(b);
     { /* anchors: the rod's tip pulled toward a point 1 cm up, AUTO's model against CG's */
