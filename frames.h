@@ -3734,6 +3734,99 @@ FRM_HOSTDEV static inline void frm_pass_mass_world(const double *ml, const frm_r
     mw[9] = (frm_real)(0.5 * (W[1] + W[3]));
 }
 
+/* One frame's 6x6 mass block [m I, -[c]x; [c]x, J] from its world mass data w
+   (frm_pass_mass_world's 10 numbers). frm__mass_matrix and the CUDA companion call it. */
+FRM_HOSTDEV static inline void frm_pass_mass_matrix(const frm_real *w, double M[36])
+{
+    double c0 = w[1], c1 = w[2], c2 = w[3];
+    int k;
+    for (k = 0; k < 36; k++) M[k] = 0;
+    for (k = 0; k < 3; k++) M[7 * k] = w[0];
+    M[4] = c2; /* -[c]x, top right */
+    M[5] = -c1;
+    M[9] = -c2;
+    M[11] = c0;
+    M[15] = c1;
+    M[16] = -c0;
+    M[19] = -c2; /* [c]x, bottom left */
+    M[20] = c1;
+    M[24] = c2;
+    M[26] = -c0;
+    M[30] = -c1;
+    M[31] = c0;
+    M[21] = w[4];
+    M[28] = w[5];
+    M[35] = w[6];
+    M[29] = M[34] = w[7];
+    M[23] = M[33] = w[8];
+    M[22] = M[27] = w[9];
+}
+
+/* out = M v for one frame from its world mass data w (6 values): (m x + omega x c,
+   c x x + J omega). frm__mass_apply and the CUDA companion call it. */
+FRM_HOSTDEV static inline void frm_pass_mass_apply(const frm_real *w, const frm_real *v, double out[6])
+{
+    double x0 = v[0], x1 = v[1], x2 = v[2], o0 = v[3], o1 = v[4], o2 = v[5];
+    out[0] = (double)w[0] * x0 + (o1 * w[3] - o2 * w[2]);
+    out[1] = (double)w[0] * x1 + (o2 * w[1] - o0 * w[3]);
+    out[2] = (double)w[0] * x2 + (o0 * w[2] - o1 * w[1]);
+    out[3] = (w[2] * x2 - w[3] * x1) + w[4] * o0 + w[9] * o1 + w[8] * o2;
+    out[4] = (w[3] * x0 - w[1] * x2) + w[9] * o0 + w[5] * o1 + w[7] * o2;
+    out[5] = (w[1] * x1 - w[2] * x0) + w[8] * o0 + w[7] * o1 + w[6] * o2;
+}
+
+/* 6x6 symmetric positive definite inverse by Cholesky of the symmetric part, in double.
+   Returns 0 (inv unset) when a pivot is not a finite number above 1e-300. The block-Jacobi
+   preconditioner of the CPU and of the CUDA companion call it. */
+FRM_HOSTDEV static inline int frm_pass_invert6(const double A[36], double inv[36])
+{
+    double L[36], y[6];
+    int i, j, k, c;
+    for (k = 0; k < 36; k++) L[k] = 0;
+    for (j = 0; j < 6; j++) {
+        double d = A[6 * j + j];
+        for (k = 0; k < j; k++) d -= L[6 * j + k] * L[6 * j + k];
+        if (!(d > 1e-300) || !(d - d == 0.0)) return 0; /* not above the floor, or infinite */
+        L[6 * j + j] = sqrt(d);
+        for (i = j + 1; i < 6; i++) {
+            double s = 0.5 * (A[6 * i + j] + A[6 * j + i]);
+            for (k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
+            L[6 * i + j] = s / L[6 * j + j];
+        }
+    }
+    for (c = 0; c < 6; c++) { /* column c of the inverse: L L^T x = e_c */
+        for (i = 0; i < 6; i++) {
+            double s = (i == c);
+            for (k = 0; k < i; k++) s -= L[6 * i + k] * y[k];
+            y[i] = s / L[6 * i + i];
+        }
+        for (i = 5; i >= 0; i--) {
+            double s = y[i];
+            for (k = i + 1; k < 6; k++) s -= L[6 * k + i] * inv[6 * k + c];
+            inv[6 * i + c] = s / L[6 * i + i];
+        }
+    }
+    return 1;
+}
+
+/* One frame's world gravity moment c = R cbar_g (gl: the frame's 4 gravity numbers m_g,
+   cbar_g) and the symmetric part of its torque's stiffness at c,
+   K_g dtheta = -1/2 (c (g . dtheta) + g (c . dtheta)) + (c . g) dtheta. The CPU force pass,
+   frm__total_force and the CUDA companion call them. */
+FRM_HOSTDEV static inline void frm_pass_gravity_moment(const frm_real *R, const double *gl, frm_real c[3])
+{
+    int r;
+    for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * gl[1] + R[3 * r + 1] * gl[2] + R[3 * r + 2] * gl[3]);
+}
+
+FRM_HOSTDEV static inline void frm_pass_gravity_stiffness(const frm_real *c, const frm_real *g, double K[9])
+{
+    double cg = (double)c[0] * g[0] + (double)c[1] * g[1] + (double)c[2] * g[2];
+    int r, k;
+    for (r = 0; r < 3; r++)
+        for (k = 0; k < 3; k++) K[3 * r + k] = -0.5 * ((double)c[r] * g[k] + (double)g[r] * c[k]) + (r == k ? cg : 0.0);
+}
+
 /* Pass 2 of K v (pair mode), after the gather: the frame-own rotational term of frame i
    (the pairs' Hs and gravity, lin_hrot) applied to v's rotation, added to out (6 per frame). */
 FRM_HOSTDEV static inline void frm_pass2_rotational(const frm_view *w, int i, const frm_real *v, frm_real *out)
@@ -3957,38 +4050,6 @@ static int frm__all_finite(const frm_real *a, size_t count)
     int ok = 1;
     for (i = 0; i < count; i++) ok &= frm__finite((double)a[i]);
     return ok;
-}
-
-/* 6x6 symmetric positive definite inverse by Cholesky (double). Returns 0 if not PD. */
-static int frm__invert6(const double A[36], double inv[36])
-{
-    double L[36], y[6];
-    int i, j, k, c;
-    memset(L, 0, sizeof L);
-    for (j = 0; j < 6; j++) {
-        double d = A[6 * j + j];
-        for (k = 0; k < j; k++) d -= L[6 * j + k] * L[6 * j + k];
-        if (!(d > 1e-300) || !frm__finite(d)) return 0;
-        L[6 * j + j] = sqrt(d);
-        for (i = j + 1; i < 6; i++) {
-            double s = 0.5 * (A[6 * i + j] + A[6 * j + i]);
-            for (k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
-            L[6 * i + j] = s / L[6 * j + j];
-        }
-    }
-    for (c = 0; c < 6; c++) { /* column c of the inverse: L L^T x = e_c */
-        for (i = 0; i < 6; i++) {
-            double s = (i == c);
-            for (k = 0; k < i; k++) s -= L[6 * i + k] * y[k];
-            y[i] = s / L[6 * i + i];
-        }
-        for (i = 5; i >= 0; i--) {
-            double s = y[i];
-            for (k = i + 1; k < 6; k++) s -= L[6 * k + i] * inv[6 * k + c];
-            inv[6 * i + c] = s / L[6 * i + i];
-        }
-    }
-    return 1;
 }
 
 /* Eigen-decomposition of a symmetric n x n matrix (n <= 6, row-major, destroyed) by cyclic
@@ -5699,13 +5760,10 @@ static void frm__update_frames(frm_model *m)
     }
 }
 
-/* World gravity moment c_g = R cbar_g of frame i. */
+/* World gravity moment c_g = R cbar_g of frame i (frm_pass_gravity_moment). */
 static void frm__gravity_moment(const frm_model *m, int i, frm_real c[3])
 {
-    const frm_real *R = m->rot + 9 * i;
-    const double *g = m->grav_local + 4 * (size_t)i;
-    int r;
-    for (r = 0; r < 3; r++) c[r] = (frm_real)(R[3 * r] * g[1] + R[3 * r + 1] * g[2] + R[3 * r + 2] * g[3]);
+    frm_pass_gravity_moment(m->rot + 9 * i, m->grav_local + 4 * (size_t)i, c);
 }
 
 /* The stabilisation's part of K v for sample s (see frm_pass1_stab_force), for the assembly: for the
@@ -6336,11 +6394,7 @@ static void frm__block_chunks(void *vctx, int begin, int end)
    K_g dtheta = -1/2 (c (g . dtheta) + g (c . dtheta)) + (c . g) dtheta, c = R cbar_g. */
 static void frm__gravity_stiffness(const frm_model *m, int i, double K[9])
 {
-    const frm_real *c = m->lin_gravity + 3 * i, *g = m->gravity;
-    double cg = (double)c[0] * g[0] + (double)c[1] * g[1] + (double)c[2] * g[2];
-    int r, k;
-    for (r = 0; r < 3; r++)
-        for (k = 0; k < 3; k++) K[3 * r + k] = -0.5 * ((double)c[r] * g[k] + (double)g[r] * c[k]) + (r == k ? cg : 0.0);
+    frm_pass_gravity_stiffness(m->lin_gravity + 3 * i, m->gravity, K);
 }
 
 /* out = K v (all frames): pairs or blocks as linearised; the symmetric part, or with
@@ -6570,42 +6624,13 @@ static void frm__mass_update(frm_model *m)
 /* The 6x6 mass block of frame i from mass_world: [m I, -[c]x; [c]x, J]. */
 static void frm__mass_matrix(const frm_model *m, int i, double M[36])
 {
-    const frm_real *w = m->mass_world + 10 * (size_t)i;
-    double c0 = w[1], c1 = w[2], c2 = w[3];
-    int k;
-    memset(M, 0, 36 * sizeof(double));
-    for (k = 0; k < 3; k++) M[7 * k] = w[0];
-    M[4] = c2; /* -[c]x, top right */
-    M[5] = -c1;
-    M[9] = -c2;
-    M[11] = c0;
-    M[15] = c1;
-    M[16] = -c0;
-    M[19] = -c2; /* [c]x, bottom left */
-    M[20] = c1;
-    M[24] = c2;
-    M[26] = -c0;
-    M[30] = -c1;
-    M[31] = c0;
-    M[21] = w[4];
-    M[28] = w[5];
-    M[35] = w[6];
-    M[29] = M[34] = w[7];
-    M[23] = M[33] = w[8];
-    M[22] = M[27] = w[9];
+    frm_pass_mass_matrix(m->mass_world + 10 * (size_t)i, M);
 }
 
 /* out = M_i v for frame i (6 values): (m x + omega x c, c x x + J omega). */
 static void frm__mass_apply(const frm_model *m, int i, const frm_real *v, double out[6])
 {
-    const frm_real *w = m->mass_world + 10 * (size_t)i;
-    double x0 = v[0], x1 = v[1], x2 = v[2], o0 = v[3], o1 = v[4], o2 = v[5];
-    out[0] = (double)w[0] * x0 + (o1 * w[3] - o2 * w[2]);
-    out[1] = (double)w[0] * x1 + (o2 * w[1] - o0 * w[3]);
-    out[2] = (double)w[0] * x2 + (o0 * w[2] - o1 * w[1]);
-    out[3] = (w[2] * x2 - w[3] * x1) + w[4] * o0 + w[9] * o1 + w[8] * o2;
-    out[4] = (w[3] * x0 - w[1] * x2) + w[9] * o0 + w[5] * o1 + w[7] * o2;
-    out[5] = (w[1] * x1 - w[2] * x0) + w[8] * o0 + w[7] * o1 + w[6] * o2;
+    frm_pass_mass_apply(m->mass_world + 10 * (size_t)i, v, out);
 }
 
 /* Block-Jacobi preconditioner: the inverse of a_mass M_i + a_stiff K_ii per free frame (a
@@ -6633,7 +6658,7 @@ static int frm__build_precond(frm_model *m, double a_mass, double a_stiff)
                     for (l = 0; l < 6; l++) A[6 * k + l] = A[6 * l + k] = 0;
                     A[7 * k] = 1;
                 }
-        if (!frm__invert6(A, inv)) {
+        if (!frm_pass_invert6(A, inv)) {
             double V[36], ev[6], top = 0;
             int r, c;
             for (r = 0; r < 6; r++)

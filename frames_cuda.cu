@@ -76,77 +76,6 @@ __global__ static void fcu_update_frames(frm_view w, frm_real *rot, frm_real *re
     frm_frame_rotations(w.quat + 4 * i, w.rest_quat + 4 * i, rot + 9 * i, rel + 9 * i, relm + 9 * i);
 }
 
-/* frm__mass_matrix. */
-__device__ static void fcu_mass_matrix(const frm_real *w, double M[36])
-{
-    double c0 = w[1], c1 = w[2], c2 = w[3];
-    int k;
-    for (k = 0; k < 36; k++) M[k] = 0;
-    for (k = 0; k < 3; k++) M[7 * k] = w[0];
-    M[4] = c2;
-    M[5] = -c1;
-    M[9] = -c2;
-    M[11] = c0;
-    M[15] = c1;
-    M[16] = -c0;
-    M[19] = -c2;
-    M[20] = c1;
-    M[24] = c2;
-    M[26] = -c0;
-    M[30] = -c1;
-    M[31] = c0;
-    M[21] = w[4];
-    M[28] = w[5];
-    M[35] = w[6];
-    M[29] = M[34] = w[7];
-    M[23] = M[33] = w[8];
-    M[22] = M[27] = w[9];
-}
-
-/* frm__mass_apply. */
-__device__ static void fcu_mass_apply(const frm_real *w, const frm_real *v, double out[6])
-{
-    double x0 = v[0], x1 = v[1], x2 = v[2], o0 = v[3], o1 = v[4], o2 = v[5];
-    out[0] = (double)w[0] * x0 + (o1 * w[3] - o2 * w[2]);
-    out[1] = (double)w[0] * x1 + (o2 * w[1] - o0 * w[3]);
-    out[2] = (double)w[0] * x2 + (o0 * w[2] - o1 * w[1]);
-    out[3] = (w[2] * x2 - w[3] * x1) + w[4] * o0 + w[9] * o1 + w[8] * o2;
-    out[4] = (w[3] * x0 - w[1] * x2) + w[9] * o0 + w[5] * o1 + w[7] * o2;
-    out[5] = (w[1] * x1 - w[2] * x0) + w[8] * o0 + w[7] * o1 + w[6] * o2;
-}
-
-/* frm__invert6 (Cholesky of the symmetric part); 0 when not positive definite. */
-__device__ static int fcu_invert6(const double A[36], double inv[36])
-{
-    double L[36], y[6];
-    int i, j, k, c;
-    for (k = 0; k < 36; k++) L[k] = 0;
-    for (j = 0; j < 6; j++) {
-        double d = A[6 * j + j];
-        for (k = 0; k < j; k++) d -= L[6 * j + k] * L[6 * j + k];
-        if (!(d > 1e-300) || !isfinite(d)) return 0;
-        L[6 * j + j] = sqrt(d);
-        for (i = j + 1; i < 6; i++) {
-            double s = 0.5 * (A[6 * i + j] + A[6 * j + i]);
-            for (k = 0; k < j; k++) s -= L[6 * i + k] * L[6 * j + k];
-            L[6 * i + j] = s / L[6 * j + j];
-        }
-    }
-    for (c = 0; c < 6; c++) {
-        for (i = 0; i < 6; i++) {
-            double s = (i == c);
-            for (k = 0; k < i; k++) s -= L[6 * i + k] * y[k];
-            y[i] = s / L[6 * i + i];
-        }
-        for (i = 5; i >= 0; i--) {
-            double s = y[i];
-            for (k = i + 1; k < 6; k++) s -= L[6 * k + i] * inv[6 * k + c];
-            inv[6 * i + c] = s / L[6 * i + i];
-        }
-    }
-    return 1;
-}
-
 /* ---- pass 1 (one thread a sample) ------------------------------------------------------- */
 
 /* The force pass (frm__force_chunks without volumetric averaging, with the kernels' laws):
@@ -215,8 +144,7 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
     int i = blockIdx.x * blockDim.x + threadIdx.x, r, k, l;
     const frm_real *R, *K;
     frm_real cg[3], tg[3], mg;
-    double Kg[9], h[6], A[36], M[36], inv[36], cgd;
-    const frm_real *gv = w.gravity;
+    double Kg[9], h[6], A[36], M[36], inv[36];
     if (i >= w.frame_count) return;
     frm_pass2_gather(&w, i, w.p_out, force, NULL);
     frm_pass2_gather(&w, i, w.p_H, w.lin_hrot, NULL);
@@ -224,13 +152,10 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
         if (!isfinite((double)force[6 * i + k])) atomicMin(err, FRM_ERR_NOT_FINITE);
     R = rot + 9 * i;
     { /* frm__gravity_moment, lin_gravity; frm__gravity_stiffness added to the frame-own term */
-        const double *gl = w.grav_local + 4 * (size_t)i;
-        for (r = 0; r < 3; r++) cg[r] = (frm_real)(R[3 * r] * gl[1] + R[3 * r + 1] * gl[2] + R[3 * r + 2] * gl[3]);
+        frm_pass_gravity_moment(R, w.grav_local + 4 * (size_t)i, cg);
         frm_cross(cg, w.gravity, tg);
         for (r = 0; r < 3; r++) lin_gravity[3 * i + r] = cg[r];
-        cgd = (double)cg[0] * gv[0] + (double)cg[1] * gv[1] + (double)cg[2] * gv[2];
-        for (r = 0; r < 3; r++)
-            for (k = 0; k < 3; k++) Kg[3 * r + k] = -0.5 * ((double)cg[r] * gv[k] + (double)gv[r] * cg[k]) + (r == k ? cgd : 0.0);
+        frm_pass_gravity_stiffness(cg, w.gravity, Kg);
         for (r = 0; r < 6; r++) h[r] = (double)w.lin_hrot[6 * i + r];
         h[0] += Kg[0], h[1] += Kg[4], h[2] += Kg[8], h[3] += Kg[5], h[4] += Kg[2], h[5] += Kg[1];
         for (r = 0; r < 6; r++) w.lin_hrot[6 * i + r] = (frm_real)h[r];
@@ -249,7 +174,7 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
         for (k = 0; k < 36; k++) precond[36 * (size_t)i + k] = 0;
         return;
     }
-    fcu_mass_matrix(mass_world + 10 * (size_t)i, M);
+    frm_pass_mass_matrix(mass_world + 10 * (size_t)i, M);
     for (k = 0; k < 36; k++) A[k] = a_mass * M[k] + a_stiff * (double)K[k];
     if (w.axes[i])
         for (k = 0; k < 6; k++)
@@ -257,7 +182,7 @@ __global__ static void fcu_frames_linearize(frm_view w, const frm_real *rot, frm
                 for (l = 0; l < 6; l++) A[6 * k + l] = A[6 * l + k] = 0;
                 A[7 * k] = 1;
             }
-    if (!fcu_invert6(A, inv)) { /* the CPU takes |eigenvalues| (Jacobi); here the inverse diagonal */
+    if (!frm_pass_invert6(A, inv)) { /* the CPU takes |eigenvalues| (Jacobi); here the inverse diagonal */
         for (k = 0; k < 36; k++) inv[k] = 0;
         for (k = 0; k < 6; k++) inv[7 * k] = A[7 * k] != 0 && isfinite(A[7 * k]) ? 1 / fabs(A[7 * k]) : 0;
     }
@@ -282,7 +207,7 @@ __global__ static void fcu_apply_pass2(frm_view w, const frm_real *v, frm_real *
         for (k = 0; k < 6; k++) out[6 * i + k] = 0;
         return;
     }
-    if (a_mass != 0) fcu_mass_apply(mass_world + 10 * (size_t)i, v + 6 * i, mv);
+    if (a_mass != 0) frm_pass_mass_apply(mass_world + 10 * (size_t)i, v + 6 * i, mv);
     for (k = 0; k < 6; k++) out[6 * i + k] = (frm_real)(a_stiff * (double)out[6 * i + k] + a_mass * mv[k]);
     for (k = 0; k < 6; k++)
         if ((w.axes[i] >> k) & 1) out[6 * i + k] = 0;
@@ -295,7 +220,7 @@ __global__ static void fcu_step_rhs(frm_view w, const frm_real *f, const frm_rea
     int i = blockIdx.x * blockDim.x + threadIdx.x, k;
     double mv[6];
     if (i >= w.frame_count) return;
-    fcu_mass_apply(mass_world + 10 * (size_t)i, w.vel + 6 * i, mv);
+    frm_pass_mass_apply(mass_world + 10 * (size_t)i, w.vel + 6 * i, mv);
     for (k = 0; k < 6; k++)
         b[6 * i + k] = (frm_real)(dt * ((double)f[6 * i + k] - (dt + (double)w.stiffness_damping) * kv[6 * i + k] -
                                         (double)w.mass_damping * mv[k]));
