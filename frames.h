@@ -1105,7 +1105,13 @@
        expression, and the stabilisation's K v torques wait in p_out until dP is complete;
        only the coupling term (frame_coupling, off by default) keeps 96 reals (nvcc -Xptxas
        -v: pass 1 of the force 768 bytes of stack, of K v 384, both from that term; no
-       spills). The volumetric option's extra stages (VOLUMETRIC AVERAGING) stay CPU-only.
+       spills). The per-frame pieces around pass 2 are shared the same way: the world mass
+       data, block and product (frm_pass_mass_world, frm_pass_mass_matrix,
+       frm_pass_mass_apply), the gravity moment and its stiffness (frm_pass_gravity_moment,
+       frm_pass_gravity_stiffness), the pair mode's block-Jacobi block and its Cholesky
+       inverse (frm_pass_precond_block, frm_pass_invert6); the CUDA file keeps only launches,
+       the device CG's scalar kernels and the reductions. The volumetric option's extra
+       stages (VOLUMETRIC AVERAGING) stay CPU-only.
        The companion (frames_cuda.cu, declared in frames_cuda.h: a separate header, so that
        frames.h needs no CUDA types and programs without a GPU see nothing of it; nvcc -c
        frames_cuda.cu [-DFRM_REAL=float], link with -lcudart; frames.h's functions with C
