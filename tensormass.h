@@ -274,7 +274,9 @@
        displacement at CG tolerance 1e-12, measured 1e-13; 2.4 to 3 times fewer
        iterations in double, 5 in float, at E = 10 MPa, dt = 0.1 s on a 20 x 2 x 2 beam;
        after a cut; with anchors and a driven node; one factorisation per coefficient; no
-       allocation; mass-dominated steps not slowed by more than 2 x Jacobi's count).
+       allocation; mass-dominated steps not slowed by more than 2 x Jacobi's count);
+       tests/test_tensormass_qs.c test_hybrid_coarse_correction (a hybrid's dynamic part,
+       its coupling block in A_c: 835 -> 287 iterations over 5 steps, same positions).
        Springs static solve: load continuation. The load fraction s goes from 0 to 1
        (gravity and external forces scaled by s, pinned nodes moved from where they are
        towards their targets by s); each increment is solved by Newton with a line search
