@@ -967,8 +967,8 @@
          turns it on after one Jacobi-only step that needed HEML_COARSE_MIN_ITERATIONS
          iterations a solve and keeps it on (a later, much smaller dt keeps paying its
          cost per iteration: set implicit_coarse = -1 for such runs); meshes under 96 nodes
-         have none. tensormass.h's implicit steps have no coarse correction (README,
-         issue 21).
+         have none. tensormass.h's implicit steps have their own (its SOLVERS, issue 21;
+         on its linear model K is exact, so its A_c is P^T (D + c K) P).
        - St Venant-Kirchhoff softens in compression (the stress falls to zero as a
          tetrahedron flattens, sec. 4.2); the J0 guard keeps it from settling inverted, but
          a homogeneous uniaxial compression is unstable in the law itself beyond about

@@ -125,8 +125,9 @@
          (cg_iterations, cg_residual, stiffness_products, negative_curvature) and set
          m->cg_indefinite when the matrix was not positive definite along a direction,
          leaving that direction in m->cg_p and mask A p in m->cg_q (the springs' static
-         minimum check, tmass__spring_check_minimum, reads them).
-         Every solve of the header calls tmass__linear_solve / tmass__linear_solve_block:
+         minimum check, tmass__spring_check_minimum, reads them). m->cg_coarse set: an
+         implicit step asks for the coarse correction (>>coarse; CG adds it, another
+         solver may ignore it). Every solve of the header calls tmass__linear_solve / tmass__linear_solve_block:
          never call a solver directly.
        Tests each must add (tests/test_tensormass.c, test_tensormass_qs.c for the
          precomputed paths): a model kind, force = -gradient of its energy by finite
@@ -158,7 +159,10 @@
    through the desc's allocator (or TMASS_MALLOC), plus a temporary one it frees before
    returning. A custom allocator must honour the alignment it is asked for (64).
    Nothing else allocates: stepping, forces, solves, cutting and tearing reuse that block
-   (cutting only removes, so capacity never runs out). The description's arrays are read
+   (cutting only removes, so capacity never runs out). The block holds the implicit steps'
+   coarse correction (SOLVERS) unless desc.implicit_coarse = -1, on the tensor model with
+   at least 96 nodes: two (6 A)^2 matrices of doubles for A = min(64, nodes / 24)
+   aggregates (up to 2.4 MB; 130 KB on a 1025-node beam) and an int per node. The description's arrays are read
    during tmass_create only. Pointers returned by tmass_positions and friends point into
    the model and stay valid until tmass_destroy.
 
@@ -218,6 +222,61 @@
        state with inverted tetrahedra is far outside the model's validity (small strains)
        and the caller should read the count. The same holds for implicit steps.
        Tensor-mass implicit Euler: one linear solve, exact for the linear model.
+       Coarse correction of the tensor model's implicit steps (issue 21;
+       desc.implicit_coarse, heml.h's option and semantics, its own code): implicit Euler,
+       its linearised form and BDF2 solve (D + c K) dv = b, D = M (1 + dt alpha), c = dt^2
+       + dt beta (BDF2: 2 dt / 3 in place of dt). Jacobi alone is good while D dominates
+       (small dt, soft bodies) and needs hundreds of iterations once c K does on slender
+       bodies (bending, which Jacobi resolves slowest). The correction adds P A_c^-1 P^T
+       to Jacobi: the nodes binned into up to 64 cells of the rest bounding box
+       (aggregates, at least 24 nodes each: meshes under 96 nodes have none), each with
+       the six rigid motions of its nodes (P), A_c = P^T (D + c K) P on the free axes with
+       K exactly the operator CG multiplies by (edge tensors, a hybrid's coupling block,
+       the anchors), dense Cholesky in double (6 A unknowns; a mode that pins or cuts
+       leave singular is dropped). P^T K P is one pass over the live edges (about 650
+       multiply-adds each: 0.43 ms on R3's 1025 nodes and 4,896 edges, 15 aggregates),
+       redone at the next step after a cut or tear, a pin change, tmass_set_anchors or
+       a hybrid's coupling change (anchor stiffnesses changed in place without the call
+       keep the old one: slower, never wrong); the factor (0.2 ms there) is kept with its
+       key (c, P^T D P bit for bit, those events) and reused by every step of one dt
+       (BDF2: one more for its 2 dt / 3). Applying it costs two serial node passes and
+       two triangular solves per iteration (7.4 us on R3 against 20 us for a K product;
+       with the extra r . z about half an iteration's cost). CG checks its answer as
+       before (results change within the CG tolerance); stats.cg_condition then bounds
+       the two-level preconditioned matrix's condition number. Modes: 0 (default)
+       automatic: Jacobi alone until a step's CG needed TMASS__COARSE_MIN_ITERATIONS (50)
+       iterations, the correction from the next step on (never off again); 1 always; -1
+       never (and no memory: MEMORY). stats.coarse_solves counts the solves that used
+       it, stats.coarse_factors its factorisations in the step. The spring model has
+       none (its tangent changes every Newton iteration; implicit_coarse is ignored).
+       Why 50, not heml's 20: a K product is cheaper here (one pass over edge tensors), so
+       the correction's cost weighs more; on R3 at dt = 1 ms over 30 steps (1 thread,
+       the machine below) it lost at E = 1, 2 MPa (Jacobi 31, 43 iterations a step -> 25,
+       30: x1.21, x1.15 the time) and won from 3 MPa (52 -> 32: x0.81; 10 MPa, 93 -> 38:
+       x0.65). Measured (`build/bench/bench --parts coarse --filter tensormass`, bench.c
+       >>coarse, the heml rows' beams clamped at x = 0, 6 implicit Euler steps from rest,
+       CG tolerance 1e-9; Intel Xeon under KVM (family 6 model 167, AVX-512), 2 vCPUs,
+       load average 6, OMP_NUM_THREADS=1; CG iterations per
+       step Jacobi only -> always, and the time ratio always / never, range of 2 runs of
+       2 interleaved repeats each):
+                              dt = 1 ms          10 ms            0.1 s            1 s
+           R3, E = 1 kPa      3 -> 4   x2.3 *   11 -> 12  x3.6 *  103 -> 40 x0.58  183 -> 51 x0.35-0.45
+           R3, E = 1 MPa     34 -> 25  x0.8-1.9 156 -> 47 x0.39-0.50 233 -> 58 x0.33-0.37 282 -> 65 x0.33
+           R3, E = 10 MPa   103 -> 40  x0.42-0.62 183 -> 51 x0.45-0.49 268 -> 61 x0.36-0.38 288 -> 67 x0.28-0.38
+           R1, steel        252 -> 43  x0.19-0.44 459 -> 51 x0.17-0.18 576 -> 56 x0.15-0.19 596 -> 60 x0.16-0.18
+       (R3: 1 x 0.1 x 0.1 m, 40 x 4 x 4 cells, 3075 dof; R1: 16 x 0.5 x 0.5 m, 64 x 2 x 2
+       cells, 1755 dof. * the first step's assembly and factor, about 0.6 ms once, over 6
+       steps of 0.16-0.36 ms; the automatic mode stays Jacobi in the rows whose Jacobi
+       count is under 50: 1 kPa at 1 and 10 ms, 1 MPa at 1 ms.) BDF2's rows are alike
+       (R1 598 -> 57 at 1 s). The automatic mode's first step is Jacobi only: over the 6
+       steps it reads x0.23 to x0.78 where it switches on. Tests: tests/test_tensormass.c
+       test_implicit_coarse_correction (same states as Jacobi only within 1e-4 of the
+       displacement at CG tolerance 1e-12, measured 1e-13; 2.4 to 3 times fewer
+       iterations in double, 5 in float, at E = 10 MPa, dt = 0.1 s on a 20 x 2 x 2 beam;
+       after a cut; with anchors and a driven node; one factorisation per coefficient; no
+       allocation; mass-dominated steps not slowed by more than 2 x Jacobi's count);
+       tests/test_tensormass_qs.c test_hybrid_coarse_correction (a hybrid's dynamic part,
+       its coupling block in A_c: 835 -> 287 iterations over 5 steps, same positions).
        Springs static solve: load continuation. The load fraction s goes from 0 to 1
        (gravity and external forces scaled by s, pinned nodes moved from where they are
        towards their targets by s); each increment is solved by Newton with a line search
@@ -293,7 +352,8 @@
                                    slightly dissipative.
        TMASS_IMPLICIT_EULER        (M (1 + dt alpha) + (dt^2 + dt beta) K) dv = dt (f - dt K v),
                                    solved by Jacobi-preconditioned conjugate gradient applied
-                                   matrix-free over the edge tensors (beyond the paper).
+                                   matrix-free over the edge tensors (beyond the paper), plus
+                                   a coarse correction at large dt (SOLVERS).
                                    Unconditionally stable (strongly damps high frequencies).
                                    Pinned nodes move to their targets over the step; their
                                    velocity enters the damping only. Springs: Newton
@@ -521,6 +581,11 @@
          with every node output, in double; examples/tensormass_hybrid.c).
 
    HISTORY
+       unreleased (issue 21) the tensor model's implicit steps add a coarse correction to
+             their Jacobi CG (desc.implicit_coarse: 0 automatic, 1, -1; SOLVERS):
+             tmass_stats gains coarse_solves and coarse_factors, the model block up to
+             2.4 MB (MEMORY). Results change within the CG tolerance where it is on;
+             with -1, or while the automatic mode has not switched, bit-identical.
        unreleased (issue 14) tmass_set_anchors (springs from nodes to caller-owned targets,
              as heml.h and frames.h), tmass_apply_stiffness (the public K v),
              TMASS_ERR_ANCHORED (the quasi-static precomputation of an anchored model).
@@ -806,6 +871,12 @@ typedef struct tmass_desc {
     tmass_linear_solver linear_solver; /* default TMASS_LINEAR_SOLVER_CG */
     tmass_real cg_tolerance;     /* relative residual of CG solves, default 1e-6 (1e-5 float) */
     int cg_max_iterations;       /* default 2000 */
+    int implicit_coarse;         /* the tensor model's implicit steps (implicit Euler, its
+                                    linearised form, BDF2): 0 (default) add a coarse
+                                    correction to Jacobi once a step's CG needed
+                                    TMASS__COARSE_MIN_ITERATIONS (20); 1 always; -1 never
+                                    (nothing allocated for it). Meshes under 96 nodes and
+                                    the spring model have none (SOLVERS) */
 
     /* Newton solves: the springs' implicit Euler step (TMASS_IMPLICIT_EULER) and static
        solve; the tensor model is linear and needs one linear solve */
@@ -852,6 +923,10 @@ typedef struct tmass_stats {
     tmass_real cg_condition; /* (tensormass extra) estimated condition number of the
                                 Jacobi-scaled matrix, largest over the call's linear
                                 solves; a lower bound, see SOLVERS and LIMITS) */
+    int coarse_solves;      /* implicit steps: CG solves preconditioned with the coarse
+                               correction (desc.implicit_coarse; SOLVERS) */
+    int coarse_factors;     /* implicit steps: factorisations of its coarse matrix (0 when the
+                               last one was reused: same dt, masses, pins and mesh) */
 } tmass_stats;
 
 /* Energies of the current state (tmass_energy). */
@@ -1373,6 +1448,7 @@ struct tmass_model {
     double *partials; /* 2 * partial_count block sums */
     int cg_indefinite; /* the last CG stopped on p . A p <= 0 */
     int cg_last_iterations; /* iterations of the last CG */
+    int cg_coarse;          /* the next CG adds the coarse correction (set by the step) */
     int partial_count;
     int *tear_list;
 
@@ -1394,6 +1470,20 @@ struct tmass_model {
     double anchor_scale; /* the anchors' weight in the operator the edge tensors hold: 1 for
                             the tensor model (K itself), the springs' tangent scale kx + kv
                             beta while their tensors hold kx K + kv D (tmass__spring_forces) */
+
+    /* the implicit steps' coarse correction (>>coarse; desc.implicit_coarse) */
+    int implicit_coarse;    /* -1 never, 0 once a step's CG needed the minimum, 1 always */
+    int coarse_on;          /* automatic mode: switched on (never off again) */
+    int agg_count;          /* aggregates (0: no coarse space) */
+    int *node_agg;          /* n: each node's aggregate */
+    double *agg_centre;     /* 3 A: mean rest position of its nodes */
+    double *coarse_k;       /* (6 A)^2: P^T K P, unfactored */
+    double *coarse_step;    /* (6 A)^2: Cholesky factor of P^T (D + c K) P */
+    double *coarse_pdp, *coarse_pdp_new; /* 36 A each: P^T D P of the factor, of this solve */
+    double *coarse_y;       /* 6 A: coarse right-hand side and solution */
+    double coarse_step_c;   /* c of the factor */
+    unsigned coarse_version; /* bumped when K's tensors, the masks or the anchors change */
+    unsigned coarse_k_version, coarse_step_version; /* coarse_version they were built at */
 };
 
 /* >>math ------------------------------------------------------------------------------ */
@@ -1623,6 +1713,16 @@ static void tmass__layout(tmass_model *m, tmass__carver *c)
     m->qs_mark = m->step_v0;
     TMASS__CARVE(c, m->partials, double, 2 * (size_t)m->partial_count);
     TMASS__CARVE(c, m->tear_list, int, t);
+    { /* the coarse correction's arrays (agg_count 0: none; >>coarse) */
+        size_t A = (size_t)m->agg_count;
+        TMASS__CARVE(c, m->node_agg, int, A ? n : 0);
+        TMASS__CARVE(c, m->agg_centre, double, 3 * A);
+        TMASS__CARVE(c, m->coarse_k, double, 36 * A * A);
+        TMASS__CARVE(c, m->coarse_step, double, 36 * A * A);
+        TMASS__CARVE(c, m->coarse_pdp, double, 36 * A);
+        TMASS__CARVE(c, m->coarse_pdp_new, double, 36 * A);
+        TMASS__CARVE(c, m->coarse_y, double, 6 * A);
+    }
 }
 
 /* >>precomputation -------------------------------------------------------------------- */
@@ -1797,6 +1897,7 @@ static void tmass__colour_chunks(tmass_model *m, int *stamp, int *colour_of)
 static void tmass__set_masks(tmass_model *m, int i, int is_free, int is_pinned)
 {
     int r;
+    if (m->free_mask[3 * i] != (tmass_real)is_free) m->coarse_version++; /* P changes (>>coarse) */
     for (r = 0; r < 3; r++) {
         m->free_mask[3 * i + r] = (tmass_real)is_free;
         m->pin_mask[3 * i + r] = (tmass_real)is_pinned;
@@ -1911,7 +2012,11 @@ static const tmass__kind_ops tmass__kinds[] = {
 /* one row per kind (a negative array size stops the build otherwise) */
 typedef char tmass__kinds_size_check[sizeof tmass__kinds / sizeof tmass__kinds[0] == TMASS_MODEL_KIND_COUNT ? 1 : -1];
 
-static void tmass__apply_tet(tmass_model *m, int t, double sign) { tmass__kinds[m->kind].assemble_tet(m, t, sign); }
+static void tmass__apply_tet(tmass_model *m, int t, double sign)
+{
+    m->coarse_version++; /* K changed: the coarse matrix is rebuilt when next used (>>coarse) */
+    tmass__kinds[m->kind].assemble_tet(m, t, sign);
+}
 
 /* >>validation ------------------------------------------------------------------------ */
 
@@ -1972,6 +2077,8 @@ static int tmass__create_validate(const tmass_desc *d)
         return tmass__fail(d, TMASS_ERR_SOLVER, "cg_tolerance / cg_max_iterations");
     if (!(tmass__finite(d->newton_tolerance) && d->newton_tolerance > 0) || d->newton_iterations < 1)
         return tmass__fail(d, TMASS_ERR_SOLVER, "newton_tolerance / newton_iterations");
+    if (d->implicit_coarse < -1 || d->implicit_coarse > 1)
+        return tmass__fail(d, TMASS_ERR_SOLVER, "implicit_coarse must be -1, 0 or 1");
     if (!(tmass__finite(d->divergence_strain) && d->divergence_strain >= 0) ||
         !(tmass__finite(d->precision_limit) && d->precision_limit >= 0))
         return tmass__fail(d, TMASS_ERR_SOLVER, "divergence_strain / precision_limit must be finite and >= 0");
@@ -2023,6 +2130,288 @@ static int tmass__create_validate(const tmass_desc *d)
         }
     }
     return TMASS_OK;
+}
+
+/* >>coarse ---------------------------------------------------------------------------- */
+
+/* The implicit steps' coarse correction (desc.implicit_coarse; SOLVERS): the nodes are
+   binned into up to TMASS__MAX_AGG roughly cubic cells of the rest bounding box
+   (aggregates), each carrying the six rigid motions of its nodes about its centre,
+   P = [I | -[X - c]x] per node on its free axes. CG's preconditioner becomes Jacobi plus
+   P A_c^-1 P^T with A_c = P^T (D + c K) P, K exactly what the solve multiplies by (the
+   edge tensors, a hybrid's coupling block, the anchors). P^T K P is assembled from the
+   tensors when coarse_version moved (cuts, pin changes, tmass_set_anchors, the hybrid's
+   coupling changes) and kept unfactored in coarse_k; the factor of A_c (dense Cholesky
+   in double) is kept with its key (c, P^T D P bit for bit, coarse_version), so the steps
+   of one dt share one factorisation. A stale factor would only precondition worse: CG
+   checks the answer. */
+#define TMASS__MAX_AGG 64
+#define TMASS__MIN_AGG_NODES 24         /* nodes per aggregate at least */
+#define TMASS__COARSE_MIN_ITERATIONS 50 /* the automatic mode's switch (SOLVERS: why 50) */
+
+/* The cell of point p in a dims grid over [lo, lo + ext]. */
+static int tmass__agg_cell(const tmass_real *p, const double *lo, const double *ext, const int *dims)
+{
+    int r, c = 0;
+    for (r = 2; r >= 0; r--) {
+        int k = (int)(((double)p[r] - lo[r]) / ext[r] * dims[r]);
+        if (k >= dims[r]) k = dims[r] - 1;
+        if (k < 0) k = 0;
+        c = c * dims[r] + k;
+    }
+    return c;
+}
+
+/* Aggregate cells of the rest bounding box for the n nodes at x: returns the number of
+   non-empty cells (0 under 4 TMASS__MIN_AGG_NODES nodes); with agg, writes each node's
+   cell, renumbered 0.. in cell order. */
+static int tmass__aggregate(const tmass_real *x, int n, int *agg)
+{
+    double lo[3], hi[3], ext[3], size, vol = 1.0, big = 0.0;
+    int dims[3], i, r, target = n / TMASS__MIN_AGG_NODES, cells, count = 0, id[TMASS__MAX_AGG];
+    if (target > TMASS__MAX_AGG) target = TMASS__MAX_AGG;
+    if (target < 4) return 0;
+    for (r = 0; r < 3; r++) lo[r] = hi[r] = (double)x[r];
+    for (i = 0; i < n; i++)
+        for (r = 0; r < 3; r++) {
+            double v = (double)x[3 * i + r];
+            if (v < lo[r]) lo[r] = v;
+            if (v > hi[r]) hi[r] = v;
+        }
+    for (r = 0; r < 3; r++) big = hi[r] - lo[r] > big ? hi[r] - lo[r] : big;
+    if (!(big > 0)) return 0;
+    for (r = 0; r < 3; r++) {
+        ext[r] = hi[r] - lo[r] > 1e-6 * big ? hi[r] - lo[r] : 1e-6 * big;
+        vol *= ext[r];
+    }
+    size = cbrt(vol / target);
+    for (;;) {
+        cells = 1;
+        for (r = 0; r < 3; r++) {
+            dims[r] = (int)(ext[r] / size + 0.5);
+            if (dims[r] < 1) dims[r] = 1;
+            cells *= dims[r];
+        }
+        if (cells <= target) break;
+        size *= 1.05;
+    }
+    for (i = 0; i < cells; i++) id[i] = -1;
+    for (i = 0; i < n; i++) id[tmass__agg_cell(x + 3 * i, lo, ext, dims)] = 0;
+    for (i = 0; i < cells; i++)
+        if (id[i] == 0) id[i] = count++;
+    if (agg)
+        for (i = 0; i < n; i++) agg[i] = id[tmass__agg_cell(x + 3 * i, lo, ext, dims)];
+    return count;
+}
+
+/* Each node's aggregate and the aggregates' centres (mean rest position), at creation. */
+static void tmass__aggregate_centres(tmass_model *m)
+{
+    int i, r;
+    double *cnt = m->coarse_y; /* (scratch, 6 A >= A) */
+    if (!m->agg_count) return;
+    tmass__aggregate(m->rest, m->node_count, m->node_agg);
+    memset(m->agg_centre, 0, sizeof(double) * 3 * (size_t)m->agg_count);
+    memset(cnt, 0, sizeof(double) * (size_t)m->agg_count);
+    for (i = 0; i < m->node_count; i++) {
+        for (r = 0; r < 3; r++) m->agg_centre[3 * m->node_agg[i] + r] += (double)m->rest[3 * i + r];
+        cnt[m->node_agg[i]] += 1.0;
+    }
+    for (i = 0; i < m->agg_count; i++)
+        for (r = 0; r < 3; r++) m->agg_centre[3 * i + r] /= cnt[i];
+    m->coarse_version = 1; /* nothing built yet (versions 0) */
+}
+
+/* Rows of P for node i: P[r][0..2] = e_r, P[r][3..5] = (-[rho]x)_r, rho = X - c; rows of
+   pinned or inactive axes are zero. */
+static void tmass__node_modes(const tmass_model *m, int i, double P[3][6])
+{
+    const double *c = m->agg_centre + 3 * m->node_agg[i];
+    double rho[3];
+    int r, k;
+    for (r = 0; r < 3; r++) rho[r] = (double)m->rest[3 * i + r] - c[r];
+    memset(P, 0, sizeof(double) * 18);
+    P[0][0] = P[1][1] = P[2][2] = 1.0;
+    P[0][4] = rho[2];
+    P[0][5] = -rho[1];
+    P[1][3] = -rho[2];
+    P[1][5] = rho[0];
+    P[2][3] = rho[1];
+    P[2][4] = -rho[0];
+    for (r = 0; r < 3; r++)
+        if (!(m->free_mask[3 * i + r] > 0))
+            for (k = 0; k < 6; k++) P[r][k] = 0.0;
+}
+
+/* Ac's block (aggregates ga, gb) += Pa^T B Pb, B a 3x3 row-major block of K times s. */
+static void tmass__coarse_add(const tmass_model *m, double *Ac, int ga, int gb, double Pa[3][6], double Pb[3][6],
+                              const double *B)
+{
+    int D = 6 * m->agg_count, r, a, b;
+    double T[3][6], *blk = Ac + (size_t)(6 * ga) * D + 6 * gb;
+    for (r = 0; r < 3; r++)
+        for (b = 0; b < 6; b++) T[r][b] = B[3 * r] * Pb[0][b] + B[3 * r + 1] * Pb[1][b] + B[3 * r + 2] * Pb[2][b];
+    for (a = 0; a < 6; a++)
+        for (b = 0; b < 6; b++) blk[(size_t)a * D + b] += Pa[0][a] * T[0][b] + Pa[1][a] * T[1][b] + Pa[2][a] * T[2][b];
+}
+
+/* coarse_k = P^T K P from what tmass__matvec multiplies by: per live edge (a, b) with
+   tensor T, out_a += T (p_b - p_a) and out_b -= T^T (p_b - p_a), i.e. the blocks
+   (a, a) -T, (a, b) T, (b, a) T^T, (b, b) -T^T; a hybrid's coupling block; the anchors'
+   k I. About 650 multiply-adds per edge, once per coarse_version. */
+static void tmass__coarse_k_update(tmass_model *m)
+{
+    int D = 6 * m->agg_count, c, e, i, j, r, s;
+    double *Ac = m->coarse_k, Pa[3][6], Pb[3][6], B[4][9];
+    if (m->coarse_k_version == m->coarse_version) return;
+    memset(Ac, 0, sizeof(double) * (size_t)D * (size_t)D);
+    for (c = 0; c < m->chunk_total; c++)
+        for (e = m->chunk_start[c]; e < m->chunk_start[c] + m->chunk_live[c]; e++) {
+            int a = m->edge_a[e], b = m->edge_b[e], ga = m->node_agg[a], gb = m->node_agg[b];
+            const tmass_real *T = m->edge_tensor + 9 * (size_t)e;
+            for (r = 0; r < 3; r++)
+                for (s = 0; s < 3; s++) {
+                    double t = (double)T[3 * r + s];
+                    B[0][3 * r + s] = -t; /* (a, a) */
+                    B[1][3 * r + s] = t;  /* (a, b) */
+                    B[2][3 * s + r] = t;  /* (b, a) */
+                    B[3][3 * s + r] = -t; /* (b, b) */
+                }
+            tmass__node_modes(m, a, Pa);
+            tmass__node_modes(m, b, Pb);
+            tmass__coarse_add(m, Ac, ga, ga, Pa, Pa, B[0]);
+            tmass__coarse_add(m, Ac, ga, gb, Pa, Pb, B[1]);
+            tmass__coarse_add(m, Ac, gb, ga, Pb, Pa, B[2]);
+            tmass__coarse_add(m, Ac, gb, gb, Pb, Pb, B[3]);
+        }
+    for (i = 0; i < m->coupling_count; i++) { /* the coupling block S: P_i^T S_ij P_j */
+        int n3c = 3 * m->coupling_count, vi = m->coupling_nodes[i];
+        tmass__node_modes(m, vi, Pa);
+        for (j = 0; j < m->coupling_count; j++) {
+            int vj = m->coupling_nodes[j];
+            for (r = 0; r < 3; r++)
+                for (s = 0; s < 3; s++) B[0][3 * r + s] = m->coupling[(size_t)(3 * i + r) * n3c + 3 * j + s];
+            tmass__node_modes(m, vj, Pb);
+            tmass__coarse_add(m, Ac, m->node_agg[vi], m->node_agg[vj], Pa, Pb, B[0]);
+        }
+    }
+    for (i = 0; i < m->anchor_count; i++) { /* the anchors' k I (times anchor_scale: 1 here) */
+        int v = m->anchor_nodes[i];
+        double k = m->anchor_scale * (double)m->anchor_k[i];
+        memset(B[0], 0, sizeof B[0]);
+        B[0][0] = B[0][4] = B[0][8] = k;
+        tmass__node_modes(m, v, Pa);
+        tmass__coarse_add(m, Ac, m->node_agg[v], m->node_agg[v], Pa, Pa, B[0]);
+    }
+    m->coarse_k_version = m->coarse_version;
+}
+
+/* Cholesky factor of the D x D matrix Ac in place (lower triangle, row-major); a mode
+   whose pivot falls below 1e-10 of its diagonal (an aggregate whose nodes are all pinned
+   or cut off, a mode the pins remove) is dropped: zero row and column of L. dg: D doubles
+   of scratch. */
+static void tmass__coarse_factor(double *Ac, int D, double *dg)
+{
+    int i, j, k;
+    for (i = 0; i < D; i++) dg[i] = Ac[(size_t)i * D + i];
+    for (k = 0; k < D; k++) {
+        double *Lk = Ac + (size_t)k * D, d = Lk[k];
+        for (j = 0; j < k; j++) d -= Lk[j] * Lk[j];
+        if (!(d > 1e-10 * dg[k])) {
+            for (i = k; i < D; i++) Ac[(size_t)i * D + k] = 0.0;
+            continue;
+        }
+        d = sqrt(d);
+        Lk[k] = d;
+        for (i = k + 1; i < D; i++) {
+            double *Li = Ac + (size_t)i * D, t = Li[k];
+            for (j = 0; j < k; j++) t -= Li[j] * Lk[j];
+            Li[k] = t / d;
+        }
+    }
+}
+
+/* The factor of A_c = P^T (D + c K) P into coarse_step, unless the one there has this
+   key: P^T D P (one pass over the nodes, compared bit for bit), c and coarse_version. */
+static void tmass__coarse_step_build(tmass_model *m, const tmass_real *diag, double c)
+{
+    int A = m->agg_count, D = 6 * A, i, r, a, b;
+    double *pdp = m->coarse_pdp_new, *Ac = m->coarse_step;
+    memset(pdp, 0, sizeof(double) * 36 * (size_t)A);
+    for (i = 0; i < m->node_count; i++) {
+        double P[3][6], *blk = pdp + 36 * (size_t)m->node_agg[i];
+        tmass__node_modes(m, i, P);
+        for (r = 0; r < 3; r++) {
+            double d = diag ? (double)diag[3 * i + r] : 0.0;
+            if (d == 0.0 || !(m->free_mask[3 * i + r] > 0)) continue;
+            for (a = 0; a < 6; a++)
+                for (b = 0; b < 6; b++) blk[6 * a + b] += d * P[r][a] * P[r][b];
+        }
+    }
+    if (m->coarse_step_version == m->coarse_version && m->coarse_step_c == c &&
+        !memcmp(pdp, m->coarse_pdp, sizeof(double) * 36 * (size_t)A))
+        return;
+    tmass__coarse_k_update(m);
+    for (i = 0; i < D * D; i++) Ac[i] = c * m->coarse_k[i];
+    for (i = 0; i < A; i++)
+        for (a = 0; a < 6; a++)
+            for (b = 0; b < 6; b++) Ac[(size_t)(6 * i + a) * D + 6 * i + b] += pdp[36 * i + 6 * a + b];
+    tmass__coarse_factor(Ac, D, m->coarse_y);
+    memcpy(m->coarse_pdp, pdp, sizeof(double) * 36 * (size_t)A);
+    m->coarse_step_c = c;
+    m->coarse_step_version = m->coarse_version;
+    m->stats.coarse_factors++;
+}
+
+/* z += P A_c^-1 P^T r on the free degrees of freedom (serial, in node order). */
+static void tmass__coarse_apply(const tmass_model *m, const tmass_real *rv, tmass_real *z)
+{
+    int D = 6 * m->agg_count, i, j, r;
+    const double *L = m->coarse_step;
+    double *y = m->coarse_y;
+    memset(y, 0, sizeof(double) * (size_t)D);
+    for (i = 0; i < m->node_count; i++) { /* y += P^T r: per node (q, rho x q) */
+        const double *c = m->agg_centre + 3 * m->node_agg[i];
+        double *ya = y + 6 * m->node_agg[i], rho[3], q[3];
+        for (r = 0; r < 3; r++) {
+            rho[r] = (double)m->rest[3 * i + r] - c[r];
+            q[r] = m->free_mask[3 * i + r] > 0 ? (double)rv[3 * i + r] : 0.0;
+            ya[r] += q[r];
+        }
+        ya[3] += rho[1] * q[2] - rho[2] * q[1];
+        ya[4] += rho[2] * q[0] - rho[0] * q[2];
+        ya[5] += rho[0] * q[1] - rho[1] * q[0];
+    }
+    for (i = 0; i < D; i++) { /* L y' = y */
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+    for (i = D - 1; i >= 0; i--) { /* L^T y'' = y', by rows of L (contiguous) */
+        const double *Li = L + (size_t)i * D;
+        double t;
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        t = y[i] /= Li[i];
+        for (j = 0; j < i; j++) y[j] -= Li[j] * t;
+    }
+    for (i = 0; i < m->node_count; i++) { /* z += P y: per node t + w x rho */
+        const double *c = m->agg_centre + 3 * m->node_agg[i], *ya = y + 6 * m->node_agg[i];
+        double rho[3], d[3];
+        for (r = 0; r < 3; r++) rho[r] = (double)m->rest[3 * i + r] - c[r];
+        d[0] = ya[0] + (ya[4] * rho[2] - ya[5] * rho[1]);
+        d[1] = ya[1] + (ya[5] * rho[0] - ya[3] * rho[2]);
+        d[2] = ya[2] + (ya[3] * rho[1] - ya[4] * rho[0]);
+        for (r = 0; r < 3; r++)
+            if (m->free_mask[3 * i + r] > 0) z[3 * i + r] += (tmass_real)d[r];
+    }
 }
 
 /* >>creation -------------------------------------------------------------------------- */
@@ -2114,6 +2503,9 @@ static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__cr
     if (sizes->chunk_size > 4096) sizes->chunk_size = 4096;
     sizes->chunk_total = (E + sizes->chunk_size - 1) / sizes->chunk_size;
     sizes->partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
+    sizes->implicit_coarse = d->implicit_coarse;
+    if (d->implicit_coarse >= 0 && (tmass__kinds[d->kind].flags & TMASS__KIND_LINEAR))
+        sizes->agg_count = tmass__aggregate(d->rest_positions, n, NULL);
     return TMASS_OK;
 }
 
@@ -2225,6 +2617,7 @@ static int tmass__create_precompute(const tmass_desc *d, tmass_model *m, tmass__
     err = tmass__build_neighbors(m, w->start, w->key, w->payload);
     if (err) return err;
     tmass__init_boundary(m);
+    tmass__aggregate_centres(m);
     m->stats.newton_iterations = 1;
     return TMASS_OK;
 }
@@ -2769,6 +3162,7 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
     int n3 = 3 * m->node_count, i, it, blocks = m->partial_count;
     tmass_real *pinv = m->cg_pinv;
     double bb = 0.0, rr, rz, tol2, pdp, rho_min = HUGE_VAL, rho_max = 0.0;
+    int coarse = m->cg_coarse && m->agg_count > 0; /* Jacobi plus P A_c^-1 P^T (>>coarse) */
     k.m = m;
     k.r = m->cg_r;
     k.z = m->cg_z;
@@ -2807,18 +3201,25 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         return TMASS_OK;
     }
     tol2 = (double)m->cg_tolerance * (double)m->cg_tolerance * bb;
-    /* r = b - A x, z = P^-1 r, p = z (once per solve: a plain serial loop) */
+    if (coarse) {
+        tmass__coarse_step_build(m, diag, c);
+        m->stats.coarse_solves++;
+    }
+    /* r = b - A x, z = P^-1 r, p = z (once per solve: plain serial loops) */
     tmass__matvec(m, x, k.q);
     rr = rz = 0.0;
     for (i = 0; i < n3; i++) {
         double ax = (diag ? (double)diag[i] * x[i] : 0.0) + c * (double)k.q[i];
         k.r[i] = (tmass_real)(((double)b[i] - ax) * m->free_mask[i]);
         k.z[i] = pinv[i] * k.r[i];
-        k.p[i] = k.z[i];
         rr += (double)k.r[i] * k.r[i];
+    }
+    if (coarse) tmass__coarse_apply(m, k.r, k.z);
+    for (i = 0; i < n3; i++) {
+        k.p[i] = k.z[i];
         rz += (double)k.r[i] * k.z[i];
     }
-    pdp = rz; /* p . D p for p = z: r . z */
+    pdp = rz; /* p . B^-1 p for p = z = B r (B the preconditioner): r . z */
     for (it = 0; it < m->cg_max_iterations && rr > tol2; it++) {
         double pq, rz_new, rho;
         tmass__matvec(m, k.p, k.q);
@@ -2842,13 +3243,18 @@ static int tmass__cg(tmass_model *m, const tmass_real *diag, double c, const tma
         tmass__run(m, blocks, tmass__cg_update, &k);
         rr = tmass__sum_partials(m, 0);
         rz_new = tmass__sum_partials(m, blocks);
+        if (coarse) { /* z = Jacobi r + P A_c^-1 P^T r: r . z again (serial, in order) */
+            tmass__coarse_apply(m, k.r, k.z);
+            rz_new = 0.0;
+            for (i = 0; i < n3; i++) rz_new += (double)k.r[i] * k.z[i];
+        }
         if (!tmass__finite(rr) || !tmass__finite(rz_new)) {
             it++;
             rr = HUGE_VAL;
             break;
         }
         k.beta = rz_new / rz;
-        pdp = rz_new + k.beta * k.beta * pdp; /* z_new . D p_old = r_new . p_old = 0 */
+        pdp = rz_new + k.beta * k.beta * pdp; /* z_new . B^-1 p_old = r_new . p_old = 0 */
         rz = rz_new;
         tmass__run(m, blocks, tmass__cg_direction, &k);
     }
@@ -3044,7 +3450,14 @@ static int tmass__implicit_euler_linear(tmass_model *m, tmass_real dt)
             f[j] = dt * (f[j] + m->ext[j] + m->mass[i] * (m->gravity[r] - alpha * v0[j]));
         }
     memcpy(dv, m->dv_prev, sizeof(tmass_real) * (size_t)n3);
+    /* the coarse correction (>>coarse): a linear kind's K is in the tensors; the automatic
+       mode switches it on for good after a solve that needed the minimum */
+    m->cg_coarse = (tmass__kinds[m->kind].flags & TMASS__KIND_LINEAR) && m->agg_count > 0 &&
+                   (m->implicit_coarse > 0 || m->coarse_on);
     err = tmass__linear_solve(m, dmass, c, f, dv);
+    if (!m->cg_coarse && m->implicit_coarse == 0 && m->cg_last_iterations >= TMASS__COARSE_MIN_ITERATIONS)
+        m->coarse_on = 1;
+    m->cg_coarse = 0;
     if (err) return err;
     for (i = 0; i < n3; i++) {
         tmass_real fm = m->free_mask[i];
@@ -3877,6 +4290,7 @@ TMASSDEF int tmass_set_anchors(tmass_model *m, int count, const int *nodes, cons
             return TMASS_ERR_ARG;
     }
     m->anchor_count = count;
+    m->coarse_version++; /* the anchors' k joins the coarse matrix (>>coarse) */
     m->anchor_nodes = count ? nodes : NULL;
     m->anchor_k = count ? stiffness : NULL;
     m->anchor_target = count ? targets : NULL;
@@ -5447,6 +5861,7 @@ static int tmass__hybrid_coupling(tmass_hybrid *h)
             }
     }
     h->dyn->coupling_count = h->conn_count;
+    h->dyn->coarse_version++; /* the coupling block joins the coarse matrix (>>coarse) */
     h->contacts_dirty = 0;
     return TMASS_OK;
 }
@@ -5563,6 +5978,7 @@ static void tmass__hybrid_drop_connections(tmass_hybrid *h)
         h->contacts_dirty = 1;
     }
     h->dyn->coupling_count = h->contacts_dirty ? 0 : h->conn_count;
+    h->dyn->coarse_version++;
 }
 
 typedef struct tmass__face_key {
@@ -5782,6 +6198,7 @@ static int tmass__hybrid_create_parts(const tmass_hybrid_desc *d, tmass__hy_buil
     if (!err) {
         tmass__hybrid_subdesc(d, b->dynamic, 0, b->qs_of, b->n_qs, b->rtmp, b->itmp, b->rtmp + 3 * N,
                               b->rtmp + 3 * N + T, &sub);
+        sub.implicit_coarse = -1; /* the precomputed part never steps */
         err = tmass_create(&sub, &b->src);
     }
     for (i = 0; i < N && !err; i++)

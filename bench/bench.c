@@ -28,9 +28,10 @@
       from a static deflection, implicit Euler and BDF2 at dt = T/20 to T/400: period
       error, amplitude decay per period, seconds of computing per simulated second.
       time.csv.
-   3b. coarse (>>coarse, alone with --parts coarse): heml.h's implicit steps on the R3 and
-      R1 beams at E = 1 kPa to 10 MPa and dt = 1 ms to 1 s, with and without the coarse
-      correction (issue 21): iterations and time per step. coarse.csv.
+   3b. coarse (>>coarse, alone with --parts coarse): heml.h's and tensormass.h's implicit
+      steps on the R3 and R1 beams at E = 1 kPa to 10 MPa and dt = 1 ms to 1 s, with and
+      without the coarse correction (issue 21): iterations and time per step (--filter
+      tensormass or heml for one library). coarse.csv.
    4. kernels: force and K*v per element from 1e3 to 1e6 elements, 1 and 2 threads, against
       the memory-bandwidth bound of the bytes each header says its kernel moves, with the
       bandwidth measured in the same run by a STREAM triad. kernels.csv.
@@ -71,6 +72,8 @@ int bench_chain_rows_double(int quick, double (*clock_s)(void), const char **nam
 int bench_chain_rows_float(int quick, double (*clock_s)(void), const char **names, double *sizes, double *seconds);
 /* heml.h's implicit steps with and without the coarse correction (issue 21): bench/model_heml.c */
 int bench_heml_coarse_rows_double(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max);
+/* tensormass.h's (issue 21): bench/model_tensormass.c */
+int bench_tensormass_coarse_rows_double(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max);
 /* the coupled scenes (issue 14): bench/model_glue.c, not a bench_model (two models glued) */
 int bench_glue_rows_double(int quick, double *v);
 int bench_glue_rows_float(int quick, double *v);
@@ -1712,36 +1715,47 @@ static void run_time(const options *o, const bench_model *const *models, int cou
     printf("  time: %.1f s\n", now() - t0);
 }
 
-/* >>coarse: heml.h's implicit steps with and without the coarse correction of its static
-   solve (issue 21; desc.implicit_coarse, the scenes in bench/model_heml.c >>coarse-rows):
-   CG and Newton iterations, coarse factorisations and seconds per step, Jacobi only
-   ("never"), automatic (the default) and "always", the time ratios against "never" from
-   the same run (best of the repeats, the modes interleaved). coarse.csv. */
+/* >>coarse: heml.h's and tensormass.h's implicit steps with and without their coarse
+   corrections (issue 21; desc.implicit_coarse, the scenes in bench/model_heml.c and
+   bench/model_tensormass.c >>coarse-rows): CG and Newton iterations, coarse
+   factorisations and seconds per step, Jacobi only ("never"), automatic (the default) and
+   "always", the time ratios against "never" from the same run (best of the repeats, the
+   modes interleaved). coarse.csv (model column: heml, tensormass). */
 static void run_coarse(const options *o)
 {
     static const char *mode_name[3] = {"never", "auto", "always"};
     static bench_coarse_row rows[128];
     double t0 = now();
-    int n, i;
+    int n, i, lib;
     FILE *f;
-    if (o->filter && !strstr("heml coarse", o->filter)) return;
-    printf("\nheml.h implicit steps, coarse correction (issue 21): Neo-Hookean beams clamped at x = 0, steps from rest; "
-           "per step: CG and Newton iterations, coarse factorisations, ms (best of the repeats); time ratio against "
-           "Jacobi only (see bench.c >>coarse)\n");
-    f = open_csv(o, "coarse.csv", "scene,integrator,young,time_step,mode,dof,cg_per_step,newton_per_step,"
+    if (o->filter && !strstr("heml tensormass coarse", o->filter)) return;
+    f = open_csv(o, "coarse.csv", "model,scene,integrator,young,time_step,mode,dof,cg_per_step,newton_per_step,"
                                   "factors_per_step,seconds_per_step,time_ratio_to_never,status");
-    n = bench_heml_coarse_rows_double(o->quick, now, rows, 128);
-    for (i = 0; i < n; i++) {
-        const bench_coarse_row *r = rows + i, *base = rows + i - (r->mode + 1);
-        double ratio = r->seconds_per_step / base->seconds_per_step;
-        printf("  %-8s %-14s E=%-6.0e dt=%-6g %-6s %5d dof: %7.1f CG %5.2f Newton %4.2f fact %9.3f ms  x%5.2f  code %d\n",
-               r->scene, r->integrator, r->young, r->dt, mode_name[r->mode + 1], r->dof, r->cg_per_step,
-               r->newton_per_step, r->factors_per_step, 1e3 * r->seconds_per_step, ratio, r->code);
-        if (f) {
-            csv_prefix(f);
-            fprintf(f, "%s,%s,%.6g,%.6g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", r->scene, r->integrator, r->young, r->dt,
-                    mode_name[r->mode + 1], r->dof, r->cg_per_step, r->newton_per_step, r->factors_per_step,
-                    r->seconds_per_step, ratio, r->code);
+    for (lib = 0; lib < 2; lib++) {
+        const char *name = lib ? "tensormass" : "heml";
+        if (o->filter && !strstr(name, o->filter) && !strstr("coarse", o->filter)) continue;
+        if (lib)
+            printf("\ntensormass.h implicit steps, coarse correction (issue 21): linear tensor-mass beams clamped at "
+                   "x = 0, steps from rest, one CG solve a step (tolerance 1e-9); the same columns\n");
+        else
+            printf("\nheml.h implicit steps, coarse correction (issue 21): Neo-Hookean beams clamped at x = 0, steps "
+                   "from rest; per step: CG and Newton iterations, coarse factorisations, ms (best of the repeats); "
+                   "time ratio against Jacobi only (see bench.c >>coarse)\n");
+        n = lib ? bench_tensormass_coarse_rows_double(o->quick, now, rows, 128)
+                : bench_heml_coarse_rows_double(o->quick, now, rows, 128);
+        for (i = 0; i < n; i++) {
+            const bench_coarse_row *r = rows + i, *base = rows + i - (r->mode + 1);
+            double ratio = r->seconds_per_step / base->seconds_per_step;
+            printf("  %-8s %-14s E=%-6.0e dt=%-6g %-6s %5d dof: %7.1f CG %5.2f Newton %4.2f fact %9.3f ms  x%5.2f  "
+                   "code %d\n",
+                   r->scene, r->integrator, r->young, r->dt, mode_name[r->mode + 1], r->dof, r->cg_per_step,
+                   r->newton_per_step, r->factors_per_step, 1e3 * r->seconds_per_step, ratio, r->code);
+            if (f) {
+                csv_prefix(f);
+                fprintf(f, "%s,%s,%s,%.6g,%.6g,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", name, r->scene, r->integrator,
+                        r->young, r->dt, mode_name[r->mode + 1], r->dof, r->cg_per_step, r->newton_per_step,
+                        r->factors_per_step, r->seconds_per_step, ratio, r->code);
+            }
         }
     }
     if (f) fclose(f);

@@ -301,6 +301,83 @@ static const bench_model tm_models[] = {
      tm_cut, tm_elements, tm_bytes_springs, tm_kernel_springs, NULL, tm_probe, NULL},
 };
 
+/* >>coarse-rows (issue 21): tensormass.h's implicit steps with and without the coarse
+   correction (desc.implicit_coarse), on heml's coarse scenes (bench/model_heml.c
+   >>coarse-rows: R3's beam at E = 1 kPa, 1 MPa, 10 MPa loaded by g = 0.01 E / 1 MPa, R1's
+   steel beam under its own weight; dt = 1 ms .. 1 s; implicit Euler and BDF2; `steps`
+   steps from rest, each mode on its own model, interleaved, best of `repeats`). The
+   model is linear: one CG solve a step (CG tolerance 1e-9 in double, tm_create). */
+static int tm_coarse_run(const bench_body *b, tmass_integrator integrator, double dt, int mode, int steps,
+                         double (*clock_s)(void), bench_coarse_row *row)
+{
+    void *v = NULL;
+    tm_sim *s;
+    double t0, cg = 0, fc = 0;
+    int k, err = tm_create(b, TMASS_TENSOR_MASS, &v);
+    if (err) return err;
+    s = (tm_sim *)v;
+    s->m->implicit_coarse = mode; /* (the arrays exist: created with the default, 0) */
+    row->dof = 3 * s->nodes;
+    t0 = clock_s();
+    for (k = 0; k < steps && !err; k++) {
+        const tmass_stats *st;
+        err = tmass_step_ex(s->m, (tmass_real)dt, integrator);
+        st = tmass_last_stats(s->m);
+        cg += st->cg_iterations, fc += st->coarse_factors;
+    }
+    t0 = (clock_s() - t0) / steps;
+    if (row->seconds_per_step == 0 || t0 < row->seconds_per_step) row->seconds_per_step = t0;
+    row->cg_per_step = cg / steps, row->newton_per_step = 1, row->factors_per_step = fc / steps;
+    row->code = err;
+    tm_destroy(v);
+    return 0;
+}
+
+#ifdef BENCH_FLOAT
+#define BENCH_COARSE_ROWS bench_tensormass_coarse_rows_float
+#else
+#define BENCH_COARSE_ROWS bench_tensormass_coarse_rows_double
+#endif
+int BENCH_COARSE_ROWS(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max);
+int BENCH_COARSE_ROWS(int quick, double (*clock_s)(void), bench_coarse_row *rows, int max)
+{
+    static const double youngs[3] = {1e3, 1e6, 1e7}, dts[4] = {1e-3, 1e-2, 0.1, 1.0};
+    static const tmass_integrator integrators[2] = {TMASS_IMPLICIT_EULER, TMASS_BDF2};
+    int scene, e, d, it, mode, rep, n = 0, k = quick ? 1 : 2, steps = quick ? 2 : 6, repeats = quick ? 1 : 2;
+    for (scene = 0; scene < 2; scene++)
+        for (e = 0; e < (scene ? 1 : 3); e++)
+            for (d = 0; d < 4; d++)
+                for (it = 0; it < 2; it++) {
+                    bench_body b;
+                    if (n + 3 > max) return n;
+                    memset(&b, 0, sizeof b);
+                    b.clamp = 1;
+                    b.poisson = 0.3;
+                    if (scene) {
+                        b.size[0] = 16, b.size[1] = b.size[2] = 0.5;
+                        b.cells[0] = 32 * k, b.cells[1] = b.cells[2] = k;
+                        b.young = 200e9, b.density = 7800, b.gravity[2] = -9.81;
+                    } else {
+                        b.size[0] = 1, b.size[1] = b.size[2] = 0.1;
+                        b.cells[0] = 20 * k, b.cells[1] = b.cells[2] = 2 * k;
+                        b.young = youngs[e], b.density = 1000, b.gravity[2] = -0.01 * youngs[e] / 1e6;
+                    }
+                    for (mode = 0; mode < 3; mode++) {
+                        bench_coarse_row *r = rows + n + mode;
+                        memset(r, 0, sizeof *r);
+                        r->scene = scene ? "R1 steel" : "R3 beam";
+                        r->integrator = it ? "bdf2" : "implicit-euler";
+                        r->young = b.young, r->dt = dts[d], r->mode = mode - 1;
+                    }
+                    for (rep = 0; rep < repeats; rep++)
+                        for (mode = 0; mode < 3; mode++)
+                            if (tm_coarse_run(&b, integrators[it], dts[d], mode - 1, steps, clock_s, rows + n + mode))
+                                rows[n + mode].code = -1;
+                    n += 3;
+                }
+    return n;
+}
+
 const bench_model *BENCH_TABLE(int *count);
 const bench_model *BENCH_TABLE(int *count)
 {
