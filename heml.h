@@ -1325,11 +1325,6 @@ typedef struct heml_desc {
                                         pressure tetrahedra for nearly incompressible bodies
                                         (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
                                         user laws with second derivatives */
-    int nodal_smoothing;             /* passes of the nodal pressure's smoothing, 0..8, default 0 */
-    heml_real nodal_stabilisation;   /* c >= 0 of the nodal pressure's stabilisation (NEAR-
-                                        INCOMPRESSIBLE BODIES): each tetrahedron keeps the share
-                                        alpha = min(1, c mu / kappa) of its own volumetric energy,
-                                        the nodes carry 1 - alpha; default 1; 0: none */
     int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
                                         tetrahedron what its linearisation point fixes (PERFORMANCE,
                                         MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
@@ -1759,7 +1754,6 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__DC_FILL 1      /* m->dc_pass: the DIFF pass fills the stiffness cache, */
 #define HEML__DC_USE 2       /* or reads it (heml__diff_run) */
 #define HEML__NODAL_SUMS 6   /* the nodal pressure's sums of Vol (J - 1) / 4 (and Vol dJ / 4) */
-#define HEML__NODAL_SMOOTH 7 /* its smoothing: sum over a node's tetrahedra of Vol / 4 times their mean */
 
 /* A material in kernel form. */
 typedef struct heml__mat {
@@ -1773,8 +1767,6 @@ typedef struct heml__mat {
     heml_real young;             /* mass-spring */
     double density;
     double small_mu, small_lambda; /* small-strain moduli: preconditioner, time step */
-    heml_real nod_keep;          /* nodal pressure: 1 - alpha, the nodes' share of the
-                                    volumetric energy (desc.nodal_stabilisation) */
     heml_user_law user;
     int prony_count, prony_first; /* its terms in the model's Prony arrays */
 } heml__mat;
@@ -1923,8 +1915,6 @@ struct heml_model {
        and sum Vol_e dJ_e / 4 of the current pass, the nodal pressure P_a and its
        differential dP_a; per node chunk its energy */
     heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
-    heml_real *nod_s1, *nod_s2; /* the smoothing's scratch (nod_smooth > 0) */
-    int nod_smooth;             /* desc.nodal_smoothing: passes of S on J_a and on P_a */
     double *nod_energy;
     int nod_chunks;
     /* the deviatoric probe (heml__dev_probe): kdev 1 while a solve runs on K_dev (the node
@@ -3120,18 +3110,18 @@ static void heml__diff_nh(const heml_model *m, const heml__mat *mt, int blk, hem
 static void heml__nodal_element(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b, int want)
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    const heml_real *p = m->nod_p, *dp = m->nod_dp, keep = mt->nod_keep;
+    const heml_real *p = m->nod_p, *dp = m->nod_dp;
     heml_real U[HEML__W], U1[HEML__W], U2[HEML__W];
     heml__blk s;
     int k;
     heml__dilation(mt, m->jm1_0, b->jm1, m->blk_valid[blk], want, &s, U, U1, U2);
     for (k = 0; k < HEML__W; k++) {
         int i0 = idx[k], i1 = idx[HEML__W + k], i2 = idx[2 * HEML__W + k], i3 = idx[3 * HEML__W + k];
-        heml_real pe = ((p[i0] + p[i1]) + (p[i2] + p[i3])) / 4 - keep * U1[k];
+        heml_real pe = ((p[i0] + p[i1]) + (p[i2] + p[i3])) / 4 - U1[k];
         b->wJ[k] += pe;
         b->s0[k] += pe;
-        b->h[5][k] -= keep * U2[k];
-        if (want & HEML__WANT_ENERGY) b->w[k] -= keep * U[k];
+        b->h[5][k] -= U2[k];
+        if (want & HEML__WANT_ENERGY) b->w[k] -= U[k];
         if (want & HEML__WANT_SECOND) b->dp[k] = ((dp[i0] + dp[i1]) + (dp[i2] + dp[i3])) / 4;
     }
 }
@@ -3432,20 +3422,6 @@ static void heml__scatter_lane_values(const int *HEML__RESTRICT idx, const heml_
     }
 }
 
-/* The nodal pressure's smoothing on a block: Vol / 4 times the mean of the four nodes'
-   values of src, added into dst at the four nodes (padding lanes: Vol 0). */
-static void heml__smooth_lanes(const heml_real *HEML__RESTRICT R, const int *HEML__RESTRICT idx,
-                               const heml_real *HEML__RESTRICT src, heml_real *HEML__RESTRICT dst)
-{
-    heml_real v[HEML__W];
-    int k;
-    for (k = 0; k < HEML__W; k++) {
-        int i0 = idx[k], i1 = idx[HEML__W + k], i2 = idx[2 * HEML__W + k], i3 = idx[3 * HEML__W + k];
-        v[k] = R[9 * HEML__W + k] / 4 * (((src[i0] + src[i1]) + (src[i2] + src[i3])) / 4);
-    }
-    heml__scatter_lane_values(idx, v, dst);
-}
-
 /* >>parallel -------------------------------------------------------------------------- */
 
 typedef void (*heml__range_fn)(void *ctx, int begin, int end);
@@ -3480,7 +3456,7 @@ typedef struct heml__pass {
     int mode, prony_write, colour;
     heml_stress_kind kind;
     const heml_real *x, *dx;
-    heml_real *out, *out2; /* (out2: NODAL_SMOOTH's second field, from dx) */
+    heml_real *out;
 } heml__pass;
 
 /* Software prefetch of a block's streams: its stiffness cache and node indices, a block
@@ -3551,10 +3527,6 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__scatter_lane_values(idx, b.jm1, m->nod_j);
                 if (p->dx) heml__scatter_lane_values(idx, b.dp, m->nod_dj);
                 break;
-            case HEML__NODAL_SMOOTH:
-                heml__smooth_lanes(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, idx, p->x, p->out);
-                if (p->dx) heml__smooth_lanes(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, idx, p->dx, p->out2);
-                break;
             case HEML__ENERGY:
                 heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
@@ -3612,16 +3584,14 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
                 const heml_real *w = m->nod_w + (size_t)i * (size_t)n + (size_t)a;
                 const heml__mat *mt = m->mats + i;
                 double sp = cx->relaxed && mt->prony_count ? (double)m->prony_s[i] : 1.0;
-                heml_real keep = mt->nod_keep;
                 int any = 0;
                 for (k = 0; k < valid; k++) any |= w[k] != 0;
                 if (!any) continue;
-                if (keep == 0) continue; /* (alpha = 1: plain P1) */
                 heml__dilation(mt, m->jm1_0, jm1, valid, want, &s, U, U1, U2);
                 for (k = 0; k < valid; k++) {
-                    P[k] += keep * w[k] * U1[k];
-                    Q[k] += keep * w[k] * U2[k];
-                    if (cx->energy) energy += sp * (double)(keep * w[k]) * (double)U[k];
+                    P[k] += w[k] * U1[k];
+                    Q[k] += w[k] * U2[k];
+                    if (cx->energy) energy += sp * (double)w[k] * (double)U[k];
                 }
             }
             for (k = 0; k < valid; k++) {
@@ -3638,35 +3608,6 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
 static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
                              heml_real *out, int prony_write, heml_stress_kind kind);
 
-/* dst = inv src per node (and dst2 = inv src2 where src2). */
-static void heml__nodal_scale(const heml_model *m, const heml_real *src, heml_real *dst, const heml_real *src2,
-                              heml_real *dst2)
-{
-    int a;
-    for (a = 0; a < m->node_count; a++) dst[a] = src[a] * m->nod_inv[a];
-    if (src2)
-        for (a = 0; a < m->node_count; a++) dst2[a] = src2[a] * m->nod_inv[a];
-}
-
-/* dst = A src (and dst2 = A src2 where src2): (A y)_a = sum over a's tetrahedra of Vol / 4
-   times the mean of y at their four nodes, coloured like the force pass. */
-static void heml__nodal_smooth(heml_model *m, const heml_real *src, heml_real *dst, const heml_real *src2,
-                               heml_real *dst2)
-{
-    heml__pass p;
-    memset(&p, 0, sizeof p);
-    p.m = m;
-    p.mode = HEML__NODAL_SMOOTH;
-    p.x = src;
-    p.dx = src2;
-    p.out = dst;
-    p.out2 = dst2;
-    memset(dst, 0, sizeof(heml_real) * (size_t)m->node_count);
-    if (src2) memset(dst2, 0, sizeof(heml_real) * (size_t)m->node_count);
-    for (p.colour = 0; p.colour < m->colour_count; p.colour++)
-        heml__run(m, m->colour_start[p.colour + 1] - m->colour_start[p.colour], heml__chunks, &p);
-}
-
 /* The nodal pressure's first two passes before a pass of `mode` at x (and dx): the sums
    over the tetrahedra (coloured like the force pass), then the node pass. Returns the
    nodal energy (ENERGY, FORCE_ENERGY; 0 otherwise). */
@@ -3678,20 +3619,11 @@ static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, c
     memset(m->nod_j, 0, sizeof(heml_real) * (size_t)m->node_count);
     if (diff) memset(m->nod_dj, 0, sizeof(heml_real) * (size_t)m->node_count);
     heml__pass_run(m, HEML__NODAL_SUMS, x, diff ? dx : NULL, NULL, 0, HEML_STRESS_PK1);
-    for (c = 0; c < m->nod_smooth; c++) { /* J - 1 -> S (J - 1), S y = inv A y (left unscaled) */
-        heml__nodal_scale(m, m->nod_j, m->nod_s1, diff ? m->nod_dj : NULL, m->nod_s2);
-        heml__nodal_smooth(m, m->nod_s1, m->nod_j, diff ? m->nod_s2 : NULL, m->nod_dj);
-    }
     cx.m = m;
     cx.diff = diff;
     cx.energy = mode == HEML__ENERGY || mode == HEML__FORCE_ENERGY;
     cx.relaxed = mode == HEML__FORCE_ENERGY;
     heml__run(m, m->nod_chunks, heml__nodal_chunks, &cx);
-    if (!m->kdev)
-        for (c = 0; c < m->nod_smooth; c++) { /* P -> S P: the gradient (S^T)^k V P = V S^k P */
-            heml__nodal_smooth(m, m->nod_p, m->nod_s1, diff ? m->nod_dp : NULL, m->nod_s2);
-            heml__nodal_scale(m, m->nod_s1, m->nod_p, diff ? m->nod_s2 : NULL, m->nod_dp);
-        }
     if (cx.energy)
         for (c = 0; c < m->nod_chunks; c++) energy += m->nod_energy[c];
     return energy;
@@ -3727,7 +3659,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     heml__pass p;
     double energy = 0.0;
     int c, below = 0, inverted = 0;
-    if (m->nodal && mode != HEML__NODAL_SUMS && mode != HEML__NODAL_SMOOTH) energy = heml__nodal_prepare(m, mode, x, dx);
+    if (m->nodal && mode != HEML__NODAL_SUMS) energy = heml__nodal_prepare(m, mode, x, dx);
     p.m = m;
     p.mode = mode;
     p.prony_write = prony_write && m->has_prony;
@@ -3735,7 +3667,6 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     p.x = x;
     p.dx = dx;
     p.out = out;
-    p.out2 = NULL;
     if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
         memset(out, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (p.colour = 0; p.colour < m->colour_count; p.colour++)
@@ -3958,8 +3889,6 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_dj, heml_real, nn);
         HEML__CARVE(c, m->nod_p, heml_real, nn);
         HEML__CARVE(c, m->nod_dp, heml_real, nn);
-        HEML__CARVE(c, m->nod_s1, heml_real, m->nod_smooth ? nn : 0);
-        HEML__CARVE(c, m->nod_s2, heml_real, m->nod_smooth ? nn : 0);
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
         HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
@@ -4229,10 +4158,6 @@ static int heml__create_validate(const heml_desc *d)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
     if (d->nodal_pressure != 0 && d->nodal_pressure != 1)
         return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0 or 1");
-    if (d->nodal_smoothing < 0 || d->nodal_smoothing > 8)
-        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_smoothing must be 0 to 8");
-    if (!(heml__finite((double)d->nodal_stabilisation) && d->nodal_stabilisation >= 0))
-        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_stabilisation must be finite and >= 0");
     if (d->stiffness_cache != 0 && d->stiffness_cache != 1)
         return heml__fail(d, HEML_ERR_ARG, "stiffness_cache must be 0 or 1");
     if (d->implicit_coarse < -1 || d->implicit_coarse > 1)
@@ -4883,7 +4808,6 @@ HEMLDEF heml_desc heml_default_desc(void)
     d.material = heml_material_from_young(HEML_NEO_HOOKEAN, 1e4, 0.3);
     d.inversion_threshold = (heml_real)0.4;
     d.stiffness_cache = 1;
-    d.nodal_stabilisation = 1;
     d.gravity[2] = (heml_real)-9.81;
     d.time_step = (heml_real)1e-3;
     d.integrator = HEML_SEMI_EXPLICIT_EULER;
@@ -4962,7 +4886,6 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     }
     tmp->slot_count = tmp->block_count * HEML__W;
     tmp->nodal = d->nodal_pressure;
-    tmp->nod_smooth = d->nodal_pressure ? d->nodal_smoothing : 0;
     for (i = 0; i < M && d->stiffness_cache && !tmp->nodal; i++) { /* a fast-path material in use */
         heml__mat mt;
         heml__make_mat(src + i, &mt);
@@ -5085,12 +5008,6 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
     }
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
     if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
-    for (i = 0; i < m->material_count; i++) { /* the stabilisation's alpha = min(1, c mu / kappa) */
-        heml__mat *mt = m->mats + i;
-        double kappa = mt->small_lambda + 2.0 / 3.0 * mt->small_mu, c = (double)d->nodal_stabilisation;
-        double alpha = c * mt->small_mu < kappa ? c * mt->small_mu / kappa : 1.0;
-        mt->nod_keep = (heml_real)(1.0 - alpha);
-    }
     m->dev_probe = m->nodal; /* where it pays: every material's bulk modulus at least
                                 HEML__DEV_PROBE_RATIO times its shear modulus (heml__dev_probe) */
     for (i = 0; i < m->material_count; i++)

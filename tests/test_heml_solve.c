@@ -1269,9 +1269,6 @@ static void cook_smooth(const tetmesh *mesh, const double *p, double *out)
    with smoothed (2 (N + 1)^2 values), that thrice-smoothed pressure (NAN on the nodes
    nearer the clamped edge) */
 static int cook_dev_probe = 1; /* 0: the saddle probe on the full tangent only (internal) */
-static double cook_stabilisation = -1; /* >= 0: desc.nodal_stabilisation (else its default) */
-static double cook_model_checker;      /* checkerboard() of the model's own nod_p (internal) */
-static int cook_smoothing = -1;         /* >= 0: desc.nodal_smoothing (else its default) */
 static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *krylov, double *jump,
                    double checker[7], double *smoothed)
 {
@@ -1292,8 +1289,6 @@ static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *kr
     mt.density = 1e-9;
     d.material = mt;
     d.nodal_pressure = nodal;
-    if (cook_stabilisation >= 0) d.nodal_stabilisation = (heml_real)cook_stabilisation;
-    if (cook_smoothing >= 0) d.nodal_smoothing = cook_smoothing;
     d.gravity[2] = 0;
     d.cg_max_iterations = 100000;
     m = make_model_ex(&mesh, mt, 0, &d);
@@ -1338,14 +1333,6 @@ static int cook_ex(int N, int split, int nodal, double bulk, double *uy, int *kr
                     worst = dp > worst ? dp : worst;
                 }
         *jump = worst / (pmax - pmin);
-        {
-            double *q = (double *)malloc(sizeof(double) * (size_t)mesh.node_count);
-            if (q) {
-                for (i = 0; i < mesh.node_count; i++) q[i] = (double)m->nod_p[i];
-                cook_model_checker = checkerboard(&mesh, q);
-                free(q);
-            }
-        }
     }
     if (checker) {
         double *p = (double *)malloc(sizeof(double) * 3 * (size_t)mesh.node_count), *pe = p + mesh.node_count,
