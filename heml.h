@@ -468,10 +468,10 @@
        (Stenberg, Math. Comp. 42, 1984: stable when every patch has such a vertex); here
        only by analogy, as each aggregate's volume reaches a ring of tetrahedra beyond its
        nodes: not proved, measured below. It keeps a tenth to a 27th of the constraints:
-       the pressure comes out smooth and the locking stays away. Forces: dW/dJ_b = V_b P_A for every node b of
-       aggregate A, P_A = sum_mat W_A,mat U'_mat(J_A) / V_A: each node carries its
-       aggregate's pressure and the element pass is that of nodal_pressure = 1 unchanged
-       (p_e the mean of its four nodes' P). Differential: dP_A = (sum_mat W_A,mat U''_mat(J_A)
+       the pressure comes out smooth and the locking stays away. Forces: dW/dJ_b = V_b P_A
+       for every node b of aggregate A, P_A = sum_mat W_A,mat U'_mat(J_A) / V_A: each node
+       carries its aggregate's pressure and the element pass is that of nodal_pressure = 1
+       unchanged (p_e the mean of its four nodes' P). Differential: dP_A = (sum_mat W_A,mat U''_mat(J_A)
        / V_A) dJ_A, dJ_A = sum_{a in A} (sum Vol dJ / 4)_a / V_A, each node carrying dP_A: the
        exact tangent, matrix-free, coupling every tetrahedron at an aggregate's nodes. The
        patch test and rigid motions hold as for nodal_pressure = 1 (a homogeneous J gives
@@ -505,10 +505,12 @@
        build/bench/bench --parts stability --filter nodal): issue 13's 2-point gap to nu =
        0.3 is not met (10.3 points, P1 bending on 3 cells across). What it gives up: the
        volume is held per patch, so inside a patch it is restored by the shear stiffness
-       alone: on very coarse meshes the body is softer (the one-cell-thick beams above
-       deflect more, and a 2 x 2 x 2-cell cube squashed through zero volume, 2 aggregates,
-       took 4 s instead of 2 to return within 5 % of its rest volumes at 20 / s of mass
-       damping: test_nodal_pressure_squash_release), and large deformations may need more
+       alone: on very coarse meshes the body is softer (the bench's NI beam at nu = 0.499,
+       build/bench/bench --parts trade --scenes NI --filter nodal: 20 % too far at 2 cells
+       across, 567 dof, then 14.6, 10.3, 6.8 % short at 3, 4, 6 cells, where
+       nodal_pressure = 1 is 41, 26, 18, 10.9 % short; a 2 x 2 x 2-cell cube squashed
+       through zero volume, 2 aggregates, took 4 s instead of 2 to return within 5 % of its
+       rest volumes at 20 / s of mass damping: test_nodal_pressure_squash_release), and large deformations may need more
        Newton iterations (the bench's stress sweep: 3 error codes against 2, no wrong
        answer; a one-cell-thick beam at nu = 0.4999 under an implicit step of 1 s from rest
        needs 30 against the cap of 20, where nodal_pressure = 1 needs 20).
