@@ -425,7 +425,7 @@
        indicator of 0.5 to 1.15 against a smooth field's 0.04 to 0.4); three passes give a
        smooth field that both tetrahedral splits agree on (tests/test_heml_solve.c
        test_nodal_pressure_cook): read pressures smoothed three times, never node by node.
-       A stabilised pressure is not done (issue 13 open). The bench's Poisson beam
+       desc.nodal_pressure = 2 removes it (PRESSURE AGGREGATES below). The bench's Poisson beam
        (1 x 0.1 x 0.1 m, 30 x 3 x 3 cells of five tetrahedra, tip against Timoshenko): 14.4,
        18.9, 22.5, 25.9 % off at nu = 0.3, 0.45, 0.49, 0.499 (plain 18.5, 22.4, 26.6,
        30.2 %); of six tetrahedra per cell at nu = 0.499 the tip is 0.0071 m instead of
@@ -444,6 +444,87 @@
        steps, vectorised; libm's cbrt made it twice as slow) about 100, the node pass
        about 25. The issue's target, 1.3 times the plain force, would need a fused
        Neo-Hookean kernel for it; not done.
+
+   PRESSURE AGGREGATES (desc.nodal_pressure = 2; issue 13's stabilised pressure): the
+       energy of NEAR-INCOMPRESSIBLE BODIES with the volume held per aggregate of nodes
+       instead of per node,
+           W = sum_e Vol_e (w(F_e) - U(J_e)) + sum_A sum_mat W_A,mat U_mat(J_A),
+       W_A,mat = sum_{a in A} W_a,mat, V_A = sum_{a in A} V_a, J_A = sum_{a in A} V_a J_a / V_A
+       (current over rest volume of the tetrahedra's shares around the aggregate's nodes).
+       The aggregates come from the mesh alone, at create, greedy in node order
+       (heml__pressure_aggregates): a node whose neighbours are all unassigned seeds an
+       aggregate of itself and them (its star), then every node left joins the aggregate of
+       a neighbour a seed took; one aggregate per 8 to 27 nodes (Cook's membrane below at
+       N = 8: 162 nodes, 9 aggregates with six tetrahedra a cell, 14 with five; a box of
+       20^3 cells: 9,261 nodes, 343 with six, whose stars are 3 x 3 x 3 blocks of nodes, 672
+       with five; a 3 x 3 x 3-cell box 64 nodes, 8). Why: the checkerboard of
+       nodal_pressure = 1 is the inf-sup defect of P1 displacements against one volume
+       constraint per node (nearly spurious pressure modes that the displacements cannot
+       see). A local change of the energy that keeps one full-rank constraint per node
+       leaves the incompressible limit, and with it the pressure, as it is: tried and
+       measured below. One constraint per patch, each patch holding a whole node star (an
+       interior vertex, whose displacement changes the patch's volume), follows the
+       macroelement argument for P1 displacements with a constant pressure per patch
+       (Stenberg, Math. Comp. 42, 1984: stable when every patch has such a vertex); here
+       only by analogy, as each aggregate's volume reaches a ring of tetrahedra beyond its
+       nodes: not proved, measured below. It keeps a tenth to a 27th of the constraints:
+       the pressure comes out smooth and the locking stays away. Forces: dW/dJ_b = V_b P_A
+       for every node b of aggregate A, P_A = sum_mat W_A,mat U'_mat(J_A) / V_A: each node
+       carries its aggregate's pressure and the element pass is that of nodal_pressure = 1
+       unchanged (p_e the mean of its four nodes' P). Differential: dP_A = (sum_mat W_A,mat U''_mat(J_A)
+       / V_A) dJ_A, dJ_A = sum_{a in A} (sum Vol dJ / 4)_a / V_A, each node carrying dP_A: the
+       exact tangent, matrix-free, coupling every tetrahedron at an aggregate's nodes. The
+       patch test and rigid motions hold as for nodal_pressure = 1 (a homogeneous J gives
+       every J_A = J). Inversion, Prony, the integrators, float: as nodal_pressure = 1 (the
+       same node pass, on the aggregates). Deterministic: the sums fold into the aggregates
+       and the pressures go back to the nodes in node order on the calling thread. Memory:
+       one int per node and 5 + M reals per aggregate (M materials). Cost per pass (callgrind,
+       2,592 tetrahedra, Neo-Hookean, gcc 12 -O3 -mavx2 -mfma, instructions per tetrahedron,
+       this code): force 540 against 567 for nodal_pressure = 1, differential 831 against
+       859 (the node pass runs on the aggregates; the fold and the broadcast are two loops
+       over the nodes).
+       Measured (tests/test_heml_solve.c test_nodal_pressure_aggregates_cook; Cook's
+       membrane R10, nu = 0.4999, corner u_y in mm at N = 4, 8, 16, 32; converged about 6.9):
+           six tetrahedra per cell    4.90 6.34 6.66 6.91   (nodal_pressure = 1: 2.65 4.38 5.99 6.61)
+           five tetrahedra per cell   3.10 5.59 6.76 6.89   (2.46 4.23 6.13 6.68)
+       the splits 37, 12, 1.5 and 0.2 % apart, both within 0.2 % of the published value at
+       N = 32. The pressure's neighbour indicator (the RMS of P_a minus its neighbours'
+       mean over P's spread, tests/test_heml_solve.c checkerboard(); a node-to-node
+       oscillation gives 1 or more, nodal_pressure = 1 gives 1.2 at every N): 0.40 0.28
+       0.17 0.10 (six) and 0.53 0.41 0.18 0.12 (five), falling with h as a smooth field
+       read in steps of a patch does; smoothed once (element means back to the nodes) 0.11
+       and 0.15 at N = 8, a smooth field's own 0.21 and 0.10 there. P_A is constant over an
+       aggregate: read it as it is, or smoothed once. Krylov iterations of the static solve
+       (bench/heml_nodal_krylov.c, third argument 2), nu = 0.3, 0.49, 0.499, 0.4999:
+           Cook N = 8     526    726  1,577   2,305   (nodal_pressure = 1: 490 745 2,243 5,738)
+           Cook N = 16    478  1,272  2,313   6,563   (449 1,480 3,434 13,446)
+           beam 40x4x4    121    402    509     617   (111 455 933 2,223)
+       so 4 to 14 times the nu = 0.3 count at 0.4999 (nodal_pressure = 1: 12 to 30). The
+       bench's Poisson beam (30 x 3 x 3 cells of five, against Timoshenko): 4.3, 11.3, 13.9,
+       14.6 % off at nu = 0.3, 0.45, 0.49, 0.499 (nodal_pressure = 1: 14.4, 18.9, 22.5, 25.9;
+       build/bench/bench --parts stability --filter nodal): issue 13's 2-point gap to nu =
+       0.3 is not met (10.3 points, P1 bending on 3 cells across). What it gives up: the
+       volume is held per patch, so inside a patch it is restored by the shear stiffness
+       alone: on very coarse meshes the body is softer (the bench's NI beam at nu = 0.499,
+       build/bench/bench --parts trade --scenes NI --filter nodal: 20 % too far at 2 cells
+       across, 567 dof, then 14.6, 10.3, 6.8 % short at 3, 4, 6 cells, where
+       nodal_pressure = 1 is 41, 26, 18, 10.9 % short; a 2 x 2 x 2-cell cube squashed
+       through zero volume, 2 aggregates, took 4 s instead of 2 to return within 5 % of its
+       rest volumes at 20 / s of mass damping: test_nodal_pressure_squash_release), and large deformations may need more
+       Newton iterations (the bench's stress sweep: 3 error codes against 2, no wrong
+       answer; a one-cell-thick beam at nu = 0.4999 under an implicit step of 1 s from rest
+       needs 30 against the cap of 20, where nodal_pressure = 1 needs 20).
+       Tried first, and not kept (branch anpstab, commit ed2e6ab, reverted; exact energies,
+       Cook N = 8 at nu = 0.4999, indicator of the model's own nodal pressure, six / five
+       tetrahedra per cell, nodal_pressure = 1 alone: u_y 4.38 / 4.23, indicator 1.22 / 1.24):
+       the classical blend W_vol = (1 - alpha) sum_a V_a U(J_a) + alpha sum_e Vol_e U(J_e),
+       alpha = min(1, c mu / kappa): c = 1: 4.23 / 4.19 mm, 1.22 / 1.24; c = 10: 3.52 / 4.00,
+       1.22 / 1.25; c = 1000: 2.22 / 3.41, 1.01 / 1.25 (it locks before it smooths); the
+       nodal energy at smoothed volume ratios J_bar = S^k J (S: element means back to the
+       nodes, self-adjoint in the nodal volumes, so the forces read S^k P): k = 1: 5.33 /
+       5.08 mm, 1.12 / 1.19; k = 3: 5.68 / 5.32, 0.87 / 0.82, and at N = 16 k = 2 still
+       0.85 / 0.88 (S is invertible: the limit constraint and its spurious pressure modes
+       stay, amplified by S^-k before S^k smooths them back).
 
    INTEGRATORS (the desc picks a default, heml_step_ex picks per call)
        HEML_SEMI_EXPLICIT_EULER  eq. 32: v1 = v + dt a(u, v), u1 = u + dt v1, lumped masses
@@ -925,15 +1006,20 @@
    LIMITS
        - Linear (P1) tetrahedra: they lock in bending and near incompressibility (nu close
          to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
-         desc.nodal_pressure = 1 for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
+         desc.nodal_pressure = 2 (or 1) for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
          BODIES), which removes the volumetric locking, not the bending one.
        - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
          shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
          probe's share is cut by running it on the deviatoric stiffness first, but a
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
-         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
-         oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read it smoothed
-         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); with
+         nodal_pressure = 1 the nodal pressure oscillates between neighbouring nodes near nu =
+         0.5 (a checkerboard: read it smoothed three times, or use nodal_pressure = 2, whose
+         pressure is smooth and whose Krylov counts grow 4 to 14 times instead of 12 to 30:
+         PRESSURE AGGREGATES); nodal_pressure = 2 holds the volume patch by patch, so on
+         very coarse meshes (a few aggregates) a body's internal volume changes return only
+         at the shear stiffness's pace and large-deformation Newton solves may need more
+         iterations; either costs the vectorised Neo-Hookean kernels (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
@@ -1199,7 +1285,7 @@ typedef HEML_REAL heml_real;
     X(HEML_ERR_DIVERGED, -29, "explicit step failed its divergence check (energy grew beyond the work done on the body); the last valid state was kept") \
     X(HEML_ERR_PRECISION, -30, "state too far from the origin for the precision of heml_real (eps max|u| > precision_limit h_min); the last valid state was kept") \
     X(HEML_ERR_UNSTABLE, -31, "static solve converged to a saddle (an unstable equilibrium: the tangent has a direction of negative curvature); set leave_saddles = 1 to descend to a minimum; the last valid state was kept") \
-    X(HEML_ERR_NODAL_PRESSURE, -32, "nodal_pressure not 0 or 1, or set with a law it cannot average (mass-spring, a user law without second derivatives)")
+    X(HEML_ERR_NODAL_PRESSURE, -32, "nodal_pressure not 0, 1 or 2, or set with a law it cannot average (mass-spring, a user law without second derivatives)")
 
 enum {
 #define HEML__ENUM(name, value, text) name = value,
@@ -1324,7 +1410,9 @@ typedef struct heml_desc {
     int nodal_pressure;              /* 0 (default): plain P1 tetrahedra; 1: average nodal
                                         pressure tetrahedra for nearly incompressible bodies
                                         (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
-                                        user laws with second derivatives */
+                                        user laws with second derivatives; 2 (recommended
+                                        there): the same over pressure aggregates, no
+                                        pressure checkerboard (PRESSURE AGGREGATES) */
     int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
                                         tetrahedron what its linearisation point fixes (PERFORMANCE,
                                         MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
@@ -1915,6 +2003,11 @@ struct heml_model {
        and sum Vol_e dJ_e / 4 of the current pass, the nodal pressure P_a and its
        differential dP_a; per node chunk its energy */
     heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
+    /* nodal_pressure = 2: the pressure aggregates (heml__pressure_aggregates): count, node
+       -> aggregate (-1: a node of no tetrahedron), and the node pass's arrays per aggregate
+       (weights per material and aggregate, 1 / V_A, the sums, P_A and dP_A) */
+    int pagg_count, *pagg;
+    heml_real *pagg_w, *pagg_inv, *pagg_j, *pagg_dj, *pagg_p, *pagg_dp;
     double *nod_energy;
     int nod_chunks;
     /* the deviatoric probe (heml__dev_probe): kdev 1 while a solve runs on K_dev (the node
@@ -3561,13 +3654,16 @@ static void heml__chunks(void *vctx, int begin, int end)
 typedef struct heml__nodal_ctx {
     heml_model *m;
     int diff, energy, relaxed;
+    int count;                            /* nodes, or pressure aggregates (nodal_pressure 2) */
+    const heml_real *w, *inv, *j, *dj;    /* their weights (stride count), 1 / V, sums */
+    heml_real *p, *dp;                    /* P and dP out */
 } heml__nodal_ctx;
 
 static void heml__nodal_chunks(void *vctx, int begin, int end)
 {
     const heml__nodal_ctx *cx = (const heml__nodal_ctx *)vctx;
     heml_model *m = cx->m;
-    const int n = m->node_count, want = cx->energy ? HEML__WANT_ENERGY : 0;
+    const int n = cx->count, want = cx->energy ? HEML__WANT_ENERGY : 0;
     heml__blk s;
     int c, a, k, i;
     for (c = begin; c < end; c++) {
@@ -3577,11 +3673,11 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
             int valid = a1 - a < HEML__W ? a1 - a : HEML__W;
             heml_real jm1[HEML__W], P[HEML__W], Q[HEML__W], U[HEML__W], U1[HEML__W], U2[HEML__W];
             for (k = 0; k < HEML__W; k++) {
-                jm1[k] = k < valid ? m->nod_j[a + k] * m->nod_inv[a + k] : 0;
+                jm1[k] = k < valid ? cx->j[a + k] * cx->inv[a + k] : 0;
                 P[k] = Q[k] = 0;
             }
             for (i = 0; i < m->material_count; i++) {
-                const heml_real *w = m->nod_w + (size_t)i * (size_t)n + (size_t)a;
+                const heml_real *w = cx->w + (size_t)i * (size_t)n + (size_t)a;
                 const heml__mat *mt = m->mats + i;
                 double sp = cx->relaxed && mt->prony_count ? (double)m->prony_s[i] : 1.0;
                 int any = 0;
@@ -3595,10 +3691,10 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
                 }
             }
             for (k = 0; k < valid; k++) {
-                heml_real inv = m->nod_inv[a + k];
-                m->nod_p[a + k] = P[k] * inv;
+                heml_real inv = cx->inv[a + k];
+                cx->p[a + k] = P[k] * inv;
                 if (cx->diff) /* (kdev: heml__dev_probe) */
-                    m->nod_dp[a + k] = m->kdev == 1 ? 0 : Q[k] * inv * inv * (m->kdev ? 1 : m->nod_dj[a + k]);
+                    cx->dp[a + k] = m->kdev == 1 ? 0 : Q[k] * inv * inv * (m->kdev ? 1 : cx->dj[a + k]);
             }
         }
         m->nod_energy[c] = energy;
@@ -3615,7 +3711,7 @@ static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, c
 {
     heml__nodal_ctx cx;
     double energy = 0.0;
-    int c, diff = mode == HEML__DIFF;
+    int c, chunks, diff = mode == HEML__DIFF;
     memset(m->nod_j, 0, sizeof(heml_real) * (size_t)m->node_count);
     if (diff) memset(m->nod_dj, 0, sizeof(heml_real) * (size_t)m->node_count);
     heml__pass_run(m, HEML__NODAL_SUMS, x, diff ? dx : NULL, NULL, 0, HEML_STRESS_PK1);
@@ -3623,9 +3719,35 @@ static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, c
     cx.diff = diff;
     cx.energy = mode == HEML__ENERGY || mode == HEML__FORCE_ENERGY;
     cx.relaxed = mode == HEML__FORCE_ENERGY;
-    heml__run(m, m->nod_chunks, heml__nodal_chunks, &cx);
+    if (m->pagg_count) { /* the sums per pressure aggregate (in node order), the node pass on them */
+        int a, A = m->pagg_count;
+        memset(m->pagg_j, 0, sizeof(heml_real) * (size_t)A);
+        if (diff) memset(m->pagg_dj, 0, sizeof(heml_real) * (size_t)A);
+        for (a = 0; a < m->node_count; a++)
+            if (m->pagg[a] >= 0) {
+                m->pagg_j[m->pagg[a]] += m->nod_j[a];
+                if (diff) m->pagg_dj[m->pagg[a]] += m->nod_dj[a];
+            }
+        cx.count = A;
+        cx.w = m->pagg_w, cx.inv = m->pagg_inv, cx.j = m->pagg_j, cx.dj = m->pagg_dj;
+        cx.p = m->pagg_p, cx.dp = m->pagg_dp;
+    } else {
+        cx.count = m->node_count;
+        cx.w = m->nod_w, cx.inv = m->nod_inv, cx.j = m->nod_j, cx.dj = m->nod_dj;
+        cx.p = m->nod_p, cx.dp = m->nod_dp;
+    }
+    chunks = (cx.count + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
+    heml__run(m, chunks, heml__nodal_chunks, &cx);
+    if (m->pagg_count) { /* every node carries its aggregate's P_A (and dP_A) */
+        int a;
+        for (a = 0; a < m->node_count; a++) {
+            int i = m->pagg[a];
+            m->nod_p[a] = i >= 0 ? m->pagg_p[i] : 0;
+            if (diff) m->nod_dp[a] = i >= 0 ? m->pagg_dp[i] : 0;
+        }
+    }
     if (cx.energy)
-        for (c = 0; c < m->nod_chunks; c++) energy += m->nod_energy[c];
+        for (c = 0; c < chunks; c++) energy += m->nod_energy[c];
     return energy;
 }
 
@@ -3889,11 +4011,19 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_dj, heml_real, nn);
         HEML__CARVE(c, m->nod_p, heml_real, nn);
         HEML__CARVE(c, m->nod_dp, heml_real, nn);
+        HEML__CARVE(c, m->pagg, int, m->pagg_count ? n : 0);
+        HEML__CARVE(c, m->pagg_w, heml_real, (size_t)m->pagg_count * M);
+        HEML__CARVE(c, m->pagg_inv, heml_real, (size_t)m->pagg_count);
+        HEML__CARVE(c, m->pagg_j, heml_real, (size_t)m->pagg_count);
+        HEML__CARVE(c, m->pagg_dj, heml_real, (size_t)m->pagg_count);
+        HEML__CARVE(c, m->pagg_p, heml_real, (size_t)m->pagg_count);
+        HEML__CARVE(c, m->pagg_dp, heml_real, (size_t)m->pagg_count);
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
         HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? HEML__NC * s : 0);
     if (!m->nodal) m->diag_dev = NULL;
+    if (!m->pagg_count) m->pagg = NULL;
     if (!m->has_springs) m->blk_spring = NULL;
     if (!m->has_dc) m->dc = NULL;
 }
@@ -4156,8 +4286,8 @@ static int heml__create_validate(const heml_desc *d)
                                               "min_increment, precision_limit, allow_inversion or leave_saddles");
     for (i = 0; i < 3; i++)
         if (!heml__finite((double)d->gravity[i])) return heml__fail(d, HEML_ERR_ARG, "gravity");
-    if (d->nodal_pressure != 0 && d->nodal_pressure != 1)
-        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0 or 1");
+    if (d->nodal_pressure < 0 || d->nodal_pressure > 2)
+        return heml__fail(d, HEML_ERR_NODAL_PRESSURE, "nodal_pressure must be 0, 1 or 2");
     if (d->stiffness_cache != 0 && d->stiffness_cache != 1)
         return heml__fail(d, HEML_ERR_ARG, "stiffness_cache must be 0 or 1");
     if (d->implicit_coarse < -1 || d->implicit_coarse > 1)
@@ -4431,6 +4561,65 @@ static void heml__nodal_weights(heml_model *m, const heml_desc *d, double *acc)
         }
     }
     for (s = 0; s < m->node_count; s++) m->nod_inv[s] = acc[s] > 0 ? (heml_real)(1.0 / acc[s]) : (heml_real)0;
+}
+
+/* The pressure aggregates of nodal_pressure = 2 (NEAR-INCOMPRESSIBLE BODIES), from the
+   mesh alone, greedy in node order: a node of at least one tetrahedron whose neighbours
+   are all unassigned seeds an aggregate of itself and them (its star); then every node
+   left joins the aggregate of its first neighbour (in the order of d->tets) assigned by a
+   seed (it has one: it was no seed because a neighbour was taken). agg (n): the aggregate
+   of each node, -1 for a node of no tetrahedron; start (n + 1), adj (12 T): scratch (the
+   adjacency, each neighbour once per shared tetrahedron). Returns the count. */
+static int heml__pressure_aggregates(const heml_desc *d, int *agg, int *start, int *adj)
+{
+    int n = d->node_count, T = d->tet_count, t, j, l, a, count = 0;
+    memset(start, 0, sizeof(int) * ((size_t)n + 1));
+    for (t = 0; t < T; t++)
+        for (j = 0; j < 4; j++) start[d->tets[4 * t + j] + 1] += 3;
+    for (a = 0; a < n; a++) start[a + 1] += start[a];
+    for (a = 0; a < n; a++) agg[a] = start[a]; /* (the fill cursor) */
+    for (t = 0; t < T; t++)
+        for (j = 0; j < 4; j++)
+            for (l = 0; l < 4; l++)
+                if (l != j) adj[agg[d->tets[4 * t + j]]++] = d->tets[4 * t + l];
+    for (a = 0; a < n; a++) agg[a] = -1;
+    for (a = 0; a < n; a++) {
+        int free_star = start[a + 1] > start[a] && agg[a] < 0;
+        for (l = start[a]; l < start[a + 1] && free_star; l++) free_star = agg[adj[l]] < 0;
+        if (!free_star) continue;
+        agg[a] = count;
+        for (l = start[a]; l < start[a + 1]; l++) agg[adj[l]] = count;
+        count++;
+    }
+    for (a = 0; a < n; a++) /* (joined: -2 - aggregate until all have joined) */
+        if (agg[a] == -1)
+            for (l = start[a]; l < start[a + 1]; l++)
+                if (agg[adj[l]] >= 0) {
+                    agg[a] = -2 - agg[adj[l]];
+                    break;
+                }
+    for (a = 0; a < n; a++)
+        if (agg[a] <= -2) agg[a] = -2 - agg[a];
+    return count;
+}
+
+/* The aggregates' node-pass weights (after heml__nodal_weights): pagg_w[mat A + i] = sum of
+   W[mat n + a] over the nodes a of aggregate i, and 1 / V_A, V_A the sum of their V_a (in
+   acc, n doubles, as heml__nodal_weights left them; vol: A doubles of scratch). */
+static void heml__pressure_aggregate_weights(heml_model *m, const int *agg, const double *acc, double *vol)
+{
+    size_t n = (size_t)m->node_count, A = (size_t)m->pagg_count, i;
+    int a, mat;
+    memcpy(m->pagg, agg, sizeof(int) * n);
+    memset(m->pagg_w, 0, sizeof(heml_real) * A * (size_t)m->material_count);
+    memset(vol, 0, sizeof(double) * A);
+    for (a = 0; a < m->node_count; a++)
+        if (agg[a] >= 0) {
+            vol[agg[a]] += acc[a];
+            for (mat = 0; mat < m->material_count; mat++)
+                m->pagg_w[(size_t)mat * A + (size_t)agg[a]] += m->nod_w[(size_t)mat * n + (size_t)a];
+        }
+    for (i = 0; i < A; i++) m->pagg_inv[i] = vol[i] > 0 ? (heml_real)(1.0 / vol[i]) : (heml_real)0;
 }
 
 /* >>coarse ---------------------------------------------------------------------------- */
@@ -4843,6 +5032,7 @@ typedef struct heml__create_tmp {
     double *mass_acc, *diag_acc;
     heml__order *order_of;
     int *counts, *fill, *bstart, *stamp, *colour_of, *order;
+    int *pagg; /* nodal_pressure = 2: node -> pressure aggregate (heml__pressure_aggregates) */
 } heml__create_tmp;
 
 /* Creation stage 2: sizes the model (in *tmp, a model not yet allocated) and allocates the
@@ -4852,8 +5042,9 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     const heml_material *src = d->materials ? d->materials : &d->material;
     int i, t, M = d->materials ? d->material_count : 1, T = d->tet_count, n = d->node_count;
     int C_max = M + T / (HEML__W * HEML__CHUNK) + 1;
+    size_t agg_ints = d->nodal_pressure == 2 ? 2 * (size_t)n + 1 + 12 * (size_t)T : 0;
     w->bytes = sizeof(double) * 4 * (size_t)n + sizeof(heml__order) * (size_t)T +
-               sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max);
+               sizeof(int) * (3 * (size_t)M + (size_t)n + 4 * (size_t)C_max + agg_ints);
     w->block = heml__alloc(&d->allocator, w->bytes);
     if (!w->block) return heml__fail(d, HEML_ERR_ALLOC, "temporary block");
     w->mass_acc = (double *)w->block;
@@ -4865,6 +5056,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     w->stamp = w->bstart + M;
     w->colour_of = w->stamp + n;
     w->order = w->colour_of + C_max;
+    w->pagg = agg_ints ? w->order + C_max : NULL;
 
     memset(tmp, 0, sizeof *tmp);
     tmp->node_count = n;
@@ -4892,6 +5084,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
         if (mt.fast && w->counts[i] > 0) tmp->has_dc = 1;
     }
     tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
+    if (w->pagg) tmp->pagg_count = heml__pressure_aggregates(d, w->pagg, w->pagg + n, w->pagg + 2 * (size_t)n + 1);
     {
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
@@ -5008,6 +5201,7 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
     }
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
     if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
+    if (m->pagg_count) heml__pressure_aggregate_weights(m, w->pagg, w->mass_acc, w->diag_acc);
     m->dev_probe = m->nodal; /* where it pays: every material's bulk modulus at least
                                 HEML__DEV_PROBE_RATIO times its shear modulus (heml__dev_probe) */
     for (i = 0; i < m->material_count; i++)

@@ -92,6 +92,8 @@ static int hm_create_mr(const bench_body *b, void **out) { return hm_create(b, H
 static int hm_create_springs(const bench_body *b, void **out) { return hm_create(b, HEML_MASS_SPRING, 0, out); }
 /* Neo-Hookean with desc.nodal_pressure = 1 (average nodal pressure tetrahedra) */
 static int hm_create_nh_nodal(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, 1, out); }
+/* Neo-Hookean with desc.nodal_pressure = 2 (the volumetric energy over pressure aggregates) */
+static int hm_create_nh_nodal_agg(const bench_body *b, void **out) { return hm_create(b, HEML_NEO_HOOKEAN, 2, out); }
 
 static void hm_destroy(void *v)
 {
@@ -509,6 +511,8 @@ static const bench_model hm_models[] = {
     {"heml", "mooney-rivlin", "mooney-rivlin", BENCH_PRECISION, HM_ALL, 1, 0, "tet", hm_create_mr, HM_FUNCTIONS},
     {"heml", "springs", "springs", BENCH_PRECISION, HM_ALL, 1, 0, "tet", hm_create_springs, HM_FUNCTIONS},
     {"heml", "neo-hookean nodal-p", "neo-hookean", BENCH_PRECISION, HM_ALL, 1, -1, "tet", hm_create_nh_nodal, HM_FUNCTIONS},
+    {"heml", "neo-hookean nodal-agg", "neo-hookean", BENCH_PRECISION, HM_ALL, 1, -1, "tet", hm_create_nh_nodal_agg,
+     HM_FUNCTIONS},
 };
 
 const bench_model *BENCH_TABLE(int *count);

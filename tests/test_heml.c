@@ -730,12 +730,13 @@ static void test_differential_with_prony(void)
     terms[1].alpha = (heml_real)0.2;
     terms[1].tau = (heml_real)0.2;
     box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
-    for (li = 0; li < 7; li++) { /* 4..6: the continuum laws again with nodal_pressure = 1 */
-        heml_material mt = material_of(laws[li % 4]);
+    for (li = 0; li < 10; li++) { /* 4..6, 7..9: the continuum laws again with nodal_pressure = 1, 2 */
+        int law = li < 4 ? li : (li - 4) % 3;
+        heml_material mt = material_of(laws[law]);
         heml_model *m;
         int n3 = 3 * mesh.node_count, i, s;
         double *x, *fp;
-        g_nodal = li >= 4;
+        g_nodal = li >= 7 ? 2 : li >= 4;
         x = (double *)malloc(sizeof(double) * n3);
         fp = (double *)malloc(sizeof(double) * n3);
         double h = IS_FLOAT ? 1e-3 : 1e-5, err = 0.0, dmax = 0.0;
@@ -768,8 +769,8 @@ static void test_differential_with_prony(void)
             err = fabs(fp[i] - (double)df[i]) > err ? fabs(fp[i] - (double)df[i]) : err;
         }
         printf("    %-18s with 2 Prony terms%s: |df - fd| / |df| = %.2g\n",
-               law_name[li % 4 == 0 ? 1 : li % 4 == 1 ? 0 : li % 4 == 2 ? 2 : 5], g_nodal ? ", nodal pressure" : "",
-               err / dmax);
+               law_name[law == 0 ? 1 : law == 1 ? 0 : law == 2 ? 2 : 5],
+               g_nodal == 2 ? ", nodal pressure 2" : g_nodal ? ", nodal pressure 1" : "", err / dmax);
         CHECK(err <= (IS_FLOAT ? 3e-3 : 1e-6) * dmax);
         free(x);
         free(fp);
@@ -1410,14 +1411,16 @@ static void test_law_table_forces_and_differentials(void)
 /* The energy of the average nodal pressure tetrahedra, written independently from F in
    double for states with every J and nodal J above J0 (one material):
        W = sum_e V_e (w(F_e) - U(J_e)) + sum_e V_e / 4 sum_{a in e} U(J_a),
-   U(J) = w(J^(1/3) I), J_a = sum_{e at a} V_e J_e / sum_{e at a} V_e. */
+   U(J) = w(J^(1/3) I), J_a = sum_{e at a} V_e J_e / sum_{e at a} V_e; with agg (a node ->
+   aggregate map, nodal_pressure = 2) the nodal term is sum_A V_A U(J_A) over the
+   aggregates, V_A = sum_{a in A} V_a, J_A = sum_{a in A} V_a J_a / V_A. */
 static double dilation_energy(const heml_material *mt, double J)
 {
     double s = cbrt(J), F[3][3] = {{s, 0, 0}, {0, s, 0}, {0, 0, s}}, P[3][3];
     return law_P(mt, 0.4, F, P);
 }
 
-static double nodal_energy(const tetmesh *mesh, const heml_material *mt, const double *x)
+static double nodal_energy(const tetmesh *mesh, const heml_material *mt, const int *agg, const double *x)
 {
     int n = mesh->node_count, t, j, a, b;
     double *Va = (double *)calloc((size_t)n, sizeof(double)), *Ja = (double *)calloc((size_t)n, sizeof(double));
@@ -1440,6 +1443,15 @@ static double nodal_energy(const tetmesh *mesh, const heml_material *mt, const d
             Ja[q[j]] += V / 4 * J;
         }
     }
+    if (agg) { /* the sums per aggregate (aggregate indices are below n) */
+        double *VA = (double *)calloc((size_t)n, sizeof(double)), *JA = (double *)calloc((size_t)n, sizeof(double));
+        for (a = 0; a < n; a++)
+            if (agg[a] >= 0) VA[agg[a]] += Va[a], JA[agg[a]] += Ja[a];
+        memcpy(Va, VA, sizeof(double) * (size_t)n);
+        memcpy(Ja, JA, sizeof(double) * (size_t)n);
+        free(VA);
+        free(JA);
+    }
     for (a = 0; a < n; a++)
         if (Va[a] > 0) W += Va[a] * dilation_energy(mt, Ja[a] / Va[a]);
     free(Va);
@@ -1447,19 +1459,56 @@ static double nodal_energy(const tetmesh *mesh, const heml_material *mt, const d
     return W;
 }
 
-/* Every law but mass-spring with nodal_pressure = 1: the forces equal minus the central
-   difference gradient of nodal_energy (independent, double, step 1e-6: truncation ~1e-12,
-   rounding ~1e-10 of the force scale) and heml_energy equals it; then, through
+/* The pressure aggregates of nodal_pressure = 2 (internal pagg) are what heml.h says:
+   every node of a tetrahedron in one aggregate in [0, count), and every aggregate holding
+   a seed whose neighbours all belong to it (so no aggregate is a single node). Returns the
+   count. */
+static int check_pressure_aggregates(const tetmesh *mesh, const heml_model *m)
+{
+    int n = mesh->node_count, A = m->pagg_count, t, a, b, i, bad = 0, seeds = 0;
+    int *out = (int *)calloc((size_t)n, sizeof(int)), *has_seed = (int *)calloc((size_t)(A > 0 ? A : 1), sizeof(int));
+    CHECK(A >= 1 && m->pagg != NULL);
+    if (!out || !has_seed || A < 1 || !m->pagg) {
+        free(out), free(has_seed);
+        return A;
+    }
+    for (t = 0; t < mesh->tet_count; t++)
+        for (a = 0; a < 4; a++) {
+            int na = mesh->tets[4 * t + a];
+            bad += m->pagg[na] < 0 || m->pagg[na] >= A;
+            for (b = 0; b < 4; b++) /* out[na]: a neighbour of na lies in another aggregate */
+                out[na] |= m->pagg[mesh->tets[4 * t + b]] != m->pagg[na];
+        }
+    CHECK(bad == 0);
+    if (bad) {
+        free(out), free(has_seed);
+        return A;
+    }
+    for (i = 0; i < n; i++)
+        if (!out[i] && m->pagg[i] >= 0) has_seed[m->pagg[i]] = 1;
+    for (i = 0; i < A; i++) seeds += has_seed[i];
+    CHECK_INT(A, seeds);
+    free(out), free(has_seed);
+    return A;
+}
+
+/* Every law but mass-spring with nodal_pressure = 1 and 2: the forces equal minus the
+   central difference gradient of nodal_energy (independent, double, step 1e-6: truncation
+   ~1e-12, rounding ~1e-10 of the force scale) and heml_energy equals it; then, through
    check_law_as_run, forces = -d(heml_energy)/du and heml_apply_stiffness = the central
    difference of the forces at a moderate state and with tetrahedra (and nodes) below J0.
-   The mesh's interior node couples 24 tetrahedra, so the differential's neighbour
-   coupling (dP_a of every node of every tetrahedron) is exercised. */
+   nodal_pressure = 1 on 2 x 2 x 2 cells: the interior node couples 24 tetrahedra, so the
+   differential's neighbour coupling (dP_a of every node of every tetrahedron) is
+   exercised; 2 on 3 x 3 x 3 cells (64 nodes in 8 aggregates; displacements 0.04 instead of
+   0.06 for the smaller cells, every J above J0 as nodal_energy needs), each aggregate's dP_A
+   reaching every tetrahedron at its nodes. */
 static void test_nodal_pressure_gradient_and_differential(void)
 {
     tetmesh mesh;
     int li, state;
-    box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
-    g_nodal = 1;
+    for (g_nodal = 1; g_nodal <= 2; g_nodal++) {
+    if (g_nodal == 1) box_mesh(&mesh, 2, 2, 2, 1, 1, 1, TETMESH_SPLIT6);
+    else box_mesh(&mesh, 3, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
     for (li = 0; li < NLAWS; li++) {
         heml_material mt = material_of(all_laws[li]);
         heml_model *m;
@@ -1470,26 +1519,33 @@ static void test_nodal_pressure_gradient_and_differential(void)
         if (all_laws[li] == HEML_MASS_SPRING) continue;
         m = make_model(&mesh, all_laws[li]);
         REQUIRE(m != NULL);
+        if (g_nodal == 2) {
+            int A = check_pressure_aggregates(&mesh, m);
+            if (li == 0) printf("    nodal_pressure = 2: %d nodes in %d aggregates\n", mesh.node_count, A);
+            CHECK(A >= 4 && 4 * A <= mesh.node_count); /* (several, none of one node) */
+        } else
+            CHECK(m->pagg_count == 0 && m->pagg == NULL);
         x = (double *)malloc(sizeof(double) * n3);
         fd = (double *)malloc(sizeof(double) * n3);
-        deformed_state(&mesh, 0.06, 11u + (unsigned)li, x);
+        deformed_state(&mesh, g_nodal == 1 ? 0.06 : 0.04, 11u + (unsigned)li, x); /* (cells of 1/2, 1/3) */
         set_positions_d(m, x, mesh.node_count);
         positions_d(m, x, mesh.node_count);
         f = heml_compute_forces(m);
         for (i = 0; i < n3; i++) {
             double s0 = x[i], Wp, Wm;
             x[i] = s0 + h;
-            Wp = nodal_energy(&mesh, &mt, x);
+            Wp = nodal_energy(&mesh, &mt, m->pagg, x);
             x[i] = s0 - h;
-            Wm = nodal_energy(&mesh, &mt, x);
+            Wm = nodal_energy(&mesh, &mt, m->pagg, x);
             x[i] = s0;
             fd[i] = -(Wp - Wm) / (2 * h);
         }
         fmax = max_abs(fd, n3);
         for (i = 0; i < n3; i++) err = fabs((double)f[i] - fd[i]) > err ? fabs((double)f[i] - fd[i]) : err;
-        W = nodal_energy(&mesh, &mt, x);
+        W = nodal_energy(&mesh, &mt, m->pagg, x);
         heml_energy(m, &en);
-        printf("    %-18s |f - fd| / |f| = %.2g, energy %.6g J vs %.6g J\n", law_name[li], err / fmax, en.elastic, W);
+        printf("    %-18s nodal %d: |f - fd| / |f| = %.2g, energy %.6g J vs %.6g J\n", law_name[li], g_nodal, err / fmax,
+               en.elastic, W);
         /* as test_forces_are_energy_gradient */
         CHECK(err <= (IS_FLOAT ? 3e-4 : 1e-7) * fmax);
         CHECK_REL(W, en.elastic, IS_FLOAT ? 2e-3 : 1e-9);
@@ -1498,15 +1554,17 @@ static void test_nodal_pressure_gradient_and_differential(void)
         heml_destroy(m);
         for (state = 0; state < 2; state++) check_law_as_run(&mesh, &mt, law_name[li], state, 5u + (unsigned)li);
     }
-    g_nodal = 0;
     tetmesh_free(&mesh);
+    }
+    g_nodal = 0;
 }
 
 /* Patch test: an unstructured mesh (a 3 x 3 x 3 box of five-tetrahedron cells whose
    interior nodes are moved at random by up to 0.3 of a cell) under a homogeneous F, placed
    1e3 m from the origin: every tetrahedron's first Piola-Kirchhoff stress is the law's
    P(F) (every J_e and so every nodal J is det F, and the nodal pressure equals the element
-   U'(J) it replaces), the interior nodes' forces vanish; a rigid motion gives zero force. */
+   U'(J) it replaces), the interior nodes' forces vanish; a rigid motion gives zero force.
+   With nodal_pressure = 1 and 2 (every aggregate's J_A is det F too). */
 static void test_nodal_pressure_patch(void)
 {
     tetmesh mesh;
@@ -1522,7 +1580,7 @@ static void test_nodal_pressure_patch(void)
         if (interior)
             for (a = 0; a < 3; a++) X[a] += 0.1 * rnd(&seed);
     }
-    g_nodal = 1;
+    for (g_nodal = 1; g_nodal <= 2; g_nodal++)
     for (li = 0; li < NLAWS - 2; li++) { /* the continuum laws with closed forms here */
         heml_material mt = material_of(all_laws[li]);
         heml_model *m = make_model(&mesh, all_laws[li]);
@@ -1559,7 +1617,8 @@ static void test_nodal_pressure_patch(void)
         heml_set_displacements(m, u);
         f = heml_compute_forces(m);
         for (i = 0; i < 3 * n; i++) frig = fabs((double)f[i]) > frig ? fabs((double)f[i]) : frig;
-        printf("    %-18s |P - P(F)| %.2g Pa, interior |f| %.2g N, rigid |f| %.2g N\n", law_name[li], worst, fint, frig);
+        printf("    %-18s nodal %d: |P - P(F)| %.2g Pa, interior |f| %.2g N, rigid |f| %.2g N\n", law_name[li], g_nodal,
+               worst, fint, frig);
         /* stresses of order E = 5e4 Pa, forces of order E h^2 = 5e3 N: round-off (float: the
            displacements of 1e3 m carry 6e-5 m of rounding, strains of 2e-4) */
         CHECK(worst <= (IS_FLOAT ? 1e-4 : 1e-10) * 5e4);
@@ -1574,7 +1633,7 @@ static void test_nodal_pressure_patch(void)
     tetmesh_free(&mesh);
 }
 
-/* nodal_pressure refused where it cannot work: a value other than 0 or 1, mass-spring, a
+/* nodal_pressure refused where it cannot work: a value other than 0, 1 or 2, mass-spring, a
    user law without second derivatives (HEML_ERR_NODAL_PRESSURE, nothing created). */
 static void test_nodal_pressure_refused(void)
 {
@@ -1592,7 +1651,10 @@ static void test_nodal_pressure_refused(void)
     d.tets = mesh.tets;
     d.tet_count = mesh.tet_count;
     d.material = nh;
-    d.nodal_pressure = 2;
+    d.nodal_pressure = 3;
+    CHECK_INT(HEML_ERR_NODAL_PRESSURE, heml_create(&d, &m));
+    CHECK(m == NULL);
+    d.nodal_pressure = -1;
     CHECK_INT(HEML_ERR_NODAL_PRESSURE, heml_create(&d, &m));
     CHECK(m == NULL);
     d.nodal_pressure = 1;
@@ -1762,7 +1824,7 @@ static void test_stiffness_cache(void)
         CHECK(m == NULL);
         free(X);
     }
-    for (nodal = 0; nodal < 2; nodal++)
+    for (nodal = 0; nodal < 3; nodal++)
         for (li = 0; li < NLAWS; li++) {
             heml_material mt = material_of(all_laws[li]);
             int n3 = 3 * mesh.node_count, i, c, bitwise = 1, allocs, fast, ok = 1, steps_same = 1;
