@@ -1687,6 +1687,13 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #else
 #define HEML__SCALAR_FN
 #endif
+/* Short lane loops that gcc unrolls and then leaves scalar when they are inlined into a
+   large caller (heml__count_lanes) stay functions of their own. */
+#if defined(__GNUC__) || defined(__clang__)
+#define HEML__NOINLINE __attribute__((noinline))
+#else
+#define HEML__NOINLINE
+#endif
 /* Vector intrinsics, only where the target has them (compile-time checks; never required):
    the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
    do not vectorise it; _mm*_sqrt_* round the same, correctly, so results are
@@ -3467,11 +3474,24 @@ static void heml__prefetch_block(const heml_real *C, int rows, const int *idx)
 {
 #if defined(__GNUC__) || defined(__clang__)
     size_t o;
-    for (o = 0; o < (size_t)rows * HEML__W * sizeof(heml_real); o += 64) __builtin_prefetch((const char *)C + o);
+    for (o = 0; o < (size_t)rows * HEML__W * sizeof(heml_real); o += 128) /* (two lines a turn) */
+        __builtin_prefetch((const char *)C + o), __builtin_prefetch((const char *)C + o + 64);
     for (o = 0; o < 4 * HEML__W * sizeof(int); o += 64) __builtin_prefetch((const char *)idx + o);
 #else
     (void)C, (void)rows, (void)idx;
 #endif
+}
+
+/* The force pass's statistics per lane: J - 1 below J0 - 1, J <= 0 (padding lanes hold
+   J - 1 = 0: neither). */
+HEML__NOINLINE static void heml__count_lanes(const heml_real *HEML__RESTRICT jm1, heml_real jm1_0, heml_real *HEML__RESTRICT below,
+                              heml_real *HEML__RESTRICT inverted)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        below[k] += jm1[k] < jm1_0 ? (heml_real)1 : (heml_real)0;
+        inverted[k] += jm1[k] <= -1 ? (heml_real)1 : (heml_real)0;
+    }
 }
 
 static void heml__chunks(void *vctx, int begin, int end)
@@ -3485,19 +3505,21 @@ static void heml__chunks(void *vctx, int begin, int end)
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         double energy = 0.0;
         int below = 0, inverted = 0;
+        heml_real below_l[HEML__W], inverted_l[HEML__W]; /* the force's counts per lane (a loop that vectorises) */
+        for (k = 0; k < HEML__W; k++) below_l[k] = inverted_l[k] = 0;
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             int valid = m->blk_valid[blk];
             switch (p->mode) {
             case HEML__FORCE:
             case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
+                if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
+                    heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR,
+                                         idx + 4 * HEML__W);
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
                 heml__scatter(m, idx, b.f, p->out);
-                for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
-                    below += b.jm1[k] < jm1_0;
-                    inverted += b.jm1[k] <= -1;
-                }
+                heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
                 if (m->dc_pass && mt->fast) { /* the stiffness cache: fill it, or read it */
@@ -3547,6 +3569,10 @@ static void heml__chunks(void *vctx, int begin, int end)
                                                   p->out + 9 * (size_t)m->slot_tet[blk * HEML__W + k]);
                 break;
             }
+        }
+        for (k = 0; k < HEML__W; k++) { /* (exact: at most HEML__CHUNK per lane) */
+            below += (int)below_l[k];
+            inverted += (int)inverted_l[k];
         }
         m->chunk_energy[ci] = energy;
         m->chunk_below[ci] = below;

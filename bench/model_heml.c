@@ -327,6 +327,9 @@ static int hm_arith(hm_sim *s)
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+            size_t o;
+            for (o = 0; blk + 1 < m->chunk_end[ci] && o < HEML__NR * HEML__W * sizeof(heml_real); o += 64)
+                __builtin_prefetch((const char *)(R + HEML__NR * HEML__W) + o); /* (the force pass's prefetch) */
             if (mt->fast) heml__forces_nh(mt, m->jm1_0, R, b);
             else {
                 heml__block_stress(m, mt, blk, b, 0, 0);
@@ -368,6 +371,8 @@ static void hm_move_groups(void *ctx, int begin, int end)
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++)
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+            if (blk + 1 < m->chunk_end[ci]) /* (the force pass's prefetch) */
+                heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR, idx + 4 * HEML__W);
             heml__gather(m, idx, m->disp, b.e);
             hm_move_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
             heml__scatter(m, idx, b.f, p->out);
