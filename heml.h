@@ -866,10 +866,11 @@
      AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
      conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
      (tests compare both, bit for bit, every law).
-   - tried and not kept: software prefetch of the next block's nodes and the rest constants
-     of the block after (large meshes): no difference measurable above this machine's
-     noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns in the
-     same interleaved series: noise).
+   - tried and not kept then: software prefetch of the next block's nodes and the rest
+     constants of the block after (large meshes): no difference measurable above this
+     machine's noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns
+     in the same interleaved series: noise). The rest constants' prefetch is now kept (the
+     force's out-of-cache gap, below); the nodes' is still not.
    The bench's ratio lines (bench/bench.c, kernels part, `--filter heml`; one loaded run of
    git ea15902 plus these kernels, double, 1 thread) put the Neo-Hookean force at 20 to 23 %
    of its bandwidth bound at 1e3 to 1e4 tetrahedra and 13 to 14 % at 1e5 to 1e6 (goal 40 %:
@@ -917,6 +918,48 @@
    constants in the uncached general path (St Venant-Kirchhoff): none either.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
+   Why the force cost twice the cached differential out of cache (issue 21: the bench's
+   kernels.csv of git 59471d0 on the Zen 5, one thread, double: force 29.9 / 36.1 ns per
+   tetrahedron at 1.1e5 / 1e6 against K*v's 14.2 / 17.6, though the product streams 162
+   bytes per tetrahedron and the force 106): not a per-element stream of the force's own.
+   The force pass writes nothing per tetrahedron (its statistics are per chunk, its only
+   writes the node forces, which K*v writes too; no linearisation cache: the stiffness
+   cache is filled by the first product, never by the force), so no write-allocate traffic
+   either, and both read their streams in the same order. The difference was the prefetch:
+   the cached product prefetches the next block's stream and indices (above), the force
+   did not, and its longer arithmetic per block (70 instructions per tetrahedron against
+   the cached product's 44, callgrind, x86-64-v3) keeps the next block's loads out of the
+   reorder window, so each block waited for its rest constants (most likely also why the
+   arith floor, which streams them alone, rose from 6.8 to 12.1 ns at 1e6 on the Zen 5).
+   The force pass now prefetches the next block's rest constants and indices
+   (heml__prefetch_block), and its statistics' counts are a vectorised lane loop
+   (heml__count_lanes: gcc had unrolled the loop inside heml__chunks and left it scalar,
+   7 of 159 instructions per tetrahedron).
+   Measured (this session's machine is not the Zen 5: an Intel Xeon virtual machine, gcc
+   12 -march=native = rocketlake, 2 vCPUs shared with other jobs, load 3 to 8; 2 MB L2 per
+   core, so 1e6 tetrahedra are out of L2 but, with its large L3, not in memory, hence the
+   5e6 row), Neo-Hookean force, double, one thread, 5-tetrahedron cubes as the bench's,
+   before and after built into one program (two models on the same mesh), single calls
+   alternated, minimum of 400 calls (60 at 1e6 and above), ns per tetrahedron:
+       tetrahedra          1,080    10,985    109,760    1.08e6    5.0e6
+       before              10.8     10.9      14.8       40.3      47.6
+       after               10.1     10.3      11.7       35.3      37.9
+       after / before      0.94     0.95      0.79       0.88      0.80
+   (two series of earlier states of the change: 0.95-1.05 at 1e3-1e4, 0.84-0.93 at 1.1e5,
+   0.78-0.80 at 1e6, 0.78 at 5e6; the same program with both sides before: 0.99-1.06 in
+   cache, 0.90-1.02 at 1.1e5, 0.85-0.93 at 1e6: in cache the change is within the noise,
+   at 1.1e5 and beyond it is a gain of about 15 to 20 %, the 1e6 figure the least sure).
+   Instructions (callgrind, x86-64-v3, 11k tetrahedra): 159 -> 157 per tetrahedron. The
+   Zen 5 is not measured here: the bench's next run there says how much of the 2x is
+   gone. Tried and not kept:
+   prefetching the next block's nodes (positions and forces, 128 prefetches a block) as
+   well: 11 % slower in cache, no gain at 1e6; compiling the Neo-Hookean force loops for
+   512-bit vectors (gcc target("prefer-vector-width=512") on heml__forces_nh: 531 zmm
+   instructions): 0.96 to 1.02 of the 256-bit code in cache here (0.92 to 1.00 with the
+   whole program at 512 bits), within the noise, so not worth a compiler-specific
+   attribute. What is left in cache is the arithmetic (70 of 157
+   instructions per tetrahedron), the scatter (47: per lane and node a 16-byte and an
+   8-byte read-modify-write) and the gather (24), run one after the other per block.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -3466,10 +3509,11 @@ typedef struct heml__pass {
     heml_real *out;
 } heml__pass;
 
-/* Software prefetch of a block's streams: its stiffness cache and node indices, a block
-   ahead (the cached stiffness product: measured 1.4 times faster on
-   meshes beyond the caches, see PERFORMANCE). A hint only: nothing where the compiler has
-   no prefetch builtin. */
+/* Software prefetch of a block's streams: its stiffness cache (the cached product) or its
+   rest constants (the force pass) and its node indices, a block ahead (the cached
+   stiffness product: measured 1.4 times faster on meshes beyond the caches; the force
+   0.8 times the time at 1e5 to 5e6 tetrahedra, see PERFORMANCE). A hint only: nothing
+   where the compiler has no prefetch builtin. */
 static void heml__prefetch_block(const heml_real *C, int rows, const int *idx)
 {
 #if defined(__GNUC__) || defined(__clang__)

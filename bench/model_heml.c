@@ -312,7 +312,8 @@ static void hm_csr_product(const hm_sim *s, const heml_real *x, heml_real *y)
 }
 
 /* The arithmetic floor: the force pass's blocks, colours and groups with the law's
-   arithmetic and the rest-constant stream, but no gather or scatter (every block computes
+   arithmetic and the rest-constant stream (prefetched a block ahead, as the force pass
+   does), but no gather or scatter (every block computes
    on the links gathered once for block 0; the forces are summed into a sink). */
 static volatile double hm_sink;
 static int hm_arith(hm_sim *s)
@@ -343,8 +344,8 @@ static int hm_arith(hm_sim *s)
     return 0;
 }
 
-/* The move kernel: the force pass of heml.h (its colours, groups and blocks, its gather
-   and scatter, reached through the implementation this file includes) with the law's
+/* The move kernel: the force pass of heml.h (its colours, groups and blocks, its prefetch,
+   gather and scatter, reached through the implementation this file includes) with the law's
    arithmetic replaced by one multiply-add per link component, so that it still reads
    every rest constant. What is left is the data movement the force cannot avoid (for
    the hyperelastic laws; the spring law streams its own constants as well, so it has no
