@@ -949,6 +949,8 @@
    0.78-0.80 at 1e6, 0.78 at 5e6; the same program with both sides before: 0.99-1.06 in
    cache, 0.90-1.02 at 1.1e5, 0.85-0.93 at 1e6: in cache the change is within the noise,
    at 1.1e5 and beyond it is a gain of about 15 to 20 %, the 1e6 figure the least sure).
+   In float (same method): 1.01 at 1e3-1e4, 0.95 at 1.1e5, 0.68 and 0.68 at 1e6 in two
+   series (a third, 1.18 by its minimum but 0.83 by its tenth percentile), 0.86 at 5e6.
    Instructions (callgrind, x86-64-v3, 11k tetrahedra): 159 -> 157 per tetrahedron. The
    Zen 5 is not measured here: the bench's next run there says how much of the 2x is
    gone. Tried and not kept:
