@@ -955,7 +955,8 @@
    Zen 5 is not measured here: the bench's next run there says how much of the 2x is
    gone. Tried and not kept:
    prefetching the next block's nodes (positions and forces, 128 prefetches a block) as
-   well: 11 % slower in cache, no gain at 1e6; compiling the Neo-Hookean force loops for
+   well: 11 % slower in cache, no gain at 1e6; prefetching two blocks ahead instead of
+   one: 1.01, 0.99 and 1.11 at 1.1e5, 1e6 and 5e6 (noise); compiling the Neo-Hookean force loops for
    512-bit vectors (gcc target("prefer-vector-width=512") on heml__forces_nh: 531 zmm
    instructions): 0.96 to 1.02 of the 256-bit code in cache here (0.92 to 1.00 with the
    whole program at 512 bits), within the noise, so not worth a compiler-specific
