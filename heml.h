@@ -947,10 +947,11 @@
      AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
      conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
      (tests compare both, bit for bit, every law).
-   - tried and not kept: software prefetch of the next block's nodes and the rest constants
-     of the block after (large meshes): no difference measurable above this machine's
-     noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns in the
-     same interleaved series: noise).
+   - tried and not kept then: software prefetch of the next block's nodes and the rest
+     constants of the block after (large meshes): no difference measurable above this
+     machine's noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns
+     in the same interleaved series: noise). The rest constants' prefetch is now kept (the
+     force's out-of-cache gap, below); the nodes' is still not.
    The bench's ratio lines (bench/bench.c, kernels part, `--filter heml`; one loaded run of
    git ea15902 plus these kernels, double, 1 thread) put the Neo-Hookean force at 20 to 23 %
    of its bandwidth bound at 1e3 to 1e4 tetrahedra and 13 to 14 % at 1e5 to 1e6 (goal 40 %:
@@ -998,6 +999,51 @@
    constants in the uncached general path (St Venant-Kirchhoff): none either.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
+   Why the force cost twice the cached differential out of cache (issue 21: the bench's
+   kernels.csv of git 59471d0 on the Zen 5, one thread, double: force 29.9 / 36.1 ns per
+   tetrahedron at 1.1e5 / 1e6 against K*v's 14.2 / 17.6, though the product streams 162
+   bytes per tetrahedron and the force 106): not a per-element stream of the force's own.
+   The force pass writes nothing per tetrahedron (its statistics are per chunk, its only
+   writes the node forces, which K*v writes too; no linearisation cache: the stiffness
+   cache is filled by the first product, never by the force), so no write-allocate traffic
+   either, and both read their streams in the same order. The difference was the prefetch:
+   the cached product prefetches the next block's stream and indices (above), the force
+   did not, and its longer arithmetic per block (70 instructions per tetrahedron against
+   the cached product's 44, callgrind, x86-64-v3) keeps the next block's loads out of the
+   reorder window, so each block waited for its rest constants (most likely also why the
+   arith floor, which streams them alone, rose from 6.8 to 12.1 ns at 1e6 on the Zen 5).
+   The force pass now prefetches the next block's rest constants and indices
+   (heml__prefetch_block), and its statistics' counts are a vectorised lane loop
+   (heml__count_lanes: gcc had unrolled the loop inside heml__chunks and left it scalar,
+   7 of 159 instructions per tetrahedron).
+   Measured (this session's machine is not the Zen 5: an Intel Xeon virtual machine, gcc
+   12 -march=native = rocketlake, 2 vCPUs shared with other jobs, load 3 to 8; 2 MB L2 per
+   core, so 1e6 tetrahedra are out of L2 but, with its large L3, not in memory, hence the
+   5e6 row), Neo-Hookean force, double, one thread, 5-tetrahedron cubes as the bench's,
+   before and after built into one program (two models on the same mesh), single calls
+   alternated, minimum of 400 calls (60 at 1e6 and above), ns per tetrahedron:
+       tetrahedra          1,080    10,985    109,760    1.08e6    5.0e6
+       before              10.8     10.9      14.8       40.3      47.6
+       after               10.1     10.3      11.7       35.3      37.9
+       after / before      0.94     0.95      0.79       0.88      0.80
+   (two series of earlier states of the change: 0.95-1.05 at 1e3-1e4, 0.84-0.93 at 1.1e5,
+   0.78-0.80 at 1e6, 0.78 at 5e6; the same program with both sides before: 0.99-1.06 in
+   cache, 0.90-1.02 at 1.1e5, 0.85-0.93 at 1e6: in cache the change is within the noise,
+   at 1.1e5 and beyond it is a gain of about 15 to 20 %, the 1e6 figure the least sure).
+   In float (same method): 1.01 at 1e3-1e4, 0.95 at 1.1e5, 0.68 and 0.68 at 1e6 in two
+   series (a third, 1.18 by its minimum but 0.83 by its tenth percentile), 0.86 at 5e6.
+   Instructions (callgrind, x86-64-v3, 11k tetrahedra): 159 -> 157 per tetrahedron. The
+   Zen 5 is not measured here: the bench's next run there says how much of the 2x is
+   gone. Tried and not kept:
+   prefetching the next block's nodes (positions and forces, 128 prefetches a block) as
+   well: 11 % slower in cache, no gain at 1e6; prefetching two blocks ahead instead of
+   one: 1.01, 0.99 and 1.11 at 1.1e5, 1e6 and 5e6 (noise); compiling the Neo-Hookean force loops for
+   512-bit vectors (gcc target("prefer-vector-width=512") on heml__forces_nh: 531 zmm
+   instructions): 0.96 to 1.02 of the 256-bit code in cache here (0.92 to 1.00 with the
+   whole program at 512 bits), within the noise, so not worth a compiler-specific
+   attribute. What is left in cache is the arithmetic (70 of 157
+   instructions per tetrahedron), the scatter (47: per lane and node a 16-byte and an
+   8-byte read-modify-write) and the gather (24), run one after the other per block.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -1774,6 +1820,13 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__SCALAR_FN __attribute__((noinline, optimize("no-tree-vectorize")))
 #else
 #define HEML__SCALAR_FN
+#endif
+/* Short lane loops that gcc unrolls and then leaves scalar when they are inlined into a
+   large caller (heml__count_lanes) stay functions of their own. */
+#if defined(__GNUC__) || defined(__clang__)
+#define HEML__NOINLINE __attribute__((noinline))
+#else
+#define HEML__NOINLINE
 #endif
 /* Vector intrinsics, only where the target has them (compile-time checks; never required):
    the square roots of the spring lengths (libm's sqrt keeps errno semantics, so compilers
@@ -3552,19 +3605,33 @@ typedef struct heml__pass {
     heml_real *out;
 } heml__pass;
 
-/* Software prefetch of a block's streams: its stiffness cache and node indices, a block
-   ahead (the cached stiffness product: measured 1.4 times faster on
-   meshes beyond the caches, see PERFORMANCE). A hint only: nothing where the compiler has
-   no prefetch builtin. */
+/* Software prefetch of a block's streams: its stiffness cache (the cached product) or its
+   rest constants (the force pass) and its node indices, a block ahead (the cached
+   stiffness product: measured 1.4 times faster on meshes beyond the caches; the force
+   0.8 times the time at 1e5 to 5e6 tetrahedra, see PERFORMANCE). A hint only: nothing
+   where the compiler has no prefetch builtin. */
 static void heml__prefetch_block(const heml_real *C, int rows, const int *idx)
 {
 #if defined(__GNUC__) || defined(__clang__)
     size_t o;
-    for (o = 0; o < (size_t)rows * HEML__W * sizeof(heml_real); o += 64) __builtin_prefetch((const char *)C + o);
+    for (o = 0; o < (size_t)rows * HEML__W * sizeof(heml_real); o += 128) /* (two lines a turn) */
+        __builtin_prefetch((const char *)C + o), __builtin_prefetch((const char *)C + o + 64);
     for (o = 0; o < 4 * HEML__W * sizeof(int); o += 64) __builtin_prefetch((const char *)idx + o);
 #else
     (void)C, (void)rows, (void)idx;
 #endif
+}
+
+/* The force pass's statistics per lane: J - 1 below J0 - 1, J <= 0 (padding lanes hold
+   J - 1 = 0: neither). */
+HEML__NOINLINE static void heml__count_lanes(const heml_real *HEML__RESTRICT jm1, heml_real jm1_0, heml_real *HEML__RESTRICT below,
+                              heml_real *HEML__RESTRICT inverted)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        below[k] += jm1[k] < jm1_0 ? (heml_real)1 : (heml_real)0;
+        inverted[k] += jm1[k] <= -1 ? (heml_real)1 : (heml_real)0;
+    }
 }
 
 static void heml__chunks(void *vctx, int begin, int end)
@@ -3578,19 +3645,21 @@ static void heml__chunks(void *vctx, int begin, int end)
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         double energy = 0.0;
         int below = 0, inverted = 0;
+        heml_real below_l[HEML__W], inverted_l[HEML__W]; /* the force's counts per lane (a loop that vectorises) */
+        for (k = 0; k < HEML__W; k++) below_l[k] = inverted_l[k] = 0;
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             int valid = m->blk_valid[blk];
             switch (p->mode) {
             case HEML__FORCE:
             case HEML__FORCE_ENERGY: /* (the energy of the relaxed Prony response: s W) */
+                if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
+                    heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR,
+                                         idx + 4 * HEML__W);
                 energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                           (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
                 heml__scatter(m, idx, b.f, p->out);
-                for (k = 0; k < HEML__W; k++) { /* (padding lanes hold J - 1 = 0: neither) */
-                    below += b.jm1[k] < jm1_0;
-                    inverted += b.jm1[k] <= -1;
-                }
+                heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
                 if (m->dc_pass && mt->fast) { /* the stiffness cache: fill it, or read it */
@@ -3640,6 +3709,10 @@ static void heml__chunks(void *vctx, int begin, int end)
                                                   p->out + 9 * (size_t)m->slot_tet[blk * HEML__W + k]);
                 break;
             }
+        }
+        for (k = 0; k < HEML__W; k++) { /* (exact: at most HEML__CHUNK per lane) */
+            below += (int)below_l[k];
+            inverted += (int)inverted_l[k];
         }
         m->chunk_energy[ci] = energy;
         m->chunk_below[ci] = below;

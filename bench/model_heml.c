@@ -314,7 +314,8 @@ static void hm_csr_product(const hm_sim *s, const heml_real *x, heml_real *y)
 }
 
 /* The arithmetic floor: the force pass's blocks, colours and groups with the law's
-   arithmetic and the rest-constant stream, but no gather or scatter (every block computes
+   arithmetic and the rest-constant stream (prefetched a block ahead, as the force pass
+   does), but no gather or scatter (every block computes
    on the links gathered once for block 0; the forces are summed into a sink). */
 static volatile double hm_sink;
 static int hm_arith(hm_sim *s)
@@ -329,6 +330,9 @@ static int hm_arith(hm_sim *s)
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+            size_t o;
+            for (o = 0; blk + 1 < m->chunk_end[ci] && o < HEML__NR * HEML__W * sizeof(heml_real); o += 64)
+                __builtin_prefetch((const char *)(R + HEML__NR * HEML__W) + o); /* (the force pass's prefetch) */
             if (mt->fast) heml__forces_nh(mt, m->jm1_0, R, b);
             else {
                 heml__block_stress(m, mt, blk, b, 0, 0);
@@ -342,8 +346,8 @@ static int hm_arith(hm_sim *s)
     return 0;
 }
 
-/* The move kernel: the force pass of heml.h (its colours, groups and blocks, its gather
-   and scatter, reached through the implementation this file includes) with the law's
+/* The move kernel: the force pass of heml.h (its colours, groups and blocks, its prefetch,
+   gather and scatter, reached through the implementation this file includes) with the law's
    arithmetic replaced by one multiply-add per link component, so that it still reads
    every rest constant. What is left is the data movement the force cannot avoid (for
    the hyperelastic laws; the spring law streams its own constants as well, so it has no
@@ -370,6 +374,8 @@ static void hm_move_groups(void *ctx, int begin, int end)
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++)
         for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+            if (blk + 1 < m->chunk_end[ci]) /* (the force pass's prefetch) */
+                heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR, idx + 4 * HEML__W);
             heml__gather(m, idx, m->disp, b.e);
             hm_move_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
             heml__scatter(m, idx, b.f, p->out);
