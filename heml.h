@@ -97,7 +97,9 @@
            ranges, HEML_ERR_MATERIAL); heml_material_from_young's case. Leave `fast_path`
            at 0: the vectorised kernels (heml__forces_nh, heml__diff_nh) compute
            Neo-Hookean and nothing else; set it only for a law that is exactly heml__law_raw
-           without an I2 term, or write a kernel for the law and a flag for it. Everything
+           without an I2 term, or write a kernel for the law and a flag for it (as St
+           Venant-Kirchhoff's differential, heml__diff_svk: heml__mat.dk, chosen in
+           heml__make_mat, with its point values in the stiffness cache). Everything
            else (the general path's kinematics, stress coefficients, P1 forces and their
            differential, Prony, energies, stresses, the small-strain moduli for the
            preconditioner and heml_stable_time_step) comes from those functions.
@@ -153,9 +155,11 @@
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
-   incompressible Mooney-Rivlin with c2 = 0; no Prony series, no nodal pressure), none
-   otherwise; desc.stiffness_cache = 0 leaves it out (each product then recomputes them:
-   see PERFORMANCE for the cost).
+   incompressible Mooney-Rivlin with c2 = 0), 21 (168 / 84 bytes) when one is St Venant-
+   Kirchhoff (the largest of the two when both are), plus a byte per block of 16; only
+   without a Prony series and without nodal pressure; none otherwise (the compressible
+   Mooney-Rivlin, springs, user laws); desc.stiffness_cache = 0 leaves it out (each
+   product then recomputes them: see PERFORMANCE for the cost).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -915,6 +919,28 @@
    rest constants, 184 bytes): 0.9 to 1.05 of the CSR at 1e6 in double; one fused loop for
    the F form's apply instead of three: no difference above noise; prefetching the rest
    constants in the uncached general path (St Venant-Kirchhoff): none either.
+   St Venant-Kirchhoff's differential (issue 21, third part: heml__diff_svk, the same
+   scheme): dP = dF S + F dS in the links, df = -(dv B + v K), B = Vol G S G^T,
+   K = lambda (X : Ah) Ah + 2 mu Ah X Ah, X = sym(v^T dv), Ah = sqrt(Vol) G G^T: 21 reals
+   of cache per tetrahedron (v, Ah, B), about 150 operations a product, filled by the first
+   product like Neo-Hookean's (bit-identical to the uncached product). It runs without
+   Prony (the general path's viscous scaling) and without nodal pressure; a block of 16
+   with a tetrahedron below J0 (the law's guard) takes the general path (m->dc_gen, a byte
+   per block). Callgrind (x86-64-v3, 10,985 tetrahedra, instructions per tetrahedron and
+   product at one state): 294 -> 153 (Neo-Hookean's cached product 137; the filling
+   product 281). Measured (bench/model_heml.c's adapter for both versions in one program,
+   old and new and the CSR product of the same tangent interleaved, minimum of 12 rounds,
+   one thread, double; Zen 5, 2 vCPUs at load 5 to 9, so absolute figures are about twice
+   a quiet run's), K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra: before 1.28, 1.16, 0.81,
+   0.89; after 0.65, 0.75, 0.62, 0.87 (25.5, 42.8, 57.9, 85.5 ns against 50.4, 66.9, 76.1,
+   88.1); float 0.44, 0.67, 0.51, 0.56 (before 0.85, 1.28, 0.80, 0.89). The bench's CSR
+   row for St Venant-Kirchhoff (and every law on the general path) was slowed 5 to 7 times
+   at small sizes by subnormal garbage: its adapter left the differential's dp
+   uninitialised (fixed there). Not done: Mooney-Rivlin (split). In the links its
+   differential needs besides B and Ah also N = Vol G (C - I) G^T / sqrt(Vol) and five
+   scalars (32 reals, near a CSR row share), and about 280 operations; its product stays
+   on the general path (320 instructions, 1.6 to 1.8 times the CSR product in the run
+   above).
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
@@ -933,7 +959,8 @@
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
          robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
          oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read it smoothed
-         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels (the general path runs)
+         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels and St Venant-Kirchhoff's
+         differential kernel (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
@@ -1325,9 +1352,10 @@ typedef struct heml_desc {
                                         pressure tetrahedra for nearly incompressible bodies
                                         (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
                                         user laws with second derivatives */
-    int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
-                                        tetrahedron what its linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
+    int stiffness_cache;             /* 1 (default): the Neo-Hookean and St Venant-Kirchhoff
+                                        stiffness products cache per tetrahedron what their
+                                        linearisation point fixes (PERFORMANCE, MEMORY: 17 or 21
+                                        reals a tetrahedron); 0: no cache, no memory */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1519,14 +1547,15 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m);
    N for dx in m; out is overwritten, caller-owned), i.e. minus the tangent stiffness
    times dx, exact for every law (the J0 continuation and Prony scaling included). One
    pass; HEML_ERR_NO_SECOND_DERIVATIVES for a user law without `second`. With the stiffness
-   cache (desc.stiffness_cache, Neo-Hookean tetrahedra) the first call after a change of
-   the state fills it, the next ones at the same state read it (bit-identical results). */
+   cache (desc.stiffness_cache, Neo-Hookean and St Venant-Kirchhoff tetrahedra) the first
+   call after a change of the state fills it, the next ones at the same state read it
+   (bit-identical results). */
 HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *out);
 /* Bytes one force pass (kernel 0) or one differential pass (kernel 1) must move at least:
    the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus spring and Prony data)
    and each node's displacement (and dx) read once and force written once; for kernel 1
-   the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 reals of
-   cache instead, and read dx only. */
+   the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 (Neo-
+   Hookean) or 21 (St Venant-Kirchhoff) reals of cache instead, and read dx only. */
 HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, size_t *written);
 
 /* ---- state access (pointers into the model, valid until heml_destroy) ---- */
@@ -1721,7 +1750,11 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #endif
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
-#define HEML__NC 17         /* stiffness cache per tetrahedron (fast path): v (9), A (6), s1, s2 (heml__diff_nh) */
+#define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
+#define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
+#define HEML__NC 21         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
+#define HEML__DK_NH 1       /* heml__mat.dk: the differential kernel of a material (0: the general path) */
+#define HEML__DK_SVK 2
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
@@ -1760,6 +1793,8 @@ typedef struct heml__mat {
     int kind, uses_i2;
     int fast;                    /* its law's fast_path flag, and no I2 term, and no Prony: the
                                     vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
+    int dk;                      /* its differential kernel (HEML__DK_*, cached in the stiffness
+                                    cache), 0: the general path (Prony, nodal pressure, other laws) */
     heml_law law;
     const struct heml__law_ops *ops; /* its law's row of heml__laws */
     heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
@@ -1898,6 +1933,10 @@ struct heml_model {
     heml_real *dc;
     const heml_real *dc_key;
     int has_dc, dc_pass; /* dc carved; the running DIFF pass's use of it (HEML__DC_*) */
+    int dc_rows;         /* reals per tetrahedron slot of dc: the largest HEML__NC_* of a cached
+                            material in use */
+    unsigned char *dc_gen; /* per block: 1 when the cache holds no point values for it (a St
+                            Venant-Kirchhoff block with a tetrahedron below J0: general path) */
 
     /* coarse space (heml__coarse_build) */
     int *node_agg;      /* aggregate of each node */
@@ -3102,6 +3141,144 @@ static void heml__diff_nh(const heml_model *m, const heml__mat *mt, int blk, hem
     heml__diff_nh_apply(mt, b->lin[0], b);
 }
 
+/* The St Venant-Kirchhoff force differential (law heml__law_svk, HEML__DK_SVK): with
+   S = lambda tr E I + 2 mu E, P = F S,
+       dP = dF S + F dS,   dS = lambda tr dE I + 2 mu dE,   dE = sym(F^T dF),
+   and in the links as heml__diff_nh's (F = v G, dF = dv G, G = V^-1, df = -Vol dP G^T):
+   dE = G^T X G with X = sym(v^T dv), tr dE = X : G G^T, so
+       df = -(dv B + v K),   B = Vol G S G^T,
+       K = lambda (X : Ah) Ah + 2 mu Ah X Ah,   Ah = Vol G G^T / sqrt(Vol) = sqrt(Vol) G G^T
+   (lambda Vol tr dE v G G^T = lambda (X : Ah) v Ah, 2 mu Vol v G G^T X G G^T = 2 mu v Ah X Ah).
+   What the linearisation point fixes: v (9), Ah (6), B (6): HEML__NC_SVK = 21 reals
+   (heml__diff_svk_point); a product (heml__diff_svk_apply) costs about 150 operations: v^T dv
+   (27 multiply-adds), X Ah and Ah (X Ah) (45), v K and dv B (54) and a few. B comes from
+   E = (H + H^T + H^T H) / 2 formed from the displacements (no cancellation at small
+   strain, as the force's). Below J0 the law adds its guard (lambda + 2 mu) d^2 / 2: a block
+   with a tetrahedron below J0 returns 1 from the point function and takes the general path
+   (heml__block_diff_general), so does a material with a Prony series (mt->dk = 0) or a
+   model with the nodal pressure. Cached and uncached products run the same functions on
+   the same values: bit-identical. */
+static int heml__diff_svk_point(const heml__mat *mt, heml_real jm1_0, int valid, const heml_real *HEML__RESTRICT R,
+                                const heml_real (*HEML__RESTRICT V)[HEML__W], const heml__blk *HEML__RESTRICT b,
+                                heml_real *HEML__RESTRICT C)
+{
+    const heml_real mu = mt->mu, lambda = mt->lambda;
+    heml_real sv[HEML__W];
+    int k, r, below = 0;
+    for (r = 0; r < 9; r++) /* v = V + du */
+        for (k = 0; k < HEML__W; k++) C[r * HEML__W + k] = V[r][k] + b->e[r][k];
+    for (k = 0; k < HEML__W; k++) sv[k] = R[9 * HEML__W + k] > 0 ? R[9 * HEML__W + k] : 1; /* (padding: G = 0) */
+    heml__sqrt_lanes(sv, HEML__W);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k], ah = sv[k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+        heml_real jm1 = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
+        /* S = lambda / 2 tr E2 I + mu E2, E2 = C - I = H + H^T + H^T H */
+        heml_real E00 = 2 * H00 + (H00 * H00 + H10 * H10 + H20 * H20);
+        heml_real E11 = 2 * H11 + (H01 * H01 + H11 * H11 + H21 * H21);
+        heml_real E22 = 2 * H22 + (H02 * H02 + H12 * H12 + H22 * H22);
+        heml_real E01 = H01 + H10 + (H00 * H01 + H10 * H11 + H20 * H21);
+        heml_real E02 = H02 + H20 + (H00 * H02 + H10 * H12 + H20 * H22);
+        heml_real E12 = H12 + H21 + (H01 * H02 + H11 * H12 + H21 * H22);
+        heml_real st = lambda / 2 * (E00 + E11 + E22);
+        heml_real S00 = st + mu * E00, S11 = st + mu * E11, S22 = st + mu * E22;
+        heml_real S01 = mu * E01, S02 = mu * E02, S12 = mu * E12;
+        /* u_j = S g_j, B_jl = Vol g_j . u_l, Ah_jl = sqrt(Vol) g_j . g_l */
+        heml_real u10 = S00 * g10 + S01 * g11 + S02 * g12, u11 = S01 * g10 + S11 * g11 + S12 * g12;
+        heml_real u12 = S02 * g10 + S12 * g11 + S22 * g12;
+        heml_real u20 = S00 * g20 + S01 * g21 + S02 * g22, u21 = S01 * g20 + S11 * g21 + S12 * g22;
+        heml_real u22 = S02 * g20 + S12 * g21 + S22 * g22;
+        heml_real u30 = S00 * g30 + S01 * g31 + S02 * g32, u31 = S01 * g30 + S11 * g31 + S12 * g32;
+        heml_real u32 = S02 * g30 + S12 * g31 + S22 * g32;
+        below |= (k < valid) & (jm1 < jm1_0);
+        C[9 * HEML__W + k] = ah * (g10 * g10 + g11 * g11 + g12 * g12);
+        C[10 * HEML__W + k] = ah * (g20 * g20 + g21 * g21 + g22 * g22);
+        C[11 * HEML__W + k] = ah * (g30 * g30 + g31 * g31 + g32 * g32);
+        C[12 * HEML__W + k] = ah * (g10 * g20 + g11 * g21 + g12 * g22);
+        C[13 * HEML__W + k] = ah * (g10 * g30 + g11 * g31 + g12 * g32);
+        C[14 * HEML__W + k] = ah * (g20 * g30 + g21 * g31 + g22 * g32);
+        C[15 * HEML__W + k] = vol * (g10 * u10 + g11 * u11 + g12 * u12);
+        C[16 * HEML__W + k] = vol * (g20 * u20 + g21 * u21 + g22 * u22);
+        C[17 * HEML__W + k] = vol * (g30 * u30 + g31 * u31 + g32 * u32);
+        C[18 * HEML__W + k] = vol * (g10 * u20 + g11 * u21 + g12 * u22);
+        C[19 * HEML__W + k] = vol * (g10 * u30 + g11 * u31 + g12 * u32);
+        C[20 * HEML__W + k] = vol * (g20 * u30 + g21 * u31 + g22 * u32);
+    }
+    return below;
+}
+
+/* The product of the point values C (heml__diff_svk_point) with the links dv of dx in
+   b->de, into b->f (nodes 1..3): df = -(dv B + v K). */
+static void heml__diff_svk_apply(const heml__mat *mt, const heml_real *HEML__RESTRICT C, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real lambda = mt->lambda, mu2 = 2 * mt->mu;
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k]; /* dv1 */
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k]; /* dv2 */
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k]; /* dv3 */
+        heml_real p0 = C[k], p1 = C[HEML__W + k], p2 = C[2 * HEML__W + k];               /* v1 */
+        heml_real q0 = C[3 * HEML__W + k], q1 = C[4 * HEML__W + k], q2 = C[5 * HEML__W + k]; /* v2 */
+        heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
+        heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
+        heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
+        heml_real B11 = C[15 * HEML__W + k], B22 = C[16 * HEML__W + k], B33 = C[17 * HEML__W + k];
+        heml_real B12 = C[18 * HEML__W + k], B13 = C[19 * HEML__W + k], B23 = C[20 * HEML__W + k];
+        /* X = sym(v^T dv): X_jl = (v_j . dv_l + v_l . dv_j) / 2 */
+        heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
+        heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
+        heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
+        heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
+        heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
+        heml_real la = lambda * ((X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23));
+        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric) */
+        heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
+        heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
+        heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
+        heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real K11 = la * A11 + mu2 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = la * A22 + mu2 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = la * A33 + mu2 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = la * A12 + mu2 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = la * A13 + mu2 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = la * A23 + mu2 * (A12 * T13 + A22 * T23 + A23 * T33);
+        b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13));
+        b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13));
+        b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13));
+        b->f[3][k] = -((x0 * B12 + y0 * B22 + z0 * B23) + (p0 * K12 + q0 * K22 + r0 * K23));
+        b->f[4][k] = -((x1 * B12 + y1 * B22 + z1 * B23) + (p1 * K12 + q1 * K22 + r1 * K23));
+        b->f[5][k] = -((x2 * B12 + y2 * B22 + z2 * B23) + (p2 * K12 + q2 * K22 + r2 * K23));
+        b->f[6][k] = -((x0 * B13 + y0 * B23 + z0 * B33) + (p0 * K13 + q0 * K23 + r0 * K33));
+        b->f[7][k] = -((x1 * B13 + y1 * B23 + z1 * B33) + (p1 * K13 + q1 * K23 + r1 * K33));
+        b->f[8][k] = -((x2 * B13 + y2 * B23 + z2 * B33) + (p2 * K13 + q2 * K23 + r2 * K33));
+    }
+}
+
+/* The uncached St Venant-Kirchhoff differential of block blk (links of u in b->e, of dx in
+   b->de), as heml__diff_nh; returns 1 (nothing computed) for a block below J0. */
+static int heml__diff_svk(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
+{
+    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    heml__gather(m, m->blk_idx + (size_t)blk * 4 * HEML__W, m->rest, b->H);
+    if (heml__diff_svk_point(mt, m->jm1_0, m->blk_valid[blk], R, (const heml_real(*)[HEML__W])b->H, b, b->lin[0]))
+        return 1;
+    heml__diff_svk_apply(mt, b->lin[0], b);
+    return 0;
+}
+
 /* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
    INCOMPRESSIBLE BODIES): the element's own volumetric function U(J_e) comes off (w -= U,
    w_J -= U', w_JJ -= U'') and the mean of its four nodes' pressures p_e = sum P_a / 4 goes
@@ -3274,20 +3451,13 @@ static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, 
        dP = 2 s da F + s dw_J cof F + 2 a dH + w_J dcof F - dH M - s F dM,
        da = dw_1 + (I1 - 1) dw_2 + w_2 dI1,   dM = 2 (dw_2 (C - I) + w_2 dE2),
    a, w_J and M those of the force (Prony-filtered), s the Prony factor (1 without
-   viscosity). Springs: d(t v) = t dv + dt v, dt = s k L (v . dv) / l^3. */
-static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
-                             const heml_real *dx, heml__blk *b)
+   viscosity). Springs: d(t v) = t dv + dt v, dt = s k L (v . dv) / l^3. The links of u are
+   in b->e, those of dx in b->de (heml__block_diff gathers them). */
+static void heml__block_diff_general(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
-    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml_real sp;
     int k;
-    heml__gather(m, idx, u, b->e);
-    heml__gather(m, idx, dx, b->de);
-    if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
-        heml__diff_nh(m, mt, blk, b);
-        return;
-    }
     sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
@@ -3322,6 +3492,22 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         for (k = 0; k < HEML__W; k++) b->dp[k] = 0;
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
+}
+
+/* The same with the gathers, through the material's differential kernel where it has one
+   (mt->dk: heml__diff_nh, heml__diff_svk; the general path where that declines). */
+static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
+                             const heml_real *dx, heml__blk *b)
+{
+    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+    heml__gather(m, idx, u, b->e);
+    heml__gather(m, idx, dx, b->de);
+    if (mt->dk == HEML__DK_NH) { /* (the law's fast_path flag: heml__laws) */
+        heml__diff_nh(m, mt, blk, b);
+        return;
+    }
+    if (mt->dk == HEML__DK_SVK && !heml__diff_svk(m, mt, blk, b)) return;
+    heml__block_diff_general(m, mt, blk, b);
 }
 
 /* Stress of one lane from its node forces (double): P = -(1/Vol) sum_k f_k V_k^T (the
@@ -3500,18 +3686,31 @@ static void heml__chunks(void *vctx, int begin, int end)
                 }
                 break;
             case HEML__DIFF:
-                if (m->dc_pass && mt->fast) { /* the stiffness cache: fill it, or read it */
+                if (m->dc_pass && mt->dk) { /* the stiffness cache: fill it, or read it */
                     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-                    heml_real *C = m->dc + (size_t)blk * HEML__NC * HEML__W;
+                    const int rows = m->dc_rows;
+                    heml_real *C = m->dc + (size_t)blk * (size_t)rows * HEML__W;
                     if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
-                        heml__prefetch_block(C + HEML__NC * HEML__W, HEML__NC, idx + 4 * HEML__W);
+                        heml__prefetch_block(C + rows * HEML__W, mt->dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH,
+                                             idx + 4 * HEML__W);
                     if (m->dc_pass == HEML__DC_FILL) {
                         heml__gather(m, idx, p->x, b.e);
                         heml__gather(m, idx, m->rest, b.H);
-                        heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        if (mt->dk == HEML__DK_SVK)
+                            m->dc_gen[blk] = (unsigned char)heml__diff_svk_point(
+                                mt, jm1_0, valid, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        else
+                            heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
                     }
-                    heml__gather(m, idx, p->dx, b.de);
-                    heml__diff_nh_apply(mt, C, &b);
+                    if (mt->dk == HEML__DK_SVK && m->dc_gen[blk]) { /* (below J0: the general path) */
+                        heml__gather(m, idx, p->x, b.e);
+                        heml__gather(m, idx, p->dx, b.de);
+                        heml__block_diff_general(m, mt, blk, &b);
+                    } else {
+                        heml__gather(m, idx, p->dx, b.de);
+                        if (mt->dk == HEML__DK_SVK) heml__diff_svk_apply(mt, C, &b);
+                        else heml__diff_nh_apply(mt, C, &b);
+                    }
                 } else
                     heml__block_diff(m, mt, blk, p->x, p->dx, &b);
                 heml__scatter(m, idx, b.f, p->out);
@@ -3892,10 +4091,11 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
         HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
-    HEML__CARVE(c, m->dc, heml_real, m->has_dc ? HEML__NC * s : 0);
+    HEML__CARVE(c, m->dc, heml_real, m->has_dc ? (size_t)m->dc_rows * s : 0);
+    HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
     if (!m->nodal) m->diag_dev = NULL;
     if (!m->has_springs) m->blk_spring = NULL;
-    if (!m->has_dc) m->dc = NULL;
+    if (!m->has_dc) m->dc = NULL, m->dc_gen = NULL;
 }
 
 /* >>validation ------------------------------------------------------------------------ */
@@ -4042,6 +4242,7 @@ static void heml__make_mat(const heml_material *src, heml__mat *mt)
     mt->prony_count = src->prony_count;
     ops->make(src, mt);
     mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
+    mt->dk = mt->fast ? HEML__DK_NH : src->law == HEML_STVK && !mt->prony_count ? HEML__DK_SVK : 0;
 }
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
@@ -4889,7 +5090,11 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     for (i = 0; i < M && d->stiffness_cache && !tmp->nodal; i++) { /* a fast-path material in use */
         heml__mat mt;
         heml__make_mat(src + i, &mt);
-        if (mt.fast && w->counts[i] > 0) tmp->has_dc = 1;
+        if (mt.dk && w->counts[i] > 0) {
+            int rows = mt.dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH;
+            tmp->has_dc = 1;
+            if (rows > tmp->dc_rows) tmp->dc_rows = rows;
+        }
     }
     tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     {
@@ -4962,7 +5167,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
-        if (m->nodal) mt->fast = 0; /* the general path carries the nodal pressure */
+        if (m->nodal) mt->fast = mt->dk = 0; /* the general path carries the nodal pressure */
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
@@ -6353,8 +6558,12 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
     {   /* the differential: cached blocks read the cache and dx, not u */
         size_t cached = 0, slots_all = (size_t)m->slot_count;
         for (i = 0; i < m->chunk_count && kernel == 1 && m->has_dc; i++)
-            if (m->mats[m->chunk_material[i]].fast) cached += (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
-        stream += cached * (HEML__NC - HEML__NR) * R; /* (the cache instead of the rest constants) */
+            if (m->mats[m->chunk_material[i]].dk) {
+                size_t slots = (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
+                int rows = m->mats[m->chunk_material[i]].dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH;
+                cached += slots;
+                stream += slots * (size_t)(rows - HEML__NR) * R; /* (the cache instead of the rest constants) */
+            }
         *read = stream + prony + nodes * (kernel == 1 ? (cached == slots_all ? 1 : 2) : 1);
     }
     *written = nodes + (kernel == 0 ? prony : 0);
