@@ -97,9 +97,10 @@
            ranges, HEML_ERR_MATERIAL); heml_material_from_young's case. Leave `fast_path`
            at 0: the vectorised kernels (heml__forces_nh, heml__diff_nh) compute
            Neo-Hookean and nothing else; set it only for a law that is exactly heml__law_raw
-           without an I2 term, or write a kernel for the law and a flag for it (as St
-           Venant-Kirchhoff's differential, heml__diff_svk: heml__mat.dk, chosen in
-           heml__make_mat, with its point values in the stiffness cache). Everything
+           without an I2 term, or write a kernel for the law and a flag for it (as the St
+           Venant-Kirchhoff and split Mooney-Rivlin differentials, heml__diff_svk and
+           heml__diff_mr: heml__mat.dk, chosen in heml__make_mat, their point values in the
+           stiffness cache, HEML__DK_ROWS). Everything
            else (the general path's kinematics, stress coefficients, P1 forces and their
            differential, Prony, energies, stresses, the small-strain moduli for the
            preconditioner and heml_stable_time_step) comes from those functions.
@@ -156,10 +157,10 @@
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
    incompressible Mooney-Rivlin with c2 = 0), 21 (168 / 84 bytes) when one is St Venant-
-   Kirchhoff (the largest of the two when both are), plus a byte per block of 16; only
-   without a Prony series and without nodal pressure; none otherwise (the compressible
-   Mooney-Rivlin, springs, user laws); desc.stiffness_cache = 0 leaves it out (each
-   product then recomputes them: see PERFORMANCE for the cost).
+   Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
+   those in use), plus a byte per block of 16; only without a Prony series and without
+   nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
+   out (each product then recomputes them: see PERFORMANCE for the cost).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -919,28 +920,55 @@
    rest constants, 184 bytes): 0.9 to 1.05 of the CSR at 1e6 in double; one fused loop for
    the F form's apply instead of three: no difference above noise; prefetching the rest
    constants in the uncached general path (St Venant-Kirchhoff): none either.
-   St Venant-Kirchhoff's differential (issue 21, third part: heml__diff_svk, the same
-   scheme): dP = dF S + F dS in the links, df = -(dv B + v K), B = Vol G S G^T,
-   K = lambda (X : Ah) Ah + 2 mu Ah X Ah, X = sym(v^T dv), Ah = sqrt(Vol) G G^T: 21 reals
-   of cache per tetrahedron (v, Ah, B), about 150 operations a product, filled by the first
-   product like Neo-Hookean's (bit-identical to the uncached product). It runs without
-   Prony (the general path's viscous scaling) and without nodal pressure; a block of 16
-   with a tetrahedron below J0 (the law's guard) takes the general path (m->dc_gen, a byte
-   per block). Callgrind (x86-64-v3, 10,985 tetrahedra, instructions per tetrahedron and
-   product at one state): 294 -> 153 (Neo-Hookean's cached product 137; the filling
-   product 281). Measured (bench/model_heml.c's adapter for both versions in one program,
-   old and new and the CSR product of the same tangent interleaved, minimum of 12 rounds,
-   one thread, double; Zen 5, 2 vCPUs at load 5 to 9, so absolute figures are about twice
-   a quiet run's), K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra: before 1.28, 1.16, 0.81,
-   0.89; after 0.65, 0.75, 0.62, 0.87 (25.5, 42.8, 57.9, 85.5 ns against 50.4, 66.9, 76.1,
-   88.1); float 0.44, 0.67, 0.51, 0.56 (before 0.85, 1.28, 0.80, 0.89). The bench's CSR
-   row for St Venant-Kirchhoff (and every law on the general path) was slowed 5 to 7 times
-   at small sizes by subnormal garbage: its adapter left the differential's dp
-   uninitialised (fixed there). Not done: Mooney-Rivlin (split). In the links its
-   differential needs besides B and Ah also N = Vol G (C - I) G^T / sqrt(Vol) and five
-   scalars (32 reals, near a CSR row share), and about 280 operations; its product stays
-   on the general path (320 instructions, 1.6 to 1.8 times the CSR product in the run
-   above).
+   St Venant-Kirchhoff's and the split Mooney-Rivlin's differentials (issue 21, third part:
+   heml__diff_svk, heml__diff_mr, the same scheme). St Venant-Kirchhoff: dP = dF S + F dS
+   in the links, df = -(dv B + v K), B = Vol G S G^T, K = lambda (X : Ah) Ah + 2 mu Ah X Ah,
+   X = sym(v^T dv), Ah = sqrt(Vol) G G^T: 21 reals of cache per tetrahedron (v, Ah, B),
+   about 150 operations a product. A block of 16 with a tetrahedron below J0 (the law's
+   guard) takes the general path (m->dc_gen, a byte per block). Mooney-Rivlin: its second
+   derivatives in I1 and I2 vanish (w_11 = w_12 = w_22 = 0, also continued below J0), so
+   its tangent in the links needs, besides v and Ah, Nh = sqrt(Vol) G (C - I) G^T and seven
+   scalars (28 reals; storing B = Vol G (2 a I - M) G^T instead of two of them, 32 reals,
+   was slower at 1e4 tetrahedra: 1.22-1.38 against 0.97-1.05 times the CSR product in
+   one interleaved run), about 290 operations; the law and the stress coefficients at the
+   point come from heml__law_split and heml__coefficients, so it needs no fallback below
+   J0. Both fill the cache at the first product like Neo-Hookean's (bit-identical to the
+   uncached product) and run without Prony (the general path's viscous scaling) and without
+   nodal pressure. Callgrind (x86-64-v3, 10,985 tetrahedra, instructions per tetrahedron
+   and product at one state): St Venant-Kirchhoff 294 -> 153, Mooney-Rivlin 320 -> 203
+   (Neo-Hookean's cached product 137; the filling products 281 and 534). Measured
+   (bench/model_heml.c's adapter for both versions in one program, old and new and the CSR
+   product of the same tangent interleaved, minimum of 12 to 20 rounds, one thread; Zen 5,
+   2 vCPUs at load 5 to 9, so absolute figures are about twice a quiet run's and ratios
+   move by 0.1 to 0.2 between runs), K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra:
+       St Venant-Kirchhoff, double  before 1.28 1.16 0.81 0.89 / 1.11 1.20 0.87 0.93 (two runs)
+                                    after  0.65 0.75 0.62 0.87 / 0.74 0.70 0.74 0.80
+       St Venant-Kirchhoff, float   before 0.85 1.28 0.80 0.89 / 0.95 1.04 1.12 0.78
+                                    after  0.44 0.67 0.51 0.56 / 0.53 0.65 0.50 0.48
+       Mooney-Rivlin, double        before 1.48 1.59 / 1.43 1.67 (two runs)
+                                    after  0.82 1.25 / 0.96 1.18
+       Mooney-Rivlin, float         before 1.02 1.21,  after 0.67 0.80
+   (the bench runs Mooney-Rivlin at the two small sizes only). So St Venant-Kirchhoff's
+   product beats the CSR product at every size in both precisions; Mooney-Rivlin's in
+   float and at 1e3 in double, but at 1e4 in double it stays 1.18 to 1.25 times the CSR
+   product (not met: its stream, 240 bytes a tetrahedron with the indices, is near the
+   CSR matrix's 276, and it does 1.3 times St Venant-Kirchhoff's instructions; float
+   K*v instructions: Neo-Hookean 112, St Venant-Kirchhoff 120, Mooney-Rivlin 145). Tried
+   for it: the apply as two loops (scalars and K, then the product, as the Neo-Hookean
+   force's stages): 214 instructions against 203, no gain measurable. The bench's CSR rows for the laws on the general path were
+   slowed 5 to 7 times at small sizes by subnormal garbage: its adapter left the
+   differential's dp uninitialised (fixed there).
+   Forces, against the Neo-Hookean force (unchanged here; callgrind, the same mesh, per
+   tetrahedron): St Venant-Kirchhoff 207, Mooney-Rivlin 231, springs 248 against 160
+   instructions in double (1.29, 1.44, 1.55), 160, 171, 200 against 128 in float (1.25,
+   1.34, 1.56). Timed, the four laws interleaved in one program (minimum of 20 rounds,
+   same load), at 1e3 and 1e4 tetrahedra, two runs each: double St Venant-Kirchhoff
+   0.98-1.12 and 1.22-1.51, Mooney-Rivlin 1.21-1.29 and 1.49-1.63, springs 1.23-1.79 and
+   1.59-1.63; float St Venant-Kirchhoff 1.37-1.92 and 1.19-1.43, Mooney-Rivlin 1.23-2.20
+   and 1.55-1.81, springs 0.65-1.22 and 1.07. So the goal of 1.5 times the Neo-Hookean
+   force holds in instructions except for springs (1.55) and is not shown in time on this
+   loaded machine (Mooney-Rivlin at 1e4 and float St Venant-Kirchhoff measured above it);
+   a quiet machine must decide.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
@@ -959,8 +987,8 @@
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
          robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); the nodal pressure
          oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read it smoothed
-         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels and St Venant-Kirchhoff's
-         differential kernel (the general path runs)
+         three times, NEAR-INCOMPRESSIBLE BODIES); it costs the vectorised Neo-Hookean kernels and the St Venant-Kirchhoff and
+         Mooney-Rivlin differential kernels (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
@@ -1352,10 +1380,11 @@ typedef struct heml_desc {
                                         pressure tetrahedra for nearly incompressible bodies
                                         (NEAR-INCOMPRESSIBLE BODIES): every law but mass-spring,
                                         user laws with second derivatives */
-    int stiffness_cache;             /* 1 (default): the Neo-Hookean and St Venant-Kirchhoff
-                                        stiffness products cache per tetrahedron what their
-                                        linearisation point fixes (PERFORMANCE, MEMORY: 17 or 21
-                                        reals a tetrahedron); 0: no cache, no memory */
+    int stiffness_cache;             /* 1 (default): the Neo-Hookean, St Venant-Kirchhoff and
+                                        Mooney-Rivlin stiffness products cache per tetrahedron
+                                        what their linearisation point fixes (PERFORMANCE,
+                                        MEMORY: 17, 21 or 28 reals a tetrahedron); 0: no cache,
+                                        no memory */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1547,15 +1576,16 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m);
    N for dx in m; out is overwritten, caller-owned), i.e. minus the tangent stiffness
    times dx, exact for every law (the J0 continuation and Prony scaling included). One
    pass; HEML_ERR_NO_SECOND_DERIVATIVES for a user law without `second`. With the stiffness
-   cache (desc.stiffness_cache, Neo-Hookean and St Venant-Kirchhoff tetrahedra) the first
-   call after a change of the state fills it, the next ones at the same state read it
-   (bit-identical results). */
+   cache (desc.stiffness_cache, Neo-Hookean, St Venant-Kirchhoff and Mooney-Rivlin
+   tetrahedra) the first call after a change of the state fills it, the next ones at the
+   same state read it (bit-identical results). */
 HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *out);
 /* Bytes one force pass (kernel 0) or one differential pass (kernel 1) must move at least:
    the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus spring and Prony data)
    and each node's displacement (and dx) read once and force written once; for kernel 1
    the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 (Neo-
-   Hookean) or 21 (St Venant-Kirchhoff) reals of cache instead, and read dx only. */
+   Hookean), 21 (St Venant-Kirchhoff) or 28 (split Mooney-Rivlin) reals of cache instead,
+   and read dx only. */
 HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, size_t *written);
 
 /* ---- state access (pointers into the model, valid until heml_destroy) ---- */
@@ -1752,9 +1782,12 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
 #define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
-#define HEML__NC 21         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
+#define HEML__NC_MR 28      /* split Mooney-Rivlin: v, Ah, Nh (21), 7 scalars (heml__diff_mr) */
+#define HEML__NC 28         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
 #define HEML__DK_NH 1       /* heml__mat.dk: the differential kernel of a material (0: the general path) */
 #define HEML__DK_SVK 2
+#define HEML__DK_MR 3
+#define HEML__DK_ROWS(dk) ((dk) == HEML__DK_SVK ? HEML__NC_SVK : (dk) == HEML__DK_MR ? HEML__NC_MR : HEML__NC_NH)
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
@@ -3279,6 +3312,157 @@ static int heml__diff_svk(const heml_model *m, const heml__mat *mt, int blk, hem
     return 0;
 }
 
+/* The split Mooney-Rivlin force differential (law heml__law_split, HEML__DK_MR), in the
+   links as heml__diff_nh's and heml__diff_svk's. With P = 2 a F - F M + w_J cof F
+   (heml__coefficients: a = w_1 + (I1 - 1) w_2, M = 2 w_2 (C - I)) and this law's second
+   derivatives (w_11 = w_12 = w_22 = 0, also below J0, where its factors are continued),
+       dP = 2 da F + 2 a dF - dF M - F dM + dw_J cof F + w_J dcof F,
+       dw_1 = w_1J dJ, dw_2 = w_2J dJ, dw_J = w_1J dI1 + w_2J dI2 + w_JJ dJ,
+       da = dw_1 + (I1 - 1) dw_2 + w_2 dI1, dM = 2 (dw_2 (C - I) + w_2 dC),
+   and in the links (X = sym(v^T dv), z = sqrt(Vol), Ah = z G G^T, Nh = z G (C - I) G^T,
+   dC = 2 G^T X G, dI1 = 2 (X : Ah) / z, dI2 = (I1 - 1) dI1 - 2 (X : Nh) / z,
+   dJ = (cof v : dv) / (6 Vol), r = 1 / (6 z)):
+       df = -(dv B + v K + t cof v + (w_J / 6) dcof v),   B = Vol G (2 a I - M) G^T
+                                                          = z (2 a Ah - 2 w_2 Nh),
+       K = (2 ca g + 4 w_2 al) Ah - 2 cb g Nh - 4 w_2 Ah X Ah,
+       t = 2 ca al - 2 cb nu + cc g,
+   al = X : Ah, nu = X : Nh, g = cof v : dv, ca = r (w_1J + (I1 - 1) w_2J), cb = r w_2J,
+   cc = r^2 w_JJ. The point values: v (9), Ah, Nh (6 each), 2 a z, 2 w_2 z, 2 ca, 2 cb, cc,
+   w_J / 6, 4 w_2: HEML__NC_MR = 28 reals (B stored instead of its two scalars, 32 reals,
+   measured no faster); a product about 290 operations. The law and the stress
+   coefficients at the point come from heml__law_split and heml__coefficients themselves
+   (the general path's kinematics), so the continuation below J0 needs no fallback; Prony
+   and the nodal pressure take the general path (mt->dk = 0). */
+static void heml__diff_mr_point(const heml_model *m, const heml__mat *mt, int blk, heml__blk *HEML__RESTRICT b,
+                                heml_real *HEML__RESTRICT C)
+{
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    heml_real sv[HEML__W];
+    int k, r;
+    for (r = 0; r < 9; r++) /* v = V + du (the rest links in b->f) */
+        for (k = 0; k < HEML__W; k++) C[r * HEML__W + k] = b->f[r][k] + b->e[r][k];
+    heml__kinematics(R, b);
+    heml__clamp_J(m->jm1_0, b);
+    heml__law(mt, b, m->blk_valid[blk], HEML__WANT_SECOND);
+    heml__coefficients(b, mt->uses_i2);
+    for (k = 0; k < HEML__W; k++) sv[k] = R[9 * HEML__W + k] > 0 ? R[9 * HEML__W + k] : 1; /* (padding: G = 0) */
+    heml__sqrt_lanes(sv, HEML__W);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k], z = sv[k], rr = vol > 0 ? 1 / (6 * z) : 0;
+        heml_real E00 = b->E2[0][k], E11 = b->E2[1][k], E22 = b->E2[2][k];
+        heml_real E01 = b->E2[3][k], E02 = b->E2[4][k], E12 = b->E2[5][k];
+        heml_real a2 = 2 * b->co[1][k], w2 = b->w2[k], m2 = 2 * w2, I1m1 = 2 + b->I1m3[k];
+        /* u_j = E2 g_j; S = 2 a I - 2 w_2 E2, so S g_j = 2 a g_j - 2 w_2 u_j */
+        heml_real u10 = E00 * g10 + E01 * g11 + E02 * g12, u11 = E01 * g10 + E11 * g11 + E12 * g12;
+        heml_real u12 = E02 * g10 + E12 * g11 + E22 * g12;
+        heml_real u20 = E00 * g20 + E01 * g21 + E02 * g22, u21 = E01 * g20 + E11 * g21 + E12 * g22;
+        heml_real u22 = E02 * g20 + E12 * g21 + E22 * g22;
+        heml_real u30 = E00 * g30 + E01 * g31 + E02 * g32, u31 = E01 * g30 + E11 * g31 + E12 * g32;
+        heml_real u32 = E02 * g30 + E12 * g31 + E22 * g32;
+        heml_real q11 = g10 * g10 + g11 * g11 + g12 * g12, q22 = g20 * g20 + g21 * g21 + g22 * g22;
+        heml_real q33 = g30 * g30 + g31 * g31 + g32 * g32, q12 = g10 * g20 + g11 * g21 + g12 * g22;
+        heml_real q13 = g10 * g30 + g11 * g31 + g12 * g32, q23 = g20 * g30 + g21 * g31 + g22 * g32;
+        heml_real n11 = g10 * u10 + g11 * u11 + g12 * u12, n22 = g20 * u20 + g21 * u21 + g22 * u22;
+        heml_real n33 = g30 * u30 + g31 * u31 + g32 * u32, n12 = g10 * u20 + g11 * u21 + g12 * u22;
+        heml_real n13 = g10 * u30 + g11 * u31 + g12 * u32, n23 = g20 * u30 + g21 * u31 + g22 * u32;
+        C[9 * HEML__W + k] = z * q11;
+        C[10 * HEML__W + k] = z * q22;
+        C[11 * HEML__W + k] = z * q33;
+        C[12 * HEML__W + k] = z * q12;
+        C[13 * HEML__W + k] = z * q13;
+        C[14 * HEML__W + k] = z * q23;
+        C[15 * HEML__W + k] = z * n11;
+        C[16 * HEML__W + k] = z * n22;
+        C[17 * HEML__W + k] = z * n33;
+        C[18 * HEML__W + k] = z * n12;
+        C[19 * HEML__W + k] = z * n13;
+        C[20 * HEML__W + k] = z * n23;
+        C[21 * HEML__W + k] = vol > 0 ? z * a2 : 0; /* B = z (2 a Ah - 2 w_2 Nh) */
+        C[22 * HEML__W + k] = vol > 0 ? z * m2 : 0;
+        C[23 * HEML__W + k] = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]);
+        C[24 * HEML__W + k] = 2 * rr * b->h[4][k];
+        C[25 * HEML__W + k] = rr * rr * b->h[5][k];
+        C[26 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
+        C[27 * HEML__W + k] = 4 * w2;
+    }
+}
+
+/* The product of the point values C (heml__diff_mr_point) with the links dv of dx in
+   b->de, into b->f (nodes 1..3). */
+static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k]; /* dv1 */
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k]; /* dv2 */
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k]; /* dv3 */
+        heml_real p0 = C[k], p1 = C[HEML__W + k], p2 = C[2 * HEML__W + k];               /* v1 */
+        heml_real q0 = C[3 * HEML__W + k], q1 = C[4 * HEML__W + k], q2 = C[5 * HEML__W + k]; /* v2 */
+        heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
+        heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
+        heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
+        heml_real N11 = C[15 * HEML__W + k], N22 = C[16 * HEML__W + k], N33 = C[17 * HEML__W + k];
+        heml_real N12 = C[18 * HEML__W + k], N13 = C[19 * HEML__W + k], N23 = C[20 * HEML__W + k];
+        heml_real za = C[21 * HEML__W + k], zm = C[22 * HEML__W + k];
+        heml_real ca2 = C[23 * HEML__W + k], cb2 = C[24 * HEML__W + k], cc = C[25 * HEML__W + k];
+        heml_real s2 = C[26 * HEML__W + k], w4 = C[27 * HEML__W + k];
+        heml_real B11 = za * A11 - zm * N11, B22 = za * A22 - zm * N22, B33 = za * A33 - zm * N33;
+        heml_real B12 = za * A12 - zm * N12, B13 = za * A13 - zm * N13, B23 = za * A23 - zm * N23;
+        heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
+        heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
+        heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
+        heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
+        heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
+        heml_real al = (X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23);
+        heml_real nu = (X11 * N11 + X22 * N22 + X33 * N33) + 2 * (X12 * N12 + X13 * N13 + X23 * N23);
+        /* cof v: c1 = v2 x v3, c2 = v3 x v1, c3 = v1 x v2; g = cof v : dv */
+        heml_real c10 = q1 * r2 - q2 * r1, c11 = q2 * r0 - q0 * r2, c12 = q0 * r1 - q1 * r0;
+        heml_real c20 = r1 * p2 - r2 * p1, c21 = r2 * p0 - r0 * p2, c22 = r0 * p1 - r1 * p0;
+        heml_real c30 = p1 * q2 - p2 * q1, c31 = p2 * q0 - p0 * q2, c32 = p0 * q1 - p1 * q0;
+        heml_real g = (c10 * x0 + c11 * x1 + c12 * x2) + (c20 * y0 + c21 * y1 + c22 * y2) + (c30 * z0 + c31 * z1 + c32 * z2);
+        heml_real e10 = (y1 * r2 - y2 * r1) + (q1 * z2 - q2 * z1), e11 = (y2 * r0 - y0 * r2) + (q2 * z0 - q0 * z2);
+        heml_real e12 = (y0 * r1 - y1 * r0) + (q0 * z1 - q1 * z0);
+        heml_real e20 = (z1 * p2 - z2 * p1) + (r1 * x2 - r2 * x1), e21 = (z2 * p0 - z0 * p2) + (r2 * x0 - r0 * x2);
+        heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
+        heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
+        heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
+        heml_real t = ca2 * al - cb2 * nu + cc * g, kA = ca2 * g + w4 * al, kN = cb2 * g;
+        /* T = X Ah, Ah X Ah = Ah T */
+        heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
+        heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
+        heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
+        heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real K11 = kA * A11 - kN * N11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = kA * A22 - kN * N22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = kA * A33 - kN * N33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = kA * A12 - kN * N12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = kA * A13 - kN * N13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = kA * A23 - kN * N23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
+        b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13) + t * c10 + s2 * e10);
+        b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13) + t * c11 + s2 * e11);
+        b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13) + t * c12 + s2 * e12);
+        b->f[3][k] = -((x0 * B12 + y0 * B22 + z0 * B23) + (p0 * K12 + q0 * K22 + r0 * K23) + t * c20 + s2 * e20);
+        b->f[4][k] = -((x1 * B12 + y1 * B22 + z1 * B23) + (p1 * K12 + q1 * K22 + r1 * K23) + t * c21 + s2 * e21);
+        b->f[5][k] = -((x2 * B12 + y2 * B22 + z2 * B23) + (p2 * K12 + q2 * K22 + r2 * K23) + t * c22 + s2 * e22);
+        b->f[6][k] = -((x0 * B13 + y0 * B23 + z0 * B33) + (p0 * K13 + q0 * K23 + r0 * K33) + t * c30 + s2 * e30);
+        b->f[7][k] = -((x1 * B13 + y1 * B23 + z1 * B33) + (p1 * K13 + q1 * K23 + r1 * K33) + t * c31 + s2 * e31);
+        b->f[8][k] = -((x2 * B13 + y2 * B23 + z2 * B33) + (p2 * K13 + q2 * K23 + r2 * K33) + t * c32 + s2 * e32);
+    }
+}
+
+/* The uncached split Mooney-Rivlin differential of block blk (links of u in b->e, of dx in
+   b->de): the rest links gathered into b->f, the point values into b->lin, the product. */
+static void heml__diff_mr(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
+{
+    heml__gather(m, m->blk_idx + (size_t)blk * 4 * HEML__W, m->rest, b->f);
+    heml__diff_mr_point(m, mt, blk, b, b->lin[0]);
+    heml__diff_mr_apply(b->lin[0], b);
+}
+
 /* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
    INCOMPRESSIBLE BODIES): the element's own volumetric function U(J_e) comes off (w -= U,
    w_J -= U', w_JJ -= U'') and the mean of its four nodes' pressures p_e = sum P_a / 4 goes
@@ -3506,6 +3690,10 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         heml__diff_nh(m, mt, blk, b);
         return;
     }
+    if (mt->dk == HEML__DK_MR) {
+        heml__diff_mr(m, mt, blk, b);
+        return;
+    }
     if (mt->dk == HEML__DK_SVK && !heml__diff_svk(m, mt, blk, b)) return;
     heml__block_diff_general(m, mt, blk, b);
 }
@@ -3691,16 +3879,20 @@ static void heml__chunks(void *vctx, int begin, int end)
                     const int rows = m->dc_rows;
                     heml_real *C = m->dc + (size_t)blk * (size_t)rows * HEML__W;
                     if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
-                        heml__prefetch_block(C + rows * HEML__W, mt->dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH,
-                                             idx + 4 * HEML__W);
+                        heml__prefetch_block(C + rows * HEML__W, HEML__DK_ROWS(mt->dk), idx + 4 * HEML__W);
                     if (m->dc_pass == HEML__DC_FILL) {
                         heml__gather(m, idx, p->x, b.e);
-                        heml__gather(m, idx, m->rest, b.H);
-                        if (mt->dk == HEML__DK_SVK)
-                            m->dc_gen[blk] = (unsigned char)heml__diff_svk_point(
-                                mt, jm1_0, valid, R, (const heml_real(*)[HEML__W])b.H, &b, C);
-                        else
-                            heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        if (mt->dk == HEML__DK_MR) { /* (the rest links in b.f: the point uses b.H) */
+                            heml__gather(m, idx, m->rest, b.f);
+                            heml__diff_mr_point(m, mt, blk, &b, C);
+                        } else {
+                            heml__gather(m, idx, m->rest, b.H);
+                            if (mt->dk == HEML__DK_SVK)
+                                m->dc_gen[blk] = (unsigned char)heml__diff_svk_point(
+                                    mt, jm1_0, valid, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                            else
+                                heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        }
                     }
                     if (mt->dk == HEML__DK_SVK && m->dc_gen[blk]) { /* (below J0: the general path) */
                         heml__gather(m, idx, p->x, b.e);
@@ -3709,6 +3901,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                     } else {
                         heml__gather(m, idx, p->dx, b.de);
                         if (mt->dk == HEML__DK_SVK) heml__diff_svk_apply(mt, C, &b);
+                        else if (mt->dk == HEML__DK_MR) heml__diff_mr_apply(C, &b);
                         else heml__diff_nh_apply(mt, C, &b);
                     }
                 } else
@@ -4242,7 +4435,11 @@ static void heml__make_mat(const heml_material *src, heml__mat *mt)
     mt->prony_count = src->prony_count;
     ops->make(src, mt);
     mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
-    mt->dk = mt->fast ? HEML__DK_NH : src->law == HEML_STVK && !mt->prony_count ? HEML__DK_SVK : 0;
+    mt->dk = mt->fast                                           ? HEML__DK_NH
+             : mt->prony_count                                  ? 0
+             : src->law == HEML_STVK                            ? HEML__DK_SVK
+             : src->law == HEML_MOONEY_RIVLIN                   ? HEML__DK_MR
+                                                                : 0;
 }
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
@@ -5091,7 +5288,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
         heml__mat mt;
         heml__make_mat(src + i, &mt);
         if (mt.dk && w->counts[i] > 0) {
-            int rows = mt.dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH;
+            int rows = HEML__DK_ROWS(mt.dk);
             tmp->has_dc = 1;
             if (rows > tmp->dc_rows) tmp->dc_rows = rows;
         }
@@ -6560,7 +6757,7 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
         for (i = 0; i < m->chunk_count && kernel == 1 && m->has_dc; i++)
             if (m->mats[m->chunk_material[i]].dk) {
                 size_t slots = (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
-                int rows = m->mats[m->chunk_material[i]].dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH;
+                int rows = HEML__DK_ROWS(m->mats[m->chunk_material[i]].dk);
                 cached += slots;
                 stream += slots * (size_t)(rows - HEML__NR) * R; /* (the cache instead of the rest constants) */
             }

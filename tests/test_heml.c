@@ -1799,9 +1799,10 @@ static void test_vector_paths_match_scalar(void)
    round-off). The cached product runs the same arithmetic on the same values, so it is
    expected bit-identical (printed); the check allows 64 units of round-off of the
    product's largest entry (a compiler contracting the two call sites differently).
-   The cache's memory is HEML__NC_NH (Neo-Hookean kernels) or HEML__NC_SVK (St Venant-
-   Kirchhoff without Prony) reals per slot and a byte per block exactly where such a
-   material is in use without nodal pressure, none otherwise; no allocation after create. */
+   The cache's memory is HEML__NC_NH (Neo-Hookean kernels), HEML__NC_SVK (St Venant-
+   Kirchhoff) or HEML__NC_MR (split Mooney-Rivlin) reals per slot (HEML__DK_ROWS; no Prony)
+   and a byte per block exactly where such a material is in use without nodal pressure,
+   none otherwise; no allocation after create. */
 static int cache_compare(heml_model *a, heml_model *b, const heml_real *dx, int n3, int *bitwise)
 {
     heml_real *ka = alloc_reals(n3), *kb = alloc_reals(n3);
@@ -1873,7 +1874,7 @@ static void test_stiffness_cache(void)
             fast = m[0]->mats[0].dk != 0;
             { /* (within the 64-byte alignment of the two carved arrays: the cache's rows and a
                  byte per block, dc_gen) */
-                int rows = m[0]->mats[0].dk == HEML__DK_SVK ? HEML__NC_SVK : HEML__NC_NH;
+                int rows = HEML__DK_ROWS(m[0]->mats[0].dk);
                 long long want = fast ? rows * (long long)sizeof(heml_real) * m[0]->slot_count + m[0]->block_count : 0;
                 long long got = (long long)heml_memory_bytes(m[0]) - (long long)heml_memory_bytes(m[1]);
                 CHECK(got > want - 2 * HEML__ALIGN && got < want + 2 * HEML__ALIGN);
