@@ -948,8 +948,14 @@
        Mooney-Rivlin, double        before 1.48 1.59 / 1.43 1.67 (two runs)
                                     after  0.82 1.25 / 0.96 1.18
        Mooney-Rivlin, float         before 1.02 1.21,  after 0.67 0.80
-   (the bench runs Mooney-Rivlin at the two small sizes only). So St Venant-Kirchhoff's
-   product beats the CSR product at every size in both precisions; Mooney-Rivlin's in
+   (the bench runs Mooney-Rivlin at the two small sizes only). The bench itself, one run
+   of its medians (`--parts kernels --filter heml/svk/double --threads 1`, same load):
+   St Venant-Kirchhoff 0.65, 0.73, 1.04, 0.99, Mooney-Rivlin 0.87, 1.09. So St Venant-
+   Kirchhoff's product beats the CSR product at 1e3 and 1e4 in both precisions by a
+   margin, and at 1e5 and 1e6 in the interleaved minima (0.62 to 0.87 in double) but
+   within this machine's noise in the bench's medians (its cache and indices, 200 bytes a
+   tetrahedron, against the CSR matrix's 301, plus the node gather and scatter);
+   Mooney-Rivlin's in
    float and at 1e3 in double, but at 1e4 in double it stays 1.18 to 1.25 times the CSR
    product (not met: its stream, 240 bytes a tetrahedron with the indices, is near the
    CSR matrix's 276, and it does 1.3 times St Venant-Kirchhoff's instructions; float
