@@ -97,7 +97,10 @@
            ranges, HEML_ERR_MATERIAL); heml_material_from_young's case. Leave `fast_path`
            at 0: the vectorised kernels (heml__forces_nh, heml__diff_nh) compute
            Neo-Hookean and nothing else; set it only for a law that is exactly heml__law_raw
-           without an I2 term, or write a kernel for the law and a flag for it. Everything
+           without an I2 term, or write a kernel for the law and a flag for it (as the St
+           Venant-Kirchhoff and split Mooney-Rivlin differentials, heml__diff_svk and
+           heml__diff_mr: heml__mat.dk, chosen in heml__make_mat, their point values in the
+           stiffness cache, HEML__DK_ROWS). Everything
            else (the general path's kinematics, stress coefficients, P1 forces and their
            differential, Prony, energies, stresses, the small-strain moduli for the
            preconditioner and heml_stable_time_step) comes from those functions.
@@ -153,9 +156,11 @@
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
-   incompressible Mooney-Rivlin with c2 = 0; no Prony series, no nodal pressure), none
-   otherwise; desc.stiffness_cache = 0 leaves it out (each product then recomputes them:
-   see PERFORMANCE for the cost).
+   incompressible Mooney-Rivlin with c2 = 0), 21 (168 / 84 bytes) when one is St Venant-
+   Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
+   those in use), plus a byte per block of 16; only without a Prony series and without
+   nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
+   out (each product then recomputes them: see PERFORMANCE for the cost).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -997,6 +1002,61 @@
    rest constants, 184 bytes): 0.9 to 1.05 of the CSR at 1e6 in double; one fused loop for
    the F form's apply instead of three: no difference above noise; prefetching the rest
    constants in the uncached general path (St Venant-Kirchhoff): none either.
+   St Venant-Kirchhoff's and the split Mooney-Rivlin's differentials (issue 21, third part:
+   heml__diff_svk, heml__diff_mr, the same scheme). St Venant-Kirchhoff: dP = dF S + F dS
+   in the links, df = -(dv B + v K), B = Vol G S G^T, K = lambda (X : Ah) Ah + 2 mu Ah X Ah,
+   X = sym(v^T dv), Ah = sqrt(Vol) G G^T: 21 reals of cache per tetrahedron (v, Ah, B),
+   about 150 operations a product. A block of 16 with a tetrahedron below J0 (the law's
+   guard) takes the general path (m->dc_gen, a byte per block). Mooney-Rivlin: its second
+   derivatives in I1 and I2 vanish (w_11 = w_12 = w_22 = 0, also continued below J0), so
+   its tangent in the links needs, besides v and Ah, Nh = sqrt(Vol) G (C - I) G^T and seven
+   scalars (28 reals; storing B = Vol G (2 a I - M) G^T instead of two of them, 32 reals,
+   was slower at 1e4 tetrahedra: 1.22-1.38 against 0.97-1.05 times the CSR product in
+   one interleaved run), about 290 operations; the law and the stress coefficients at the
+   point come from heml__law_split and heml__coefficients, so it needs no fallback below
+   J0. Both fill the cache at the first product like Neo-Hookean's (bit-identical to the
+   uncached product) and run without Prony (the general path's viscous scaling) and without
+   nodal pressure. Callgrind (x86-64-v3, 10,985 tetrahedra, instructions per tetrahedron
+   and product at one state): St Venant-Kirchhoff 294 -> 153, Mooney-Rivlin 320 -> 203
+   (Neo-Hookean's cached product 137; the filling products 281 and 534). Measured
+   (bench/model_heml.c's adapter for both versions in one program, old and new and the CSR
+   product of the same tangent interleaved, minimum of 12 to 20 rounds, one thread; Zen 5,
+   2 vCPUs at load 5 to 9, so absolute figures are about twice a quiet run's and ratios
+   move by 0.1 to 0.2 between runs), K*v / CSR at 1e3, 1e4, 1e5, 1e6 tetrahedra:
+       St Venant-Kirchhoff, double  before 1.28 1.16 0.81 0.89 / 1.11 1.20 0.87 0.93 (two runs)
+                                    after  0.65 0.75 0.62 0.87 / 0.74 0.70 0.74 0.80
+       St Venant-Kirchhoff, float   before 0.85 1.28 0.80 0.89 / 0.95 1.04 1.12 0.78
+                                    after  0.44 0.67 0.51 0.56 / 0.53 0.65 0.50 0.48
+       Mooney-Rivlin, double        before 1.48 1.59 / 1.43 1.67 (two runs)
+                                    after  0.82 1.25 / 0.96 1.18
+       Mooney-Rivlin, float         before 1.02 1.21,  after 0.67 0.80
+   (the bench runs Mooney-Rivlin at the two small sizes only). The bench itself, one run
+   of its medians (`--parts kernels --filter heml/svk/double --threads 1`, same load):
+   St Venant-Kirchhoff 0.65, 0.73, 1.04, 0.99, Mooney-Rivlin 0.87, 1.09. So St Venant-
+   Kirchhoff's product beats the CSR product at 1e3 and 1e4 in both precisions by a
+   margin, and at 1e5 and 1e6 in the interleaved minima (0.62 to 0.87 in double) but
+   within this machine's noise in the bench's medians (its cache and indices, 200 bytes a
+   tetrahedron, against the CSR matrix's 301, plus the node gather and scatter);
+   Mooney-Rivlin's in
+   float and at 1e3 in double, but at 1e4 in double it stays 1.18 to 1.25 times the CSR
+   product (not met: its stream, 240 bytes a tetrahedron with the indices, is near the
+   CSR matrix's 276, and it does 1.3 times St Venant-Kirchhoff's instructions; float
+   K*v instructions: Neo-Hookean 112, St Venant-Kirchhoff 120, Mooney-Rivlin 145). Tried
+   for it: the apply as two loops (scalars and K, then the product, as the Neo-Hookean
+   force's stages): 214 instructions against 203, no gain measurable. The bench's CSR rows for the laws on the general path were
+   slowed 5 to 7 times at small sizes by subnormal garbage: its adapter left the
+   differential's dp uninitialised (fixed there).
+   Forces, against the Neo-Hookean force (unchanged here; callgrind, the same mesh, per
+   tetrahedron): St Venant-Kirchhoff 207, Mooney-Rivlin 231, springs 248 against 160
+   instructions in double (1.29, 1.44, 1.55), 160, 171, 200 against 128 in float (1.25,
+   1.34, 1.56). Timed, the four laws interleaved in one program (minimum of 20 rounds,
+   same load), at 1e3 and 1e4 tetrahedra, two runs each: double St Venant-Kirchhoff
+   0.98-1.12 and 1.22-1.51, Mooney-Rivlin 1.21-1.29 and 1.49-1.63, springs 1.23-1.79 and
+   1.59-1.63; float St Venant-Kirchhoff 1.37-1.92 and 1.19-1.43, Mooney-Rivlin 1.23-2.20
+   and 1.55-1.81, springs 0.65-1.22 and 1.07. So the goal of 1.5 times the Neo-Hookean
+   force holds in instructions except for springs (1.55) and is not shown in time on this
+   loaded machine (Mooney-Rivlin at 1e4 and float St Venant-Kirchhoff measured above it);
+   a quiet machine must decide.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
@@ -1065,7 +1125,8 @@
          PRESSURE AGGREGATES); nodal_pressure = 2 holds the volume patch by patch, so on
          very coarse meshes (a few aggregates) a body's internal volume changes return only
          at the shear stiffness's pace and large-deformation Newton solves may need more
-         iterations; either costs the vectorised Neo-Hookean kernels (the general path runs)
+         iterations; either costs the vectorised Neo-Hookean kernels and the St Venant-Kirchhoff
+         and Mooney-Rivlin differential kernels (the general path runs)
          and two extra passes; not for mass-spring (HEML_ERR_NODAL_PRESSURE) nor for user
          laws without second derivatives (the continuation of U needs U'').
        - The semi-explicit integrator is conditionally stable. The divergence check
@@ -1459,9 +1520,11 @@ typedef struct heml_desc {
                                         user laws with second derivatives; 2 (recommended
                                         there): the same over pressure aggregates, no
                                         pressure checkerboard (PRESSURE AGGREGATES) */
-    int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
-                                        tetrahedron what its linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
+    int stiffness_cache;             /* 1 (default): the Neo-Hookean, St Venant-Kirchhoff and
+                                        Mooney-Rivlin stiffness products cache per tetrahedron
+                                        what their linearisation point fixes (PERFORMANCE,
+                                        MEMORY: 17, 21 or 28 reals a tetrahedron); 0: no cache,
+                                        no memory */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1653,14 +1716,16 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m);
    N for dx in m; out is overwritten, caller-owned), i.e. minus the tangent stiffness
    times dx, exact for every law (the J0 continuation and Prony scaling included). One
    pass; HEML_ERR_NO_SECOND_DERIVATIVES for a user law without `second`. With the stiffness
-   cache (desc.stiffness_cache, Neo-Hookean tetrahedra) the first call after a change of
-   the state fills it, the next ones at the same state read it (bit-identical results). */
+   cache (desc.stiffness_cache, Neo-Hookean, St Venant-Kirchhoff and Mooney-Rivlin
+   tetrahedra) the first call after a change of the state fills it, the next ones at the
+   same state read it (bit-identical results). */
 HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *out);
 /* Bytes one force pass (kernel 0) or one differential pass (kernel 1) must move at least:
    the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus spring and Prony data)
    and each node's displacement (and dx) read once and force written once; for kernel 1
-   the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 reals of
-   cache instead, and read dx only. */
+   the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 (Neo-
+   Hookean), 21 (St Venant-Kirchhoff) or 28 (split Mooney-Rivlin) reals of cache instead,
+   and read dx only. */
 HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, size_t *written);
 
 /* ---- state access (pointers into the model, valid until heml_destroy) ---- */
@@ -1862,7 +1927,14 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #endif
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
-#define HEML__NC 17         /* stiffness cache per tetrahedron (fast path): v (9), A (6), s1, s2 (heml__diff_nh) */
+#define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
+#define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
+#define HEML__NC_MR 28      /* split Mooney-Rivlin: v, Ah, Nh (21), 7 scalars (heml__diff_mr) */
+#define HEML__NC 28         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
+#define HEML__DK_NH 1       /* heml__mat.dk: the differential kernel of a material (0: the general path) */
+#define HEML__DK_SVK 2
+#define HEML__DK_MR 3
+#define HEML__DK_ROWS(dk) ((dk) == HEML__DK_SVK ? HEML__NC_SVK : (dk) == HEML__DK_MR ? HEML__NC_MR : HEML__NC_NH)
 #define HEML__NQ 9          /* Prony state per tetrahedron and term: the stress coefficients
                                (c0, a, w_J, M), see heml__coefficients */
 #define HEML__KRYLOV 8      /* 3n vectors of the linear solvers' workspace (m->krylov) */
@@ -1901,6 +1973,8 @@ typedef struct heml__mat {
     int kind, uses_i2;
     int fast;                    /* its law's fast_path flag, and no I2 term, and no Prony: the
                                     vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
+    int dk;                      /* its differential kernel (HEML__DK_*, cached in the stiffness
+                                    cache), 0: the general path (Prony, nodal pressure, other laws) */
     heml_law law;
     const struct heml__law_ops *ops; /* its law's row of heml__laws */
     heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
@@ -2039,6 +2113,10 @@ struct heml_model {
     heml_real *dc;
     const heml_real *dc_key;
     int has_dc, dc_pass; /* dc carved; the running DIFF pass's use of it (HEML__DC_*) */
+    int dc_rows;         /* reals per tetrahedron slot of dc: the largest HEML__NC_* of a cached
+                            material in use */
+    unsigned char *dc_gen; /* per block: 1 when the cache holds no point values for it (a St
+                            Venant-Kirchhoff block with a tetrahedron below J0: general path) */
 
     /* coarse space (heml__coarse_build) */
     int *node_agg;      /* aggregate of each node */
@@ -3248,6 +3326,295 @@ static void heml__diff_nh(const heml_model *m, const heml__mat *mt, int blk, hem
     heml__diff_nh_apply(mt, b->lin[0], b);
 }
 
+/* The St Venant-Kirchhoff force differential (law heml__law_svk, HEML__DK_SVK): with
+   S = lambda tr E I + 2 mu E, P = F S,
+       dP = dF S + F dS,   dS = lambda tr dE I + 2 mu dE,   dE = sym(F^T dF),
+   and in the links as heml__diff_nh's (F = v G, dF = dv G, G = V^-1, df = -Vol dP G^T):
+   dE = G^T X G with X = sym(v^T dv), tr dE = X : G G^T, so
+       df = -(dv B + v K),   B = Vol G S G^T,
+       K = lambda (X : Ah) Ah + 2 mu Ah X Ah,   Ah = Vol G G^T / sqrt(Vol) = sqrt(Vol) G G^T
+   (lambda Vol tr dE v G G^T = lambda (X : Ah) v Ah, 2 mu Vol v G G^T X G G^T = 2 mu v Ah X Ah).
+   What the linearisation point fixes: v (9), Ah (6), B (6): HEML__NC_SVK = 21 reals
+   (heml__diff_svk_point); a product (heml__diff_svk_apply) costs about 150 operations: v^T dv
+   (27 multiply-adds), X Ah and Ah (X Ah) (45), v K and dv B (54) and a few. B comes from
+   E = (H + H^T + H^T H) / 2 formed from the displacements (no cancellation at small
+   strain, as the force's). Below J0 the law adds its guard (lambda + 2 mu) d^2 / 2: a block
+   with a tetrahedron below J0 returns 1 from the point function and takes the general path
+   (heml__block_diff_general), so does a material with a Prony series (mt->dk = 0) or a
+   model with the nodal pressure. Cached and uncached products run the same functions on
+   the same values: bit-identical. */
+static int heml__diff_svk_point(const heml__mat *mt, heml_real jm1_0, int valid, const heml_real *HEML__RESTRICT R,
+                                const heml_real (*HEML__RESTRICT V)[HEML__W], const heml__blk *HEML__RESTRICT b,
+                                heml_real *HEML__RESTRICT C)
+{
+    const heml_real mu = mt->mu, lambda = mt->lambda;
+    heml_real sv[HEML__W];
+    int k, r, below = 0;
+    for (r = 0; r < 9; r++) /* v = V + du */
+        for (k = 0; k < HEML__W; k++) C[r * HEML__W + k] = V[r][k] + b->e[r][k];
+    for (k = 0; k < HEML__W; k++) sv[k] = R[9 * HEML__W + k] > 0 ? R[9 * HEML__W + k] : 1; /* (padding: G = 0) */
+    heml__sqrt_lanes(sv, HEML__W);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k], ah = sv[k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+        heml_real jm1 = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
+        /* S = lambda / 2 tr E2 I + mu E2, E2 = C - I = H + H^T + H^T H */
+        heml_real E00 = 2 * H00 + (H00 * H00 + H10 * H10 + H20 * H20);
+        heml_real E11 = 2 * H11 + (H01 * H01 + H11 * H11 + H21 * H21);
+        heml_real E22 = 2 * H22 + (H02 * H02 + H12 * H12 + H22 * H22);
+        heml_real E01 = H01 + H10 + (H00 * H01 + H10 * H11 + H20 * H21);
+        heml_real E02 = H02 + H20 + (H00 * H02 + H10 * H12 + H20 * H22);
+        heml_real E12 = H12 + H21 + (H01 * H02 + H11 * H12 + H21 * H22);
+        heml_real st = lambda / 2 * (E00 + E11 + E22);
+        heml_real S00 = st + mu * E00, S11 = st + mu * E11, S22 = st + mu * E22;
+        heml_real S01 = mu * E01, S02 = mu * E02, S12 = mu * E12;
+        /* u_j = S g_j, B_jl = Vol g_j . u_l, Ah_jl = sqrt(Vol) g_j . g_l */
+        heml_real u10 = S00 * g10 + S01 * g11 + S02 * g12, u11 = S01 * g10 + S11 * g11 + S12 * g12;
+        heml_real u12 = S02 * g10 + S12 * g11 + S22 * g12;
+        heml_real u20 = S00 * g20 + S01 * g21 + S02 * g22, u21 = S01 * g20 + S11 * g21 + S12 * g22;
+        heml_real u22 = S02 * g20 + S12 * g21 + S22 * g22;
+        heml_real u30 = S00 * g30 + S01 * g31 + S02 * g32, u31 = S01 * g30 + S11 * g31 + S12 * g32;
+        heml_real u32 = S02 * g30 + S12 * g31 + S22 * g32;
+        below |= (k < valid) & (jm1 < jm1_0);
+        C[9 * HEML__W + k] = ah * (g10 * g10 + g11 * g11 + g12 * g12);
+        C[10 * HEML__W + k] = ah * (g20 * g20 + g21 * g21 + g22 * g22);
+        C[11 * HEML__W + k] = ah * (g30 * g30 + g31 * g31 + g32 * g32);
+        C[12 * HEML__W + k] = ah * (g10 * g20 + g11 * g21 + g12 * g22);
+        C[13 * HEML__W + k] = ah * (g10 * g30 + g11 * g31 + g12 * g32);
+        C[14 * HEML__W + k] = ah * (g20 * g30 + g21 * g31 + g22 * g32);
+        C[15 * HEML__W + k] = vol * (g10 * u10 + g11 * u11 + g12 * u12);
+        C[16 * HEML__W + k] = vol * (g20 * u20 + g21 * u21 + g22 * u22);
+        C[17 * HEML__W + k] = vol * (g30 * u30 + g31 * u31 + g32 * u32);
+        C[18 * HEML__W + k] = vol * (g10 * u20 + g11 * u21 + g12 * u22);
+        C[19 * HEML__W + k] = vol * (g10 * u30 + g11 * u31 + g12 * u32);
+        C[20 * HEML__W + k] = vol * (g20 * u30 + g21 * u31 + g22 * u32);
+    }
+    return below;
+}
+
+/* The product of the point values C (heml__diff_svk_point) with the links dv of dx in
+   b->de, into b->f (nodes 1..3): df = -(dv B + v K). */
+static void heml__diff_svk_apply(const heml__mat *mt, const heml_real *HEML__RESTRICT C, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real lambda = mt->lambda, mu2 = 2 * mt->mu;
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k]; /* dv1 */
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k]; /* dv2 */
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k]; /* dv3 */
+        heml_real p0 = C[k], p1 = C[HEML__W + k], p2 = C[2 * HEML__W + k];               /* v1 */
+        heml_real q0 = C[3 * HEML__W + k], q1 = C[4 * HEML__W + k], q2 = C[5 * HEML__W + k]; /* v2 */
+        heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
+        heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
+        heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
+        heml_real B11 = C[15 * HEML__W + k], B22 = C[16 * HEML__W + k], B33 = C[17 * HEML__W + k];
+        heml_real B12 = C[18 * HEML__W + k], B13 = C[19 * HEML__W + k], B23 = C[20 * HEML__W + k];
+        /* X = sym(v^T dv): X_jl = (v_j . dv_l + v_l . dv_j) / 2 */
+        heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
+        heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
+        heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
+        heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
+        heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
+        heml_real la = lambda * ((X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23));
+        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric) */
+        heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
+        heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
+        heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
+        heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real K11 = la * A11 + mu2 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = la * A22 + mu2 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = la * A33 + mu2 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = la * A12 + mu2 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = la * A13 + mu2 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = la * A23 + mu2 * (A12 * T13 + A22 * T23 + A23 * T33);
+        b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13));
+        b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13));
+        b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13));
+        b->f[3][k] = -((x0 * B12 + y0 * B22 + z0 * B23) + (p0 * K12 + q0 * K22 + r0 * K23));
+        b->f[4][k] = -((x1 * B12 + y1 * B22 + z1 * B23) + (p1 * K12 + q1 * K22 + r1 * K23));
+        b->f[5][k] = -((x2 * B12 + y2 * B22 + z2 * B23) + (p2 * K12 + q2 * K22 + r2 * K23));
+        b->f[6][k] = -((x0 * B13 + y0 * B23 + z0 * B33) + (p0 * K13 + q0 * K23 + r0 * K33));
+        b->f[7][k] = -((x1 * B13 + y1 * B23 + z1 * B33) + (p1 * K13 + q1 * K23 + r1 * K33));
+        b->f[8][k] = -((x2 * B13 + y2 * B23 + z2 * B33) + (p2 * K13 + q2 * K23 + r2 * K33));
+    }
+}
+
+/* The uncached St Venant-Kirchhoff differential of block blk (links of u in b->e, of dx in
+   b->de), as heml__diff_nh; returns 1 (nothing computed) for a block below J0. */
+static int heml__diff_svk(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
+{
+    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    heml__gather(m, m->blk_idx + (size_t)blk * 4 * HEML__W, m->rest, b->H);
+    if (heml__diff_svk_point(mt, m->jm1_0, m->blk_valid[blk], R, (const heml_real(*)[HEML__W])b->H, b, b->lin[0]))
+        return 1;
+    heml__diff_svk_apply(mt, b->lin[0], b);
+    return 0;
+}
+
+/* The split Mooney-Rivlin force differential (law heml__law_split, HEML__DK_MR), in the
+   links as heml__diff_nh's and heml__diff_svk's. With P = 2 a F - F M + w_J cof F
+   (heml__coefficients: a = w_1 + (I1 - 1) w_2, M = 2 w_2 (C - I)) and this law's second
+   derivatives (w_11 = w_12 = w_22 = 0, also below J0, where its factors are continued),
+       dP = 2 da F + 2 a dF - dF M - F dM + dw_J cof F + w_J dcof F,
+       dw_1 = w_1J dJ, dw_2 = w_2J dJ, dw_J = w_1J dI1 + w_2J dI2 + w_JJ dJ,
+       da = dw_1 + (I1 - 1) dw_2 + w_2 dI1, dM = 2 (dw_2 (C - I) + w_2 dC),
+   and in the links (X = sym(v^T dv), z = sqrt(Vol), Ah = z G G^T, Nh = z G (C - I) G^T,
+   dC = 2 G^T X G, dI1 = 2 (X : Ah) / z, dI2 = (I1 - 1) dI1 - 2 (X : Nh) / z,
+   dJ = (cof v : dv) / (6 Vol), r = 1 / (6 z)):
+       df = -(dv B + v K + t cof v + (w_J / 6) dcof v),   B = Vol G (2 a I - M) G^T
+                                                          = z (2 a Ah - 2 w_2 Nh),
+       K = (2 ca g + 4 w_2 al) Ah - 2 cb g Nh - 4 w_2 Ah X Ah,
+       t = 2 ca al - 2 cb nu + cc g,
+   al = X : Ah, nu = X : Nh, g = cof v : dv, ca = r (w_1J + (I1 - 1) w_2J), cb = r w_2J,
+   cc = r^2 w_JJ. The point values: v (9), Ah, Nh (6 each), 2 a z, 2 w_2 z, 2 ca, 2 cb, cc,
+   w_J / 6, 4 w_2: HEML__NC_MR = 28 reals (B stored instead of its two scalars, 32 reals,
+   measured no faster); a product about 290 operations. The law and the stress
+   coefficients at the point come from heml__law_split and heml__coefficients themselves
+   (the general path's kinematics), so the continuation below J0 needs no fallback; Prony
+   and the nodal pressure take the general path (mt->dk = 0). */
+static void heml__diff_mr_point(const heml_model *m, const heml__mat *mt, int blk, heml__blk *HEML__RESTRICT b,
+                                heml_real *HEML__RESTRICT C)
+{
+    const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    heml_real sv[HEML__W];
+    int k, r;
+    for (r = 0; r < 9; r++) /* v = V + du (the rest links in b->f) */
+        for (k = 0; k < HEML__W; k++) C[r * HEML__W + k] = b->f[r][k] + b->e[r][k];
+    heml__kinematics(R, b);
+    heml__clamp_J(m->jm1_0, b);
+    heml__law(mt, b, m->blk_valid[blk], HEML__WANT_SECOND);
+    heml__coefficients(b, mt->uses_i2);
+    for (k = 0; k < HEML__W; k++) sv[k] = R[9 * HEML__W + k] > 0 ? R[9 * HEML__W + k] : 1; /* (padding: G = 0) */
+    heml__sqrt_lanes(sv, HEML__W);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real vol = R[9 * HEML__W + k], z = sv[k], rr = vol > 0 ? 1 / (6 * z) : 0;
+        heml_real E00 = b->E2[0][k], E11 = b->E2[1][k], E22 = b->E2[2][k];
+        heml_real E01 = b->E2[3][k], E02 = b->E2[4][k], E12 = b->E2[5][k];
+        heml_real a2 = 2 * b->co[1][k], w2 = b->w2[k], m2 = 2 * w2, I1m1 = 2 + b->I1m3[k];
+        /* u_j = E2 g_j; S = 2 a I - 2 w_2 E2, so S g_j = 2 a g_j - 2 w_2 u_j */
+        heml_real u10 = E00 * g10 + E01 * g11 + E02 * g12, u11 = E01 * g10 + E11 * g11 + E12 * g12;
+        heml_real u12 = E02 * g10 + E12 * g11 + E22 * g12;
+        heml_real u20 = E00 * g20 + E01 * g21 + E02 * g22, u21 = E01 * g20 + E11 * g21 + E12 * g22;
+        heml_real u22 = E02 * g20 + E12 * g21 + E22 * g22;
+        heml_real u30 = E00 * g30 + E01 * g31 + E02 * g32, u31 = E01 * g30 + E11 * g31 + E12 * g32;
+        heml_real u32 = E02 * g30 + E12 * g31 + E22 * g32;
+        heml_real q11 = g10 * g10 + g11 * g11 + g12 * g12, q22 = g20 * g20 + g21 * g21 + g22 * g22;
+        heml_real q33 = g30 * g30 + g31 * g31 + g32 * g32, q12 = g10 * g20 + g11 * g21 + g12 * g22;
+        heml_real q13 = g10 * g30 + g11 * g31 + g12 * g32, q23 = g20 * g30 + g21 * g31 + g22 * g32;
+        heml_real n11 = g10 * u10 + g11 * u11 + g12 * u12, n22 = g20 * u20 + g21 * u21 + g22 * u22;
+        heml_real n33 = g30 * u30 + g31 * u31 + g32 * u32, n12 = g10 * u20 + g11 * u21 + g12 * u22;
+        heml_real n13 = g10 * u30 + g11 * u31 + g12 * u32, n23 = g20 * u30 + g21 * u31 + g22 * u32;
+        C[9 * HEML__W + k] = z * q11;
+        C[10 * HEML__W + k] = z * q22;
+        C[11 * HEML__W + k] = z * q33;
+        C[12 * HEML__W + k] = z * q12;
+        C[13 * HEML__W + k] = z * q13;
+        C[14 * HEML__W + k] = z * q23;
+        C[15 * HEML__W + k] = z * n11;
+        C[16 * HEML__W + k] = z * n22;
+        C[17 * HEML__W + k] = z * n33;
+        C[18 * HEML__W + k] = z * n12;
+        C[19 * HEML__W + k] = z * n13;
+        C[20 * HEML__W + k] = z * n23;
+        C[21 * HEML__W + k] = vol > 0 ? z * a2 : 0; /* B = z (2 a Ah - 2 w_2 Nh) */
+        C[22 * HEML__W + k] = vol > 0 ? z * m2 : 0;
+        C[23 * HEML__W + k] = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]);
+        C[24 * HEML__W + k] = 2 * rr * b->h[4][k];
+        C[25 * HEML__W + k] = rr * rr * b->h[5][k];
+        C[26 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
+        C[27 * HEML__W + k] = 4 * w2;
+    }
+}
+
+/* The product of the point values C (heml__diff_mr_point) with the links dv of dx in
+   b->de, into b->f (nodes 1..3). */
+static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HEML__RESTRICT b)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k]; /* dv1 */
+        heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k]; /* dv2 */
+        heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k]; /* dv3 */
+        heml_real p0 = C[k], p1 = C[HEML__W + k], p2 = C[2 * HEML__W + k];               /* v1 */
+        heml_real q0 = C[3 * HEML__W + k], q1 = C[4 * HEML__W + k], q2 = C[5 * HEML__W + k]; /* v2 */
+        heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
+        heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
+        heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
+        heml_real N11 = C[15 * HEML__W + k], N22 = C[16 * HEML__W + k], N33 = C[17 * HEML__W + k];
+        heml_real N12 = C[18 * HEML__W + k], N13 = C[19 * HEML__W + k], N23 = C[20 * HEML__W + k];
+        heml_real za = C[21 * HEML__W + k], zm = C[22 * HEML__W + k];
+        heml_real ca2 = C[23 * HEML__W + k], cb2 = C[24 * HEML__W + k], cc = C[25 * HEML__W + k];
+        heml_real s2 = C[26 * HEML__W + k], w4 = C[27 * HEML__W + k];
+        heml_real B11 = za * A11 - zm * N11, B22 = za * A22 - zm * N22, B33 = za * A33 - zm * N33;
+        heml_real B12 = za * A12 - zm * N12, B13 = za * A13 - zm * N13, B23 = za * A23 - zm * N23;
+        heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
+        heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
+        heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
+        heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
+        heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
+        heml_real al = (X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23);
+        heml_real nu = (X11 * N11 + X22 * N22 + X33 * N33) + 2 * (X12 * N12 + X13 * N13 + X23 * N23);
+        /* cof v: c1 = v2 x v3, c2 = v3 x v1, c3 = v1 x v2; g = cof v : dv */
+        heml_real c10 = q1 * r2 - q2 * r1, c11 = q2 * r0 - q0 * r2, c12 = q0 * r1 - q1 * r0;
+        heml_real c20 = r1 * p2 - r2 * p1, c21 = r2 * p0 - r0 * p2, c22 = r0 * p1 - r1 * p0;
+        heml_real c30 = p1 * q2 - p2 * q1, c31 = p2 * q0 - p0 * q2, c32 = p0 * q1 - p1 * q0;
+        heml_real g = (c10 * x0 + c11 * x1 + c12 * x2) + (c20 * y0 + c21 * y1 + c22 * y2) + (c30 * z0 + c31 * z1 + c32 * z2);
+        heml_real e10 = (y1 * r2 - y2 * r1) + (q1 * z2 - q2 * z1), e11 = (y2 * r0 - y0 * r2) + (q2 * z0 - q0 * z2);
+        heml_real e12 = (y0 * r1 - y1 * r0) + (q0 * z1 - q1 * z0);
+        heml_real e20 = (z1 * p2 - z2 * p1) + (r1 * x2 - r2 * x1), e21 = (z2 * p0 - z0 * p2) + (r2 * x0 - r0 * x2);
+        heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
+        heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
+        heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
+        heml_real t = ca2 * al - cb2 * nu + cc * g, kA = ca2 * g + w4 * al, kN = cb2 * g;
+        /* T = X Ah, Ah X Ah = Ah T */
+        heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
+        heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
+        heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
+        heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real K11 = kA * A11 - kN * N11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = kA * A22 - kN * N22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = kA * A33 - kN * N33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = kA * A12 - kN * N12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = kA * A13 - kN * N13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = kA * A23 - kN * N23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
+        b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13) + t * c10 + s2 * e10);
+        b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13) + t * c11 + s2 * e11);
+        b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13) + t * c12 + s2 * e12);
+        b->f[3][k] = -((x0 * B12 + y0 * B22 + z0 * B23) + (p0 * K12 + q0 * K22 + r0 * K23) + t * c20 + s2 * e20);
+        b->f[4][k] = -((x1 * B12 + y1 * B22 + z1 * B23) + (p1 * K12 + q1 * K22 + r1 * K23) + t * c21 + s2 * e21);
+        b->f[5][k] = -((x2 * B12 + y2 * B22 + z2 * B23) + (p2 * K12 + q2 * K22 + r2 * K23) + t * c22 + s2 * e22);
+        b->f[6][k] = -((x0 * B13 + y0 * B23 + z0 * B33) + (p0 * K13 + q0 * K23 + r0 * K33) + t * c30 + s2 * e30);
+        b->f[7][k] = -((x1 * B13 + y1 * B23 + z1 * B33) + (p1 * K13 + q1 * K23 + r1 * K33) + t * c31 + s2 * e31);
+        b->f[8][k] = -((x2 * B13 + y2 * B23 + z2 * B33) + (p2 * K13 + q2 * K23 + r2 * K33) + t * c32 + s2 * e32);
+    }
+}
+
+/* The uncached split Mooney-Rivlin differential of block blk (links of u in b->e, of dx in
+   b->de): the rest links gathered into b->f, the point values into b->lin, the product. */
+static void heml__diff_mr(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
+{
+    heml__gather(m, m->blk_idx + (size_t)blk * 4 * HEML__W, m->rest, b->f);
+    heml__diff_mr_point(m, mt, blk, b, b->lin[0]);
+    heml__diff_mr_apply(b->lin[0], b);
+}
+
 /* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
    INCOMPRESSIBLE BODIES): the element's own volumetric function U(J_e) comes off (w -= U,
    w_J -= U', w_JJ -= U'') and the mean of its four nodes' pressures p_e = sum P_a / 4 goes
@@ -3420,20 +3787,13 @@ static void heml__diff_general(heml_real sp, const heml_real *HEML__RESTRICT R, 
        dP = 2 s da F + s dw_J cof F + 2 a dH + w_J dcof F - dH M - s F dM,
        da = dw_1 + (I1 - 1) dw_2 + w_2 dI1,   dM = 2 (dw_2 (C - I) + w_2 dE2),
    a, w_J and M those of the force (Prony-filtered), s the Prony factor (1 without
-   viscosity). Springs: d(t v) = t dv + dt v, dt = s k L (v . dv) / l^3. */
-static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
-                             const heml_real *dx, heml__blk *b)
+   viscosity). Springs: d(t v) = t dv + dt v, dt = s k L (v . dv) / l^3. The links of u are
+   in b->e, those of dx in b->de (heml__block_diff gathers them). */
+static void heml__block_diff_general(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
-    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml_real sp;
     int k;
-    heml__gather(m, idx, u, b->e);
-    heml__gather(m, idx, dx, b->de);
-    if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
-        heml__diff_nh(m, mt, blk, b);
-        return;
-    }
     sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
     if (mt->kind == HEML__K_SPRING) {
         const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
@@ -3468,6 +3828,26 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
         for (k = 0; k < HEML__W; k++) b->dp[k] = 0;
     heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
     heml__diff_general(sp, R, b);
+}
+
+/* The same with the gathers, through the material's differential kernel where it has one
+   (mt->dk: heml__diff_nh, heml__diff_svk; the general path where that declines). */
+static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, const heml_real *u,
+                             const heml_real *dx, heml__blk *b)
+{
+    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+    heml__gather(m, idx, u, b->e);
+    heml__gather(m, idx, dx, b->de);
+    if (mt->dk == HEML__DK_NH) { /* (the law's fast_path flag: heml__laws) */
+        heml__diff_nh(m, mt, blk, b);
+        return;
+    }
+    if (mt->dk == HEML__DK_MR) {
+        heml__diff_mr(m, mt, blk, b);
+        return;
+    }
+    if (mt->dk == HEML__DK_SVK && !heml__diff_svk(m, mt, blk, b)) return;
+    heml__block_diff_general(m, mt, blk, b);
 }
 
 /* Stress of one lane from its node forces (double): P = -(1/Vol) sum_k f_k V_k^T (the
@@ -3662,18 +4042,36 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
-                if (m->dc_pass && mt->fast) { /* the stiffness cache: fill it, or read it */
+                if (m->dc_pass && mt->dk) { /* the stiffness cache: fill it, or read it */
                     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-                    heml_real *C = m->dc + (size_t)blk * HEML__NC * HEML__W;
+                    const int rows = m->dc_rows;
+                    heml_real *C = m->dc + (size_t)blk * (size_t)rows * HEML__W;
                     if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
-                        heml__prefetch_block(C + HEML__NC * HEML__W, HEML__NC, idx + 4 * HEML__W);
+                        heml__prefetch_block(C + rows * HEML__W, HEML__DK_ROWS(mt->dk), idx + 4 * HEML__W);
                     if (m->dc_pass == HEML__DC_FILL) {
                         heml__gather(m, idx, p->x, b.e);
-                        heml__gather(m, idx, m->rest, b.H);
-                        heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        if (mt->dk == HEML__DK_MR) { /* (the rest links in b.f: the point uses b.H) */
+                            heml__gather(m, idx, m->rest, b.f);
+                            heml__diff_mr_point(m, mt, blk, &b, C);
+                        } else {
+                            heml__gather(m, idx, m->rest, b.H);
+                            if (mt->dk == HEML__DK_SVK)
+                                m->dc_gen[blk] = (unsigned char)heml__diff_svk_point(
+                                    mt, jm1_0, valid, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                            else
+                                heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
+                        }
                     }
-                    heml__gather(m, idx, p->dx, b.de);
-                    heml__diff_nh_apply(mt, C, &b);
+                    if (mt->dk == HEML__DK_SVK && m->dc_gen[blk]) { /* (below J0: the general path) */
+                        heml__gather(m, idx, p->x, b.e);
+                        heml__gather(m, idx, p->dx, b.de);
+                        heml__block_diff_general(m, mt, blk, &b);
+                    } else {
+                        heml__gather(m, idx, p->dx, b.de);
+                        if (mt->dk == HEML__DK_SVK) heml__diff_svk_apply(mt, C, &b);
+                        else if (mt->dk == HEML__DK_MR) heml__diff_mr_apply(C, &b);
+                        else heml__diff_nh_apply(mt, C, &b);
+                    }
                 } else
                     heml__block_diff(m, mt, blk, p->x, p->dx, &b);
                 heml__scatter(m, idx, b.f, p->out);
@@ -4094,11 +4492,12 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
         HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
-    HEML__CARVE(c, m->dc, heml_real, m->has_dc ? HEML__NC * s : 0);
+    HEML__CARVE(c, m->dc, heml_real, m->has_dc ? (size_t)m->dc_rows * s : 0);
+    HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
     if (!m->nodal) m->diag_dev = NULL;
     if (!m->pagg_count) m->pagg = NULL;
     if (!m->has_springs) m->blk_spring = NULL;
-    if (!m->has_dc) m->dc = NULL;
+    if (!m->has_dc) m->dc = NULL, m->dc_gen = NULL;
 }
 
 /* >>validation ------------------------------------------------------------------------ */
@@ -4245,6 +4644,11 @@ static void heml__make_mat(const heml_material *src, heml__mat *mt)
     mt->prony_count = src->prony_count;
     ops->make(src, mt);
     mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
+    mt->dk = mt->fast                                           ? HEML__DK_NH
+             : mt->prony_count                                  ? 0
+             : src->law == HEML_STVK                            ? HEML__DK_SVK
+             : src->law == HEML_MOONEY_RIVLIN                   ? HEML__DK_MR
+                                                                : 0;
 }
 
 /* Small-strain shear and Lame moduli of a law from its derivatives at rest (see THE
@@ -5154,7 +5558,11 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     for (i = 0; i < M && d->stiffness_cache && !tmp->nodal; i++) { /* a fast-path material in use */
         heml__mat mt;
         heml__make_mat(src + i, &mt);
-        if (mt.fast && w->counts[i] > 0) tmp->has_dc = 1;
+        if (mt.dk && w->counts[i] > 0) {
+            int rows = HEML__DK_ROWS(mt.dk);
+            tmp->has_dc = 1;
+            if (rows > tmp->dc_rows) tmp->dc_rows = rows;
+        }
     }
     tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     if (w->pagg) tmp->pagg_count = heml__pressure_aggregates(d, w->pagg, w->pagg + n, w->pagg + 2 * (size_t)n + 1);
@@ -5228,7 +5636,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
-        if (m->nodal) mt->fast = 0; /* the general path carries the nodal pressure */
+        if (m->nodal) mt->fast = mt->dk = 0; /* the general path carries the nodal pressure */
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;
@@ -6620,8 +7028,12 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
     {   /* the differential: cached blocks read the cache and dx, not u */
         size_t cached = 0, slots_all = (size_t)m->slot_count;
         for (i = 0; i < m->chunk_count && kernel == 1 && m->has_dc; i++)
-            if (m->mats[m->chunk_material[i]].fast) cached += (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
-        stream += cached * (HEML__NC - HEML__NR) * R; /* (the cache instead of the rest constants) */
+            if (m->mats[m->chunk_material[i]].dk) {
+                size_t slots = (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
+                int rows = HEML__DK_ROWS(m->mats[m->chunk_material[i]].dk);
+                cached += slots;
+                stream += slots * (size_t)(rows - HEML__NR) * R; /* (the cache instead of the rest constants) */
+            }
         *read = stream + prony + nodes * (kernel == 1 ? (cached == slots_all ? 1 : 2) : 1);
     }
     *written = nodes + (kernel == 0 ? prony : 0);

@@ -197,15 +197,14 @@ static double hm_kernel_bytes(void *v, int kernel)
 }
 
 /* The differential of one block for the link directions already in b->de (heml__block_diff
-   without its gathers). */
+   without its gathers; St Venant-Kirchhoff through the general path, so that the CSR check
+   below compares two evaluations). heml__block_diff_general zeroes the nodal pressure's dp
+   (this adapter called heml__diff_general with b->dp uninitialised: malloc's garbage, at
+   times subnormal, entered the matrix and slowed its product 5 to 7 times). */
 static void hm_block_diff(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
-    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-    if (mt->fast) heml__diff_nh(m, mt, blk, b);
-    else {
-        heml__block_stress(m, mt, blk, b, HEML__WANT_SECOND, 0);
-        heml__diff_general(1, R, b);
-    }
+    if (mt->dk == HEML__DK_NH) heml__diff_nh(m, mt, blk, b);
+    else heml__block_diff_general(m, mt, blk, b);
 }
 
 static int hm_int_cmp(const void *a, const void *b) { return *(const int *)a - *(const int *)b; }

@@ -714,6 +714,85 @@ static void test_differential_is_force_derivative(void)
     tetmesh_free(&mesh);
 }
 
+/* St Venant-Kirchhoff's differential kernel (heml__diff_svk, HEML__DK_SVK) on a mesh where
+   some blocks hold a tetrahedron below J0 (they take the general path: m->dc_gen) and the
+   others do not: one corner node pushed through its cell on a mildly deformed bar. The
+   product equals the central difference of the independent FEM forces (double: FD
+   truncation ~1e-10; float: the differential's round-off, as in
+   test_differential_is_force_derivative), with the cache (filled, then read) and without
+   it, and both kinds of block are present (checked, so that the test covers the mix). */
+static void test_svk_differential_mixed_blocks(void)
+{
+    tetmesh mesh;
+    heml_material mt = material_of(HEML_STVK);
+    int n3, i, c, c0 = 0, c1 = 0, gen = 0, kern = 0;
+    double *x, *xp, *fp, *fm, *dir, h = 1e-6, best = 1e30, dmax, far[3];
+    heml_real *dxr, *df;
+    unsigned seed = 5u;
+    box_mesh(&mesh, 4, 2, 2, 1, 0.5, 0.5, TETMESH_SPLIT6); /* 96 tetrahedra: 6 blocks */
+    n3 = 3 * mesh.node_count;
+    x = (double *)calloc((size_t)n3, sizeof(double));
+    xp = (double *)calloc((size_t)n3, sizeof(double));
+    fp = (double *)calloc((size_t)n3, sizeof(double));
+    fm = (double *)calloc((size_t)n3, sizeof(double));
+    dir = (double *)calloc((size_t)n3, sizeof(double));
+    REQUIRE(x && xp && fp && fm && dir);
+    dxr = alloc_reals(n3), df = alloc_reals(n3);
+    deformed_state(&mesh, 0.02, 17u, x);
+    for (i = 0; i < mesh.node_count; i++) /* the corner (0, 0, 0) and its cell's far corner */
+        if (mesh.nodes[3 * i] + mesh.nodes[3 * i + 1] + mesh.nodes[3 * i + 2] == 0) c0 = i;
+    for (i = 0; i < 3; i++) far[i] = mesh.nodes[3 * c0 + i] + 0.25;
+    for (i = 0; i < mesh.node_count; i++) {
+        double d = fabs(mesh.nodes[3 * i] - far[0]) + fabs(mesh.nodes[3 * i + 1] - far[1]) +
+                   fabs(mesh.nodes[3 * i + 2] - far[2]);
+        if (d < best) best = d, c1 = i;
+    }
+    for (i = 0; i < 3; i++) x[3 * c0 + i] += 1.3 * (x[3 * c1 + i] - x[3 * c0 + i]);
+    for (i = 0; i < n3; i++) {
+        dxr[i] = (heml_real)rnd(&seed);
+        dir[i] = (double)dxr[i];
+    }
+    for (i = 0; i < n3; i++) xp[i] = x[i] + h * dir[i];
+    fem_energy_forces(&mesh, &mt, 0.4, xp, fp);
+    for (i = 0; i < n3; i++) xp[i] = x[i] - h * dir[i];
+    fem_energy_forces(&mesh, &mt, 0.4, xp, fm);
+    for (i = 0; i < n3; i++) fp[i] = (fp[i] - fm[i]) / (2 * h);
+    dmax = max_abs(fp, n3);
+    for (c = 0; c < 2; c++) {
+        heml_desc d = heml_default_desc();
+        heml_model *m = NULL;
+        heml_real *X = alloc_reals(n3);
+        double err = 0;
+        int rep;
+        for (i = 0; i < n3; i++) X[i] = (heml_real)mesh.nodes[i];
+        d.rest_positions = X;
+        d.node_count = mesh.node_count;
+        d.tets = mesh.tets;
+        d.tet_count = mesh.tet_count;
+        d.material = mt;
+        d.stiffness_cache = c == 0;
+        CHECK_INT(HEML_OK, heml_create(&d, &m));
+        free(X);
+        if (!m) break;
+        CHECK_INT(HEML__DK_SVK, m->mats[0].dk);
+        set_positions_d(m, x, mesh.node_count);
+        for (rep = 0; rep < 2; rep++) { /* (with the cache: fill, then read) */
+            CHECK_INT(HEML_OK, heml_apply_stiffness(m, dxr, df));
+            for (i = 0; i < n3; i++) err = fabs((double)df[i] - fp[i]) > err ? fabs((double)df[i] - fp[i]) : err;
+        }
+        if (c == 0)
+            for (i = 0; i < m->block_count; i++) gen += m->dc_gen[i], kern += !m->dc_gen[i];
+        (void)heml_compute_forces(m); /* (the count below J0) */
+        printf("    cache %d: below J0 %d, blocks general / kernel %d / %d: |df - fd| / |df| = %.2g\n", c == 0,
+               (int)heml_last_stats(m)->below_threshold, gen, kern, err / dmax);
+        CHECK(err <= (IS_FLOAT ? 3e-4 : 1e-6) * dmax);
+        heml_destroy(m);
+    }
+    CHECK(gen > 0 && kern > 0);
+    free(x), free(xp), free(fp), free(fm), free(dir), free(dxr), free(df);
+    tetmesh_free(&mesh);
+}
+
 /* With a Prony series and a viscous state built up by a few steps, the differential is
    still the derivative of the force actually used (the state held): the elastic part
    scaled by 1 - sum a_i, the geometric part with the relaxed stress. Central differences
@@ -1782,8 +1861,10 @@ static void test_vector_paths_match_scalar(void)
    round-off). The cached product runs the same arithmetic on the same values, so it is
    expected bit-identical (printed); the check allows 64 units of round-off of the
    product's largest entry (a compiler contracting the two call sites differently).
-   The cache's memory is HEML__NC reals per slot exactly where a fast-path (Neo-Hookean)
-   material is in use without nodal pressure, none otherwise; no allocation after create. */
+   The cache's memory is HEML__NC_NH (Neo-Hookean kernels), HEML__NC_SVK (St Venant-
+   Kirchhoff) or HEML__NC_MR (split Mooney-Rivlin) reals per slot (HEML__DK_ROWS; no Prony)
+   and a byte per block exactly where such a material is in use without nodal pressure,
+   none otherwise; no allocation after create. */
 static int cache_compare(heml_model *a, heml_model *b, const heml_real *dx, int n3, int *bitwise)
 {
     heml_real *ka = alloc_reals(n3), *kb = alloc_reals(n3);
@@ -1852,11 +1933,13 @@ static void test_stiffness_cache(void)
                 CHECK_INT(HEML_OK, heml_create(&d, &m[c]));
             }
             if (!m[0] || !m[1]) break;
-            fast = m[0]->mats[0].fast;
-            { /* (within the 64-byte alignment of the carved arrays) */
-                long long want = fast ? HEML__NC * (long long)sizeof(heml_real) * m[0]->slot_count : 0;
+            fast = m[0]->mats[0].dk != 0;
+            { /* (within the 64-byte alignment of the two carved arrays: the cache's rows and a
+                 byte per block, dc_gen) */
+                int rows = HEML__DK_ROWS(m[0]->mats[0].dk);
+                long long want = fast ? rows * (long long)sizeof(heml_real) * m[0]->slot_count + m[0]->block_count : 0;
                 long long got = (long long)heml_memory_bytes(m[0]) - (long long)heml_memory_bytes(m[1]);
-                CHECK(got > want - HEML__ALIGN && got < want + HEML__ALIGN);
+                CHECK(got > want - 2 * HEML__ALIGN && got < want + 2 * HEML__ALIGN);
             }
             for (i = 0; i < n3; i++) dx1[i] = (heml_real)rnd(&seed), dx2[i] = (heml_real)rnd(&seed);
             allocs = ca.allocs;
@@ -1927,6 +2010,7 @@ static const test_case cases[] = {
     TEST(test_forces_equal_p1_fem),
     TEST(test_paper_appendix_quantities),
     TEST(test_differential_is_force_derivative),
+    TEST(test_svk_differential_mixed_blocks),
     TEST(test_differential_with_prony),
     TEST(test_rest_and_small_strains),
     TEST(test_rigid_motion_zero_force),

@@ -882,13 +882,14 @@ static void odd_parallel_for(int count, heml_task_fn task, void *ctx, void *user
     }
 }
 
-/* Explicit and implicit steps and a static solve on a two-material mesh with Prony
-   viscosity, positions hashed. */
+/* Explicit and implicit steps and a static solve on a four-material mesh (Neo-Hookean, St
+   Venant-Kirchhoff and Mooney-Rivlin on their own differential kernels and stiffness cache,
+   Mooney-Rivlin with Prony viscosity on the general path), positions hashed. */
 static unsigned long long run_hashed(int threads, int job_system, int nodal)
 {
     tetmesh mesh;
     heml_model *m;
-    heml_material mats[2];
+    heml_material mats[4];
     heml_prony_term term;
     heml_desc d;
     heml_real *X;
@@ -906,8 +907,10 @@ static unsigned long long run_hashed(int threads, int job_system, int nodal)
         tetmesh_beam(&mesh, 1.0, 0.3, 0.3, 10, 3, 3, TETMESH_SPLIT6);
     X = to_real(mesh.nodes, 3 * mesh.node_count);
     tm = (int *)malloc(sizeof(int) * mesh.tet_count);
-    for (i = 0; i < mesh.tet_count; i++) tm[i] = (i / 13) % 2;
+    for (i = 0; i < mesh.tet_count; i++) tm[i] = (i / 13) % 4;
     mats[0] = heml_material_from_young(HEML_NEO_HOOKEAN, 4e6, 0.35);
+    mats[2] = heml_material_from_young(HEML_STVK, 3e6, 0.3);
+    mats[3] = heml_material_from_young(HEML_MOONEY_RIVLIN, 3e6, 0.35);
     mats[1] = heml_material_from_young(HEML_MOONEY_RIVLIN, 2e6, 0.4);
     term.alpha = (heml_real)0.2;
     term.tau = (heml_real)0.05;
@@ -915,7 +918,7 @@ static unsigned long long run_hashed(int threads, int job_system, int nodal)
     mats[1].prony_count = 1;
     d = mesh_desc(&mesh, X);
     d.materials = mats;
-    d.material_count = 2;
+    d.material_count = 4;
     d.tet_material = tm;
     if (job_system) d.parallel_for = odd_parallel_for;
     d.nodal_pressure = nodal; /* (its node pass runs in chunks of 1024 nodes: one here) */
@@ -1091,7 +1094,8 @@ static void test_no_allocation_nodal_pressure(void)
 
 /* The bytes a force pass streams: HEML_KERNEL_BYTES_PER_TET per slot (4 indices and 10
    rest constants: 96 in double, 56 in float), plus each node's displacements read and
-   forces written; the stiffness product's (Neo-Hookean, cached) likewise with the cache. */
+   forces written; the stiffness product's (Neo-Hookean, St Venant-Kirchhoff and split
+   Mooney-Rivlin, cached) likewise with the cache. */
 static void test_kernel_bytes(void)
 {
     tetmesh mesh;
@@ -1111,6 +1115,20 @@ static void test_kernel_bytes(void)
     CHECK_INT((long long)(slots * (4 * sizeof(int) + 17 * sizeof(heml_real)) + 3 * 125 * sizeof(heml_real)),
               (long long)rd);
     CHECK_INT(HEML_ERR_ARG, heml_kernel_bytes(m, 2, &rd, &wr));
+    heml_destroy(m);
+    /* St Venant-Kirchhoff's cache: 21 reals (v, A / sqrt(Vol), Vol G S G^T) */
+    m = make_model(&mesh, HEML_STVK, 1e4, 0.3, 1000);
+    REQUIRE(m != NULL);
+    CHECK_INT(HEML_OK, heml_kernel_bytes(m, 1, &rd, &wr));
+    CHECK_INT((long long)(slots * (4 * sizeof(int) + 21 * sizeof(heml_real)) + 3 * 125 * sizeof(heml_real)),
+              (long long)rd);
+    heml_destroy(m);
+    /* the split Mooney-Rivlin's: 28 reals (v, A / sqrt(Vol), sqrt(Vol) G (C - I) G^T, 7 scalars) */
+    m = make_model(&mesh, HEML_MOONEY_RIVLIN, 1e4, 0.3, 1000);
+    REQUIRE(m != NULL);
+    CHECK_INT(HEML_OK, heml_kernel_bytes(m, 1, &rd, &wr));
+    CHECK_INT((long long)(slots * (4 * sizeof(int) + 28 * sizeof(heml_real)) + 3 * 125 * sizeof(heml_real)),
+              (long long)rd);
     heml_destroy(m);
     tetmesh_free(&mesh);
 }
