@@ -5124,27 +5124,36 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
 
 /* Second moment J = tr(L) I - L of a set of points (L their covariance about the mean),
    accumulated by frm__spread_add relative to a nearby origin o (far from the world origin
-   the raw products would cancel): sums in acc[0..2] (coordinates), acc[3..11] (products),
-   acc[12] (count). A rotation dtheta moves some point relative to the others at first
-   order iff dtheta . J dtheta > 0. */
+   the raw products would cancel) as running mean and centred co-moments (Welford):
+   acc[0..2] the mean, acc[3..11] sum (y - mean_old)(y - mean_new)^T, acc[12] the count.
+   A rotation dtheta moves some point relative to the others at first order iff
+   dtheta . J dtheta > 0. The centred update makes L exactly zero for one point or several
+   coincident ones, whatever the compiler contracts: the one-pass form sum(y y^T)/n - mean
+   mean^T it replaces cancels to round-off there, and a contracted multiply-add
+   (-ffp-contract=fast with FMA, gcc's default outside ISO C mode) keeps the rounding error
+   of y y^T, so a frame with a single sample (a tetrahedral mesh's corner frames) got a
+   J of noise whose eigenvalue ratios made one random axis, not all three, "unseen"
+   (issue: bench R1 tet4 in double, FRM_ERR_UNSTABLE; see SOLVERS, the minimum check). */
 static void frm__spread_add(double acc[13], const frm_real *x, const frm_real *o)
 {
-    double y[3];
+    double y[3], d[3];
     int r, c;
-    for (r = 0; r < 3; r++) y[r] = (double)x[r] - (double)o[r];
-    for (r = 0; r < 3; r++) {
-        acc[r] += y[r];
-        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += y[r] * y[c];
-    }
     acc[12] += 1;
+    for (r = 0; r < 3; r++) {
+        y[r] = (double)x[r] - (double)o[r];
+        d[r] = y[r] - acc[r];
+        acc[r] += d[r] / acc[12];
+    }
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += d[r] * (y[c] - acc[c]);
 }
 
 static void frm__spread_J(const double acc[13], double J[9])
 {
     double L[9], n = acc[12] > 0 ? acc[12] : 1;
     int r, c;
-    for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++) L[3 * r + c] = acc[3 + 3 * r + c] / n - (acc[r] / n) * (acc[c] / n);
+    for (r = 0; r < 3; r++) /* the co-moment sums are symmetric up to round-off: average them */
+        for (c = 0; c < 3; c++) L[3 * r + c] = 0.5 * (acc[3 + 3 * r + c] + acc[3 + 3 * c + r]) / n;
     for (r = 0; r < 9; r++) J[r] = -L[r];
     for (r = 0; r < 3; r++) J[4 * r] += L[0] + L[4] + L[8];
 }
