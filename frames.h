@@ -294,7 +294,9 @@
        sits at 0.04 rad of spurious rotation and 78 % more sag on R1 one cell across). For
        those frames only (found at creation: the kernel of the samples' second moment
        J = tr(L) I - L, projector N in rest axes, unless the whole neighbourhood is
-       collinear too, a rod whose torsion lives in that rotation) the model adds, per
+       collinear too, a rod whose torsion lives in that rotation; L by centred running
+       sums, exactly zero for one sample whatever the compiler contracts, see SOLVERS'
+       minimum check for what the one-pass form did) the model adds, per
        (sample, frame), beta mu v / 2 omega . N omega with omega = axial(skew(Q^T F)), the
        frame's rotation relative to the sample's, about the unseen axes only (measured:
        beta 0.5 against 0.1 moves the tip by 0.49 % on R3 one cell across, by 0.09 % at
@@ -490,6 +492,36 @@
        cap counts as a minimum). Hold the symmetric components (frm_model_set_frame_axes)
        or nudge the state and solve again to reach a minimum. Held axes' values (and
        the rest of the state) are the starting point: they are not continued.
+       What it caught (measured, bench R1 with one-sample tetrahedral frames, 32 k x k x k
+       cells): in double at k = 3 the bench (-O3 -ffp-contract=fast) got FRM_ERR_UNSTABLE
+       where float solved. A correct refusal of a wrongly built model: the rotation
+       stabilisation's second moment, then sum(y y^T)/n - mean mean^T, kept in a fused
+       multiply-add the rounding error of y y^T, so the beam's corner frames (one sample
+       each) had one random axis stabilised instead of three, and gravity's torque made
+       the tangent indefinite (a banded LDL^T of the probe's operator at rest: one negative
+       pivot, -1.2 N m against pivots up to 1.4e11; none without contraction, smallest
+       1.05e6); Newton took 19 iterations with 18 positive-definite fallbacks instead of 3.
+       Float built the model right (products of float coordinates are exact in double).
+       Fixed at the moment (centred sums; tests/test_frames.c test_unseen_rotations_exact):
+       3 Newton, 179 CG, a minimum, as without contraction. Not fixed, float's precision
+       limit: at k = 6 (56,742 dof) float's K v carries more round-off than the beam's
+       soft modes have curvature (k = 4: 6 Newton, 305 CG; k = 6: 8 Newton, 39,643 CG, its
+       linear solves meeting "negative curvature" in the positive-definite part too and
+       ending with relative residuals of 24 and 97 after 2,557 and 23,424 iterations;
+       double at k = 6: 3 Newton, 293 CG, a minimum), so the float solve takes minutes and
+       its probe can call round-off a saddle: p . K p / sum |p_k (K p)_k| = -2.35e-4 against
+       the threshold 1.2e-4 (FRM_ERR_UNSTABLE after 8 Newton iterations, gcc -O3
+       -march=native -ffp-contract=fast, this revision and the one before it alike; the
+       bench's run at revision 59471d0 returned success, tip 0.15105 m, in 64 s). The
+       allowance's scale sum |p_k (K p)_k| underestimates the round-off of K p where K p
+       cancels (soft modes): against sum K_kk p_k^2 the same p . K p is -8.6e-10, far
+       inside float's round-off. Not done: an allowance on that scale would also pass a
+       genuine saddle that shallow, which float cannot tell apart; FRM_ERR_PRECISION there
+       may be the honest answer. Float's accepted answers on this beam are limited the
+       same way: at k = 4 its end-face sag is 0.75 % (St Venant-Kirchhoff; Neo-Hookean
+       0.02 %; k = 3: 0.001 %, 0.08 %) off double's for the same model, its relative
+       residual stopping at 2.6e-3 on the round-off floor. Use double for a stiff, slender
+       body that fine.
        static_regularization (default 1e-10; 1e-6 at least in the positive-definite
        attempt) adds that fraction of |K_ii| to each frame's rotational diagonal inside CG
        only: the forces and the equilibrium are unchanged. Keep it small: a slender beam's
@@ -5191,27 +5223,36 @@ static int frm__compute_masses(frm_model *m, const frm_desc *d)
 
 /* Second moment J = tr(L) I - L of a set of points (L their covariance about the mean),
    accumulated by frm__spread_add relative to a nearby origin o (far from the world origin
-   the raw products would cancel): sums in acc[0..2] (coordinates), acc[3..11] (products),
-   acc[12] (count). A rotation dtheta moves some point relative to the others at first
-   order iff dtheta . J dtheta > 0. */
+   the raw products would cancel) as running mean and centred co-moments (Welford):
+   acc[0..2] the mean, acc[3..11] sum (y - mean_old)(y - mean_new)^T, acc[12] the count.
+   A rotation dtheta moves some point relative to the others at first order iff
+   dtheta . J dtheta > 0. The centred update makes L exactly zero for one point or several
+   coincident ones, whatever the compiler contracts: the one-pass form sum(y y^T)/n - mean
+   mean^T it replaces cancels to round-off there, and a contracted multiply-add
+   (-ffp-contract=fast with FMA, gcc's default outside ISO C mode) keeps the rounding error
+   of y y^T, so a frame with a single sample (a tetrahedral mesh's corner frames) got a
+   J of noise whose eigenvalue ratios made one random axis, not all three, "unseen"
+   (issue: bench R1 tet4 in double, FRM_ERR_UNSTABLE; see SOLVERS, the minimum check). */
 static void frm__spread_add(double acc[13], const frm_real *x, const frm_real *o)
 {
-    double y[3];
+    double y[3], d[3];
     int r, c;
-    for (r = 0; r < 3; r++) y[r] = (double)x[r] - (double)o[r];
-    for (r = 0; r < 3; r++) {
-        acc[r] += y[r];
-        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += y[r] * y[c];
-    }
     acc[12] += 1;
+    for (r = 0; r < 3; r++) {
+        y[r] = (double)x[r] - (double)o[r];
+        d[r] = y[r] - acc[r];
+        acc[r] += d[r] / acc[12];
+    }
+    for (r = 0; r < 3; r++)
+        for (c = 0; c < 3; c++) acc[3 + 3 * r + c] += d[r] * (y[c] - acc[c]);
 }
 
 static void frm__spread_J(const double acc[13], double J[9])
 {
     double L[9], n = acc[12] > 0 ? acc[12] : 1;
     int r, c;
-    for (r = 0; r < 3; r++)
-        for (c = 0; c < 3; c++) L[3 * r + c] = acc[3 + 3 * r + c] / n - (acc[r] / n) * (acc[c] / n);
+    for (r = 0; r < 3; r++) /* the co-moment sums are symmetric up to round-off: average them */
+        for (c = 0; c < 3; c++) L[3 * r + c] = 0.5 * (acc[3 + 3 * r + c] + acc[3 + 3 * c + r]) / n;
     for (r = 0; r < 9; r++) J[r] = -L[r];
     for (r = 0; r < 3; r++) J[4 * r] += L[0] + L[4] + L[8];
 }
@@ -7518,7 +7559,7 @@ static void frm__set_load(frm_model *m, double lambda, const frm_real g_full[3])
 /* Is the converged static state a minimum? A zero residual holds at saddles too (a
    squashed cube's symmetric state, which the model's tilted branches lie below: LIMITS).
    A probe solve K x = b (b a fixed pseudo-random vector on the free components, K the
-   full tangent at the state, block-Jacobi CG to 1e-10, float 1e-5) meets a direction p of
+   full tangent at the state, block-Jacobi CG to 1e-7, float 1e-5) meets a direction p of
    negative curvature where K is indefinite. A saddle is reported when p . K p is below
    -1e3 eps sum_k |p_k (K p)_k| (the round-off of that sum: a singular or nearly singular
    positive semi-definite K, e.g. rotations held only by static_regularization, stays

@@ -1361,6 +1361,94 @@ static void test_invisible_rotations(void)
     }
 }
 
+/* The largest difference between the stabilised rotations of a model (its view's f_stab,
+   beta N, Voigt xx yy zz yz xz xy) and invisible_projector's (independent) over sampling
+   s's frames (HUGE_VAL without a view). */
+static double projector_mismatch(const frm_model *m, const frm_sampling *s, double beta)
+{
+    frm_view v;
+    double worst = 0;
+    int i, k;
+    static const int rr[6] = {0, 1, 2, 1, 0, 0}, cc[6] = {0, 1, 2, 2, 2, 1};
+    if (frm_model_view(m, &v) != FRM_OK) return HUGE_VAL;
+    for (i = 0; i < s->frame_count; i++) {
+        double N[9];
+        invisible_projector(s, i, N);
+        for (k = 0; k < 6; k++) {
+            double lib = v.f_stab && v.f_stab_on[i] ? (double)v.f_stab[6 * i + k] / beta : 0;
+            worst = fmax(worst, fabs(lib - N[3 * rr[k] + cc[k]]));
+        }
+    }
+    return worst;
+}
+
+/* The bench's R1 tet4 rows in double (32 k x k x k cells, k = 3) failed with
+   FRM_ERR_UNSTABLE while float solved them: the bench compiles with -ffp-contract=fast, and
+   the second moment of a frame's samples, taken as sum(y y^T)/n - mean mean^T, kept the
+   rounding error of y y^T in a fused multiply-add, so a frame with a single sample (the
+   beam's corner frames) got a J of round-off noise and one random axis, not all three,
+   stabilised; the corner frame left with two unstabilised rotations under gravity's torque
+   made the tangent indefinite, and the minimum check rightly refused the model's saddle
+   (double: negative pivot -1.2 N m against pivots up to 1.4e11 at rest; 19 Newton
+   iterations with 18 positive-definite fallbacks instead of 3). Float was immune (its
+   coordinates' products are exact in double). Without contraction the same cancellation
+   shows with coincident samples (three in 79 % of random offsets, measured), which is what
+   this test builds: the R3 tet4 beam of test_invisible_rotations and the same beam with
+   every sample split into three coincident thirds, the same model (the same energy, hence
+   the same static answer). Both must stabilise exactly the rotations invisible_projector
+   finds (1e-5: above float's rounding of the stored beta N, far below the defect's O(1)
+   error) and solve to the same tip; the test also goes red in a contracted build of the old
+   code through the first model alone. */
+static void test_unseen_rotations_exact(void)
+{
+    scene sc;
+    frm_desc d;
+    frm_model *split = NULL;
+    frm_real g[3] = {0, 0, (frm_real)-0.01}, *pos, *vol, *wts, *grads;
+    int *start, *frames, S, P, s, j, e, n;
+    double beta, tip[2], worst;
+    REQUIRE(scene_tet5(&sc, 1, 0.1, 0.1, 10, 1, 1, FRM_LAW_SVK, 1e6, 0.3, 1000, FRM_STIFFNESS_AUTO) == FRM_OK);
+    beta = (double)sc.d.rotation_stabilization;
+    worst = projector_mismatch(sc.m, &sc.s, beta);
+    printf("    one sample per tet: stabilised rotations off the independent projector by %.2g\n", worst);
+    CHECK(worst < 1e-5);
+    S = sc.s.sample_count, P = sc.s.pair_count;
+    pos = alloc_reals(9 * S), vol = alloc_reals(3 * S), wts = alloc_reals(3 * P), grads = alloc_reals(9 * P);
+    start = (int *)calloc((size_t)(3 * S + 1), sizeof(int)), frames = (int *)calloc((size_t)(3 * P), sizeof(int));
+    REQUIRE(pos && vol && wts && grads && start && frames);
+    for (s = 0, n = 0; s < S; s++)
+        for (j = 0; j < 3; j++) {
+            int c;
+            for (c = 0; c < 3; c++) pos[3 * (3 * s + j) + c] = sc.s.sample_positions[3 * s + c];
+            vol[3 * s + j] = sc.s.sample_volumes[s] / 3;
+            for (e = sc.s.neighbor_start[s]; e < sc.s.neighbor_start[s + 1]; e++, n++) {
+                frames[n] = sc.s.neighbor_frames[e];
+                wts[n] = sc.s.neighbor_weights[e];
+                for (c = 0; c < 3; c++) grads[3 * n + c] = sc.s.neighbor_gradients[3 * e + c];
+            }
+            start[3 * s + j + 1] = n;
+        }
+    d = sc.d;
+    d.sample_count = 3 * S, d.sample_positions = pos, d.sample_volumes = vol, d.sample_cells = NULL;
+    d.neighbor_start = start, d.neighbor_frames = frames, d.neighbor_weights = wts, d.neighbor_gradients = grads;
+    REQUIRE(frm_model_create(&d, &split) == FRM_OK);
+    worst = projector_mismatch(split, &sc.s, beta);
+    printf("    each sample split in three coincident thirds: off by %.2g\n", worst);
+    CHECK(worst < 1e-5);
+    for (j = 0; j < 2; j++) {
+        frm_model *m = j ? split : sc.m;
+        clamp_face(m, &sc.s);
+        REQUIRE(frm_model_set_gravity(m, g) == FRM_OK);
+        CHECK_INT(FRM_OK, frm_model_solve_static(m));
+        tip[j] = -end_face_z(m, &sc.s, 1);
+    }
+    printf("    tip %.6f mm, split %.6f mm (%+.2g)\n", 1e3 * tip[0], 1e3 * tip[1], tip[1] / tip[0] - 1);
+    CHECK_REL(tip[0], tip[1], IS_FLOAT ? 1e-3 : 1e-6);
+    frm_model_destroy(split);
+    free(pos), free(vol), free(wts), free(grads), free(start), free(frames);
+    scene_free(&sc);
+}
+
 /* The bench's stability scenes, small: implicit Euler at a time step of 1 s on the
    stability beam (20 x 2 x 2 cells, gravity for a 1 cm sag) for E from 1 kPa to 10 MPa
    (it failed with CG breakdown from dt = 0.014 s at 10 MPa: M + dt^2 K indefinite); a
@@ -4377,6 +4465,7 @@ static const test_case cases[] = {
     TEST(test_beam_frequency_r3),
     TEST(test_soft_cantilever_r2),
     TEST(test_invisible_rotations),
+    TEST(test_unseen_rotations_exact),
     TEST(test_solver_extremes),
     TEST(test_torsion_180),
     TEST(test_shepard_sheet),
