@@ -10955,20 +10955,38 @@ FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, 
     U[k] = wu;
 }
 
-/* Pivot k of block i: refused below the tolerance, else swept; p becomes the next pivot,
-   computed from r by one multiply-add (the next pivot's entry loses e^2 r; e its entry in
-   row k), which is the factorisation's whole sequential chain. */
+/* Block i's six pivots pv judged: each must be finite and above tol times the block's own
+   diagonal entry A_kk (A: the block's 36 reals). Returns 0, or the first refused pivot's
+   code (FRM_ERR_NOT_FINITE, FRM_ERR_BTD_INDEFINITE below -tol A_kk, FRM_ERR_BTD_SINGULAR
+   within it) with *failed_block = i. The pass is branch-free; the code is found again only
+   on refusal. */
+static int frm__btd_judge(const double *pv, const frm_real *A, const double tol, int i, int *failed_block)
+{
+    int k, ok = 1, err = FRM_ERR_NOT_FINITE;
+    for (k = 0; k < 6; k++) ok &= (pv[k] > tol * fabs((double)A[7 * k])) & (pv[k] <= DBL_MAX);
+    if (ok) return FRM_OK;
+    for (k = 0; k < 6; k++) {
+        const double p = pv[k], scale = fabs((double)A[7 * k]);
+        if (!frm__finite(p)) break;
+        if (!(p > tol * scale)) {
+            err = p < -tol * scale ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;
+            break;
+        }
+    }
+    if (failed_block) *failed_block = i;
+    return err;
+}
+
+/* Pivot k of block i, swept; p becomes the next pivot, computed from r by one multiply-add
+   (the next pivot's entry loses e^2 r; e its entry in row k), which is the factorisation's
+   whole sequential chain. The pivot is recorded in pv and judged with the block's other
+   five by frm__btd_judge after the sixth (a refused pivot's block is abandoned before its
+   output is stored, so nothing changes but the branches: one a block instead of three a
+   pivot). */
 #define FRM__BTD_PIVOT(k)                                                                              \
     do {                                                                                               \
-        double scale_ = fabs((double)A[7 * (k)]), r_, q_, e_;                                        \
-        if (!frm__finite(p)) {                                                                         \
-            if (failed_block) *failed_block = i;                                                       \
-            return FRM_ERR_NOT_FINITE;                                                                 \
-        }                                                                                              \
-        if (!(p > tol * scale_)) {                                                                     \
-            if (failed_block) *failed_block = i;                                                       \
-            return p < -tol * scale_ ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;                  \
-        }                                                                                              \
+        double r_, q_, e_;                                                                             \
+        pv[k] = p;                                                                                     \
         r_ = 1.0 / p;                                                                                  \
         e_ = (k) < 5 ? FRM__BTD_LANE(T[k], ((k) + 1) % 6) : FRM__BTD_LANE(U[k], 0);                   \
         q_ = (k) < 5 ? FRM__BTD_LANE(T[((k) + 1) % 6], ((k) + 1) % 6) : FRM__BTD_LANE(N[0], 0);        \
@@ -11039,21 +11057,6 @@ FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, 
     _mm512_mask_storeu_pd(Eout + 6 * a, 0x3f, U##a);
 #define FRM__BTD_ZNEXT(a) T##a = N##a;
 #define FRM__BTD_Z6(OP) OP(0) OP(1) OP(2) OP(3) OP(4) OP(5)
-/* the first of block i's six pivots pv that FRM__BTD_PIVOT refuses, and its code */
-static int frm__btd_refused(const double *pv, const double *A, const double tol, int i, int *failed_block)
-{
-    int k, err = FRM_ERR_NOT_FINITE;
-    for (k = 0; k < 6; k++) {
-        const double p = pv[k], scale = fabs(A[7 * k]);
-        if (!frm__finite(p)) break;
-        if (!(p > tol * scale)) {
-            err = p < -tol * scale ? FRM_ERR_BTD_INDEFINITE : FRM_ERR_BTD_SINGULAR;
-            break;
-        }
-    }
-    if (failed_block) *failed_block = i;
-    return err;
-}
 static int frm__btd_factor_zmm(int n, const double *diag, const double *lower, double *factor, int *failed_block,
                                const double tol)
 {
@@ -11090,7 +11093,7 @@ static int frm__btd_factor_zmm(int n, const double *diag, const double *lower, d
             const __mmask8 ok = _mm512_mask_cmp_pd_mask(0x3f, P, S, _CMP_GT_OQ) &
                                 _mm512_mask_cmp_pd_mask(0x3f, P, _mm512_set1_pd(DBL_MAX), _CMP_LE_OQ);
             if ((__mmask8)(ok & _mm512_mask_cmp_pd_mask(0x3f, _mm512_sub_pd(acc, acc), _mm512_setzero_pd(), _CMP_EQ_OQ)) != 0x3f) {
-                if (ok != 0x3f) return frm__btd_refused(pv_, A, tol, i, failed_block);
+                if (ok != 0x3f) return frm__btd_judge(pv_, A, tol, i, failed_block);
                 if (failed_block) *failed_block = i;
                 return FRM_ERR_NOT_FINITE;
             }
@@ -11110,7 +11113,7 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
     /* the window: T = rows / columns 0..5, U = rows 0..5 x columns 6..11, N = rows /
        columns 6..11 */
     frm__v8 T[6], U[6], N[6];
-    double t[6][6], p;
+    double t[6][6], p, pv[6];
     memset(t, 0, sizeof t);
     for (a = 0; a < 6; a++)
         for (b = 0; b <= a; b++) t[a][b] = t[b][a] = (double)diag[6 * a + b];
@@ -11136,6 +11139,8 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
         FRM__BTD_PIVOT(3);
         FRM__BTD_PIVOT(4);
         FRM__BTD_PIVOT(5);
+        a = frm__btd_judge(pv, A, tol, i, failed_block);
+        if (a) return a;
 #if defined(FRM__BTD_VECTOR) && !FRM__CAT(FRM__IS_, FRM_REAL)
         { /* double: rows stored straight from the registers (factor 109 -> 97 us for 1,000
              blocks against staging them through arrays, -O3 -march=native, best of 50) */
