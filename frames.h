@@ -1149,8 +1149,9 @@
    (Gauss-Jordan) of the 12 x 12 window [D_i B_i^T; B_i A(i + 1, i + 1)] over its first six
    pivots: each pivot costs one division, and the next pivot is formed from it by one
    multiply-add, so the sequential chain of the whole factorisation is 6 (division +
-   multiply-add) a block; every other operation is a row update of fixed size (rows as
-   vectors of 4 + 2 doubles with GCC / Clang, plain loops elsewhere). O(n), 72 reals a block,
+   multiply-add) a block; every other operation is a row update of fixed size (rows as one
+   zmm register in double builds with AVX-512, vectors of 4 + 2 doubles with other GCC /
+   Clang targets, plain loops elsewhere). O(n), 72 reals a block,
    one or many right-hand sides, arithmetic in double whatever frm_real. The pivots are
    LDL^T's (Cholesky's squared diagonal): one at or below 4 (n + 16) eps(frm_real) times the
    block's own diagonal entry is refused: FRM_ERR_BTD_INDEFINITE (negative) or
@@ -1194,6 +1195,47 @@
    13 + multiply-add 4) ~ 100 cycles a block), and halving the chain does not pay; 50 us
    would need a kernel of roughly a third of those instructions (an estimate: broadcasts
    from memory, T's column scaling folded away), not attempted.
+   Third pass (issue 15's speed item, last; the padded AVX-512 rows above had kept three
+   branches a pivot and broadcasts by lane extraction, and with both gone they pay): two
+   changes. (1) Every build judges a block's six pivots together after the sixth
+   (frm__btd_judge: one branch a block instead of three a pivot; on a refusal the first
+   refused pivot is found again, so the codes and failed blocks are those of the
+   pivot-by-pivot test, and a refused block's output is not stored). (2) Double builds with
+   AVX-512 (GCC / Clang; FRM_BTD_NO_AVX512 opts out) factor with frm__btd_factor_zmm: one zmm
+   register a row (lanes 6, 7 zero), the 18 rows as named variables, lane masks for the
+   pivot's column, the pivot's rows read back from a small array so that the lane broadcasts
+   are loads (an empty asm statement keeps GCC from turning them back into shuffles), B^T and
+   the mirrored lower triangles by gathers of constant indices; the same operations and
+   roundings as the 4 + 2 rows (bit-identical on the bench's chain at the bench's flags,
+   within 3e-16 of a block's largest entry in test_btd_paths, which compares the two paths).
+   Measured on a 2-vCPU Intel Xeon VM (AVX-512, reported as family 6 model 167; shared with
+   other builds, load average 7-10), 1,000 blocks, best of 20 x 50 runs, the previous header
+   and this one built as separate objects and run interleaved in one process, factor + solve:
+       gcc -O3 -march=native -ffp-contract=fast (the bench's flags)
+                                   89.0 + 18.4 = 107.4 us -> 51.4 + 18.7 = 70.8 us (0.66)
+       gcc -O2 -march=native       134.9 + 36.5 = 172.4 us -> 50.4 + 36.7 = 87.1 us (0.51)
+       gcc -O3 -march=x86-64-v3 -ffp-contract=fast (AVX2, 4 + 2 rows)
+                                   130.4 + 20.7 = 151.4 us -> 113.4 + 20.0 = 134.0 us (0.89)
+       plain gcc -O2 (SSE2)        230.3 + 38.0 = 269.5 us -> 191.5 + 38.0 = 229.6 us (0.85)
+   The issue's 50 us for factor + solve is not met (71 us at best). What bounds it: the
+   factor is throughput-bound, not chain-bound: with the division taken off the chain (r from
+   a constant, timing only) it ran no faster (49 against 48-51 us), while its chain alone
+   (6,000 dependent divisions and multiply-adds) takes 26 us here; a block is about 96
+   multiply-adds, 42 multiplies and 66 broadcasts of 8 lanes, plus about 300 more
+   instructions from the compiler (register copies, mask moves, the scalar pivots), and the
+   512-bit arithmetic shares two ports. The 13 gathers a block cost about 6 us (rows loaded
+   without them, timing only: 44.7 us). The solve (18 us) is kept as it was: each vector
+   form tried was slower. Tried and dropped (same harness, the factor unless
+   said): GCC vector_size(64) rows in the portable sweep (91 against 86 us for the 4 + 2
+   rows, and contracted differently); arrays of zmm rows (left on the stack: 69 us);
+   broadcasts by shuffles of the registers (no asm statement: 76 us); the next pivot's two
+   entries formed as scalars straight from r (bit-identical, 54 against 50 us: the chain is
+   not the bound); the masks replaced by constant vectors (51-52 us); B^T by an in-register
+   transpose (16 shuffles, 57 us) or by scalar copies staged in the factor's next block (50.4
+   against 50.0 us); the solve in zmm registers (both sweeps, the backward one gathering
+   E_i^T's columns: 30 us; the forward one alone: 26.5 us; only z = D^-1 y: 27.7 us, against
+   17-19 us for the scalar loops); the solve's answers judged finite in one pass after the
+   sweeps (21.6 against 17 us).
    In the frames solvers: desc.linear_solver (frm_linear_solver) defaults to
    FRM_LINEAR_SOLVER_AUTO, resolved at creation (frm_model_linear_solver tells which):
    FRM_LINEAR_SOLVER_BTD when the block pattern is a chain in frame order (every sample's
@@ -11015,8 +11057,8 @@ static int frm__btd_judge(const double *pv, const frm_real *A, const double tol,
 /* Pivot k of block i (k1 = k + 1 mod 6), as FRM__BTD_PIVOT then frm__btd_sweep. Rows k of
    T and U go through cb_ / vb_ so that the broadcasts of their lanes are loads; the empty
    asm statement (no instruction) stops GCC from turning those loads back into shuffles of
-   the registers (port 5, which the 512-bit multiply-adds share on Intel): factor 68 -> 63
-   us for 1,000 blocks. */
+   the registers (port 5, which the 512-bit multiply-adds share on Intel): factor 76 -> 48
+   us for 1,000 blocks. The pivot is judged with the block's others (frm__btd_judge). */
 #define FRM__BTD_ZPIVOT(k, k1)                                                                         \
     do {                                                                                               \
         const __mmask8 mk_ = (__mmask8)(1u << (k)), rest_ = (__mmask8)(0x3fu & ~(1u << (k)));          \
@@ -11084,8 +11126,8 @@ static int frm__btd_factor_zmm(int n, const double *diag, const double *lower, d
         FRM__BTD_ZPIVOT(4, 5);
         FRM__BTD_ZPIVOT(5, 0);
         acc = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(U0, U1), _mm512_add_pd(U2, U3)), _mm512_add_pd(U4, U5));
-        { /* the six pivots judged at once, as FRM__BTD_PIVOT judges each (one branch a block
-             instead of three a pivot: factor 69 -> 49 us for 1,000 blocks), and E_i^T's
+        { /* the six pivots judged at once, as frm__btd_judge judges them (one branch a block
+             instead of three a pivot: factor 69 -> 50 us for 1,000 blocks), and E_i^T's
              column sums finite */
             const __m512d P = _mm512_load_pd(pv_),
                           S = _mm512_mul_pd(_mm512_set1_pd(tol), _mm512_abs_pd(_mm512_mask_i32gather_pd(
