@@ -217,10 +217,10 @@ static void test_btd_refusals(void)
 /* The factorisation's two implementations: frm_btd_factor (the AVX-512 path where the build
    has it, double) against frm__btd_factor_rows (the portable rows), entry by entry, with
    NaN in the diagonal blocks' upper triangles (never read), and the same refusal codes and
-   blocks. Unscaled, diagonally dominant chains (cond < 100): the paths differ only by fused
-   against separate roundings of the same operations (bit-identical where the compiler
-   fuses the portable path's multiply-adds the same way), so 1e-13 of the block's largest
-   entry (float builds use one path: 0). */
+   blocks. Unscaled, diagonally dominant chains (cond < 100): the paths differ only by
+   roundings (fused or separate multiply-adds; the AVX-512 path's deferred column scaling),
+   each a few eps relative to the block's entries, times the blocks' condition numbers:
+   1e-13 of the block's largest entry (float builds use one path: 0). */
 static void test_btd_paths(void)
 {
     static const int sizes[] = {1, 2, 7, 60};
