@@ -10950,18 +10950,22 @@ typedef struct frm__v8 {
 #define FRM__ALWAYS_INLINE static inline
 #endif
 
-/* One pivot k (a constant where inlined; r = 1 / a_kk) of the sweep: every row a of T
-   becomes T_a s - c_a w0 with s = 1 but r in lane k and w0 = c r but 0 in lane k (so lane
-   k, the column, receives c_a r exactly: no column writes), then row k is replaced by c r
-   with -r in lane k; U's rows lose c_a (v r), N loses v v^T r (c, v: row k of T and of U
-   before the pivot). */
-FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, frm__v8 *U, frm__v8 *N)
+/* One pivot k (a constant where inlined; r = 1 / a_kk) of the sweep, with the pivots'
+   column scaling deferred: T holds T~ = T diag(1 / sigma), sigma_b = r_b once column b has
+   been pivoted (1 before; the block stores D^-1 = -T~ sigma). Every row a of T~ loses
+   c_a w0 with c = T~_k sigma (the true row k) and w0 = T~_k r but 0 in lane k, then row k
+   is replaced by w0 with -1 in lane k and sigma_k = r; U's rows lose c_a (v r), N loses
+   v v^T r (v: row k of U). The unpivoted columns hold T's values exactly (the pivots, e
+   and q); the scaled ones differ from scaling at each pivot (T_a s - c_a w0, the first
+   form) by one rounding. 1,000 blocks with 4 + 2 rows at -O3 -march=x86-64-v3: 111 -> 99
+   us; plain -O2: 179 -> 171 us. */
+FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, frm__v8 *U, frm__v8 *N, frm__v8 *sg)
 {
-    frm__v8 c = T[k], v = U[k], s, w0, wk, wu;
+    frm__v8 c, v = U[k], w0, wk, wu;
     int a;
 #ifdef FRM__BTD_VECTOR
-    /* e_k and 1 - e_k as constant vectors: s = (1 - e_k) + e_k r, w0 = c r (1 - e_k),
-       wk = w0 - e_k r, each lane exact (a product by 1 or 0, a sum with 0) */
+    /* e_k and 1 - e_k as constant vectors: w0 = T~_k r (1 - e_k), wk = w0 - e_k,
+       sigma = sigma (1 - e_k) + e_k r, each lane exact (a product by 1 or 0, a sum with 0) */
     static const double eye[6][6] = {{1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0}, {0, 0, 1, 0, 0, 0},
                                      {0, 0, 0, 1, 0, 0}, {0, 0, 0, 0, 1, 0}, {0, 0, 0, 0, 0, 1}};
     static const double off[6][6] = {{0, 1, 1, 1, 1, 1}, {1, 0, 1, 1, 1, 1}, {1, 1, 0, 1, 1, 1},
@@ -10969,26 +10973,29 @@ FRM__ALWAYS_INLINE void frm__btd_sweep(const int k, const double r, frm__v8 *T, 
     frm__v8 m, m1;
     FRM__BTD_LOAD(m, eye[k]);
     FRM__BTD_LOAD(m1, off[k]);
-#define FRM__BTD_SCALE(P) wu.P = v.P * r, s.P = m1.P + m.P * r, w0.P = c.P * r * m1.P, wk.P = w0.P - m.P * r;
+#define FRM__BTD_SCALE(P)                                                                              \
+    c.P = T[k].P * sg->P, wu.P = v.P * r, w0.P = T[k].P * r * m1.P, wk.P = w0.P - m.P,                 \
+    sg->P = sg->P * m1.P + m.P * r;
     FRM__BTD_PARTS(FRM__BTD_SCALE)
 #undef FRM__BTD_SCALE
     for (a = 0; a < 6; a++) {
         const double ca = FRM__BTD_LANE(c, a), va = FRM__BTD_LANE(v, a);
-#define FRM__BTD_UPDATE(P) T[a].P = T[a].P * s.P - ca * w0.P, U[a].P = U[a].P - ca * wu.P, N[a].P = N[a].P - va * wu.P;
+#define FRM__BTD_UPDATE(P) T[a].P = T[a].P - ca * w0.P, U[a].P = U[a].P - ca * wu.P, N[a].P = N[a].P - va * wu.P;
         FRM__BTD_PARTS(FRM__BTD_UPDATE)
 #undef FRM__BTD_UPDATE
     }
 #else
     int b;
     for (b = 0; b < 6; b++) {
-        s.e[b] = b == k ? r : 1.0;
-        wk.e[b] = b == k ? -r : c.e[b] * r;
-        w0.e[b] = b == k ? 0.0 : c.e[b] * r;
+        c.e[b] = T[k].e[b] * sg->e[b];
+        wk.e[b] = b == k ? -1.0 : T[k].e[b] * r;
+        w0.e[b] = b == k ? 0.0 : T[k].e[b] * r;
         wu.e[b] = v.e[b] * r;
     }
+    sg->e[k] = r;
     for (a = 0; a < 6; a++)
         for (b = 0; b < 6; b++) {
-            T[a].e[b] = T[a].e[b] * s.e[b] - c.e[a] * w0.e[b];
+            T[a].e[b] -= c.e[a] * w0.e[b];
             U[a].e[b] -= c.e[a] * wu.e[b];
             N[a].e[b] -= v.e[a] * wu.e[b];
         }
@@ -11032,7 +11039,7 @@ static int frm__btd_judge(const double *pv, const frm_real *A, const double tol,
         r_ = 1.0 / p;                                                                                  \
         e_ = (k) < 5 ? FRM__BTD_LANE(T[k], ((k) + 1) % 6) : FRM__BTD_LANE(U[k], 0);                   \
         q_ = (k) < 5 ? FRM__BTD_LANE(T[((k) + 1) % 6], ((k) + 1) % 6) : FRM__BTD_LANE(N[0], 0);        \
-        frm__btd_sweep((k), r_, T, U, N);                                                              \
+        frm__btd_sweep((k), r_, T, U, N, &sg);                                                         \
         p = q_ - (e_ * e_) * r_;                                                                       \
     } while (0)
 
@@ -11162,7 +11169,8 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
     int i, a, b;
     /* the window: T = rows / columns 0..5, U = rows 0..5 x columns 6..11, N = rows /
        columns 6..11 */
-    frm__v8 T[6], U[6], N[6];
+    static const double ones[6] = {1, 1, 1, 1, 1, 1};
+    frm__v8 T[6], U[6], N[6], sg;
     double t[6][6], p, pv[6];
     memset(t, 0, sizeof t);
     for (a = 0; a < 6; a++)
@@ -11183,6 +11191,7 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
                 for (b = 0; b <= a; b++) t[a][b] = t[b][a] = (double)A1[6 * a + b];
         }
         for (a = 0; a < 6; a++) FRM__BTD_LOAD(U[a], u[a]), FRM__BTD_LOAD(N[a], t[a]);
+        FRM__BTD_LOAD(sg, ones);
         FRM__BTD_PIVOT(0);
         FRM__BTD_PIVOT(1);
         FRM__BTD_PIVOT(2);
@@ -11196,7 +11205,7 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
              blocks against staging them through arrays, -O3 -march=native, best of 50) */
             frm__v8 acc = U[0], d;
             for (a = 0; a < 6; a++) {
-#define FRM__BTD_OUT(P) d.P = -T[a].P, acc.P = a ? acc.P + U[a].P : acc.P;
+#define FRM__BTD_OUT(P) d.P = -(T[a].P * sg.P), acc.P = a ? acc.P + U[a].P : acc.P;
                 FRM__BTD_PARTS(FRM__BTD_OUT)
 #undef FRM__BTD_OUT
                 FRM__BTD_STORE(Dout + 6 * a, d);
@@ -11205,11 +11214,12 @@ static int frm__btd_factor_rows(int n, const frm_real *diag, const frm_real *low
             for (b = 0; b < 6; b++) usum += FRM__BTD_LANE(acc, b);
         }
 #else
+        FRM__BTD_STORE(pv, sg); /* (the pivots are judged) */
         for (a = 0; a < 6; a++) {
             FRM__BTD_STORE(t[a], T[a]);
             FRM__BTD_STORE(u[a], U[a]);
             for (b = 0; b < 6; b++) {
-                Dout[6 * a + b] = (frm_real)-t[a][b];
+                Dout[6 * a + b] = (frm_real)(-(t[a][b] * pv[b]));
                 Eout[6 * a + b] = (frm_real)u[a][b];
                 usum += u[a][b];
             }
