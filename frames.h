@@ -1196,46 +1196,53 @@
    would need a kernel of roughly a third of those instructions (an estimate: broadcasts
    from memory, T's column scaling folded away), not attempted.
    Third pass (issue 15's speed item, last; the padded AVX-512 rows above had kept three
-   branches a pivot and broadcasts by lane extraction, and with both gone they pay): two
+   branches a pivot and broadcasts by lane extraction, and with both gone they pay): three
    changes. (1) Every build judges a block's six pivots together after the sixth
    (frm__btd_judge: one branch a block instead of three a pivot; on a refusal the first
    refused pivot is found again, so the codes and failed blocks are those of the
-   pivot-by-pivot test, and a refused block's output is not stored). (2) Double builds with
-   AVX-512 (GCC / Clang; FRM_BTD_NO_AVX512 opts out) factor with frm__btd_factor_zmm: one zmm
-   register a row (lanes 6, 7 zero), the 18 rows as named variables, lane masks for the
-   pivot's column, the pivot's rows read back from a small array so that the lane broadcasts
-   are loads (an empty asm statement keeps GCC from turning them back into shuffles), B^T and
-   the mirrored lower triangles by gathers of constant indices; the same operations and
-   roundings as the 4 + 2 rows (bit-identical on the bench's chain at the bench's flags,
-   within 3e-16 of a block's largest entry in test_btd_paths, which compares the two paths).
-   Measured on a 2-vCPU Intel Xeon VM (AVX-512, reported as family 6 model 167; shared with
-   other builds, load average 7-10), 1,000 blocks, best of 20 x 50 runs, the previous header
-   and this one built as separate objects and run interleaved in one process, factor + solve:
+   pivot-by-pivot test, and a refused block's output is not stored). (2) Every build defers
+   the pivots' column scaling (frm__btd_sweep: T held as T diag(1 / sigma), sigma_b = r_b
+   once column b has been pivoted, D^-1 = -T~ sigma stored; one product of row k by sigma a
+   pivot instead of one of every row by s). The results are no longer bit-identical to the
+   second pass's (the scaled columns are rounded once, at the end): errors in the tests as
+   before (scaled error against dense Cholesky 6.4e-16 at 60 blocks, was 6.0e-16; residual
+   6.8e-16 at 1,000; float unchanged). (3) Double builds with AVX-512 (GCC / Clang;
+   FRM_BTD_NO_AVX512 opts out) factor with frm__btd_factor_zmm: one zmm register a row (lanes
+   6, 7 zero), the 18 rows as named variables, lane masks for the pivot's column, the pivot's
+   rows read back from a small array so that the lane broadcasts are loads (an empty asm
+   statement keeps GCC from turning them back into shuffles), B^T and the mirrored lower
+   triangles by gathers of constant indices; the same operations and roundings as the
+   portable rows where the compiler fuses their multiply-adds (bit-identical at
+   -ffp-contract=fast; within 3e-16 of a block's largest entry otherwise: test_btd_paths
+   compares the two). Measured on a 2-vCPU Intel Xeon VM (AVX-512, reported as family 6 model
+   167; shared with other builds, load average 6-10), 1,000 blocks, best of 20 x 50 runs, the
+   second pass's header (main) and this one built as separate objects and run interleaved in
+   one process; factor, solve, best factor + solve:
        gcc -O3 -march=native -ffp-contract=fast (the bench's flags)
-                                   89.0 + 18.4 = 107.4 us -> 51.4 + 18.7 = 70.8 us (0.66)
-       gcc -O2 -march=native       134.9 + 36.5 = 172.4 us -> 50.4 + 36.7 = 87.1 us (0.51)
+                                   84.4 + 17.0, 101.4 us -> 47.7 + 17.7, 66.3 us (0.65)
+       gcc -O2 -march=native       134.9 + 36.7, 171.6 us -> 51.3 + 37.2, 88.7 us (0.52)
        gcc -O3 -march=x86-64-v3 -ffp-contract=fast (AVX2, 4 + 2 rows)
-                                   130.4 + 20.7 = 151.4 us -> 113.4 + 20.0 = 134.0 us (0.89)
-       plain gcc -O2 (SSE2)        230.3 + 38.0 = 269.5 us -> 191.5 + 38.0 = 229.6 us (0.85)
-   The issue's 50 us for factor + solve is not met (71 us at best). What bounds it: the
+                                   128.1 + 20.1, 148.2 us -> 100.6 + 19.4, 120.3 us (0.81)
+       plain gcc -O2 (SSE2)        211.9 + 36.1, 249.0 us -> 168.9 + 35.2, 205.2 us (0.82)
+   The issue's 50 us for factor + solve is not met (66 us at best). What bounds it: the
    factor is throughput-bound, not chain-bound: with the division taken off the chain (r from
-   a constant, timing only) it ran no faster (49 against 48-51 us), while its chain alone
-   (6,000 dependent divisions and multiply-adds) takes 26 us here; a block is about 96
-   multiply-adds, 42 multiplies and 66 broadcasts of 8 lanes, plus about 300 more
-   instructions from the compiler (register copies, mask moves, the scalar pivots), and the
-   512-bit arithmetic shares two ports. The 13 gathers a block cost about 6 us (rows loaded
-   without them, timing only: 44.7 us). The solve (18 us) is kept as it was: each vector
-   form tried was slower. Tried and dropped (same harness, the factor unless
-   said): GCC vector_size(64) rows in the portable sweep (91 against 86 us for the 4 + 2
-   rows, and contracted differently); arrays of zmm rows (left on the stack: 69 us);
-   broadcasts by shuffles of the registers (no asm statement: 76 us); the next pivot's two
-   entries formed as scalars straight from r (bit-identical, 54 against 50 us: the chain is
-   not the bound); the masks replaced by constant vectors (51-52 us); B^T by an in-register
-   transpose (16 shuffles, 57 us) or by scalar copies staged in the factor's next block (50.4
-   against 50.0 us); the solve in zmm registers (both sweeps, the backward one gathering
-   E_i^T's columns: 30 us; the forward one alone: 26.5 us; only z = D^-1 y: 27.7 us, against
-   17-19 us for the scalar loops); the solve's answers judged finite in one pass after the
-   sweeps (21.6 against 17 us).
+   a constant, timing only) it ran no faster (49 against 48-51 us, before (2)), while its
+   chain alone (6,000 dependent divisions and multiply-adds) takes 26 us here; its loop is
+   about 360 instructions a block (objdump, gcc -O3 -march=native): 96 multiply-adds, 24
+   multiplies, 36 broadcast loads (30 more folded into the multiply-adds), 13 gathers, 24
+   stores, some 60 register copies and 23 mask moves, the 512-bit arithmetic on two ports.
+   The 13 gathers a block cost about 6 us (rows loaded without them, timing only: 44.7 us).
+   The solve (18 us) is kept as it was: each vector form tried was slower. Tried and dropped
+   (same harness, the factor unless said): GCC vector_size(64) rows in the portable sweep (91
+   against 86 us for the 4 + 2 rows, and contracted differently); arrays of zmm rows (left on
+   the stack: 69 us); broadcasts by shuffles of the registers (no asm statement: 76 us); the
+   next pivot's two entries formed as scalars straight from r (bit-identical, 54 against 50
+   us: the chain is not the bound); the masks replaced by constant vectors (51-52 us); B^T by
+   an in-register transpose (16 shuffles, 57 us) or by scalar copies staged in the factor's
+   next block (50.4 against 50.0 us); the solve in zmm registers (both sweeps, the backward
+   one gathering E_i^T's columns: 30 us; the forward one alone: 26.5 us; only z = D^-1 y:
+   27.7 us, against 17-19 us for the scalar loops); the solve's answers judged finite in one
+   pass after the sweeps (21.6 against 17 us).
    In the frames solvers: desc.linear_solver (frm_linear_solver) defaults to
    FRM_LINEAR_SOLVER_AUTO, resolved at creation (frm_model_linear_solver tells which):
    FRM_LINEAR_SOLVER_BTD when the block pattern is a chain in frame order (every sample's
@@ -11049,14 +11056,9 @@ static int frm__btd_judge(const double *pv, const frm_real *A, const double tol,
    one instruction (two with the 4 + 2 split), the 18 rows of the window in 18 of the 32
    registers as named variables (arrays of vectors stayed on the stack); lane masks replace
    the e_k / 1 - e_k constant vectors; the broadcasts of c_a and v_a read c and v back
-   from a small array (loads, not shuffles). The pivot's column scaling is deferred: T holds
-   T~ = T diag(1 / sigma), sigma_b = r_b once column b has been pivoted (1 before), so
-   pivot k multiplies no row of T by s (frm__btd_sweep's T_a s): c = T~_k sigma (the true
-   row k, one product), w0 = T~_k r without lane k, T~_a -= c_a w0, T~_k = w0 with -1 in
-   lane k, sigma_k = r; the block stores D^-1 = -T~ sigma. Unpivoted columns are exact (the
-   pivots, e and q, as frm__btd_sweep); the rest differs from it by rounding only (the
-   scaling rounded once at the end instead of at the pivot): factor 50 -> 46 us for 1,000
-   blocks. */
+   from a small array (loads, not shuffles); the pivots' column scaling deferred as in
+   frm__btd_sweep (factor 50 -> 46 us for 1,000 blocks). The same operations and roundings
+   as frm__btd_sweep where the compiler fuses its multiply-adds (-ffp-contract=fast). */
 #include <immintrin.h>
 #define FRM__BTD_ZMM 1
 /* row a (a literal) in pivot k (a literal) */
