@@ -11253,6 +11253,7 @@ FRMDEF int frm_btd_factor(int n, const frm_real *diag, const frm_real *lower, fr
 FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
 {
     int i, r, a, k, bad = 0;
+    double chk[6] = {0, 0, 0, 0, 0, 0};
     size_t n6 = 6 * (size_t)n;
     if (n < 1 || !factor || !b || nrhs < 0) return FRM_ERR_ARG;
     for (r = 0; r < nrhs; r++) {
@@ -11279,7 +11280,7 @@ FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
                 x[6 * i + a] = (frm_real)s;
             }
         }
-        for (a = 0; a < 6; a++) y[a] = (double)x[n6 - 6 + a], bad |= !frm__finite(y[a]);
+        for (a = 0; a < 6; a++) y[a] = (double)x[n6 - 6 + a], chk[a] += y[a] - y[a];
         for (i = n - 2; i >= 0; i--) { /* backward: x_i = z_i - E_i^T x_{i+1} */
             const frm_real *Et = factor + 72 * (size_t)i + 36;
             for (a = 0; a < 6; a++) { /* two partial sums, as forward */
@@ -11293,10 +11294,11 @@ FRMDEF int frm_btd_solve(int n, const frm_real *factor, int nrhs, frm_real *b)
             for (a = 0; a < 6; a++) {
                 y[a] = t[a];
                 x[6 * i + a] = (frm_real)t[a];
-                bad |= !frm__finite(t[a]);
+                chk[a] += t[a] - t[a]; /* 0, or NaN from a non-finite answer */
             }
         }
     }
+    for (a = 0; a < 6; a++) bad |= !(chk[a] == 0);
     if (bad) {
         memset(b, 0, sizeof(frm_real) * n6 * (size_t)nrhs);
         return FRM_ERR_NOT_FINITE;
