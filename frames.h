@@ -1232,17 +1232,19 @@
    multiplies, 36 broadcast loads (30 more folded into the multiply-adds), 13 gathers, 24
    stores, some 60 register copies and 23 mask moves, the 512-bit arithmetic on two ports.
    The 13 gathers a block cost about 6 us (rows loaded without them, timing only: 44.7 us).
-   The solve (18 us) is kept as it was: each vector form tried was slower. Tried and dropped
-   (same harness, the factor unless said): GCC vector_size(64) rows in the portable sweep (91
-   against 86 us for the 4 + 2 rows, and contracted differently); arrays of zmm rows (left on
-   the stack: 69 us); broadcasts by shuffles of the registers (no asm statement: 76 us); the
-   next pivot's two entries formed as scalars straight from r (bit-identical, 54 against 50
-   us: the chain is not the bound); the masks replaced by constant vectors (51-52 us); B^T by
-   an in-register transpose (16 shuffles, 57 us) or by scalar copies staged in the factor's
-   next block (50.4 against 50.0 us); the solve in zmm registers (both sweeps, the backward
-   one gathering E_i^T's columns: 30 us; the forward one alone: 26.5 us; only z = D^-1 y:
-   27.7 us, against 17-19 us for the scalar loops); the solve's answers judged finite in one
-   pass after the sweeps (21.6 against 17 us).
+   The solve (17-18 us) keeps its scalar loops (each vector form tried was slower); it judges
+   its answers by six running sums of t - t instead of a test an element (17.4 -> 17.1 us;
+   plain -O2 36.4 -> 35.0 us). Tried and dropped (same harness, the factor unless said): GCC
+   vector_size(64) rows in the portable sweep (91 against 86 us for the 4 + 2 rows, and
+   contracted differently); arrays of zmm rows (left on the stack: 69 us); broadcasts by
+   shuffles of the registers (no asm statement: 76 us); the next pivot's two entries formed
+   as scalars straight from r (bit-identical, 54 against 50 us: the chain is not the bound);
+   the masks replaced by constant vectors (51-52 us); B^T by an in-register transpose (16
+   shuffles, 57 us) or by scalar copies staged in the factor's next block (50.4 against 50.0
+   us); the solve in zmm registers (both sweeps, the backward one gathering E_i^T's columns:
+   30 us; the forward one alone: 26.5 us; only z = D^-1 y: 27.7 us, against 17-19 us for the
+   scalar loops); the solve's answers judged finite in one pass after the sweeps (21.6
+   against 17 us).
    In the frames solvers: desc.linear_solver (frm_linear_solver) defaults to
    FRM_LINEAR_SOLVER_AUTO, resolved at creation (frm_model_linear_solver tells which):
    FRM_LINEAR_SOLVER_BTD when the block pattern is a chain in frame order (every sample's
