@@ -214,6 +214,65 @@ static void test_btd_refusals(void)
     for (k = 0; k < 36; k++) CHECK(b[k] == 0);
 }
 
+/* The factorisation's two implementations: frm_btd_factor (the AVX-512 path where the build
+   has it, double) against frm__btd_factor_rows (the portable rows), entry by entry, with
+   NaN in the diagonal blocks' upper triangles (never read), and the same refusal codes and
+   blocks. Unscaled, diagonally dominant chains (cond < 100): the paths differ only by
+   roundings (fused or separate multiply-adds; the AVX-512 path's deferred column scaling),
+   each a few eps relative to the block's entries, times the blocks' condition numbers:
+   1e-13 of the block's largest entry (float builds use one path: 0). */
+static void test_btd_paths(void)
+{
+    static const int sizes[] = {1, 2, 7, 60};
+    int s, k;
+    for (s = 0; s < 4; s++) {
+        int n = sizes[s], f1 = 7, f2 = 8, i, a;
+        frm_real *diag = (frm_real *)calloc((size_t)36 * n, sizeof(frm_real));
+        frm_real *lower = (frm_real *)calloc((size_t)36 * n, sizeof(frm_real));
+        frm_real *F1 = (frm_real *)calloc(frm_btd_factor_size(n), sizeof(frm_real));
+        frm_real *F2 = (frm_real *)calloc(frm_btd_factor_size(n), sizeof(frm_real));
+        double *sc = (double *)calloc((size_t)6 * n, sizeof(double)), worst = 0;
+        const double tol = 4.0 * (double)(n + 16) * (IS_FLOAT ? (double)FLT_EPSILON : DBL_EPSILON);
+        random_btd(n, 0.0, diag, lower, sc);
+        for (i = 0; i < n; i++)
+            for (a = 0; a < 6; a++)
+                for (k = a + 1; k < 6; k++) diag[36 * i + 6 * a + k] = (frm_real)NAN;
+        CHECK_INT(FRM_OK, frm_btd_factor(n, diag, n > 1 ? lower : NULL, F1, &f1));
+        CHECK_INT(FRM_OK, frm__btd_factor_rows(n, diag, n > 1 ? lower : NULL, F2, &f2, tol));
+        CHECK_INT(-1, f1);
+        for (i = 0; i < n; i++) {
+            double big = 0, diff = 0;
+            for (k = 0; k < 72; k++) {
+                double x = fabs((double)F2[72 * i + k]), d = fabs((double)F1[72 * i + k] - (double)F2[72 * i + k]);
+                if (x > big) big = x;
+                if (!(d <= diff)) diff = d; /* NaN counts */
+            }
+            if (!(diff / big <= worst)) worst = diff / big;
+        }
+        CHECK(worst <= (IS_FLOAT ? 0.0 : 1e-13));
+        printf("    %2d blocks: largest difference %.2e of the block's largest entry\n", n, worst);
+        if (n == 60) { /* refusals: the same code and block from both */
+            int b;
+            for (b = 0; b < 3; b++) {
+                int e1, e2;
+                random_btd(n, 0.0, diag, lower, sc);
+                if (b == 0) diag[36 * 33 + 7 * 4] = -diag[36 * 33 + 7 * 4]; /* indefinite at block 33 */
+                if (b == 1) /* block 41 zero and coupled to nothing: singular there */
+                    for (k = 0; k < 36; k++) diag[36 * 41 + k] = lower[36 * 40 + k] = lower[36 * 41 + k] = 0;
+                if (b == 2) lower[36 * 12 + 20] = (frm_real)HUGE_VAL;
+                f1 = f2 = -7;
+                e1 = frm_btd_factor(n, diag, lower, F1, &f1);
+                e2 = frm__btd_factor_rows(n, diag, lower, F2, &f2, tol);
+                CHECK_INT(b == 0 ? FRM_ERR_BTD_INDEFINITE : b == 1 ? FRM_ERR_BTD_SINGULAR : FRM_ERR_NOT_FINITE, e1);
+                CHECK_INT(e2, e1);
+                CHECK_INT(f2, f1);
+                CHECK_INT(b == 0 ? 33 : b == 1 ? 41 : 12, f1);
+            }
+        }
+        free(diag), free(lower), free(F1), free(F2), free(sc);
+    }
+}
+
 /* W = J A^-1 J^T for 4 dense random rows against dense solves (same tolerance argument as
    above, unscaled: 1e-10 relative, float 1e-4). */
 static void test_btd_compliance_blocks(void)
@@ -1196,6 +1255,7 @@ static void test_frames_btd_auto(void)
 static const test_case cases[] = {
     TEST(test_btd_dense),
     TEST(test_btd_refusals),
+    TEST(test_btd_paths),
     TEST(test_btd_compliance_blocks),
     TEST(test_qp_kkt),
     TEST(test_chain_derivatives),
