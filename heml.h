@@ -149,7 +149,13 @@
    solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
    24, at most 64: up to 1.2 MB), and for the implicit steps' coarse correction two more
    (the unfactored P^T K0 P and the step's factor: up to 2.4 MB more; none with
-   desc.implicit_coarse = -1). The stiffness cache (desc.stiffness_cache = 1, the
+   desc.implicit_coarse = -1). desc.nodal_pressure = 2 with at most HEML_PAGG_PC_MAX
+   (1024) pressure aggregates also holds the static solve's pressure-aggregate
+   preconditioner (PRESSURE AGGREGATES): per node w slots of an int and 3 doubles (w the
+   most aggregates around a node: 8 or 9 in 3D meshes, 28 w bytes a node) and 3 reals,
+   and for P pressure aggregates P^2 + 6 P A + P doubles (P = 466, A = 64: 3.2 MB; P =
+   1024: 11.5 MB); allocated whether or not the materials' moduli turn it on. The
+   stiffness cache (desc.stiffness_cache = 1, the
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
@@ -367,7 +373,9 @@
            five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
        so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
        it and converge (as O(h)) towards the published value. What it does not fix
-       (LIMITS): the static solve's Krylov iterations grow with the bulk-to-shear ratio.
+       (LIMITS): the static solve's Krylov iterations grow with the bulk-to-shear ratio
+       (nodal_pressure = 2 has a preconditioner that removes that growth: PRESSURE
+       AGGREGATES, "Krylov iterations").
        Measured (Zen 5, 2 vCPUs, loaded; gcc -O2 -march=native, double; heml_solve_static,
        Krylov iterations in total (Newton iterations), for nu = 0.3, 0.49, 0.499, 0.4999 at
        mu fixed, the bulk modulus from nu; Cook six tetrahedra per cell; the beam 1 x 0.1 x
@@ -494,12 +502,66 @@
        0.17 0.10 (six) and 0.53 0.41 0.18 0.12 (five), falling with h as a smooth field
        read in steps of a patch does; smoothed once (element means back to the nodes) 0.11
        and 0.15 at N = 8, a smooth field's own 0.21 and 0.10 there. P_A is constant over an
-       aggregate: read it as it is, or smoothed once. Krylov iterations of the static solve
-       (bench/heml_nodal_krylov.c, third argument 2), nu = 0.3, 0.49, 0.499, 0.4999:
-           Cook N = 8     526    726  1,577   2,305   (nodal_pressure = 1: 490 745 2,243 5,738)
-           Cook N = 16    478  1,272  2,313   6,563   (449 1,480 3,434 13,446)
-           beam 40x4x4    121    402    509     617   (111 455 933 2,223)
-       so 4 to 14 times the nu = 0.3 count at 0.4999 (nodal_pressure = 1: 12 to 30). The
+       aggregate: read it as it is, or smoothed once.
+       Krylov iterations: the static solve's preconditioner (heml__pagg_pc_build; on where
+       every material's kappa >= 20 mu, nu >= 0.476, the saddle probe's rule, and the mesh
+       has at most HEML_PAGG_PC_MAX = 1024 pressure aggregates; below or beyond, Jacobi and
+       the rigid-mode coarse space as before, bit for bit). The tangent is K = K_dev + s G^T
+       Dn G with one row of G per aggregate (g_A = dJ_A V_A, sparse: the 3-vectors Vol_e cof
+       F_e grad N / 4 of the tetrahedra at its nodes), so its stiff part has rank A. The
+       preconditioner is B = (B_dev^-1 + s G^T Dn G)^-1, B_dev the deviatoric two-level one
+       of the saddle probe (Jacobi of the deviatoric small-strain diagonal, the rigid-mode
+       coarse space of the deviatoric small-strain stiffness), applied exactly by the
+       Woodbury identity: z = B_dev r - B_dev G^^T S^-1 G^ B_dev r, G^ = sqrt(s Dn) G,
+       S = I + G^ B_dev G^^T (A x A, dense Cholesky). The bulk part cancels exactly: v.K v /
+       v.B^-1 v lies within the extremes of v.K_dev v / v.B_dev^-1 v, so the iterations are
+       those of the deviatoric problem at every kappa. G^ is the current state's (one sums
+       and node pass for d_A, one loop over the tetrahedra), kept per node (the aggregates of
+       the node's star, 3 on Cook's one-cell-thick membrane, 8 or 9 in the beams below), and
+       S is factored once per Krylov solve: O(n w^2 + A (6 A_c)^2 + A^2 6 A_c + A^3 / 3);
+       each application costs two Jacobi-and-coarse applications, two passes over the per-
+       node vectors and two triangular solves of A. The answers are the same to the solve
+       tolerances (printed digits unchanged below; tests/test_heml_solve.c
+       test_pagg_preconditioner: 1e-9 relative in double). Measured (bench/heml_nodal_krylov.c,
+       third argument 2; Xeon Sapphire Rapids class, KVM, 2 vCPUs loaded by other jobs; gcc
+       -O2 -march=native, double; Krylov iterations in total (Newton iterations), time the
+       minimum of 6 interleaved runs, before -> after), nu = 0.3, 0.49, 0.499, 0.4999:
+           Cook N = 8    526 (4)          726 -> 529 (5)    1,577 -> 679 (9)    2,305 -> 691 (11)
+                         0.038 s          0.053 -> 0.043    0.119 -> 0.058      0.168 -> 0.059 s
+           Cook N = 16   478 (5)        1,272 -> 663 (9)    2,313 -> 627 (10)   6,563 -> 1,101 (18 -> 17)
+                         0.153 s          0.388 -> 0.245    0.700 -> 0.223      1.957 -> 0.418 s
+           beam 40x4x4   121 (2)          402 -> 261 (3)      509 -> 261 (3)      617 -> 271 (3 -> 4)
+                         0.084 s          0.251 -> 0.179    0.303 -> 0.178      0.377 -> 0.187 s
+       (nodal_pressure = 1, which has no such preconditioner: 490 745 2,243 5,738; 449 1,480
+       3,434 13,446; 111 455 933 2,223), so 1.3, 2.3 and 2.2 times the nu = 0.3 count at
+       0.4999 (before: 4.4, 13.7, 5.1); what remains is Newton's iteration count, which grows
+       with nu (Cook N = 16: 65 Krylov iterations per Newton iteration at 0.4999, 96 at 0.3).
+       On a finer beam (80 x 8 x 8 cells, 6,561 nodes, 466 pressure aggregates, 64 rigid-mode
+       aggregates; one run each): 148 at nu = 0.3, then 813 -> 573, 1,361 -> 571, 2,653 ->
+       586 (4 times the 0.3 count), 6.1 -> 5.6, 9.8 -> 5.3, 18.2 -> 5.5 s: the deviatoric
+       problem's own conditioning grows with the mesh (its coarse space is 64 aggregates at
+       most), and an iteration costs more (9.9 against 7.5 ms at nu = 0.49, builds included:
+       S, about 0.1 GFlop by count there, once per Krylov solve). With it forced on at
+       nu = 0.3 (the bench's fourth argument 1): 494, 422, 109 iterations, but the
+       beam 1.27 times slower (0.094 -> 0.119 s, min of 5 interleaved: the build and the
+       second coarse application), hence the kappa >= 20 mu rule. Memory (MEMORY): per node
+       w slots of one int and 3 doubles and 3 reals of scratch, A^2 + 6 A A_c + A doubles.
+       Not used by the implicit steps (their D + c K has the same structure; not done), nor
+       by nodal_pressure = 1 (one aggregate per node: S would be n x n).
+       Tried first, on dense copies of the operators (Cook 8 x 8, nodal_pressure = 2, one
+       linear solve to 1e-6 at the rest state and at the converged state, nu = 0.3 / 0.4999;
+       today's Jacobi and K0 coarse space: 126 / 500 and 126 / 615): the coarse space
+       augmented with the A vectors g_A next to the rigid modes (coarse matrix Z^T K Z exact,
+       dense) used additively, 117-122 / 276-279 (the stiff part's range is in the coarse
+       space, but the soft, nearly volume-preserving modes that Jacobi leaves are not);
+       as deflation or balancing (BNN) with the deviatoric Jacobi, 97-100 / 93-94, robust,
+       but it needs K Z at the current state: 6 A_c + A stiffness products per Newton
+       iteration (176 on Cook 16 x 16), and with the rest state's K in Z^T K Z and the
+       projection instead, 277 at the converged state (K - K0's bulk part, of order kappa
+       times the strain squared, is then not deflated); the deviatoric Jacobi alone with
+       today's coarse space, in the solver: Cook 8 x 8 2,135 instead of 2,305, the beam
+       2,392 instead of 617. The Woodbury form on the same dense copies: 118-119 / 113-122.
+       The saddle-point MINRES retried with these aggregates was not needed. The
        bench's Poisson beam (30 x 3 x 3 cells of five, against Timoshenko): 4.3, 11.3, 13.9,
        14.6 % off at nu = 0.3, 0.45, 0.49, 0.499 (nodal_pressure = 1: 14.4, 18.9, 22.5, 25.9;
        build/bench/bench --parts stability --filter nodal): issue 13's 2-point gap to nu =
@@ -676,7 +738,10 @@
        Jacobi plus a coarse correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
        small-strain stiffness projected on their rigid motions (6 per aggregate) is solved
        exactly (slender bodies bend by rotating their sections, which Jacobi alone resolves
-       slowest: 15 times fewer iterations on R1). A backtracking line search accepts a step
+       slowest: 15 times fewer iterations on R1); with nodal_pressure = 2 and every material's
+       kappa >= 20 mu, Jacobi and the coarse space are the deviatoric ones, corrected for the
+       bulk part exactly (PRESSURE AGGREGATES, "Krylov iterations": the iterations no longer
+       grow with kappa). A backtracking line search accepts a step
        only when it lowers the potential (Armijo, up to its round-off), so Newton descends
        to minima and does not converge to the unstable equilibria it may start near (St
        Venant-Kirchhoff compressed beyond its softening point settles in its lower, sheared
@@ -1008,15 +1073,18 @@
          to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
          desc.nodal_pressure = 2 (or 1) for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
          BODIES), which removes the volumetric locking, not the bending one.
-       - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
-         shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
+       - nodal_pressure = 1: the static solve's Krylov iterations still grow with the bulk-
+         to-shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
          probe's share is cut by running it on the deviatoric stiffness first, but a
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
-         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); with
-         nodal_pressure = 1 the nodal pressure oscillates between neighbouring nodes near nu =
-         0.5 (a checkerboard: read it smoothed three times, or use nodal_pressure = 2, whose
-         pressure is smooth and whose Krylov counts grow 4 to 14 times instead of 12 to 30:
-         PRESSURE AGGREGATES); nodal_pressure = 2 holds the volume patch by patch, so on
+         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES), and the nodal
+         pressure oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read
+         it smoothed three times, or use nodal_pressure = 2, whose pressure is smooth and
+         whose static solve has a preconditioner whose Krylov counts do not grow with the
+         bulk modulus: 1.3 to 2.3 times the nu = 0.3 count at 0.4999 on the meshes measured,
+         4 on a 6,561-node beam, the rest Newton's growing iteration count; PRESSURE
+         AGGREGATES; the implicit steps' solves do not use it); nodal_pressure = 2 holds
+         the volume patch by patch, so on
          very coarse meshes (a few aggregates) a body's internal volume changes return only
          at the shear stiffness's pace and large-deformation Newton solves may need more
          iterations; either costs the vectorised Neo-Hookean kernels (the general path runs)

@@ -1792,14 +1792,15 @@ static void test_nodal_pressure_buckling_saddle(void)
    2). First its formulas, on a 3 x 3 x 3-cell cube (64 nodes: no rigid-mode coarse space,
    so B_dev is the deviatoric Jacobi alone) at a twisted and squashed state: the tangent's
    volumetric part K v - K_dev v equals G^^T G^ v from the explicit per-node vectors
-   (measured 1e-15 relative in double, 1e-6 in float: sums of products of a few terms), and
-   the Woodbury form inverts B_dev^-1 + G^^T G^: z = B r gives back r (measured 1e-15 and
-   1e-6). Then Cook's membrane (N x N x 1 cells of six, R10) at nu = 0.3 and 0.4999: the
-   same corner deflection with and without it (to the solve's tolerance: measured 1e-9
-   relative in double, 2e-6 in float), and the Krylov iterations of the whole static solve
-   at nu = 0.4999 within 2 times those at nu = 0.3 (measured 8 x 8: 691 against 494, 1.40),
-   where without it they are 4.4 times (2,305); the margin asserted is against half the
-   count without it. */
+   (measured 6e-16 relative in double, 2e-7 in float: sums of products of a few terms), and
+   the Woodbury form inverts B_dev^-1 + G^^T G^: z = B r gives back r (measured 2e-13 and
+   2e-5 relative: S's condition number, about kappa / mu, times the rounding). Then Cook's
+   membrane (N x N x 1 cells of six, R10) at nu = 0.3 (the preconditioner off there by its
+   rule) and 0.4999: the same corner deflection with and without it (to the solve's
+   tolerance: equal to 1e-9 relative in double, 3e-6 in float), and the Krylov iterations of
+   the whole static solve at nu = 0.4999 within 2 times those at nu = 0.3 (measured 8 x 8:
+   695 against 526, 1.32; float 637 against 402, 1.58; 6 x 6 in the reduced builds 612
+   against 487, 1.26), and at most half those without it (2,295, 3,422 and 1,932). */
 static void test_pagg_preconditioner(void)
 {
     tetmesh mesh;
@@ -1843,7 +1844,8 @@ static void test_pagg_preconditioner(void)
         REQUIRE(y != NULL);
         for (i = 0; i < mesh.node_count; i++) /* y = G^ v */
             for (l = 0; l < W && m->pgt_agg[i * W + l] >= 0; l++)
-                for (r = 0; r < 3; r++) y[m->pgt_agg[i * W + l]] += m->pgt_val[3 * (i * W + l) + r] * (double)v[3 * i + r];
+                for (r = 0; r < 3; r++)
+                    y[m->pgt_agg[i * W + l]] += m->pgt_val[3 * (i * W + l) + r] * (double)v[3 * i + r];
         for (i = 0; i < mesh.node_count; i++) /* G^^T y against -(df v - df_dev v) = K v - K_dev v */
             for (r = 0; r < 3; r++) {
                 double g = 0, k = -((double)kv[3 * i + r] - (double)kdv[3 * i + r]);
@@ -1856,7 +1858,8 @@ static void test_pagg_preconditioner(void)
         memset(y, 0, sizeof(double) * (size_t)m->pagg_count);
         for (i = 0; i < mesh.node_count; i++)
             for (l = 0; l < W && m->pgt_agg[i * W + l] >= 0; l++)
-                for (r = 0; r < 3; r++) y[m->pgt_agg[i * W + l]] += m->pgt_val[3 * (i * W + l) + r] * (double)z[3 * i + r];
+                for (r = 0; r < 3; r++)
+                    y[m->pgt_agg[i * W + l]] += m->pgt_val[3 * (i * W + l) + r] * (double)z[3 * i + r];
         for (i = 0; i < n3; i++) {
             double g = (double)z[i] / (double)pinv[i];
             for (l = 0; l < W && m->pgt_agg[(i / 3) * W + l] >= 0; l++)
@@ -1880,8 +1883,8 @@ static void test_pagg_preconditioner(void)
     cook_pagg_pc = 0;
     CHECK_INT(HEML_OK, cook_ex(N, TETMESH_SPLIT6, 2, 400942, &u4p, &it4p, &jump, checker, NULL));
     cook_pagg_pc = 1;
-    printf("    Cook %d x %d: nu = 0.3 %d Krylov; nu = 0.4999 %d (u_y %.8f mm), without it %d (u_y %.8f mm)\n", N, N, it3,
-           it4, u4, it4p, u4p);
+    printf("    Cook %d x %d: nu = 0.3 %d Krylov; nu = 0.4999 %d (u_y %.8f mm), without it %d (u_y %.8f mm)\n", N, N,
+           it3, it4, u4, it4p, u4p);
     CHECK(fabs(u4 - u4p) <= (IS_FLOAT ? 1e-4 : 1e-7) * fabs(u4p));
     CHECK(it4 <= 2 * it3);
     CHECK(2 * it4 <= it4p);
