@@ -541,7 +541,11 @@
        586 (4 times the 0.3 count), 6.1 -> 5.6, 9.8 -> 5.3, 18.2 -> 5.5 s: the deviatoric
        problem's own conditioning grows with the mesh (its coarse space is 64 aggregates at
        most), and an iteration costs more (9.9 against 7.5 ms at nu = 0.49, builds included:
-       S, about 0.1 GFlop by count there, once per Krylov solve). With it forced on at
+       S, about 0.1 GFlop by count there, once per Krylov solve); at 100 x 10 x 10 cells
+       (12,221 nodes, 895 pressure aggregates, near the cap; one run each, the bench's fourth
+       argument 0 for "before"): 181 at nu = 0.3, then 1,106 -> 808, 1,808 -> 801, 3,149 ->
+       823 (4.5 times), 10.9 -> 10.2, 13.9 -> 10.6, 22.4 -> 10.9 s (S: about 0.46 GFlop
+       by count a Krylov solve there). With it forced on at
        nu = 0.3 (the bench's fourth argument 1): 494, 422, 109 iterations, but the
        beam 1.27 times slower (0.094 -> 0.119 s, min of 5 interleaved: the build and the
        second coarse application), hence the kappa >= 20 mu rule. Memory (MEMORY): per node
