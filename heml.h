@@ -152,7 +152,13 @@
    solve's coarse space: a dense matrix of (6 A)^2 doubles for A aggregates (A = nodes /
    24, at most 64: up to 1.2 MB), and for the implicit steps' coarse correction two more
    (the unfactored P^T K0 P and the step's factor: up to 2.4 MB more; none with
-   desc.implicit_coarse = -1). The stiffness cache (desc.stiffness_cache = 1, the
+   desc.implicit_coarse = -1). desc.nodal_pressure = 2 with at most HEML_PAGG_PC_MAX
+   (1024) pressure aggregates also holds the static solve's pressure-aggregate
+   preconditioner (PRESSURE AGGREGATES): per node w slots of an int and 3 doubles (w the
+   most aggregates around a node: 8 or 9 in 3D meshes, 28 w bytes a node) and 3 reals,
+   and for P pressure aggregates P^2 + 6 P A + P doubles (P = 466, A = 64: 3.2 MB; P =
+   1024: 11.5 MB); allocated whether or not the materials' moduli turn it on. The
+   stiffness cache (desc.stiffness_cache = 1, the
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
@@ -372,7 +378,9 @@
            five tetrahedra per cell  plain 2.26 3.19 5.20 6.33   nodal 2.46 4.23 6.13 6.68
        so the two splits, 35 % and 8 % apart at N = 32 without it, agree within 1 % with
        it and converge (as O(h)) towards the published value. What it does not fix
-       (LIMITS): the static solve's Krylov iterations grow with the bulk-to-shear ratio.
+       (LIMITS): the static solve's Krylov iterations grow with the bulk-to-shear ratio
+       (nodal_pressure = 2 has a preconditioner that removes that growth: PRESSURE
+       AGGREGATES, "Krylov iterations").
        Measured (Zen 5, 2 vCPUs, loaded; gcc -O2 -march=native, double; heml_solve_static,
        Krylov iterations in total (Newton iterations), for nu = 0.3, 0.49, 0.499, 0.4999 at
        mu fixed, the bulk modulus from nu; Cook six tetrahedra per cell; the beam 1 x 0.1 x
@@ -499,12 +507,70 @@
        0.17 0.10 (six) and 0.53 0.41 0.18 0.12 (five), falling with h as a smooth field
        read in steps of a patch does; smoothed once (element means back to the nodes) 0.11
        and 0.15 at N = 8, a smooth field's own 0.21 and 0.10 there. P_A is constant over an
-       aggregate: read it as it is, or smoothed once. Krylov iterations of the static solve
-       (bench/heml_nodal_krylov.c, third argument 2), nu = 0.3, 0.49, 0.499, 0.4999:
-           Cook N = 8     526    726  1,577   2,305   (nodal_pressure = 1: 490 745 2,243 5,738)
-           Cook N = 16    478  1,272  2,313   6,563   (449 1,480 3,434 13,446)
-           beam 40x4x4    121    402    509     617   (111 455 933 2,223)
-       so 4 to 14 times the nu = 0.3 count at 0.4999 (nodal_pressure = 1: 12 to 30). The
+       aggregate: read it as it is, or smoothed once.
+       Krylov iterations: the static solve's preconditioner (heml__pagg_pc_build; on where
+       every material's kappa >= 20 mu, nu >= 0.476, the saddle probe's rule, and the mesh
+       has at most HEML_PAGG_PC_MAX = 1024 pressure aggregates; below or beyond, Jacobi and
+       the rigid-mode coarse space as before, bit for bit). The tangent is K = K_dev + s G^T
+       Dn G with one row of G per aggregate (g_A = dJ_A V_A, sparse: the 3-vectors Vol_e cof
+       F_e grad N / 4 of the tetrahedra at its nodes), so its stiff part has rank A. The
+       preconditioner is B = (B_dev^-1 + s G^T Dn G)^-1, B_dev the deviatoric two-level one
+       of the saddle probe (Jacobi of the deviatoric small-strain diagonal, the rigid-mode
+       coarse space of the deviatoric small-strain stiffness), applied exactly by the
+       Woodbury identity: z = B_dev r - B_dev G^^T S^-1 G^ B_dev r, G^ = sqrt(s Dn) G,
+       S = I + G^ B_dev G^^T (A x A, dense Cholesky). The bulk part cancels exactly: v.K v /
+       v.B^-1 v lies within the extremes of v.K_dev v / v.B_dev^-1 v, so the iterations are
+       those of the deviatoric problem at every kappa. G^ is the current state's (one sums
+       and node pass for d_A, one loop over the tetrahedra), kept per node (the aggregates of
+       the node's star, 3 on Cook's one-cell-thick membrane, 8 or 9 in the beams below), and
+       S is factored once per Krylov solve: O(n w^2 + A (6 A_c)^2 + A^2 6 A_c + A^3 / 3);
+       each application costs two Jacobi-and-coarse applications, two passes over the per-
+       node vectors and two triangular solves of A. The answers are the same to the solve
+       tolerances (printed digits unchanged below; tests/test_heml_solve.c
+       test_pagg_preconditioner: 1e-9 relative in double). Measured (bench/heml_nodal_krylov.c,
+       third argument 2; Xeon Sapphire Rapids class, KVM, 2 vCPUs loaded by other jobs; gcc
+       -O2 -march=native, double; Krylov iterations in total (Newton iterations), time the
+       minimum of 6 interleaved runs, before -> after), nu = 0.3, 0.49, 0.499, 0.4999:
+           Cook N = 8    526 (4)          726 -> 529 (5)    1,577 -> 679 (9)    2,305 -> 691 (11)
+                         0.038 s          0.053 -> 0.043    0.119 -> 0.058      0.168 -> 0.059 s
+           Cook N = 16   478 (5)        1,272 -> 663 (9)    2,313 -> 627 (10)   6,563 -> 1,101 (18 -> 17)
+                         0.153 s          0.388 -> 0.245    0.700 -> 0.223      1.957 -> 0.418 s
+           beam 40x4x4   121 (2)          402 -> 261 (3)      509 -> 261 (3)      617 -> 271 (3 -> 4)
+                         0.084 s          0.251 -> 0.179    0.303 -> 0.178      0.377 -> 0.187 s
+       (nodal_pressure = 1, which has no such preconditioner: 490 745 2,243 5,738; 449 1,480
+       3,434 13,446; 111 455 933 2,223), so 1.3, 2.3 and 2.2 times the nu = 0.3 count at
+       0.4999 (before: 4.4, 13.7, 5.1); what remains is Newton's iteration count, which grows
+       with nu (Cook N = 16: 65 Krylov iterations per Newton iteration at 0.4999, 96 at 0.3).
+       On a finer beam (80 x 8 x 8 cells, 6,561 nodes, 466 pressure aggregates, 64 rigid-mode
+       aggregates; one run each): 148 at nu = 0.3, then 813 -> 573, 1,361 -> 571, 2,653 ->
+       586 (4 times the 0.3 count), 6.1 -> 5.6, 9.8 -> 5.3, 18.2 -> 5.5 s: the deviatoric
+       problem's own conditioning grows with the mesh (its coarse space is 64 aggregates at
+       most), and an iteration costs more (9.9 against 7.5 ms at nu = 0.49, builds included:
+       S, about 0.1 GFlop by count there, once per Krylov solve); at 100 x 10 x 10 cells
+       (12,221 nodes, 895 pressure aggregates, near the cap; one run each, the bench's fourth
+       argument 0 for "before"): 181 at nu = 0.3, then 1,106 -> 808, 1,808 -> 801, 3,149 ->
+       823 (4.5 times), 10.9 -> 10.2, 13.9 -> 10.6, 22.4 -> 10.9 s (S: about 0.46 GFlop
+       by count a Krylov solve there). With it forced on at
+       nu = 0.3 (the bench's fourth argument 1): 494, 422, 109 iterations, but the
+       beam 1.27 times slower (0.094 -> 0.119 s, min of 5 interleaved: the build and the
+       second coarse application), hence the kappa >= 20 mu rule. Memory (MEMORY): per node
+       w slots of one int and 3 doubles and 3 reals of scratch, A^2 + 6 A A_c + A doubles.
+       Not used by the implicit steps (their D + c K has the same structure; not done), nor
+       by nodal_pressure = 1 (one aggregate per node: S would be n x n).
+       Tried first, on dense copies of the operators (Cook 8 x 8, nodal_pressure = 2, one
+       linear solve to 1e-6 at the rest state and at the converged state, nu = 0.3 / 0.4999;
+       today's Jacobi and K0 coarse space: 126 / 500 and 126 / 615): the coarse space
+       augmented with the A vectors g_A next to the rigid modes (coarse matrix Z^T K Z exact,
+       dense) used additively, 117-122 / 276-279 (the stiff part's range is in the coarse
+       space, but the soft, nearly volume-preserving modes that Jacobi leaves are not);
+       as deflation or balancing (BNN) with the deviatoric Jacobi, 97-100 / 93-94, robust,
+       but it needs K Z at the current state: 6 A_c + A stiffness products per Newton
+       iteration (176 on Cook 16 x 16), and with the rest state's K in Z^T K Z and the
+       projection instead, 277 at the converged state (K - K0's bulk part, of order kappa
+       times the strain squared, is then not deflated); the deviatoric Jacobi alone with
+       today's coarse space, in the solver: Cook 8 x 8 2,135 instead of 2,305, the beam
+       2,392 instead of 617. The Woodbury form on the same dense copies: 118-119 / 113-122.
+       The saddle-point MINRES retried with these aggregates was not needed. The
        bench's Poisson beam (30 x 3 x 3 cells of five, against Timoshenko): 4.3, 11.3, 13.9,
        14.6 % off at nu = 0.3, 0.45, 0.49, 0.499 (nodal_pressure = 1: 14.4, 18.9, 22.5, 25.9;
        build/bench/bench --parts stability --filter nodal): issue 13's 2-point gap to nu =
@@ -681,7 +747,10 @@
        Jacobi plus a coarse correction: the nodes are binned into up to 64 aggregates of the rest shape, and the
        small-strain stiffness projected on their rigid motions (6 per aggregate) is solved
        exactly (slender bodies bend by rotating their sections, which Jacobi alone resolves
-       slowest: 15 times fewer iterations on R1). A backtracking line search accepts a step
+       slowest: 15 times fewer iterations on R1); with nodal_pressure = 2 and every material's
+       kappa >= 20 mu, Jacobi and the coarse space are the deviatoric ones, corrected for the
+       bulk part exactly (PRESSURE AGGREGATES, "Krylov iterations": the iterations no longer
+       grow with kappa). A backtracking line search accepts a step
        only when it lowers the potential (Armijo, up to its round-off), so Newton descends
        to minima and does not converge to the unstable equilibria it may start near (St
        Venant-Kirchhoff compressed beyond its softening point settles in its lower, sheared
@@ -1114,15 +1183,18 @@
          to 0.5 or a stiff penalty): refine the mesh across thin parts, and set
          desc.nodal_pressure = 2 (or 1) for nearly incompressible bodies (NEAR-INCOMPRESSIBLE
          BODIES), which removes the volumetric locking, not the bending one.
-       - nodal_pressure: the static solve's Krylov iterations still grow with the bulk-to-
-         shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
+       - nodal_pressure = 1: the static solve's Krylov iterations still grow with the bulk-
+         to-shear ratio (12 to 30 times more at nu = 0.4999 than at nu = 0.3; the saddle
          probe's share is cut by running it on the deviatoric stiffness first, but a
          saddle-point MINRES with a block-diagonal preconditioner was tried and is not
-         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES); with
-         nodal_pressure = 1 the nodal pressure oscillates between neighbouring nodes near nu =
-         0.5 (a checkerboard: read it smoothed three times, or use nodal_pressure = 2, whose
-         pressure is smooth and whose Krylov counts grow 4 to 14 times instead of 12 to 30:
-         PRESSURE AGGREGATES); nodal_pressure = 2 holds the volume patch by patch, so on
+         robust for this inf-sup-unstable pair, NEAR-INCOMPRESSIBLE BODIES), and the nodal
+         pressure oscillates between neighbouring nodes near nu = 0.5 (a checkerboard: read
+         it smoothed three times, or use nodal_pressure = 2, whose pressure is smooth and
+         whose static solve has a preconditioner whose Krylov counts do not grow with the
+         bulk modulus: 1.3 to 2.3 times the nu = 0.3 count at 0.4999 on the meshes measured,
+         4 on a 6,561-node beam, the rest Newton's growing iteration count; PRESSURE
+         AGGREGATES; the implicit steps' solves do not use it); nodal_pressure = 2 holds
+         the volume patch by patch, so on
          very coarse meshes (a few aggregates) a body's internal volume changes return only
          at the shear stiffness's pace and large-deformation Newton solves may need more
          iterations; either costs the vectorised Neo-Hookean kernels and the St Venant-Kirchhoff
@@ -1941,6 +2013,12 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__DEV_PROBE_RATIO 20.0 /* kappa / mu from which the probe runs on K_dev first (nu of
                                       0.476; measured on Cook's membrane, 8 x 8: 169 iterations at
                                       every nu, the full probe 155 at nu = 0.3, 236 at 0.49) */
+#ifndef HEML_PAGG_PC_MAX
+#define HEML_PAGG_PC_MAX 1024 /* pressure aggregates at most for the static solve's pressure-
+                                 aggregate preconditioner (heml__pagg_pc_build: a dense A^2
+                                 matrix, factored once per Krylov solve; beyond: Jacobi and
+                                 the rigid-mode coarse space alone) */
+#endif
 #define HEML__VEC_BLOCK 4096 /* reals per partial sum of the vector reductions */
 #define HEML__NODE_CHUNK 1024 /* nodes per work item of the nodal pressure's node pass */
 #define HEML__MAX_TETS 100000000
@@ -2148,6 +2226,15 @@ struct heml_model {
        dj_a instead; dev_probe: the model's bulk-to-shear ratio makes it pay */
     int kdev, coarse_dev, dev_probe;
     heml_real *diag_dev;
+    /* the static solve's pressure-aggregate preconditioner (nodal_pressure = 2,
+       heml__pagg_pc_build): pagg_pc on for this model, pc_live while a Krylov solve uses it
+       (Jacobi and the coarse space then deviatoric); per node its pgt_width aggregates
+       (pgt_agg, -1: none) and the 3-vectors of G^T sqrt(s d_A) e_A there (pgt_val,
+       refilled per solve); pc_s the factored A x A matrix I + G^ B_dev G^T^, pc_gp (A x 6
+       agg_count) scratch, pc_y (A) the coarse unknowns, pc_w (3n) scratch */
+    int pagg_pc, pc_live, pgt_width, *pgt_agg;
+    double *pgt_val, *pc_s, *pc_gp, *pc_y;
+    heml_real *pc_w;
 
     heml_stats stats;
 };
@@ -4492,6 +4579,15 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_energy, double, m->nodal ? (size_t)m->nod_chunks : 0);
         HEML__CARVE(c, m->diag_dev, heml_real, 3 * nn);
     }
+    {
+        size_t A = m->pgt_width ? (size_t)m->pagg_count : 0, nw = m->pgt_width ? n * (size_t)m->pgt_width : 0;
+        HEML__CARVE(c, m->pgt_agg, int, nw);
+        HEML__CARVE(c, m->pgt_val, double, 3 * nw);
+        HEML__CARVE(c, m->pc_s, double, A * A);
+        HEML__CARVE(c, m->pc_gp, double, A * 6 * (size_t)m->agg_count);
+        HEML__CARVE(c, m->pc_y, double, A);
+        HEML__CARVE(c, m->pc_w, heml_real, A ? 3 * n : 0);
+    }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? (size_t)m->dc_rows * s : 0);
     HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
     if (!m->nodal) m->diag_dev = NULL;
@@ -5289,15 +5385,16 @@ static void heml__coarse_factor(double *Ac, int D, double *dg)
 static void heml__coarse_build(heml_model *m)
 {
     size_t D = 6 * (size_t)m->agg_count;
-    if (!m->agg_count || (m->coarse_version == m->pin_version && m->coarse_dev == m->kdev)) return;
-    if (m->implicit_coarse < 0 || m->kdev) heml__coarse_assemble(m, m->coarse, m->kdev != 0); /* (no coarse_k) */
+    int dev = m->kdev || m->pc_live;
+    if (!m->agg_count || (m->coarse_version == m->pin_version && m->coarse_dev == dev)) return;
+    if (m->implicit_coarse < 0 || dev) heml__coarse_assemble(m, m->coarse, dev); /* (no coarse_k) */
     else {
         heml__coarse_k_update(m);
         memcpy(m->coarse, m->coarse_k, sizeof(double) * D * D);
     }
     heml__coarse_factor(m->coarse, (int)D, m->coarse_rhs);
     m->coarse_version = m->pin_version;
-    m->coarse_dev = m->kdev;
+    m->coarse_dev = dev;
 }
 
 /* The implicit steps' coarse matrix P^T (D + c K0) P (D the solve's diagonal, NULL: 0),
@@ -5400,6 +5497,204 @@ static void heml__coarse_apply(heml_model *m, const double *L, const heml_real *
         for (r = 0; r < 3; r++)
             if (m->free_mask[3 * i + r] > 0) z[3 * i + r] += (heml_real)d[r];
     }
+}
+
+/* The static solve's pressure-aggregate preconditioner (nodal_pressure = 2; SOLVERS, PRESSURE
+   AGGREGATES "Krylov iterations"). The tangent is K = K_dev + s G^T Dn G (heml__dev_probe):
+   G's row A is g_A(v) = sum_{a in A} sum_{e at a} Vol_e dJ_e(v) / 4 (the sums pass folded
+   into the aggregate), Dn = diag(d_A), d_A = sum_mat W_A,mat U''(J_A) / V_A^2, s the Prony
+   factor. With B_dev the deviatoric two-level preconditioner (Jacobi of the deviatoric
+   small-strain diagonal plus the coarse space of the deviatoric small-strain stiffness),
+   the preconditioner is (B_dev^-1 + G^T Dn G)^-1 (s Dn clamped at 0), applied by the
+   Sherman-Morrison-Woodbury identity with G^ = sqrt(s Dn) G:
+       z = B_dev r - B_dev G^^T S^-1 G^ B_dev r,   S = I + G^ B_dev G^^T  (A x A, dense),
+   so that z^T K z / z^T B^-1 z lies between the extremes of v^T K_dev v / v^T B_dev^-1 v:
+   the bulk modulus cancels exactly, and the iterations are those of the deviatoric
+   problem. G^ is held explicitly per node (pgt_*: the aggregates of the node's star), from
+   the current state, once per Krylov solve, with S (O(n w^2 + A (6 A_c)^2 + A^3)). */
+
+/* pgt_agg: per node the aggregates of its tetrahedra's nodes, in the order met in d->tets
+   (at creation). */
+static void heml__pagg_pc_lists(heml_model *m, const heml_desc *d)
+{
+    int W = m->pgt_width, t, j, l, i;
+    for (i = 0; i < m->node_count * W; i++) m->pgt_agg[i] = -1;
+    for (t = 0; t < d->tet_count; t++)
+        for (j = 0; j < 4; j++) {
+            int *list = m->pgt_agg + (size_t)d->tets[4 * t + j] * W;
+            for (l = 0; l < 4; l++) {
+                int A = m->pagg[d->tets[4 * t + l]];
+                for (i = 0; i < W && list[i] >= 0 && list[i] != A; i++) continue;
+                if (i < W && list[i] < 0) list[i] = A; /* (i < W always: the width counted them) */
+            }
+        }
+}
+
+/* y = L^-1 y (forward) or L^-T y (backward) for a heml__coarse_factor factor L (D x D). */
+static void heml__chol_forward(const double *L, int D, double *y)
+{
+    int i, j;
+    for (i = 0; i < D; i++) {
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+}
+static void heml__chol_backward(const double *L, int D, double *y)
+{
+    int i, j;
+    for (i = D - 1; i >= 0; i--) {
+        double t = y[i], Lii = L[(size_t)i * D + i];
+        if (Lii == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
+        y[i] = t / Lii;
+    }
+}
+
+/* Whether a static Krylov solve may use the preconditioner: the model has it, and every
+   material has the same Prony factor s > 0 (else K is no K_dev + s G^T Dn G); *sp = s. */
+static int heml__pagg_pc_usable(const heml_model *m, double *sp)
+{
+    int i;
+    double s = 1.0;
+    if (!m->pagg_pc || m->kdev) return 0;
+    for (i = 0; i < m->material_count; i++) {
+        double si = m->mats[i].prony_count ? (double)m->prony_s[i] : 1.0;
+        if (i == 0) s = si;
+        else if (si != s) return 0;
+    }
+    *sp = s;
+    return s > 0;
+}
+
+/* Fills pgt_val with G^ at x (sqrt(s d_A) g_A on the free axes) and factors S = I + G^
+   B_dev G^^T into pc_s (B_dev: pinv, the deviatoric Jacobi, and the factored deviatoric
+   coarse matrix in m->coarse when the mesh has one). One sums and node pass (d_A), one
+   loop over the tetrahedra, all on the calling thread in a fixed order. */
+static void heml__pagg_pc_build(heml_model *m, const heml_real *x, const heml_real *pinv, double s)
+{
+    int W = m->pgt_width, A = m->pagg_count, Dc = 6 * m->agg_count, slot, i, j, l, r, a, b;
+    double *S = m->pc_s;
+    memset(m->pc_w, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
+    m->kdev = 2; /* the node pass writes d_A into pagg_dp */
+    heml__nodal_prepare(m, HEML__DIFF, x, m->pc_w);
+    m->kdev = 0;
+    memset(m->pgt_val, 0, sizeof(double) * 3 * (size_t)m->node_count * (size_t)W);
+    for (slot = 0; slot < m->slot_count; slot++) {
+        int blk = slot / HEML__W, k = slot % HEML__W, q[4];
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+        double g[4][3], H[3][3], cof[3][3], cf[3][3], tr, vq, v[4][3];
+        if (m->slot_tet[slot] < 0) continue;
+        for (j = 0; j < 4; j++) q[j] = idx[j * HEML__W + k];
+        for (j = 0; j < 3; j++)
+            for (r = 0; r < 3; r++) g[j + 1][r] = (double)R[(3 * j + r) * HEML__W + k];
+        for (r = 0; r < 3; r++) g[0][r] = -(g[1][r] + g[2][r] + g[3][r]);
+        vq = (double)R[9 * HEML__W + k] / 4;
+        for (r = 0; r < 3; r++) /* H = grad u, as heml__nodal_sums */
+            for (l = 0; l < 3; l++) {
+                H[r][l] = 0;
+                for (j = 1; j < 4; j++) H[r][l] += ((double)x[3 * q[j] + r] - (double)x[3 * q[0] + r]) * g[j][l];
+            }
+        cof[0][0] = H[1][1] * H[2][2] - H[1][2] * H[2][1], cof[0][1] = H[1][2] * H[2][0] - H[1][0] * H[2][2];
+        cof[0][2] = H[1][0] * H[2][1] - H[1][1] * H[2][0], cof[1][0] = H[0][2] * H[2][1] - H[0][1] * H[2][2];
+        cof[1][1] = H[0][0] * H[2][2] - H[0][2] * H[2][0], cof[1][2] = H[0][1] * H[2][0] - H[0][0] * H[2][1];
+        cof[2][0] = H[0][1] * H[1][2] - H[0][2] * H[1][1], cof[2][1] = H[0][2] * H[1][0] - H[0][0] * H[1][2];
+        cof[2][2] = H[0][0] * H[1][1] - H[0][1] * H[1][0];
+        tr = H[0][0] + H[1][1] + H[2][2];
+        for (r = 0; r < 3; r++) /* cof F = (tr H + 1) I - H^T + cof H */
+            for (l = 0; l < 3; l++) cf[r][l] = (r == l ? tr + 1 : 0) - H[l][r] + cof[r][l];
+        for (j = 0; j < 4; j++) /* Vol dJ / 4 = sum_j v_j . du_j */
+            for (r = 0; r < 3; r++) v[j][r] = vq * (cf[r][0] * g[j][0] + cf[r][1] * g[j][1] + cf[r][2] * g[j][2]);
+        for (b = 0; b < 4; b++) {
+            int Ab = m->pagg[q[b]];
+            for (j = 0; j < 4; j++) {
+                const int *list = m->pgt_agg + (size_t)q[j] * W;
+                double *val = m->pgt_val + 3 * (size_t)q[j] * W;
+                for (i = 0; list[i] != Ab; i++) continue; /* (listed at creation) */
+                for (r = 0; r < 3; r++) val[3 * i + r] += v[j][r];
+            }
+        }
+    }
+    for (i = 0; i < m->node_count; i++) /* times sqrt(s d_A), on the free axes */
+        for (l = 0; l < W && m->pgt_agg[(size_t)i * W + l] >= 0; l++) {
+            double dA = s * (double)m->pagg_dp[m->pgt_agg[(size_t)i * W + l]], f = dA > 0 ? sqrt(dA) : 0.0;
+            for (r = 0; r < 3; r++) m->pgt_val[3 * ((size_t)i * W + l) + r] *= m->free_mask[3 * i + r] > 0 ? f : 0.0;
+        }
+    memset(S, 0, sizeof(double) * (size_t)A * (size_t)A);
+    for (i = 0; i < m->node_count; i++) /* S = G^ pinv G^^T */
+        for (l = 0; l < W && m->pgt_agg[(size_t)i * W + l] >= 0; l++) {
+            const double *vl = m->pgt_val + 3 * ((size_t)i * W + l);
+            double *row = S + (size_t)m->pgt_agg[(size_t)i * W + l] * A;
+            for (j = 0; j < W && m->pgt_agg[(size_t)i * W + j] >= 0; j++) {
+                const double *vj = m->pgt_val + 3 * ((size_t)i * W + j);
+                row[m->pgt_agg[(size_t)i * W + j]] += vl[0] * vj[0] * (double)pinv[3 * i] +
+                                                     vl[1] * vj[1] * (double)pinv[3 * i + 1] +
+                                                     vl[2] * vj[2] * (double)pinv[3 * i + 2];
+            }
+        }
+    if (Dc) { /* + (L^-1 P^T G^^T)^T (L^-1 P^T G^^T), rows of pc_gp per aggregate */
+        double *GP = m->pc_gp;
+        memset(GP, 0, sizeof(double) * (size_t)A * (size_t)Dc);
+        for (i = 0; i < m->node_count; i++) {
+            double P[3][6];
+            heml__node_modes(m, i, P);
+            for (l = 0; l < W && m->pgt_agg[(size_t)i * W + l] >= 0; l++) {
+                const double *vl = m->pgt_val + 3 * ((size_t)i * W + l);
+                double *row = GP + (size_t)m->pgt_agg[(size_t)i * W + l] * Dc + 6 * m->node_agg[i];
+                for (a = 0; a < 6; a++) row[a] += vl[0] * P[0][a] + vl[1] * P[1][a] + vl[2] * P[2][a];
+            }
+        }
+        for (a = 0; a < A; a++) heml__chol_forward(m->coarse, Dc, GP + (size_t)a * Dc);
+        for (a = 0; a < A; a++)
+            for (b = 0; b <= a; b++) {
+                const double *ga = GP + (size_t)a * Dc, *gb = GP + (size_t)b * Dc;
+                double t = 0;
+                for (i = 0; i < Dc; i++) t += ga[i] * gb[i];
+                S[(size_t)a * A + b] += t;
+            }
+    }
+    for (a = 0; a < A; a++) S[(size_t)a * A + a] += 1.0;
+    heml__coarse_factor(S, A, m->pc_y);
+}
+
+/* z = B r with B = (B_dev^-1 + G^^T G^)^-1 (the Woodbury form above); pinv the deviatoric
+   Jacobi. */
+static void heml__pagg_pc_apply(heml_model *m, const heml_real *pinv, const heml_real *r, heml_real *z)
+{
+    int W = m->pgt_width, A = m->pagg_count, i, l, k, n3 = 3 * m->node_count;
+    double *y = m->pc_y;
+    heml_real *w = m->pc_w;
+    for (i = 0; i < n3; i++) z[i] = pinv[i] * r[i];
+    if (m->agg_count) heml__coarse_apply(m, m->coarse, r, z);
+    memset(y, 0, sizeof(double) * (size_t)A);
+    for (i = 0; i < m->node_count; i++) /* y = G^ z */
+        for (l = 0; l < W && m->pgt_agg[(size_t)i * W + l] >= 0; l++) {
+            const double *v = m->pgt_val + 3 * ((size_t)i * W + l);
+            y[m->pgt_agg[(size_t)i * W + l]] +=
+                v[0] * (double)z[3 * i] + v[1] * (double)z[3 * i + 1] + v[2] * (double)z[3 * i + 2];
+        }
+    heml__chol_forward(m->pc_s, A, y);
+    heml__chol_backward(m->pc_s, A, y);
+    for (i = 0; i < m->node_count; i++) { /* w = -G^^T y */
+        double t[3] = {0, 0, 0};
+        for (l = 0; l < W && m->pgt_agg[(size_t)i * W + l] >= 0; l++) {
+            const double *v = m->pgt_val + 3 * ((size_t)i * W + l);
+            double ya = y[m->pgt_agg[(size_t)i * W + l]];
+            for (k = 0; k < 3; k++) t[k] += v[k] * ya;
+        }
+        for (k = 0; k < 3; k++) w[3 * i + k] = (heml_real)-t[k];
+    }
+    for (i = 0; i < n3; i++) z[i] += pinv[i] * w[i];
+    if (m->agg_count) heml__coarse_apply(m, m->coarse, w, z);
 }
 
 /* >>creation -------------------------------------------------------------------------- */
@@ -5566,6 +5861,19 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     }
     tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     if (w->pagg) tmp->pagg_count = heml__pressure_aggregates(d, w->pagg, w->pagg + n, w->pagg + 2 * (size_t)n + 1);
+    if (tmp->pagg_count > 0 && tmp->pagg_count <= HEML_PAGG_PC_MAX) { /* heml__pagg_pc_build's width: the */
+        const int *agg = w->pagg, *start = w->pagg + n, *adj = w->pagg + 2 * (size_t)n + 1; /* most */
+        int a, l;                           /* aggregates among a node and its neighbours */
+        for (a = 0; a < tmp->pagg_count; a++) w->stamp[a] = -1;
+        for (a = 0; a < n; a++) {
+            int count = 0;
+            if (agg[a] < 0) continue;
+            w->stamp[agg[a]] = a, count = 1;
+            for (l = start[a]; l < start[a + 1]; l++)
+                if (w->stamp[agg[adj[l]]] != a) w->stamp[agg[adj[l]]] = a, count++;
+            if (count > tmp->pgt_width) tmp->pgt_width = count;
+        }
+    }
     {
         int cells[HEML__MAX_AGG];
         tmp->agg_count = heml__aggregate(d->rest_positions, n, w->stamp, cells);
@@ -5683,11 +5991,13 @@ static void heml__create_precompute(const heml_desc *d, heml_model *m, heml__cre
     heml__fill_tets(m, d, w->mass_acc, w->diag_acc);
     if (m->nodal) heml__nodal_weights(m, d, w->mass_acc);
     if (m->pagg_count) heml__pressure_aggregate_weights(m, w->pagg, w->mass_acc, w->diag_acc);
+    if (m->pgt_width) heml__pagg_pc_lists(m, d);
     m->dev_probe = m->nodal; /* where it pays: every material's bulk modulus at least
                                 HEML__DEV_PROBE_RATIO times its shear modulus (heml__dev_probe) */
     for (i = 0; i < m->material_count; i++)
         if (m->mats[i].small_lambda + 2.0 / 3.0 * m->mats[i].small_mu < HEML__DEV_PROBE_RATIO * m->mats[i].small_mu)
             m->dev_probe = 0;
+    m->pagg_pc = m->pgt_width > 0 && m->dev_probe; /* the same rule: where it pays (SOLVERS) */
     heml__create_chunks(m, src, w);
     if (m->agg_count) memcpy(m->node_agg, w->stamp, sizeof(int) * (size_t)m->node_count);
     heml__aggregate_centres(m);
@@ -5761,7 +6071,7 @@ static void heml__cg_apply(heml_model *m, const heml_real *diag, double c, const
 static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, heml_real *pinv)
 {
     int i, n3 = 3 * m->node_count;
-    const heml_real *kd = m->kdev ? m->diag_dev : m->diag;
+    const heml_real *kd = m->kdev || m->pc_live ? m->diag_dev : m->diag;
     for (i = 0; i < n3; i++) {
         double dgl = (diag ? (double)diag[i] : 0.0) + c * (double)kd[i];
         pinv[i] = (heml_real)(m->free_mask[i] > 0 && dgl > 0 ? 1.0 / dgl : 0.0);
@@ -5793,6 +6103,10 @@ static void heml__jacobi(const heml_model *m, const heml_real *diag, double c, h
 static void heml__precond(heml_model *m, const heml_real *pinv, const heml_real *r, heml_real *z, int coarse)
 {
     int i, n3 = 3 * m->node_count;
+    if (m->pc_live) {
+        heml__pagg_pc_apply(m, pinv, r, z);
+        return;
+    }
     for (i = 0; i < n3; i++) z[i] = pinv[i] * r[i];
     if (coarse) heml__coarse_apply(m, coarse == HEML__COARSE_STEP ? m->coarse_step : m->coarse, r, z);
 }
@@ -5817,11 +6131,13 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
 {
     heml_real *r = s[0], *z = s[1], *p = s[2], *q = s[3], *pinv = s[4];
     int n3 = 3 * m->node_count, i, it;
-    double bb, rr, rz, tol2;
+    double bb, rr, rz, tol2, ps;
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
+    m->pc_live = coarse == HEML__COARSE_STATIC && heml__pagg_pc_usable(m, &ps);
     coarse = heml__coarse_prepare(m, coarse, diag, c);
     heml__jacobi(m, diag, c, pinv);
+    if (m->pc_live) heml__pagg_pc_build(m, x_lin, pinv, ps * c);
     for (i = 0; i < n3; i++) {
         x[i] *= m->free_mask[i];
         r[i] = b[i] * m->free_mask[i];
@@ -5882,11 +6198,13 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     heml_real *r1 = s[0], *r2 = s[1], *y = s[2], *v = s[3], *w = s[4], *w1 = s[5], *w2 = s[6];
     heml_real *pinv = s[7];
     int n3 = 3 * m->node_count, i, it;
-    double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol;
+    double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol, ps;
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
+    m->pc_live = coarse == HEML__COARSE_STATIC && heml__pagg_pc_usable(m, &ps);
     coarse = heml__coarse_prepare(m, coarse, diag, c);
     heml__jacobi(m, diag, c, pinv);
+    if (m->pc_live) heml__pagg_pc_build(m, x_lin, pinv, ps * c);
     for (i = 0; i < n3; i++) {
         x[i] = w[i] = w2[i] = 0;
         r1[i] = r2[i] = b[i] * m->free_mask[i];
@@ -6026,6 +6344,7 @@ static int heml__linear_solve(heml_model *m, int kind, const heml_real *x_lin, c
     }
     err = (kind == HEML__INDEFINITE ? ops->solve_indefinite : ops->solve)(m, x_lin, diag, c, b, x, rtol, coarse,
                                                                            m->krylov);
+    m->pc_live = 0;
     heml__dc_invalidate(m);
     return err;
 }
