@@ -1352,6 +1352,10 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #else
 #define TMASS__PREFETCH(p) ((void)0)
 #endif
+/* How many edges ahead the force pass prefetches the tensor stream (see PERFORMANCE) */
+#ifndef TMASS__PREFETCH_EDGES
+#define TMASS__PREFETCH_EDGES 24
+#endif
 
 #define TMASS__COOKIE 0x544D4153u /* "TMAS" */
 #define TMASS__ALIGN 64
@@ -2481,6 +2485,44 @@ typedef struct tmass__create_tables {
     int *start, *key, *payload, *tet_edge;
 } tmass__create_tables;
 
+/* Slots per edge chunk. Small models (serial): E / 32 in [256, 4096]. Models large enough
+   to run in parallel get bands instead when their numbering allows (issue 21): chunks of
+   at least `width` slots, the most edges whose lower vertices lie within reach + 1 of
+   each other (reach: the largest b - a of an edge), so that chunks c and c + 2 never share
+   a vertex (chunk c + 1 holds every edge whose lower vertex lies within reach of chunk
+   c's last one) and the greedy colouring (tmass__colour_chunks) finds two colours, even
+   and odd chunks, each run in slot order. Chunks of 4 widths (at least 16 chunks) keep
+   most node accesses of a sweep in cache: a node is visited in one colour's pass as the
+   lower vertex, and again in the other's only when it lies within reach of a chunk's
+   end. The greedy colouring of small chunks it replaces ran 4 colours on a 1e6-tet cube,
+   each colour sweeping all the nodes. A mesh without such locality (reach near the node
+   count: width above E / 16) keeps the small chunks. Cuts only remove edges, so the
+   colouring stays valid. Uses start and key as build_edges left them (start is
+   overwritten). */
+static int tmass__chunk_size(int n, int E, int *start, const int *key)
+{
+    int v, i, lo = start[0], cum = 0, reach = 0, width = 0, size = E / 32, band;
+    if (size < 256) size = 256;
+    if (size > 4096) size = 4096;
+    if (E < TMASS_PARALLEL_MIN_EDGES) return size;
+    for (v = 0; v < n; v++) { /* start: distinct edges before lower vertex v */
+        int hi = start[v + 1], distinct = 0;
+        for (i = lo; i < hi; i++) distinct += i == lo || key[i] != key[i - 1];
+        if (hi > lo && key[hi - 1] - v > reach) reach = key[hi - 1] - v; /* keys sorted */
+        start[v] = cum;
+        cum += distinct;
+        lo = hi;
+    }
+    start[n] = cum;
+    for (v = 0; v < n; v++) {
+        int w = start[reach + 1 > n - v ? n : v + reach + 1] - start[v];
+        if (w > width) width = w;
+    }
+    band = E / 16 < 4 * width ? E / 16 : 4 * width;
+    if (band < width) return size; /* no locality to use */
+    return band > size ? band : size;
+}
+
 /* Allocates the temporary tables and counts the edges; sizes holds every array length
    tmass__layout needs. */
 static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__create_tables *w)
@@ -2498,9 +2540,7 @@ static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__cr
     sizes->node_count = n;
     sizes->tet_count = T;
     sizes->edge_total = E;
-    sizes->chunk_size = E / 32;
-    if (sizes->chunk_size < 256) sizes->chunk_size = 256;
-    if (sizes->chunk_size > 4096) sizes->chunk_size = 4096;
+    sizes->chunk_size = tmass__chunk_size(n, E, w->start, w->key);
     sizes->chunk_total = (E + sizes->chunk_size - 1) / sizes->chunk_size;
     sizes->partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
     sizes->implicit_coarse = d->implicit_coarse;
@@ -2679,9 +2719,13 @@ typedef struct tmass__matvec_ctx {
     int colour;
 } tmass__matvec_ctx;
 
-static void tmass__matvec_chunks(void *vctx, int begin, int end)
+/* The edge pass over chunks [begin, end) of the context's colour: out += K p (neg 0) or
+   out -= K p (neg 1). The negated pass forms each difference the other way round,
+   d = p_a - p_b: every product and sum is then the exact negative of the neg = 0 one
+   (rounding to nearest is symmetric), so -K p comes out bit for bit as the negation of
+   K p, signed zeros aside, without a pass over the nodes to negate it (issue 21). */
+static void tmass__edge_pass(const tmass__matvec_ctx *c, int begin, int end, const int neg)
 {
-    const tmass__matvec_ctx *c = (const tmass__matvec_ctx *)vctx;
     const tmass_model *m = c->m;
     const int *TMASS__RESTRICT ea = m->edge_a;
     const int *TMASS__RESTRICT eb = m->edge_b;
@@ -2700,8 +2744,9 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
             do {
                 const tmass_real *K = T + 9 * s, *pb = p + 3 * eb[s];
                 tmass_real *ob = out + 3 * eb[s];
-                tmass_real d0 = pb[0] - a0, d1 = pb[1] - a1, d2 = pb[2] - a2;
-                TMASS__PREFETCH(K + 9 * 24); /* the tensor stream, a few lines ahead */
+                tmass_real d0 = neg ? a0 - pb[0] : pb[0] - a0, d1 = neg ? a1 - pb[1] : pb[1] - a1,
+                           d2 = neg ? a2 - pb[2] : pb[2] - a2;
+                TMASS__PREFETCH(K + 9 * TMASS__PREFETCH_EDGES); /* the tensor stream, pages ahead */
                 f0 += K[0] * d0 + K[1] * d1 + K[2] * d2;
                 f1 += K[3] * d0 + K[4] * d1 + K[5] * d2;
                 f2 += K[6] * d0 + K[7] * d1 + K[8] * d2;
@@ -2715,6 +2760,16 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
             out[3 * a + 2] += f2;
         }
     }
+}
+
+static void tmass__matvec_chunks(void *vctx, int begin, int end)
+{
+    tmass__edge_pass((const tmass__matvec_ctx *)vctx, begin, end, 0);
+}
+
+static void tmass__matvec_chunks_neg(void *vctx, int begin, int end)
+{
+    tmass__edge_pass((const tmass__matvec_ctx *)vctx, begin, end, 1);
 }
 
 /* out += S p over the coupling nodes (serial: the block is small and dense). */
@@ -2736,17 +2791,37 @@ static void tmass__coupling_matvec(const tmass_model *m, const tmass_real *p, tm
 
 /* out = K p over the edge tensors and a hybrid's coupling block, without the anchors (the
    force passes add the anchors' own force, formed in double: tmass__anchor_force). */
-static void tmass__matvec_elastic(const tmass_model *m, const tmass_real *p, tmass_real *out)
+static void tmass__matvec_signed(const tmass_model *m, const tmass_real *p, tmass_real *out, int neg)
 {
     tmass__matvec_ctx c;
+    int i, n3 = 3 * m->node_count;
     c.m = m;
     c.p = p;
     c.out = out;
-    memset(out, 0, sizeof(tmass_real) * 3 * (size_t)m->node_count);
+    memset(out, 0, sizeof(tmass_real) * (size_t)n3);
     for (c.colour = 0; c.colour < m->colour_count; c.colour++)
         tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
-                   tmass__matvec_chunks, &c);
-    if (m->coupling_count) tmass__coupling_matvec(m, p, out);
+                   neg ? tmass__matvec_chunks_neg : tmass__matvec_chunks, &c);
+    if (m->coupling_count) {
+        /* (serial, small): negate around it so that it adds as in K p */
+        if (neg)
+            for (i = 0; i < n3; i++) out[i] = -out[i];
+        tmass__coupling_matvec(m, p, out);
+        if (neg)
+            for (i = 0; i < n3; i++) out[i] = -out[i];
+    }
+}
+
+static void tmass__matvec_elastic(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    tmass__matvec_signed(m, p, out, 0);
+}
+
+/* out = -K p (tmass__matvec_elastic negated, bit for bit but for signed zeros): the
+   force passes */
+static void tmass__matvec_elastic_neg(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    tmass__matvec_signed(m, p, out, 1);
 }
 
 /* The anchors' part of a force pass (tmass_set_anchors): per anchor a on node n,
@@ -2982,11 +3057,10 @@ static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass
     if (v && m->stiffness_damping != 0) {
         tmass_real beta = m->stiffness_damping;
         for (i = 0; i < n3; i++) w[i] = u[i] + beta * v[i];
-        tmass__matvec_elastic(m, w, out);
+        tmass__matvec_elastic_neg(m, w, out);
     } else {
-        tmass__matvec_elastic(m, u, out);
+        tmass__matvec_elastic_neg(m, u, out);
     }
-    for (i = 0; i < n3; i++) out[i] = -out[i];
     if (m->anchor_count) tmass__anchor_force(m, u, v, (double)m->stiffness_damping, out);
     m->stats.force_evaluations++;
 }
@@ -3414,8 +3488,7 @@ static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tm
     int i, n3 = 3 * m->node_count;
     tmass_real *w = m->force_work, beta = m->stiffness_damping;
     for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
-    tmass__matvec_elastic(m, w, f);
-    for (i = 0; i < n3; i++) f[i] = -f[i];
+    tmass__matvec_elastic_neg(m, w, f);
     if (m->anchor_count) tmass__anchor_force(m, w, NULL, 0.0, f); /* -k ((rest - t) + w) */
     m->stats.force_evaluations++;
     return (double)dt * dt + (double)dt * m->stiffness_damping;
