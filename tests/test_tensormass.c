@@ -1107,24 +1107,25 @@ static void test_threads_bit_identical(void)
 }
 
 /* The force pass (issue 21): tmass_forces runs the edge pass negated (d = p_a - p_b, no
-   pass over the nodes to negate K u) and, on models large enough to run in parallel,
-   over chunks of bands of the node numbering in two colours. A 6 x 6 x 100-cell beam
-   numbered along its length (bands: two colours) and the same beam with its nodes
-   shuffled (no locality: the small chunks and greedy colours), each before and after a
-   cut: the forces equal eq. 6, -(K_ii u_i + sum_j K_ij u_j), summed here in double
-   from the model's tensors in another order, to 8 eps times the sum of the terms'
-   magnitudes (each product and partial sum is rounded once in tmass_real, and the
-   difference form rounds u_b - u_a once more: a few eps of that sum at worst; 1 eps
-   seen in double and float); and tmass_forces equals -K u from tmass_apply_stiffness (the plain pass) bit
-   for bit (== : the negated pass forms the exact negative of every rounded product and
-   sum). */
+   pass over the nodes to negate K u), with 4-wide vectors in double AVX2 builds (the
+   portable loop too, through m->plain_pass), and, on models large enough to run in
+   parallel, over chunks of bands of the node numbering in two colours. A 6 x 6 x
+   100-cell beam numbered along its length (bands: two colours) and the same beam with
+   its nodes shuffled (no locality: the small chunks and greedy colours), each before
+   and after a cut: the forces equal eq. 6, -(K_ii u_i + sum_j K_ij u_j), summed here in
+   double from the model's tensors in another order, to 8 eps times the sum of the
+   terms' magnitudes (each product and partial sum is rounded once in tmass_real, and
+   the difference form rounds u_b - u_a once more: a few eps of that sum at worst; 1 eps
+   seen in double and float); tmass_forces equals -K u from tmass_apply_stiffness (the
+   plain pass) bit for bit (== : the negated pass forms the exact negative of every
+   rounded product and sum); and, in OpenMP builds, 1 and 2 threads give the same bits. */
 static void force_pass_compare(tmass_model *m, const tmass_real *u, int n)
 {
     double *ref = (double *)calloc(3 * (size_t)n, sizeof(double)), *scale = (double *)calloc((size_t)n, sizeof(double));
     tmass_real *ku = alloc_reals(3 * n), T[9];
     const tmass_real *f;
     double worst = 0.0;
-    int i, r, c, s, k, same = 1;
+    int i, r, c, s, k, same = 1, plain;
     REQUIRE(ref && scale);
     for (i = 0; i < n; i++) { /* K_ii u_i */
         REQUIRE(tmass_vertex_tensor(m, i, T) == TMASS_OK);
@@ -1147,17 +1148,34 @@ static void force_pass_compare(tmass_model *m, const tmass_real *u, int n)
                     scale[b] += fabs(ba);
                 }
         }
-    f = tmass_forces(m);
-    REQUIRE(tmass_apply_stiffness(m, u, ku) == TMASS_OK);
-    for (i = 0; i < 3 * n; i++) {
-        double e = fabs((double)f[i] - ref[i]) / (8 * EPS * scale[i / 3] + 1e-300);
-        if (e > worst) worst = e;
-        if (!(f[i] == -ku[i])) same = 0;
+    for (plain = 0; plain < 2; plain++) { /* the AVX2 loop where compiled in, the portable one */
+        m->plain_pass = plain;
+        f = tmass_forces(m);
+        REQUIRE(tmass_apply_stiffness(m, u, ku) == TMASS_OK);
+        worst = 0.0;
+        same = 1;
+        for (i = 0; i < 3 * n; i++) {
+            double e = fabs((double)f[i] - ref[i]) / (8 * EPS * scale[i / 3] + 1e-300);
+            if (e > worst) worst = e;
+            if (!(f[i] == -ku[i])) same = 0;
+        }
+        printf("    %d nodes, %d chunks, %d colours, %s loop: |f - eq. 6| at most %.3f of its bound, f == -K u: %d\n",
+               n, m->chunk_total, m->colour_count, plain ? "portable" : TMASS__AVX2 ? "AVX2" : "portable", worst,
+               same);
+        CHECK(worst <= 1.0);
+        CHECK(same);
+#ifdef _OPENMP
+        { /* the chunks of a colour on 1 and 2 threads: the same bits */
+            tmass_real *f1 = alloc_reals(3 * n);
+            omp_set_num_threads(1);
+            memcpy(f1, tmass_forces(m), sizeof(tmass_real) * 3 * (size_t)n);
+            omp_set_num_threads(2);
+            CHECK(memcmp(f1, tmass_forces(m), sizeof(tmass_real) * 3 * (size_t)n) == 0);
+            free(f1);
+        }
+#endif
     }
-    printf("    %d nodes, %d chunks, %d colours: |f - eq. 6| at most %.3f of its bound, f == -K u: %d\n", n,
-           m->chunk_total, m->colour_count, worst, same);
-    CHECK(worst <= 1.0);
-    CHECK(same);
+    m->plain_pass = 0;
     free(ref);
     free(scale);
     free(ku);
