@@ -60,6 +60,9 @@
                        default allocator (malloc/free) when the desc gives none.
        TMASS_ASSERT(x) internal sanity checks (default: assert from <assert.h>).
        TMASS_STATIC    make every function static (private to the including file).
+       TMASS_NO_SIMD   keep the edge pass's portable loop in double builds with AVX2 and
+                       FMA (which otherwise run it with 4-wide vectors: another rounding
+                       of the same sums; see PERFORMANCE).
 
    STEP BY STEP
        1. tmass_desc d = tmass_default_desc(); fill the mesh, the material, the time step.
@@ -500,7 +503,48 @@
    vertex it touches 3 displacements and 3 forces (zeroed, then accumulated). There is no
    vertex pass: eq. 6 is evaluated in its difference form (see THE MODEL). Edges are sorted
    by their lower vertex and grouped in contiguous chunks, so the tensors stream from
-   memory; a run of edges sharing their lower vertex accumulates in registers. Measured on
+   memory; a run of edges sharing their lower vertex accumulates in registers. Issue 21
+   (out of cache the pass fell to 34 % of its bandwidth bound on Zen 5): the force pass
+   now forms -K u itself (d = p_a - p_b) instead of negating K u in a second pass over
+   the nodes (bit-identical); models of TMASS_PARALLEL_MIN_EDGES edges or more chunk
+   their edges in bands of the node numbering run in two colours (tmass__chunk_size),
+   where the small chunks' greedy colouring ran 4 colours on a 1e6-tet cube, each
+   sweeping all the nodes (summation order changed: forces move by round-off, within
+   3e-16 of the largest in double, deterministic for any thread count); and double builds
+   with AVX2 and FMA (-march=native on x86-64) run the pass with 4-wide vectors
+   (tmass__edge_pass_avx2: the K d sums of a run are formed lane-wise, another rounding
+   than the portable loop's, within 1 eps of eq. 6 like it, tested against it). callgrind
+   (x86-64-v3 build, cube of 40^3 cells, 320,000 tetrahedra, simulated 2 MB last-level
+   cache, per tetrahedron and force evaluation): 79.1 instructions before, 74.9 with the
+   fused sign and bands in the portable loop, 61.7 with the AVX2 loop (in cache, 10,985
+   tetrahedra: 86.4, 81.8, 67.7); memory lines missed 2.02 before, 1.86 after (129 and
+   119 bytes; the stated 110 bytes are 1.72 lines). Interleaved timings (old and new
+   programs alternated, 6 to 8 rounds of 10 repeats, CPU-time minima; Intel Xeon,
+   Sapphire Rapids class, KVM, 2 vCPUs shared with a load of 7 to 10, gcc 12 -O3
+   -march=native, STREAM triad 14.5 to 14.9 GB/s at its quietest; the bench's wall-clock
+   rows swung 3x under that load), two runs, each figure the range over both: ns per
+   tetrahedron before -> after, after / before, ratio to the bound (time / (stated bytes
+   / triad rate)):
+       double      1,080 tets  5.28-5.40 -> 3.96-3.97  0.73-0.75  0.57 -> 0.42
+                  10,985       4.77-4.84 -> 3.63-3.64  0.75-0.76  0.59 -> 0.44
+                 109,760       4.93-5.18 -> 4.48-4.55  0.87-0.92  0.65-0.67 -> 0.58-0.60
+               1,026,895       7.42-8.62 -> 7.00-7.01  0.81-0.95  0.99-1.17 -> 0.94-0.95
+       float (no vector loop): 1.00 to 1.04 up to 110k tets, 0.91 and 1.01 at 1e6 (ratio
+       1.09 to 1.15 there).
+   So on this machine the pass runs at 0.94 to 0.95 times its bound out of cache, inside
+   the goal's 1.43 (a triad's rate undercounts a pure read stream: reading the tensors
+   and indices alone took 0.9 of the bound). The old pass was at 0.99 to 1.17 here by the
+   same minima: the 2.92 of the Zen 5 run is not reproduced on this machine, where a core
+   streams 15 GB/s against Zen 5's 32 and the arithmetic hides under the memory time. On
+   Zen 5 the in-cache arithmetic (5.4 ns a tetrahedron there, above its 1e6 bound of 3.3)
+   is what the vector loop cuts; whether the goal is met there is for the next full bench
+   to say. Tried and not kept: prefetch distances of 12, 64 and 128 edges (none at all is
+   1.4 times slower out of cache; the others within the noise of 24). Not done: folding
+   the zeroing of the forces into the bands (each even chunk zeroing its own and the next
+   odd chunk's nodes before its sweep) would save the memset's 24 bytes per node, about
+   5 % of the traffic; a float vector loop (float is at its bound in cache already). What
+   bounds it now: out of cache the tensor stream; in cache the arithmetic and the
+   scattered updates of p_b's forces. Before issue 21, measured on
    an AMD EPYC (Zen 5) core, gcc -O3 -march=native, double, beam meshes of 768 to 768,000
    tetrahedra: 3.4 to 3.6 ns per edge (4.1 to 5.1 ns per tetrahedron), 1.5 to 1.6 times the
    time to stream the 80 bytes per edge at the STREAM triad rate measured in the same run
@@ -1352,6 +1396,19 @@ TMASSDEF int tmass_hybrid_connection_count(const tmass_hybrid *h);
 #else
 #define TMASS__PREFETCH(p) ((void)0)
 #endif
+/* How many edges ahead the force pass prefetches the tensor stream (see PERFORMANCE) */
+#ifndef TMASS__PREFETCH_EDGES
+#define TMASS__PREFETCH_EDGES 24
+#endif
+
+/* The edge pass's AVX2 path (double, compiled with AVX2 and FMA, e.g. -march=native on
+   x86-64; TMASS_NO_SIMD turns it off): see tmass__edge_pass_avx2 */
+#if !TMASS__CAT(TMASS__IS_, TMASS_REAL) && defined(__AVX2__) && defined(__FMA__) && !defined(TMASS_NO_SIMD)
+#define TMASS__AVX2 1
+#include <immintrin.h>
+#else
+#define TMASS__AVX2 0
+#endif
 
 #define TMASS__COOKIE 0x544D4153u /* "TMAS" */
 #define TMASS__ALIGN 64
@@ -1412,6 +1469,8 @@ struct tmass_model {
     /* chunks of contiguous slots, listed colour by colour */
     int chunk_size, chunk_total, colour_count;
     int *chunk_start, *chunk_live, *chunk_of_orig, *colour_start;
+    int plain_pass; /* 1: the edge pass runs its portable loop even where the AVX2 one is
+                       compiled in (tests compare the two) */
 
     /* boundary triangles */
     int *tri, *tri_owner, *face_pos;
@@ -2481,6 +2540,44 @@ typedef struct tmass__create_tables {
     int *start, *key, *payload, *tet_edge;
 } tmass__create_tables;
 
+/* Slots per edge chunk. Small models (serial): E / 32 in [256, 4096]. Models large enough
+   to run in parallel get bands instead when their numbering allows (issue 21): chunks of
+   at least `width` slots, the most edges whose lower vertices lie within reach + 1 of
+   each other (reach: the largest b - a of an edge), so that chunks c and c + 2 never share
+   a vertex (chunk c + 1 holds every edge whose lower vertex lies within reach of chunk
+   c's last one) and the greedy colouring (tmass__colour_chunks) finds two colours, even
+   and odd chunks, each run in slot order. Chunks of 4 widths (at least 16 chunks) keep
+   most node accesses of a sweep in cache: a node is visited in one colour's pass as the
+   lower vertex, and again in the other's only when it lies within reach of a chunk's
+   end. The greedy colouring of small chunks it replaces ran 4 colours on a 1e6-tet cube,
+   each colour sweeping all the nodes. A mesh without such locality (reach near the node
+   count: width above E / 16) keeps the small chunks. Cuts only remove edges, so the
+   colouring stays valid. Uses start and key as build_edges left them (start is
+   overwritten). */
+static int tmass__chunk_size(int n, int E, int *start, const int *key)
+{
+    int v, i, lo = start[0], cum = 0, reach = 0, width = 0, size = E / 32, band;
+    if (size < 256) size = 256;
+    if (size > 4096) size = 4096;
+    if (E < TMASS_PARALLEL_MIN_EDGES) return size;
+    for (v = 0; v < n; v++) { /* start: distinct edges before lower vertex v */
+        int hi = start[v + 1], distinct = 0;
+        for (i = lo; i < hi; i++) distinct += i == lo || key[i] != key[i - 1];
+        if (hi > lo && key[hi - 1] - v > reach) reach = key[hi - 1] - v; /* keys sorted */
+        start[v] = cum;
+        cum += distinct;
+        lo = hi;
+    }
+    start[n] = cum;
+    for (v = 0; v < n; v++) {
+        int w = start[reach + 1 > n - v ? n : v + reach + 1] - start[v];
+        if (w > width) width = w;
+    }
+    if (width > E / 16) return size; /* no locality to use */
+    band = width > E / 64 ? E / 16 : 4 * width;
+    return band > size ? band : size;
+}
+
 /* Allocates the temporary tables and counts the edges; sizes holds every array length
    tmass__layout needs. */
 static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__create_tables *w)
@@ -2498,9 +2595,7 @@ static int tmass__create_size(const tmass_desc *d, tmass_model *sizes, tmass__cr
     sizes->node_count = n;
     sizes->tet_count = T;
     sizes->edge_total = E;
-    sizes->chunk_size = E / 32;
-    if (sizes->chunk_size < 256) sizes->chunk_size = 256;
-    if (sizes->chunk_size > 4096) sizes->chunk_size = 4096;
+    sizes->chunk_size = tmass__chunk_size(n, E, w->start, w->key);
     sizes->chunk_total = (E + sizes->chunk_size - 1) / sizes->chunk_size;
     sizes->partial_count = (3 * n + TMASS__VEC_BLOCK - 1) / TMASS__VEC_BLOCK;
     sizes->implicit_coarse = d->implicit_coarse;
@@ -2679,9 +2774,77 @@ typedef struct tmass__matvec_ctx {
     int colour;
 } tmass__matvec_ctx;
 
-static void tmass__matvec_chunks(void *vctx, int begin, int end)
+#if TMASS__AVX2
+/* The edge pass (tmass__edge_pass below) with 4-wide vectors (lane 3 unused: masked
+   loads never read past a node's 3 reals or a tensor's 9). Per edge: d = p_b - p_a (or
+   p_a - p_b) in one register; K^T d = d0 row0 + d1 row1 + d2 row2 (rows of the
+   row-major tensor; the multiply-adds in the order gcc 12 contracts the portable loop's:
+   the b side came out bit-identical); K d accumulated lane-wise over the run of edges
+   sharing a (acc_r += row_r * d) and summed across lanes once at the run's end,
+   (l0 + l1) + l2: another summation order than the portable loop's row dot products
+   (within round-off of it; deterministic for any thread count). About 20 % fewer
+   instructions than the portable loop (callgrind) and 25 % less time in cache
+   (PERFORMANCE). */
+static void tmass__edge_pass_avx2(const tmass__matvec_ctx *c, int begin, int end, const int neg)
 {
-    const tmass__matvec_ctx *c = (const tmass__matvec_ctx *)vctx;
+    const tmass_model *m = c->m;
+    const int *TMASS__RESTRICT ea = m->edge_a;
+    const int *TMASS__RESTRICT eb = m->edge_b;
+    const double *TMASS__RESTRICT T = m->edge_tensor;
+    const double *TMASS__RESTRICT p = c->p;
+    double *TMASS__RESTRICT out = c->out;
+    const __m256i three = _mm256_set_epi64x(0, -1, -1, -1);
+    int k;
+    for (k = m->colour_start[c->colour] + begin; k < m->colour_start[c->colour] + end; k++) {
+        int s = m->chunk_start[k], s1 = s + m->chunk_live[k];
+        while (s < s1) {
+            int a = ea[s];
+            __m256d pa = _mm256_maskload_pd(p + 3 * a, three), acc0 = _mm256_setzero_pd(), acc1 = acc0,
+                    acc2 = acc0, f;
+            double *oa = out + 3 * a;
+            do {
+                const double *K = T + 9 * s;
+                double *ob = out + 3 * eb[s];
+                __m256d pb = _mm256_maskload_pd(p + 3 * eb[s], three);
+                __m256d d = neg ? _mm256_sub_pd(pa, pb) : _mm256_sub_pd(pb, pa);
+                __m256d r0 = _mm256_loadu_pd(K), r1 = _mm256_loadu_pd(K + 3),
+                        r2 = _mm256_maskload_pd(K + 6, three);
+                __m256d t, o;
+                TMASS__PREFETCH(K + 9 * TMASS__PREFETCH_EDGES);
+                acc0 = _mm256_fmadd_pd(r0, d, acc0);
+                acc1 = _mm256_fmadd_pd(r1, d, acc1);
+                acc2 = _mm256_fmadd_pd(r2, d, acc2);
+                t = _mm256_mul_pd(r1, _mm256_permute4x64_pd(d, 0x55));
+                t = _mm256_fmadd_pd(r0, _mm256_permute4x64_pd(d, 0x00), t);
+                t = _mm256_fmadd_pd(r2, _mm256_permute4x64_pd(d, 0xAA), t);
+                o = _mm256_sub_pd(_mm256_maskload_pd(ob, three), t);
+                _mm_storeu_pd(ob, _mm256_castpd256_pd128(o));
+                _mm_store_sd(ob + 2, _mm256_extractf128_pd(o, 1));
+                s++;
+            } while (s < s1 && ea[s] == a);
+            {
+                /* lanes of acc_r: l0 l1 l2 0; hadd(acc0, acc1) = (a0+a1, b0+b1, a2+0, b2+0) */
+                __m256d h01 = _mm256_hadd_pd(acc0, acc1), h22 = _mm256_hadd_pd(acc2, acc2);
+                __m128d s01 = _mm_add_pd(_mm256_castpd256_pd128(h01), _mm256_extractf128_pd(h01, 1));
+                __m128d s2 = _mm_add_sd(_mm256_castpd256_pd128(h22), _mm256_extractf128_pd(h22, 1));
+                f = _mm256_insertf128_pd(_mm256_castpd128_pd256(s01), s2, 1);
+                f = _mm256_add_pd(_mm256_maskload_pd(oa, three), f);
+                _mm_storeu_pd(oa, _mm256_castpd256_pd128(f));
+                _mm_store_sd(oa + 2, _mm256_extractf128_pd(f, 1));
+            }
+        }
+    }
+}
+#endif
+
+/* The edge pass over chunks [begin, end) of the context's colour: out += K p (neg 0) or
+   out -= K p (neg 1). The negated pass forms each difference the other way round,
+   d = p_a - p_b: every product and sum is then the exact negative of the neg = 0 one
+   (rounding to nearest is symmetric), so -K p comes out bit for bit as the negation of
+   K p, signed zeros aside, without a pass over the nodes to negate it (issue 21). */
+
+static void tmass__edge_pass(const tmass__matvec_ctx *c, int begin, int end, const int neg)
+{
     const tmass_model *m = c->m;
     const int *TMASS__RESTRICT ea = m->edge_a;
     const int *TMASS__RESTRICT eb = m->edge_b;
@@ -2689,6 +2852,12 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
     const tmass_real *TMASS__RESTRICT p = c->p;
     tmass_real *TMASS__RESTRICT out = c->out;
     int k;
+#if TMASS__AVX2
+    if (!m->plain_pass) {
+        tmass__edge_pass_avx2(c, begin, end, neg);
+        return;
+    }
+#endif
     for (k = m->colour_start[c->colour] + begin; k < m->colour_start[c->colour] + end; k++) {
         int s = m->chunk_start[k], s1 = s + m->chunk_live[k];
         /* Edges come sorted by their lower vertex a: sum a run of equal a in registers
@@ -2700,8 +2869,9 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
             do {
                 const tmass_real *K = T + 9 * s, *pb = p + 3 * eb[s];
                 tmass_real *ob = out + 3 * eb[s];
-                tmass_real d0 = pb[0] - a0, d1 = pb[1] - a1, d2 = pb[2] - a2;
-                TMASS__PREFETCH(K + 9 * 24); /* the tensor stream, a few lines ahead */
+                tmass_real d0 = neg ? a0 - pb[0] : pb[0] - a0, d1 = neg ? a1 - pb[1] : pb[1] - a1,
+                           d2 = neg ? a2 - pb[2] : pb[2] - a2;
+                TMASS__PREFETCH(K + 9 * TMASS__PREFETCH_EDGES); /* the tensor stream, pages ahead */
                 f0 += K[0] * d0 + K[1] * d1 + K[2] * d2;
                 f1 += K[3] * d0 + K[4] * d1 + K[5] * d2;
                 f2 += K[6] * d0 + K[7] * d1 + K[8] * d2;
@@ -2715,6 +2885,16 @@ static void tmass__matvec_chunks(void *vctx, int begin, int end)
             out[3 * a + 2] += f2;
         }
     }
+}
+
+static void tmass__matvec_chunks(void *vctx, int begin, int end)
+{
+    tmass__edge_pass((const tmass__matvec_ctx *)vctx, begin, end, 0);
+}
+
+static void tmass__matvec_chunks_neg(void *vctx, int begin, int end)
+{
+    tmass__edge_pass((const tmass__matvec_ctx *)vctx, begin, end, 1);
 }
 
 /* out += S p over the coupling nodes (serial: the block is small and dense). */
@@ -2736,17 +2916,37 @@ static void tmass__coupling_matvec(const tmass_model *m, const tmass_real *p, tm
 
 /* out = K p over the edge tensors and a hybrid's coupling block, without the anchors (the
    force passes add the anchors' own force, formed in double: tmass__anchor_force). */
-static void tmass__matvec_elastic(const tmass_model *m, const tmass_real *p, tmass_real *out)
+static void tmass__matvec_signed(const tmass_model *m, const tmass_real *p, tmass_real *out, int neg)
 {
     tmass__matvec_ctx c;
+    int i, n3 = 3 * m->node_count;
     c.m = m;
     c.p = p;
     c.out = out;
-    memset(out, 0, sizeof(tmass_real) * 3 * (size_t)m->node_count);
+    memset(out, 0, sizeof(tmass_real) * (size_t)n3);
     for (c.colour = 0; c.colour < m->colour_count; c.colour++)
         tmass__run(m, m->colour_start[c.colour + 1] - m->colour_start[c.colour],
-                   tmass__matvec_chunks, &c);
-    if (m->coupling_count) tmass__coupling_matvec(m, p, out);
+                   neg ? tmass__matvec_chunks_neg : tmass__matvec_chunks, &c);
+    if (m->coupling_count) {
+        /* (serial, small): negate around it so that it adds as in K p */
+        if (neg)
+            for (i = 0; i < n3; i++) out[i] = -out[i];
+        tmass__coupling_matvec(m, p, out);
+        if (neg)
+            for (i = 0; i < n3; i++) out[i] = -out[i];
+    }
+}
+
+static void tmass__matvec_elastic(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    tmass__matvec_signed(m, p, out, 0);
+}
+
+/* out = -K p (tmass__matvec_elastic negated, bit for bit but for signed zeros): the
+   force passes */
+static void tmass__matvec_elastic_neg(const tmass_model *m, const tmass_real *p, tmass_real *out)
+{
+    tmass__matvec_signed(m, p, out, 1);
 }
 
 /* The anchors' part of a force pass (tmass_set_anchors): per anchor a on node n,
@@ -2982,11 +3182,10 @@ static void tmass__tensor_force(tmass_model *m, const tmass_real *u, const tmass
     if (v && m->stiffness_damping != 0) {
         tmass_real beta = m->stiffness_damping;
         for (i = 0; i < n3; i++) w[i] = u[i] + beta * v[i];
-        tmass__matvec_elastic(m, w, out);
+        tmass__matvec_elastic_neg(m, w, out);
     } else {
-        tmass__matvec_elastic(m, u, out);
+        tmass__matvec_elastic_neg(m, u, out);
     }
-    for (i = 0; i < n3; i++) out[i] = -out[i];
     if (m->anchor_count) tmass__anchor_force(m, u, v, (double)m->stiffness_damping, out);
     m->stats.force_evaluations++;
 }
@@ -3414,8 +3613,7 @@ static double tmass__tensor_differential(tmass_model *m, tmass_real dt, const tm
     int i, n3 = 3 * m->node_count;
     tmass_real *w = m->force_work, beta = m->stiffness_damping;
     for (i = 0; i < n3; i++) w[i] = x0[i] + (beta + dt * m->free_mask[i]) * v0[i];
-    tmass__matvec_elastic(m, w, f);
-    for (i = 0; i < n3; i++) f[i] = -f[i];
+    tmass__matvec_elastic_neg(m, w, f);
     if (m->anchor_count) tmass__anchor_force(m, w, NULL, 0.0, f); /* -k ((rest - t) + w) */
     m->stats.force_evaluations++;
     return (double)dt * dt + (double)dt * m->stiffness_damping;

@@ -1106,6 +1106,135 @@ static void test_threads_bit_identical(void)
     CHECK(h1 != 0);
 }
 
+/* The force pass (issue 21): tmass_forces runs the edge pass negated (d = p_a - p_b, no
+   pass over the nodes to negate K u), with 4-wide vectors in double AVX2 builds (the
+   portable loop too, through m->plain_pass), and, on models large enough to run in
+   parallel, over chunks of bands of the node numbering in two colours. A 6 x 6 x
+   100-cell beam numbered along its length (bands: two colours) and the same beam with
+   its nodes shuffled (no locality: the small chunks and greedy colours), each before
+   and after a cut: the forces equal eq. 6, -(K_ii u_i + sum_j K_ij u_j), summed here in
+   double from the model's tensors in another order, to 8 eps times the sum of the
+   terms' magnitudes (each product and partial sum is rounded once in tmass_real, and
+   the difference form rounds u_b - u_a once more: a few eps of that sum at worst; 1 eps
+   seen in double and float); tmass_forces equals -K u from tmass_apply_stiffness (the
+   plain pass) bit for bit (== : the negated pass forms the exact negative of every
+   rounded product and sum); and, in OpenMP builds, 1 and 2 threads give the same bits. */
+static void force_pass_compare(tmass_model *m, const tmass_real *u, int n)
+{
+    double *ref = (double *)calloc(3 * (size_t)n, sizeof(double)), *scale = (double *)calloc((size_t)n, sizeof(double));
+    tmass_real *ku = alloc_reals(3 * n), T[9];
+    const tmass_real *f;
+    double worst = 0.0;
+    int i, r, c, s, k, same = 1, plain;
+    REQUIRE(ref && scale);
+    for (i = 0; i < n; i++) { /* K_ii u_i */
+        REQUIRE(tmass_vertex_tensor(m, i, T) == TMASS_OK);
+        for (r = 0; r < 3; r++)
+            for (c = 0; c < 3; c++) {
+                ref[3 * i + r] -= (double)T[3 * r + c] * (double)u[3 * i + c];
+                scale[i] += fabs((double)T[3 * r + c] * (double)u[3 * i + c]);
+            }
+    }
+    for (k = 0; k < m->chunk_total; k++) /* K_ab u_b and K_ba u_a = K_ab^T u_a */
+        for (s = m->chunk_start[k]; s < m->chunk_start[k] + m->chunk_live[k]; s++) {
+            int a = m->edge_a[s], b = m->edge_b[s];
+            const tmass_real *K = m->edge_tensor + 9 * s;
+            for (r = 0; r < 3; r++)
+                for (c = 0; c < 3; c++) {
+                    double ab = (double)K[3 * r + c] * (double)u[3 * b + c], ba = (double)K[3 * c + r] * (double)u[3 * a + c];
+                    ref[3 * a + r] -= ab;
+                    ref[3 * b + r] -= ba;
+                    scale[a] += fabs(ab);
+                    scale[b] += fabs(ba);
+                }
+        }
+    for (plain = 0; plain < 2; plain++) { /* the AVX2 loop where compiled in, the portable one */
+        m->plain_pass = plain;
+        f = tmass_forces(m);
+        REQUIRE(tmass_apply_stiffness(m, u, ku) == TMASS_OK);
+        worst = 0.0;
+        same = 1;
+        for (i = 0; i < 3 * n; i++) {
+            double e = fabs((double)f[i] - ref[i]) / (8 * EPS * scale[i / 3] + 1e-300);
+            if (e > worst) worst = e;
+            if (!(f[i] == -ku[i])) same = 0;
+        }
+        printf("    %d nodes, %d chunks, %d colours, %s loop: |f - eq. 6| at most %.3f of its bound, f == -K u: %d\n",
+               n, m->chunk_total, m->colour_count, plain ? "portable" : TMASS__AVX2 ? "AVX2" : "portable", worst,
+               same);
+        CHECK(worst <= 1.0);
+        CHECK(same);
+#ifdef _OPENMP
+        { /* the chunks of a colour on 1 and 2 threads: the same bits */
+            tmass_real *f1 = alloc_reals(3 * n);
+            omp_set_num_threads(1);
+            memcpy(f1, tmass_forces(m), sizeof(tmass_real) * 3 * (size_t)n);
+            omp_set_num_threads(2);
+            CHECK(memcmp(f1, tmass_forces(m), sizeof(tmass_real) * 3 * (size_t)n) == 0);
+            free(f1);
+        }
+#endif
+    }
+    m->plain_pass = 0;
+    free(ref);
+    free(scale);
+    free(ku);
+}
+
+static void test_force_pass_matches_plain(void)
+{
+    int shuffled;
+    for (shuffled = 0; shuffled < 2; shuffled++) {
+        tetmesh mesh;
+        tmass_model *m;
+        tmass_real *x;
+        int i, n, *perm, *list, count = 0;
+        unsigned seed = 2026u;
+        REQUIRE(tetmesh_beam(&mesh, 0.6, 0.6, 10.0, 6, 6, 100, TETMESH_SPLIT6) == TETMESH_OK);
+        n = mesh.node_count;
+        perm = (int *)malloc(sizeof(int) * (size_t)n);
+        list = (int *)malloc(sizeof(int) * (size_t)mesh.tet_count);
+        REQUIRE(perm && list);
+        for (i = 0; i < n; i++) perm[i] = i;
+        if (shuffled) { /* node i becomes perm[i] */
+            double *nodes = (double *)malloc(sizeof(double) * 3 * (size_t)n);
+            REQUIRE(nodes != NULL);
+            for (i = n - 1; i > 0; i--) {
+                int j, t;
+                seed = seed * 1103515245u + 12345u;
+                j = (int)((seed >> 8) % (unsigned)(i + 1));
+                t = perm[i], perm[i] = perm[j], perm[j] = t;
+            }
+            for (i = 0; i < n; i++) memcpy(nodes + 3 * perm[i], mesh.nodes + 3 * i, 3 * sizeof(double));
+            memcpy(mesh.nodes, nodes, sizeof(double) * 3 * (size_t)n);
+            for (i = 0; i < 4 * mesh.tet_count; i++) mesh.tets[i] = perm[mesh.tets[i]];
+            free(nodes);
+        }
+        m = make_model(&mesh, TMASS_TENSOR_MASS, 1e5, 0.3, 1000);
+        REQUIRE(m != NULL);
+        CHECK(tmass_edge_count(m) >= TMASS_PARALLEL_MIN_EDGES);
+        if (shuffled)
+            CHECK(m->chunk_size <= 4096 && m->colour_count > 2); /* kept the small chunks */
+        else
+            CHECK(m->chunk_size > 4096 / 4 && m->colour_count == 2 && m->chunk_total >= 16); /* bands */
+        x = alloc_reals(3 * n);
+        for (i = 0; i < 3 * n; i++) {
+            seed = seed * 1103515245u + 12345u;
+            x[i] = (tmass_real)(mesh.nodes[i] + 1e-3 * ((double)(seed >> 8) / 16777216.0 - 0.5));
+        }
+        REQUIRE(tmass_set_positions(m, x) == TMASS_OK);
+        force_pass_compare(m, tmass_displacements(m), n);
+        for (i = 0; i < mesh.tet_count; i += 5) list[count++] = i; /* a fifth of the tets, all over */
+        REQUIRE(tmass_remove_tets(m, list, count, NULL) == TMASS_OK);
+        force_pass_compare(m, tmass_displacements(m), n);
+        free(x);
+        free(perm);
+        free(list);
+        tmass_destroy(m);
+        tetmesh_free(&mesh);
+    }
+}
+
 /* No allocation during steps, forces, solves, cutting or tearing; everything freed. */
 static void test_no_allocation_after_create(void)
 {
@@ -3054,6 +3183,7 @@ static const test_case cases[] = {
     TEST(test_rotation_ghost_forces),
     TEST(test_tearing),
     TEST(test_threads_bit_identical),
+    TEST(test_force_pass_matches_plain),
     TEST(test_no_allocation_after_create),
     TEST(test_validation_errors),
     TEST(test_error_strings),
