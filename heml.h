@@ -153,8 +153,7 @@
    default; PERFORMANCE) holds 17 reals per tetrahedron slot (136 bytes in double, 68 in
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
-   incompressible Mooney-Rivlin with c2 = 0; no Prony series; with or without the nodal
-   pressure), none
+   incompressible Mooney-Rivlin with c2 = 0; no Prony series, no nodal pressure), none
    otherwise; desc.stiffness_cache = 0 leaves it out (each product then recomputes them:
    see PERFORMANCE for the cost).
 
@@ -359,12 +358,9 @@
        fast-path flag (heml__mat.fast_nodal: Neo-Hookean, its incompressible form,
        incompressible Mooney-Rivlin with c2 = 0; no Prony) runs the vectorised Neo-Hookean
        kernel with w_J - U'(J_e) = -2 c1 J^(-1/3) in closed form and the nodes' mean
-       pressure gathered into it (heml__nh_nodal_s0), its node pass U', U'' in closed
-       form (heml__dilation_nh), and its differential the Neo-Hookean product
-       (heml__diff_nh_point, heml__diff_nh_apply: w_J as the force's, w_JJ = (2/3) c1
-       J^(-4/3), plus dp_e / 6 times the cofactor links) with the stiffness cache (17 reals
-       a tetrahedron, desc.stiffness_cache); its energy, and every other law, the general
-       path. Prony: the nodal pressure enters w_J
+       pressure gathered into it (heml__nh_nodal_s0), and its node pass U', U'' in closed
+       form (heml__dilation_nh); its energy and differential, and every other law, the
+       general path. Prony: the nodal pressure enters w_J
        before the filter, so it relaxes with the rest of the stress. Inversion: the
        continued U is restoring below J0 at the nodes; a single tetrahedron's own
        resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
@@ -450,10 +446,8 @@
        of six: 2,592 tetrahedra, 676 nodes, Neo-Hookean, 100 heml_compute_forces or
        heml_apply_stiffness less the creation; instructions per tetrahedron and pass):
        force 256 against 158 for the plain force (1.62 times; nodal_pressure = 2: 248,
-       1.57), differential (cached) 306 against the plain cached product's 136 (297 for
-       nodal_pressure = 2: gathers of u and dx and the sums' arithmetic and two scalar
-       scatters in the sums pass about 140, the product with the gather of the four dP_a
-       about 155). Where the force's go: the element pass 81 (the plain kernel's
+       1.57), differential 590 against the plain cached product's 134 (581 for
+       nodal_pressure = 2). Where the force's go: the element pass 81 (the plain kernel's
        70 plus the cube root and the gather of the four pressures) + gather 24 + scatter 47;
        the sums pass 24 (its gather) + 26 (H and J - 1 again) + 20 (the scalar scatter to
        the four nodes); the node pass 14. What bounds it above 1.3: the sums pass, 70
@@ -468,17 +462,13 @@
        18.5 and 17.3 (2.48 and 2.32); the bench (build/bench/bench --quick --parts kernels
        --filter heml/neo-hookean --repeats 5, same machine, best of 4 runs): force 19.2 and
        17.2 ns against 11.3 in double (1.70, 1.52), 13.6 and 13.6 against 8.6 in float
-       (1.57). The product (heml_apply_stiffness at one point, cached; same timing set-up,
-       double): 21.9 ns against the plain 8.9 (nodal_pressure = 2: 21.0), before 48.4 and
-       46.5. Before (the general path: heml__kinematics, the law,
+       (1.57). Before (the general path: heml__kinematics, the law,
        heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
        the sums in a loop with a branch that did not vectorise): force 500 (476),
        differential 730 (705). Not done: keeping H from the sums pass for the element
        pass (9 reals per tetrahedron more, stored and read back; would save the second
-       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it); for
-       the cached differential, the sums pass's dJ from the cache's links (Vol dJ / 4 =
-       cof v : dv / 24) and no J sums or U' again at an unchanged point (about 100 of its
-       306; needs the nodal arrays keyed like the cache).
+       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it); the
+       differential's own fast path (its element pass is the general heml__diff_general).
 
    PRESSURE AGGREGATES (desc.nodal_pressure = 2; issue 13's stabilised pressure): the
        energy of NEAR-INCOMPRESSIBLE BODIES with the volume held per aggregate of nodes
@@ -515,7 +505,7 @@
        and the pressures go back to the nodes in node order on the calling thread. Memory:
        one int per node and 5 + M reals per aggregate (M materials). Cost per pass: force
        248 instructions per tetrahedron against 256 for nodal_pressure = 1, differential
-       297 against 306 (the callgrind set-up of NEAR-INCOMPRESSIBLE BODIES; the node pass
+       581 against 590 (the callgrind set-up of NEAR-INCOMPRESSIBLE BODIES; the node pass
        runs on the aggregates; the fold and the broadcast are two loops over the nodes).
        Measured (tests/test_heml_solve.c test_nodal_pressure_aggregates_cook; Cook's
        membrane R10, nu = 0.4999, corner u_y in mm at N = 4, 8, 16, 32; converged about 6.9):
@@ -1012,9 +1002,7 @@
    test_stiffness_cache, and so are implicit steps with and without it); the cache is keyed
    by the linearisation point and invalidated at every linear solve's start and end and by
    every public function that changes the state, the pins, J0 or the viscous state (Prony
-   models do not take the Neo-Hookean kernels and have no cache; with the nodal pressure
-   the cache holds the element's part at the point, its w_J with the nodes' mean pressure,
-   and each product gathers the nodes' dP_a afresh; caching
+   and nodal pressure models do not take the Neo-Hookean kernels and have no cache; caching
    the general path would need about 40 reals per tetrahedron, more than a CSR row share in
    float: not done). The cached pass prefetches the next block's cache and indices
    (__builtin_prefetch where the compiler has it): the prefetch alone took the cached
@@ -1497,8 +1485,7 @@ typedef struct heml_desc {
                                         pressure checkerboard (PRESSURE AGGREGATES) */
     int stiffness_cache;             /* 1 (default): the Neo-Hookean stiffness product caches per
                                         tetrahedron what its linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 17 reals a tetrahedron; with nodal_pressure too);
-                                        0: no cache, no memory */
+                                        MEMORY: 17 reals a tetrahedron); 0: no cache, no memory */
 
     /* dynamics */
     heml_real mass_damping;          /* 1/s: damping force -mass_damping m v, default 0 */
@@ -1938,10 +1925,9 @@ typedef struct heml__mat {
     int kind, uses_i2;
     int fast;                    /* its law's fast_path flag, and no I2 term, and no Prony: the
                                     vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
-    int fast_nodal;              /* fast, with desc.nodal_pressure (fast is then 0): the
-                                    Neo-Hookean force and differential kernels with the nodal
-                                    pressure, the node pass's heml__dilation_nh; the energy
-                                    takes the general path (NEAR-INCOMPRESSIBLE BODIES) */
+    int fast_nodal;              /* fast, with desc.nodal_pressure (fast is then 0): the force
+                                    kernel heml__forces_nh with the nodal pressure, and the node
+                                    pass's heml__dilation_nh (NEAR-INCOMPRESSIBLE BODIES) */
     heml_law law;
     const struct heml__law_ops *ops; /* its law's row of heml__laws */
     heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
@@ -3276,11 +3262,9 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
    product is bit-identical to the uncached one. */
 static void heml__diff_nh_point(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
                                 const heml_real (*HEML__RESTRICT V)[HEML__W], const heml__blk *HEML__RESTRICT b,
-                                const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
                                 heml_real *HEML__RESTRICT C)
 {
     const heml_real p0 = mt->p0, kappa = mt->kappa;
-    heml_real jv[HEML__W];
     int k, r;
     for (r = 0; r < 9; r++) /* v = V + du */
         for (k = 0; k < HEML__W; k++) C[r * HEML__W + k] = V[r][k] + b->e[r][k];
@@ -3313,27 +3297,14 @@ static void heml__diff_nh_point(const heml__mat *mt, heml_real jm1_0, const heml
         heml_real jc1 = heml__max(J - 1, jm1_0), Jc = 1 + jc1, d = (J - 1) - jc1, iJ = 1 / Jc;
         heml_real L = heml__log(Jc);
         heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
-        jv[k] = J - 1;
         C[15 * HEML__W + k] = vol > 0 ? hh / (36 * vol) : 0; /* (padding lanes: 0) */
         C[16 * HEML__W + k] = ((kappa * L - p0) * iJ + hh * d) * (heml_real)(1.0 / 6.0);
-    }
-    if (np) { /* the nodal pressure (heml__nh_nodal_s0): w_J = -2 c1 r + (2/3) c1 r^4 d + p_e, w_JJ = (2/3) c1 r^4 */
-        const heml_real c1 = mt->c1, lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18;
-        for (k = 0; k < HEML__W; k++) {
-            heml_real jc1 = heml__max(jv[k], jm1_0), Jc = 1 + jc1, d = jv[k] - jc1, vol = R[9 * HEML__W + k];
-            heml_real rr = Jc < lo || Jc > hi ? (heml_real)(1 / cbrt((double)Jc)) : heml__inv_cbrt(Jc);
-            heml_real r4 = (rr * rr) * (rr * rr), h2 = (heml_real)(2.0 / 3.0) * c1 * r4;
-            heml_real pe = ((np[idx[k]] + np[idx[HEML__W + k]]) + (np[idx[2 * HEML__W + k]] + np[idx[3 * HEML__W + k]])) / 4;
-            C[15 * HEML__W + k] = vol > 0 ? h2 / (36 * vol) : 0;
-            C[16 * HEML__W + k] = (-2 * c1 * rr + h2 * d + pe) * (heml_real)(1.0 / 6.0);
-        }
     }
 }
 
 /* The product of the point values C (heml__diff_nh_point) with the links dv of dx in
    b->de, into b->f (nodes 1..3). */
-HEML__INLINE void heml__diff_nh_lanes(const heml__mat *mt, const heml_real *HEML__RESTRICT C,
-                                     const heml_real *HEML__RESTRICT dq, heml__blk *HEML__RESTRICT b, const int with_dq)
+static void heml__diff_nh_apply(const heml__mat *mt, const heml_real *HEML__RESTRICT C, heml__blk *HEML__RESTRICT b)
 {
     const heml_real mu = 2 * mt->c1;
     int k;
@@ -3360,7 +3331,6 @@ HEML__INLINE void heml__diff_nh_lanes(const heml__mat *mt, const heml_real *HEML
         heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
         heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
         heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
-        if (with_dq) t += dq[k];
         b->f[0][k] = -((x0 * A11 + y0 * A12 + z0 * A13) + t * c10 + s2 * e10);
         b->f[1][k] = -((x1 * A11 + y1 * A12 + z1 * A13) + t * c11 + s2 * e11);
         b->f[2][k] = -((x2 * A11 + y2 * A12 + z2 * A13) + t * c12 + s2 * e12);
@@ -3373,35 +3343,14 @@ HEML__INLINE void heml__diff_nh_lanes(const heml__mat *mt, const heml_real *HEML
     }
 }
 
-/* With ndp (the nodes' dP_a, heml__mat.fast_nodal; idx the block's nodes), t gains the
-   nodal pressure's dp_e / 6 (-Vol dp_e cof F grad N_k = -(dp_e / 6) c_k, as cof F G^T =
-   cof v / (6 Vol)); the plain product is compiled without it. */
-static void heml__diff_nh_apply(const heml__mat *mt, const heml_real *HEML__RESTRICT C,
-                                const heml_real *HEML__RESTRICT ndp, const int *HEML__RESTRICT idx,
-                                heml__blk *HEML__RESTRICT b)
-{
-    heml_real dq[HEML__W];
-    int k;
-    if (!ndp) {
-        heml__diff_nh_lanes(mt, C, NULL, b, 0);
-        return;
-    }
-    for (k = 0; k < HEML__W; k++)
-        dq[k] = ((ndp[idx[k]] + ndp[idx[HEML__W + k]]) + (ndp[idx[2 * HEML__W + k]] + ndp[idx[3 * HEML__W + k]])) *
-                (heml_real)(1.0 / 24.0);
-    heml__diff_nh_lanes(mt, C, dq, b, 1);
-}
-
 /* The uncached differential of block blk (links of u in b->e, of dx in b->de): point
    values into the workspace (the rest links gathered into b->H), then the product. */
 static void heml__diff_nh(const heml_model *m, const heml__mat *mt, int blk, heml__blk *b)
 {
     const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml__gather(m, m->blk_idx + (size_t)blk * 4 * HEML__W, m->rest, b->H);
-    const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
-    heml__diff_nh_point(mt, m->jm1_0, R, (const heml_real(*)[HEML__W])b->H, b, mt->fast_nodal ? m->nod_p : NULL, idx,
-                        b->lin[0]);
-    heml__diff_nh_apply(mt, b->lin[0], mt->fast_nodal ? m->nod_dp : NULL, idx, b);
+    heml__diff_nh_point(mt, m->jm1_0, R, (const heml_real(*)[HEML__W])b->H, b, b->lin[0]);
+    heml__diff_nh_apply(mt, b->lin[0], b);
 }
 
 /* The average nodal pressure's share of a block whose law was just evaluated (NEAR-
@@ -3590,7 +3539,7 @@ static void heml__block_diff(const heml_model *m, const heml__mat *mt, int blk, 
     int k;
     heml__gather(m, idx, u, b->e);
     heml__gather(m, idx, dx, b->de);
-    if (mt->fast || mt->fast_nodal) { /* (the law's fast_path flag: heml__laws) */
+    if (mt->fast) { /* (the law's fast_path flag: heml__laws) */
         heml__diff_nh(m, mt, blk, b);
         return;
     }
@@ -3843,7 +3792,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
-                if (m->dc_pass && (mt->fast || mt->fast_nodal)) { /* the stiffness cache: fill it, or read it */
+                if (m->dc_pass && mt->fast) { /* the stiffness cache: fill it, or read it */
                     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
                     heml_real *C = m->dc + (size_t)blk * HEML__NC * HEML__W;
                     if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
@@ -3851,11 +3800,10 @@ static void heml__chunks(void *vctx, int begin, int end)
                     if (m->dc_pass == HEML__DC_FILL) {
                         heml__gather(m, idx, p->x, b.e);
                         heml__gather(m, idx, m->rest, b.H);
-                        heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b,
-                                            mt->fast_nodal ? m->nod_p : NULL, idx, C);
+                        heml__diff_nh_point(mt, jm1_0, R, (const heml_real(*)[HEML__W])b.H, &b, C);
                     }
                     heml__gather(m, idx, p->dx, b.de);
-                    heml__diff_nh_apply(mt, C, mt->fast_nodal ? m->nod_dp : NULL, idx, &b);
+                    heml__diff_nh_apply(mt, C, &b);
                 } else
                     heml__block_diff(m, mt, blk, p->x, p->dx, &b);
                 heml__scatter(m, idx, b.f, p->out);
@@ -5334,7 +5282,7 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
     }
     tmp->slot_count = tmp->block_count * HEML__W;
     tmp->nodal = d->nodal_pressure;
-    for (i = 0; i < M && d->stiffness_cache; i++) { /* a fast-path material in use (fast_nodal too) */
+    for (i = 0; i < M && d->stiffness_cache && !tmp->nodal; i++) { /* a fast-path material in use */
         heml__mat mt;
         heml__make_mat(src + i, &mt);
         if (mt.fast && w->counts[i] > 0) tmp->has_dc = 1;
@@ -5411,7 +5359,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
-        if (m->nodal) { /* the Neo-Hookean kernels' nodal variants (and the general path's energy) */
+        if (m->nodal) { /* the general path carries the nodal pressure, but for the force */
             mt->fast_nodal = mt->fast;
             mt->fast = 0;
         }
@@ -6806,7 +6754,7 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
     {   /* the differential: cached blocks read the cache and dx, not u */
         size_t cached = 0, slots_all = (size_t)m->slot_count;
         for (i = 0; i < m->chunk_count && kernel == 1 && m->has_dc; i++)
-            if (m->mats[m->chunk_material[i]].fast || m->mats[m->chunk_material[i]].fast_nodal) cached += (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
+            if (m->mats[m->chunk_material[i]].fast) cached += (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
         stream += cached * (HEML__NC - HEML__NR) * R; /* (the cache instead of the rest constants) */
         *read = stream + prony + nodes * (kernel == 1 ? (cached == slots_all ? 1 : 2) : 1);
     }
