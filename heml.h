@@ -467,8 +467,19 @@
        the sums in a loop with a branch that did not vectorise): force 500 (476),
        differential 730 (705). Not done: keeping H from the sums pass for the element
        pass (9 reals per tetrahedron more, stored and read back; would save the second
-       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it); the
-       differential's own fast path (its element pass is the general heml__diff_general).
+       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it). Tried
+       and reverted (branch anpcost, commit 9d4b379): the differential on the Neo-Hookean
+       product with the stiffness cache (w_J as the force's, w_JJ = (2/3) c1 J^(-4/3), dp_e
+       / 6 times the cofactor links): exact (against the general path 1.5e-15 in double,
+       1.6e-6 in float; the finite-difference tests pass; cached and uncached bit for bit),
+       590 -> 306 instructions, 48.4 -> 21.9 ns on the timing above; but in float
+       tests/test_heml_solve.c test_nodal_pressure_squash_release (nodal_pressure = 2,
+       implicit steps from J = -0.2) then fails its first step (HEML_ERR_NO_CONVERGENCE,
+       every Newton iteration meeting negative curvature). That step sits at a round-off
+       edge: on a 2 x 2 x 2 tetmesh_box cube of five tetrahedra this code, the code before
+       this fast path (git f3bae68) and the general path (the same law with a zero Prony
+       term) fail it in float too, the last in double as well; the Newton solve from that
+       state, not the product, needs the work.
 
    PRESSURE AGGREGATES (desc.nodal_pressure = 2; issue 13's stabilised pressure): the
        energy of NEAR-INCOMPRESSIBLE BODIES with the volume held per aggregate of nodes
