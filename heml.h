@@ -365,8 +365,13 @@
        usual pass then gathers the four P_a (and dP_a) and evaluates the element's U at
        J_e besides the law. U', U'' are formed from the law's s0 and second derivatives at
        the dilation point: U' = s0 - 2 w_1 (s - 1) / s + 4 w_2 (s - 1), s = J^(1/3), s - 1 =
-       (J - 1) / (s^2 + s + 1), without cancellation at rest. It runs the general path
-       (not the vectorised Neo-Hookean kernels). Prony: the nodal pressure enters w_J
+       (J - 1) / (s^2 + s + 1), without cancellation at rest. The force of a law with the
+       fast-path flag (heml__mat.fast_nodal: Neo-Hookean, its incompressible form,
+       incompressible Mooney-Rivlin with c2 = 0; no Prony) runs the vectorised Neo-Hookean
+       kernel with w_J - U'(J_e) = -2 c1 J^(-1/3) in closed form and the nodes' mean
+       pressure gathered into it (heml__nh_nodal_s0), and its node pass U', U'' in closed
+       form (heml__dilation_nh); its energy and differential, and every other law, the
+       general path. Prony: the nodal pressure enters w_J
        before the filter, so it relaxes with the rest of the stress. Inversion: the
        continued U is restoring below J0 at the nodes; a single tetrahedron's own
        resistance to inversion is that of w - U (about mu), the neighbours' nodes carry
@@ -450,13 +455,44 @@
        N = 6 and 9 agree within half a point, +1.7, +1.3, +1.3 %). So the issue's 2-point
        target on the bench's beam (3 cells across: 8.1 points at 0.49, 11.5 at 0.499) is
        not met, and would be from about 15 cells across.
-       Cost (callgrind, 2,592 tetrahedra, Neo-Hookean, gcc -O3 -mavx2 -mfma, instructions
-       per tetrahedron and pass): force 643 against 229 on the vectorised kernel (284 on
-       the general path it runs instead), differential 979 against 310 (431): the sums
-       pass (a second gather) about 130, the element's U with its cube root (Halley, 4
-       steps, vectorised; libm's cbrt made it twice as slow) about 100, the node pass
-       about 25. The issue's target, 1.3 times the plain force, would need a fused
-       Neo-Hookean kernel for it; not done.
+       Cost (callgrind --dump-instr=no, gcc 12 -O3 -mavx2 -mfma, double, a 12 x 12 x 3 box
+       of six: 2,592 tetrahedra, 676 nodes, Neo-Hookean, 100 heml_compute_forces or
+       heml_apply_stiffness less the creation; instructions per tetrahedron and pass):
+       force 256 against 158 for the plain force (1.62 times; nodal_pressure = 2: 248,
+       1.57), differential 590 against the plain cached product's 134 (581 for
+       nodal_pressure = 2). Where the force's go: the element pass 81 (the plain kernel's
+       70 plus the cube root and the gather of the four pressures) + gather 24 + scatter 47;
+       the sums pass 24 (its gather) + 26 (H and J - 1 again) + 20 (the scalar scatter to
+       the four nodes); the node pass 14. What bounds it above 1.3: the sums pass, 70
+       instructions, 0.44 of the plain force alone: the nodal pressure needs every
+       tetrahedron's J before any element's force, so the displacements are gathered and
+       H formed twice; the issue's "one more scalar gather and scatter" leaves that out.
+       Timed (Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs at load 7; gcc -O3
+       -march=native -ffp-contract=fast, 1,080 tetrahedra, one thread, min of 240 rounds
+       of 200 forces, interleaved with the previous code): double 17.2 ns per tetrahedron
+       against the plain 10.0 (1.71 times; nodal_pressure = 2: 15.9, 1.58), before 29.5
+       and 27.0 (2.95 and 2.70 times); float 12.5 against 7.6 (1.64; 12.0, 1.57), before
+       18.5 and 17.3 (2.48 and 2.32); the bench (build/bench/bench --quick --parts kernels
+       --filter heml/neo-hookean --repeats 5, same machine, best of 4 runs): force 19.2 and
+       17.2 ns against 11.3 in double (1.70, 1.52), 13.6 and 13.6 against 8.6 in float
+       (1.57). Before (the general path: heml__kinematics, the law,
+       heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
+       the sums in a loop with a branch that did not vectorise): force 500 (476),
+       differential 730 (705). Not done: keeping H from the sums pass for the element
+       pass (9 reals per tetrahedron more, stored and read back; would save the second
+       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it). Tried
+       and reverted (branch anpcost, commit 9d4b379): the differential on the Neo-Hookean
+       product with the stiffness cache (w_J as the force's, w_JJ = (2/3) c1 J^(-4/3), dp_e
+       / 6 times the cofactor links): exact (against the general path 1.5e-15 in double,
+       1.6e-6 in float; the finite-difference tests pass; cached and uncached bit for bit),
+       590 -> 306 instructions, 48.4 -> 21.9 ns on the timing above; but in float
+       tests/test_heml_solve.c test_nodal_pressure_squash_release (nodal_pressure = 2,
+       implicit steps from J = -0.2) then fails its first step (HEML_ERR_NO_CONVERGENCE,
+       every Newton iteration meeting negative curvature). That step sits at a round-off
+       edge: on a 2 x 2 x 2 tetmesh_box cube of five tetrahedra this code, the code before
+       this fast path (git f3bae68) and the general path (the same law with a zero Prony
+       term) fail it in float too, the last in double as well; the Newton solve from that
+       state, not the product, needs the work.
 
    PRESSURE AGGREGATES (desc.nodal_pressure = 2; issue 13's stabilised pressure): the
        energy of NEAR-INCOMPRESSIBLE BODIES with the volume held per aggregate of nodes
@@ -491,11 +527,10 @@
        every J_A = J). Inversion, Prony, the integrators, float: as nodal_pressure = 1 (the
        same node pass, on the aggregates). Deterministic: the sums fold into the aggregates
        and the pressures go back to the nodes in node order on the calling thread. Memory:
-       one int per node and 5 + M reals per aggregate (M materials). Cost per pass (callgrind,
-       2,592 tetrahedra, Neo-Hookean, gcc 12 -O3 -mavx2 -mfma, instructions per tetrahedron,
-       this code): force 540 against 567 for nodal_pressure = 1, differential 831 against
-       859 (the node pass runs on the aggregates; the fold and the broadcast are two loops
-       over the nodes).
+       one int per node and 5 + M reals per aggregate (M materials). Cost per pass: force
+       248 instructions per tetrahedron against 256 for nodal_pressure = 1, differential
+       581 against 590 (the callgrind set-up of NEAR-INCOMPRESSIBLE BODIES; the node pass
+       runs on the aggregates; the fold and the broadcast are two loops over the nodes).
        Measured (tests/test_heml_solve.c test_nodal_pressure_aggregates_cook; Cook's
        membrane R10, nu = 0.4999, corner u_y in mm at N = 4, 8, 16, 32; converged about 6.9):
            six tetrahedra per cell    4.90 6.34 6.66 6.91   (nodal_pressure = 1: 2.65 4.38 5.99 6.61)
@@ -2053,6 +2088,9 @@ typedef struct heml__mat {
                                     vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
     int dk;                      /* its differential kernel (HEML__DK_*, cached in the stiffness
                                     cache), 0: the general path (Prony, nodal pressure, other laws) */
+    int fast_nodal;              /* fast, with desc.nodal_pressure (fast is then 0): the force
+                                    kernel heml__forces_nh with the nodal pressure, and the node
+                                    pass's heml__dilation_nh (NEAR-INCOMPRESSIBLE BODIES) */
     heml_law law;
     const struct heml__law_ops *ops; /* its law's row of heml__laws */
     heml_real c1, c2, p0, kappa; /* heml__law_raw, heml__law_split (c1, c2, kappa) */
@@ -2746,6 +2784,39 @@ static void heml__dilation(const heml__mat *mt, heml_real jm1_0, const heml_real
     }
 }
 
+/* heml__dilation for a heml__mat.fast_nodal law (w = c1 (I1 - 3) + V(J), c2 = 0, p0 =
+   2 c1) without the energy, in closed form: U(J) = 3 c1 (J^(2/3) - 1) + V(J), so with
+   r = Jc^(-1/3) and the law's s0 = V'(Jc) + p0, V'' (heml__law_raw)
+       U'  = s0 - 2 c1 (1 - r) + U'' d,   U'' = V''(Jc) - (2/3) c1 r^4,
+   1 - r = (Jc - 1) / (Jc (1 + r + r^2)) as in heml__nh_nodal_s0: the same values as
+   heml__dilation's to round-off, without its Halley root and its law evaluation. */
+static void heml__dilation_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *jm1, heml_real *U1,
+                              heml_real *U2)
+{
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real Jc = 1 + heml__max(jm1[k], jm1_0);
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real Jc = 1 + heml__max(jm1[k], jm1_0);
+            if (Jc < lo || Jc > hi) rc[k] = (heml_real)(1 / cbrt((double)Jc));
+        }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real j = jm1[k], jc1 = heml__max(j, jm1_0), Jc = 1 + jc1, d = j - jc1, iJ = 1 / Jc, r = rc[k];
+        heml_real r2 = r * r, L = heml__log_jc(Jc, jc1, iJ);
+        heml_real u2 = (kappa * (1 - L) + p0) * iJ * iJ - mu / 3 * (r2 * r2);
+        heml_real u1 = (kappa * L + p0 * jc1) * iJ - mu * jc1 * iJ / (1 + r + r2);
+        U1[k] = u1 + u2 * d;
+        U2[k] = u2;
+    }
+}
+
 /* >>forces ---------------------------------------------------------------------------- */
 
 /* Links du_1, du_2, du_3 of the block's lanes from a 3n field (displacements or dx). */
@@ -3234,6 +3305,45 @@ static void heml__p_times_grad(const heml_real *HEML__RESTRICT R, heml__blk *HEM
     }
 }
 
+/* The Neo-Hookean force's volumetric scalar with the nodal pressure (heml__mat.fast_nodal,
+   NEAR-INCOMPRESSIBLE BODIES), from b->jm1 into b->s0: what heml__law_raw and
+   heml__nodal_element give together, in closed form. For w = c1 (I1 - 3) + V(J) (c2 = 0,
+   p0 = 2 c1) the dilation energy is U(J) = 3 c1 (J^(2/3) - 1) + V(J), so w_J - U'(J) =
+   -2 c1 r with r = Jc^(-1/3): V cancels exactly (below J0 both are the same quadratic
+   continuation, leaving -(2 c1 r)' d = (2/3) c1 r^4 d), and with the nodes' mean pressure
+   p_e = (P_a + P_b + P_c + P_d) / 4
+       w_J = -2 c1 r + (2/3) c1 r^4 d + p_e,   s0 = 2 c1 + w_J = 2 c1 (1 - r) + (2/3) c1 r^4 d + p_e,
+   1 - r = (Jc - 1) / (Jc (1 + r + r^2)) formed without cancellation (r^3 = 1 / Jc). The
+   stress stage of heml__forces_nh is then unchanged (w_J = s0 - p0, p0 = 2 c1). r by
+   heml__inv_cbrt (libm outside [2^-60, 2^60], as heml__law_split); the general path
+   (heml__dilation's Halley root, the law's logarithm twice, cancelling) gives the same
+   forces to round-off (tests/test_heml.c test_nodal_pressure_fast_force). */
+static void heml__nh_nodal_s0(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT np,
+                              const int *HEML__RESTRICT idx, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real mu = 2 * mt->c1, mu3 = mu / 3;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W], pe[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real Jc = 1 + heml__max(b->jm1[k], jm1_0);
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside)
+        for (k = 0; k < HEML__W; k++) {
+            heml_real Jc = 1 + heml__max(b->jm1[k], jm1_0);
+            if (Jc < lo || Jc > hi) rc[k] = (heml_real)(1 / cbrt((double)Jc));
+        }
+    for (k = 0; k < HEML__W; k++) /* (the one more scalar gather) */
+        pe[k] = ((np[idx[k]] + np[idx[HEML__W + k]]) + (np[idx[2 * HEML__W + k]] + np[idx[3 * HEML__W + k]])) / 4;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real jm1 = b->jm1[k], jc1 = heml__max(jm1, jm1_0), Jc = 1 + jc1, d = jm1 - jc1, r = rc[k];
+        heml_real r2 = r * r;
+        b->s0[k] = mu * jc1 / (Jc * (1 + r + r2)) + mu3 * (r2 * r2) * d + pe[k];
+    }
+}
+
 /* The Neo-Hookean kernel (heml__law_raw without I2 and without Prony: heml__mat.fast), in stages that are each a
    short loop over the lanes: H and J - 1; the volumetric scalars (w_J = U'(J), continued
    below J0, s0 = p0 + w_J); the stress
@@ -3243,8 +3353,11 @@ static void heml__p_times_grad(const heml_real *HEML__RESTRICT R, heml__blk *HEM
    Short loops let the processor overlap the lanes' long dependency chains (the logarithm
    and two divisions): measured 11 against 14 ns per tetrahedron for one loop up to the
    stress and one for the product (12,000 tetrahedra, arithmetic alone); one loop for all
-   of it spills the 16 AVX2 registers and was slower still. */
+   of it spills the 16 AVX2 registers and was slower still. With np (the nodal pressures
+   P_a, heml__mat.fast_nodal; idx the block's nodes) the volumetric stage is
+   heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). */
 static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                            const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
                             heml__blk *HEML__RESTRICT b)
 {
     const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
@@ -3274,14 +3387,17 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         b->H[8][k] = H22;
         b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
     }
-    for (k = 0; k < HEML__W; k++) {
-        heml_real jm1 = b->jm1[k];
-        heml_real jc1 = heml__max(jm1, jm1_0), Jc = 1 + jc1, d = jm1 - jc1, iJ = 1 / Jc;
-        heml_real L = heml__log_jc(Jc, jc1, iJ);
-        heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
-        heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
-        b->s0[k] = s0;
-    }
+    if (np) /* the nodal pressure (NEAR-INCOMPRESSIBLE BODIES): heml__nh_nodal_s0 */
+        heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
+    else
+        for (k = 0; k < HEML__W; k++) {
+            heml_real jm1 = b->jm1[k];
+            heml_real jc1 = heml__max(jm1, jm1_0), Jc = 1 + jc1, d = jm1 - jc1, iJ = 1 / Jc;
+            heml_real L = heml__log_jc(Jc, jc1, iJ);
+            heml_real hh = (kappa * (1 - L) + p0) * iJ * iJ;
+            heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
+            b->s0[k] = s0;
+        }
     for (k = 0; k < HEML__W; k++) {
         heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
         heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
@@ -3769,7 +3885,11 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
-        heml__forces_nh(mt, m->jm1_0, R, b);
+        heml__forces_nh(mt, m->jm1_0, R, NULL, idx, b);
+        return 0.0;
+    }
+    if (mt->fast_nodal && !want_energy) {
+        heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b);
         return 0.0;
     }
     heml__block_stress(m, mt, blk, b, want_energy ? HEML__WANT_ENERGY : 0, prony_write);
@@ -3988,6 +4108,27 @@ static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__bl
 static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b, int with_d)
 {
     int k;
+    if (!with_d) { /* (a loop of its own, without the branch: it vectorises) */
+        for (k = 0; k < HEML__W; k++) {
+            heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+            heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+            heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+            heml_real q = R[9 * HEML__W + k] / 4;
+            heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+            heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+            heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+            heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+            heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+            heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+            heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+            heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+            heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+            heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+            heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+            b->jm1[k] = q * (tr + i2 + det);
+        }
+        return;
+    }
     for (k = 0; k < HEML__W; k++) {
         heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
         heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
@@ -4241,7 +4382,8 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
                 int any = 0;
                 for (k = 0; k < valid; k++) any |= w[k] != 0;
                 if (!any) continue;
-                heml__dilation(mt, m->jm1_0, jm1, valid, want, &s, U, U1, U2);
+                if (mt->fast_nodal && !cx->energy) heml__dilation_nh(mt, m->jm1_0, jm1, U1, U2);
+                else heml__dilation(mt, m->jm1_0, jm1, valid, want, &s, U, U1, U2);
                 for (k = 0; k < valid; k++) {
                     P[k] += w[k] * U1[k];
                     Q[k] += w[k] * U2[k];
@@ -5944,7 +6086,10 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
             m->prony_alpha[t] = src[i].prony[k].alpha;
             m->prony_tau[t] = src[i].prony[k].tau;
         }
-        if (m->nodal) mt->fast = mt->dk = 0; /* the general path carries the nodal pressure */
+        if (m->nodal) { /* the general path carries the nodal pressure, but for the force */
+            mt->fast_nodal = mt->fast;
+            mt->fast = mt->dk = 0;
+        }
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
         if (mt->small_lambda + mt->small_mu < 0) mt->small_lambda = -mt->small_mu;

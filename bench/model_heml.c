@@ -315,7 +315,9 @@ static void hm_csr_product(const hm_sim *s, const heml_real *x, heml_real *y)
 /* The arithmetic floor: the force pass's blocks, colours and groups with the law's
    arithmetic and the rest-constant stream (prefetched a block ahead, as the force pass
    does), but no gather or scatter (every block computes
-   on the links gathered once for block 0; the forces are summed into a sink). */
+   on the links gathered once for block 0; the forces are summed into a sink). With the
+   nodal pressure, its element pass alone (heml__forces_nh with the pressures last
+   computed, or the general path), without its sums pass and node pass. */
 static volatile double hm_sink;
 static int hm_arith(hm_sim *s)
 {
@@ -332,7 +334,8 @@ static int hm_arith(hm_sim *s)
             size_t o;
             for (o = 0; blk + 1 < m->chunk_end[ci] && o < HEML__NR * HEML__W * sizeof(heml_real); o += 64)
                 __builtin_prefetch((const char *)(R + HEML__NR * HEML__W) + o); /* (the force pass's prefetch) */
-            if (mt->fast) heml__forces_nh(mt, m->jm1_0, R, b);
+            if (mt->fast || mt->fast_nodal) /* (nodal: the element pass alone, at the pressures last computed) */
+                heml__forces_nh(mt, m->jm1_0, R, mt->fast_nodal ? m->nod_p : NULL, m->blk_idx + (size_t)blk * 4 * HEML__W, b);
             else {
                 heml__block_stress(m, mt, blk, b, 0, 0);
                 heml__pk1_forces(R, b);

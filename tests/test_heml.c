@@ -1638,6 +1638,69 @@ static void test_nodal_pressure_gradient_and_differential(void)
     g_nodal = 0;
 }
 
+/* The Neo-Hookean force kernel with the nodal pressure (heml__mat.fast_nodal: the
+   closed-form volumetric scalar heml__nh_nodal_s0 in heml__forces_nh, and the node pass's
+   heml__dilation_nh) against the general path (heml__dilation's Halley root, the law, U
+   taken off and the nodal pressure put on in heml__nodal_element): the same material with
+   one Prony term of alpha = 0 (the relaxation factor is then exactly 1 and the state 0,
+   so the same energy) runs the general path for both passes. Every law the fast path
+   covers (Neo-Hookean, its incompressible form, incompressible Mooney-Rivlin with c2 = 0),
+   nodal_pressure = 1 and 2, a moderate state and one with tetrahedra and nodes below J0.
+   The two differ by round-off: the general path cancels the law's volumetric terms
+   (kappa-sized) against U's: measured at most 1.7e-15 (double) and 2.1e-6 (float) of the
+   largest force, checked at 1e-12 and 1e-5; a wrong coefficient is off by far more (the
+   continuation's 2/3 as 1/2: 0.06 to 0.23 below J0; the node pass's 1 + r + r^2 as
+   1 + 2 r: 4e-5 to 2e-3, in double). */
+static void test_nodal_pressure_fast_force(void)
+{
+    static const heml_law laws[3] = {HEML_NEO_HOOKEAN, HEML_NEO_HOOKEAN_INCOMPRESSIBLE,
+                                     HEML_MOONEY_RIVLIN_INCOMPRESSIBLE};
+    heml_prony_term zero = {0, 0.5};
+    tetmesh mesh;
+    int li, state;
+    box_mesh(&mesh, 3, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
+    for (g_nodal = 1; g_nodal <= 2; g_nodal++)
+        for (li = 0; li < 3; li++)
+            for (state = 0; state < 2; state++) {
+                heml_material mt = material_of(laws[li]), mg;
+                heml_model *mf, *m;
+                int n3 = 3 * mesh.node_count, i;
+                double *x = (double *)malloc(sizeof(double) * n3), err = 0.0, fmax = 0.0;
+                const heml_real *f, *g;
+                if (laws[li] == HEML_MOONEY_RIVLIN_INCOMPRESSIBLE) {
+                    mt.c1 = (heml_real)(mt.c1 + mt.c2);
+                    mt.c2 = 0;
+                }
+                mg = mt;
+                mg.prony_count = 1;
+                mg.prony = &zero;
+                mf = make_model_mt(&mesh, &mt, 1, NULL);
+                m = make_model_mt(&mesh, &mg, 1, NULL);
+                REQUIRE(mf != NULL && m != NULL);
+                CHECK_INT(1, mf->mats[0].fast_nodal); /* (the two paths, really) */
+                CHECK_INT(0, m->mats[0].fast_nodal);
+                deformed_state(&mesh, state ? 0.28 : 0.04, 41u + 3u * (unsigned)li + (unsigned)state, x);
+                set_positions_d(mf, x, mesh.node_count);
+                set_positions_d(m, x, mesh.node_count);
+                f = heml_compute_forces(mf);
+                g = heml_compute_forces(m);
+                for (i = 0; i < n3; i++) {
+                    double e = fabs((double)f[i] - (double)g[i]);
+                    err = e > err ? e : err;
+                    fmax = fabs((double)g[i]) > fmax ? fabs((double)g[i]) : fmax;
+                }
+                if (state) CHECK(heml_last_stats(mf)->below_threshold > 0);
+                printf("    %-28s nodal %d %s: |f_fast - f_general| / |f| = %.2g\n", law_name[li == 0 ? 1 : li == 1 ? 3 : 4],
+                       g_nodal, state ? "J < J0  " : "moderate", err / fmax);
+                CHECK(fmax > 0 && err <= (IS_FLOAT ? 1e-5 : 1e-12) * fmax);
+                free(x);
+                heml_destroy(mf);
+                heml_destroy(m);
+            }
+    g_nodal = 0;
+    tetmesh_free(&mesh);
+}
+
 /* Patch test: an unstructured mesh (a 3 x 3 x 3 box of five-tetrahedron cells whose
    interior nodes are moved at random by up to 0.3 of a cell) under a homogeneous F, placed
    1e3 m from the origin: every tetrahedron's first Piola-Kirchhoff stress is the law's
@@ -2021,6 +2084,7 @@ static const test_case cases[] = {
     TEST(test_stresses_homogeneous),
     TEST(test_law_table_forces_and_differentials),
     TEST(test_nodal_pressure_gradient_and_differential),
+    TEST(test_nodal_pressure_fast_force),
     TEST(test_nodal_pressure_patch),
     TEST(test_nodal_pressure_refused),
     TEST(test_inv_cbrt_accuracy),
