@@ -6276,7 +6276,7 @@ static int heml__cg(heml_model *m, const heml_real *x_lin, const heml_real *diag
 {
     heml_real *r = s[0], *z = s[1], *p = s[2], *q = s[3], *pinv = s[4];
     int n3 = 3 * m->node_count, i, it;
-    double bb, rr, rz, tol2, ps;
+    double bb, rr, rz, tol2, ps = 0; /* set by heml__pagg_pc_usable where pc_live */
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
     m->pc_live = coarse == HEML__COARSE_STATIC && heml__pagg_pc_usable(m, &ps);
@@ -6343,7 +6343,7 @@ static int heml__minres(heml_model *m, const heml_real *x_lin, const heml_real *
     heml_real *r1 = s[0], *r2 = s[1], *y = s[2], *v = s[3], *w = s[4], *w1 = s[5], *w2 = s[6];
     heml_real *pinv = s[7];
     int n3 = 3 * m->node_count, i, it;
-    double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol, ps;
+    double beta1, beta, oldb = 0, dbar = 0, epsln = 0, phibar, cs = -1, sn = 0, tol, ps = 0;
     m->lin_x = x_lin;
     heml__dc_invalidate(m);
     m->pc_live = coarse == HEML__COARSE_STATIC && heml__pagg_pc_usable(m, &ps);
