@@ -1181,7 +1181,9 @@
    15.11 / 15.57 -> 13.46 / 14.48, Neo-Hookean 10.76 / 11.56, so 1.40 / 1.35 -> 1.25 / 1.25
    times the Neo-Hookean force (the quiet full bench before it: 16.5 / 16.3 against
    10.1 / 10.25, 1.63 / 1.59). In a program of its own (both laws interleaved, min of 8
-   rounds, 18,720 tetrahedra, same machine and load) 1.39-1.49 -> 1.28-1.34.
+   rounds, 18,720 tetrahedra, same machine and load) 1.39-1.49 -> 1.28-1.34 in double,
+   1.37-1.40 -> 1.10-1.15 in float. The differential's goal (Mooney-Rivlin's K*v below the
+   CSR product at 1e4) is not touched here: 1.03-1.17 in the same bench runs.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
