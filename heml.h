@@ -1161,6 +1161,29 @@
    force holds in instructions except for springs (1.55) and is not shown in time on this
    loaded machine (Mooney-Rivlin at 1e4 and float St Venant-Kirchhoff measured above it);
    a quiet machine must decide.
+   The split Mooney-Rivlin force on a kernel of its own (issue 21, heml__forces_mr,
+   heml__mat.fast_mr: no Prony, no nodal pressure; those keep the general path): the
+   general path's kinematics, law, coefficients and stress in three lane loops as
+   heml__forces_nh's, H (2 a I - M) in place of 2 a H - H M, C - I kept from the first stage,
+   nothing stored for the energy or the differential. Instructions per tetrahedron and
+   force (callgrind, -march=x86-64-v3 -O3, 11,000-tetrahedron box, c2 != 0): double 229 ->
+   217 against Neo-Hookean's 159 (1.44 -> 1.37), float 167 -> 148 against 122 (1.37 ->
+   1.21). Of the double kernel's 217: the kernel's stages 115 (Neo-Hookean's 56) and
+   f = -P grad N 14, gather 24, scatter 47 (both as Neo-Hookean's): what Mooney-Rivlin needs
+   more is arithmetic, C - I (six entries, their squares summed for I2), J^-1/3 by four
+   Newton steps and the stress's H M (27 products); J, 1/J and the scatter are shared.
+   Storing cof F - I from the first stage too (213 instructions) measured no faster
+   (1.34-1.40 against 1.28-1.34 of the Neo-Hookean force, interleaved), the version
+   without the H (2 a I - M) form and with C - I formed twice (227) about 4 % slower.
+   Timed (Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs, one other job running; min of
+   3 interleaved runs of build/bench/bench --parts kernels --filter mooney / neo-hookean
+   --repeats 5, double, one thread, ns per tetrahedron at 1,080 / 10,985): Mooney-Rivlin
+   15.11 / 15.57 -> 13.46 / 14.48, Neo-Hookean 10.76 / 11.56, so 1.40 / 1.35 -> 1.25 / 1.25
+   times the Neo-Hookean force (the quiet full bench before it: 16.5 / 16.3 against
+   10.1 / 10.25, 1.63 / 1.59). In a program of its own (both laws interleaved, min of 8
+   rounds, 18,720 tetrahedra, same machine and load) 1.39-1.49 -> 1.28-1.34 in double,
+   1.37-1.40 -> 1.10-1.15 in float. The differential's goal (Mooney-Rivlin's K*v below the
+   CSR product at 1e4) is not touched here: 1.03-1.17 in the same bench runs.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
@@ -2088,6 +2111,8 @@ typedef struct heml__mat {
                                     vectorised Neo-Hookean kernels (heml__forces_nh, heml__diff_nh) */
     int dk;                      /* its differential kernel (HEML__DK_*, cached in the stiffness
                                     cache), 0: the general path (Prony, nodal pressure, other laws) */
+    int fast_mr;                 /* split Mooney-Rivlin without Prony or the nodal pressure: the
+                                    force kernel heml__forces_mr */
     int fast_nodal;              /* fast, with desc.nodal_pressure (fast is then 0): the force
                                     kernel heml__forces_nh with the nodal pressure, and the node
                                     pass's heml__dilation_nh (NEAR-INCOMPRESSIBLE BODIES) */
@@ -3420,6 +3445,121 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
     heml__p_times_grad(R, b);
 }
 
+/* The split Mooney-Rivlin force kernel (heml__law_split without Prony or the nodal
+   pressure: heml__mat.fast_mr), in stages as heml__forces_nh: H, J - 1, C - I and the
+   invariants (heml__kinematics' formulas; H and C - I kept, cof F - I formed again later
+   rather than stored), J^-1/3 by heml__inv_cbrt; the law's stress terms (heml__law_split's
+   w_1, w_2, w_J, s0, continued below J0: no fallback) and heml__coefficients' c0 and a;
+   the stress
+       P = c0 I + H (2 a I - M) - M + w_J K,  c0 = s0 + 2 w_2 (I1 - 3), a = w_1 + (I1 - 1) w_2,
+       M = 2 w_2 (C - I), K = cof F - I   (times Vol, into b->K)
+   then f_k = -P grad N_k. The general path's arithmetic (heml__kinematics, heml__law_split,
+   heml__coefficients, heml__pk1_forces) but for H (2 a I - M) in place of 2 a H - H M
+   (forces differ by round-off: 2e-16 of the largest, tests/test_heml.c
+   test_mooney_rivlin_fast_force), without the stores of K, the second derivatives and the
+   coefficients that the general path keeps for the energy and the differential. See
+   PERFORMANCE (issue 21) for what it costs against the Neo-Hookean kernel and why. */
+static void heml__forces_mr(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                            heml__blk *HEML__RESTRICT b)
+{
+    const heml_real c1 = mt->c1, c2 = mt->c2, kappa = mt->kappa;
+    const heml_real lo = (heml_real)8.7e-19, hi = (heml_real)1.15e18; /* 2^-60, 2^60 */
+    heml_real rc[HEML__W];
+    int k, outside = 0;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+        heml_real E00 = 2 * H00 + (H00 * H00 + H10 * H10 + H20 * H20);
+        heml_real E11 = 2 * H11 + (H01 * H01 + H11 * H11 + H21 * H21);
+        heml_real E22 = 2 * H22 + (H02 * H02 + H12 * H12 + H22 * H22);
+        heml_real E01 = H01 + H10 + (H00 * H01 + H10 * H11 + H20 * H21);
+        heml_real E02 = H02 + H20 + (H00 * H02 + H10 * H12 + H20 * H22);
+        heml_real E12 = H12 + H21 + (H01 * H02 + H11 * H12 + H21 * H22);
+        heml_real t = E00 + E11 + E22;
+        heml_real tr2 = E00 * E00 + E11 * E11 + E22 * E22 + 2 * (E01 * E01 + E02 * E02 + E12 * E12);
+        heml_real jm1 = tr + i2 + det, jc = heml__max(jm1, jm1_0), Jc = 1 + jc;
+        b->H[0][k] = H00;
+        b->H[1][k] = H01;
+        b->H[2][k] = H02;
+        b->H[3][k] = H10;
+        b->H[4][k] = H11;
+        b->H[5][k] = H12;
+        b->H[6][k] = H20;
+        b->H[7][k] = H21;
+        b->H[8][k] = H22;
+        b->E2[0][k] = E00;
+        b->E2[1][k] = E11;
+        b->E2[2][k] = E22;
+        b->E2[3][k] = E01;
+        b->E2[4][k] = E02;
+        b->E2[5][k] = E12;
+        b->jm1[k] = jm1;
+        b->I1m3[k] = t;
+        b->I2m3[k] = 2 * t + (t * t - tr2) / 2;
+        rc[k] = heml__inv_cbrt(Jc);
+        outside += (Jc < lo) | (Jc > hi);
+    }
+    if (outside) /* (NaN lanes stay NaN either way) */
+        for (k = 0; k < HEML__W; k++) {
+            heml_real Jc = 1 + heml__max(b->jm1[k], jm1_0);
+            if (Jc < lo || Jc > hi) rc[k] = (heml_real)(1 / cbrt((double)Jc));
+        }
+    for (k = 0; k < HEML__W; k++) { /* heml__law_split's stress terms, then heml__coefficients' */
+        heml_real jm1 = b->jm1[k], jc1 = heml__max(jm1, jm1_0), Jc = 1 + jc1, d = jm1 - jc1;
+        heml_real I1m3 = b->I1m3[k], I2m3 = b->I2m3[k], I1 = 3 + I1m3, I2 = 3 + I2m3;
+        heml_real r = rc[k], iJ = 1 / Jc;
+        heml_real a = r * r, bq = a * a;
+        heml_real a1 = (heml_real)(-2.0 / 3.0) * a * iJ, a2 = (heml_real)(10.0 / 9.0) * a * iJ * iJ;
+        heml_real b1 = (heml_real)(-4.0 / 3.0) * bq * iJ, b2 = (heml_real)(28.0 / 9.0) * bq * iJ * iJ;
+        heml_real at = a + d * (a1 + d / 2 * a2), at1 = a1 + d * a2;
+        heml_real bt = bq + d * (b1 + d / 2 * b2), bt1 = b1 + d * b2;
+        heml_real sa = (heml_real)(2.0 / 3.0) * a * iJ * (3 * jc1 - I1m3) + d * (2 * a1 + I1 * a2 + d * a2);
+        heml_real sb = (heml_real)(4.0 / 3.0) * bq * iJ * (3 * jc1 - I2m3) + d * (4 * b1 + I2 * b2 + 2 * d * b2);
+        heml_real w1 = c1 * at, w2 = c2 * bt;
+        b->wJ[k] = c1 * I1 * at1 + c2 * I2 * bt1 + kappa * jm1;
+        b->co[0][k] = (c1 * sa + c2 * sb + kappa * jm1) + 2 * w2 * I1m3;
+        b->co[1][k] = w1 + (2 + I1m3) * w2;
+        b->w2[k] = 2 * w2;
+    }
+    for (k = 0; k < HEML__W; k++) {
+        heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
+        heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
+        heml_real H20 = b->H[6][k], H21 = b->H[7][k], H22 = b->H[8][k];
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22;
+        heml_real vol = R[9 * HEML__W + k], w2 = b->w2[k]; /* b->w2: 2 w_2 here */
+        heml_real c0 = vol * b->co[0][k], a2 = 2 * vol * b->co[1][k], wj = vol * b->wJ[k];
+        heml_real M00 = vol * (w2 * b->E2[0][k]), M11 = vol * (w2 * b->E2[1][k]), M22 = vol * (w2 * b->E2[2][k]);
+        heml_real M01 = vol * (w2 * b->E2[3][k]), M02 = vol * (w2 * b->E2[4][k]), M12 = vol * (w2 * b->E2[5][k]);
+        heml_real A00 = a2 - M00, A11 = a2 - M11, A22 = a2 - M22; /* A = 2 a I - M: H A = 2 a H - H M */
+        heml_real A01 = -M01, A02 = -M02, A12 = -M12;
+        b->K[0][k] = c0 + wj * (tr - H00 + c00) - M00 + (H00 * A00 + H01 * A01 + H02 * A02);
+        b->K[1][k] = wj * (c01 - H10) - M01 + (H00 * A01 + H01 * A11 + H02 * A12);
+        b->K[2][k] = wj * (c02 - H20) - M02 + (H00 * A02 + H01 * A12 + H02 * A22);
+        b->K[3][k] = wj * (c10 - H01) - M01 + (H10 * A00 + H11 * A01 + H12 * A02);
+        b->K[4][k] = c0 + wj * (tr - H11 + c11) - M11 + (H10 * A01 + H11 * A11 + H12 * A12);
+        b->K[5][k] = wj * (c12 - H21) - M12 + (H10 * A02 + H11 * A12 + H12 * A22);
+        b->K[6][k] = wj * (c20 - H02) - M02 + (H20 * A00 + H21 * A01 + H22 * A02);
+        b->K[7][k] = wj * (c21 - H12) - M12 + (H20 * A01 + H21 * A11 + H22 * A12);
+        b->K[8][k] = c0 + wj * (tr - H22 + c22) - M22 + (H20 * A02 + H21 * A12 + H22 * A22);
+    }
+    heml__p_times_grad(R, b);
+}
+
 /* The Neo-Hookean force differential: with F = I + H, dH = dv V^-1, dJ = cof F : dH,
        dP = 2 c1 dH + U''(J) dJ cof F + w_J dcof F,   df_k = -Vol dP grad N_k,
    dcof F the derivative of the cofactors. Evaluated in the links (our form): with
@@ -3890,6 +4030,10 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
     }
     if (mt->fast_nodal && !want_energy) {
         heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b);
+        return 0.0;
+    }
+    if (mt->fast_mr && !want_energy) {
+        heml__forces_mr(mt, m->jm1_0, R, b);
         return 0.0;
     }
     heml__block_stress(m, mt, blk, b, want_energy ? HEML__WANT_ENERGY : 0, prony_write);
@@ -4882,6 +5026,7 @@ static void heml__make_mat(const heml_material *src, heml__mat *mt)
     mt->prony_count = src->prony_count;
     ops->make(src, mt);
     mt->fast = ops->fast_path && !mt->uses_i2 && !mt->prony_count;
+    mt->fast_mr = src->law == HEML_MOONEY_RIVLIN && !mt->prony_count;
     mt->dk = mt->fast                                           ? HEML__DK_NH
              : mt->prony_count                                  ? 0
              : src->law == HEML_STVK                            ? HEML__DK_SVK
@@ -6088,7 +6233,7 @@ static void heml__create_materials(heml_model *m, const heml_material *src)
         }
         if (m->nodal) { /* the general path carries the nodal pressure, but for the force */
             mt->fast_nodal = mt->fast;
-            mt->fast = mt->dk = 0;
+            mt->fast = mt->dk = mt->fast_mr = 0;
         }
         (void)heml__small_strain(mt, m->jm1_0, &mt->small_mu, &mt->small_lambda);
         if (mt->small_mu < 0) mt->small_mu = 0;
