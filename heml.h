@@ -1181,9 +1181,11 @@
    builds alternated, minimum of 10 rounds of 100 calls, gcc 12 -O3 -march=native, the
    Xeon above at load about 1): springs / Neo-Hookean 1.51-1.80 after against 1.51-1.66
    before, springs 19.0-20.0 ns against 18.5-19.2 ns: no gain in cache, where the stream
-   was not the limit; callgrind (x86-64-v3, the same harness) 32.3 M instructions against
-   32.7 M. (A first version with the link loop's from/to tables lost vectorisation in the
-   x86-64-v3 build, "control flow in loop": 3.3 times the instructions of
+   was not the limit. Callgrind (x86-64-v3, the same harness, 20 calls less setup): 246 ->
+   209 instructions per tetrahedron against Neo-Hookean's 158 (1.56 -> 1.32), mostly from
+   heml__spring_J, whose conditional division kept its loop scalar without AVX-512's
+   masks ("control flow in loop"; now a branch-free select). (A first version of the link
+   loop with from/to tables lost vectorisation the same way: 3.3 times the instructions of
    heml__spring_tensions; the links 4 to 6 now have a loop of their own.) What bounds the
    spring force in cache is the divider: 6 square roots and 7 divisions per tetrahedron
    (the J - 1 of the statistics is one) against Neo-Hookean's 2 divisions; replacing the
@@ -3331,7 +3333,9 @@ static void heml__spring_J(const heml_real *HEML__RESTRICT R, heml__blk *HEML__R
         heml_real d0 = b->H[6][k] + b->e[6][k], d1 = b->H[7][k] + b->e[7][k];
         heml_real d2 = b->H[8][k] + b->e[8][k], v6 = 6 * R[9 * HEML__W + k];
         heml_real det = a0 * (b1 * d2 - b2 * d1) + a1 * (b2 * d0 - b0 * d2) + a2 * (b0 * d1 - b1 * d0);
-        b->jm1[k] = v6 > 0 ? det / v6 - 1 : 0;
+        heml_real ok = (heml_real)(v6 > 0); /* (no branch: the loop vectorises without
+                                                AVX-512's masks) */
+        b->jm1[k] = ok * (det / (v6 + (1 - ok)) - 1);
     }
 }
 
