@@ -1193,9 +1193,16 @@
    15.4 ns (1.63 -> 1.44 times Neo-Hookean, same harness). So 1.5 times the Neo-Hookean
    force in cache needs the square roots or divisions off the divider (pairs of divisions
    through one reciprocal, or Newton reciprocal square roots from a bit-trick guess, both
-   bit-reproducible but 1 to 2 ulp instead of correctly rounded): not done. Out of cache
-   (the bench runs springs at 1e3 and 1e4 only) the halved stream is what the bound was
-   made of: its ratio to its own bound was 1.17 / 1.38 at 208.7 bytes.
+   bit-reproducible but 1 to 2 ulp instead of correctly rounded): not done. The bench
+   (`build/bench/bench --parts kernels --filter springs --repeats 5` and `--filter
+   neo-hookean`, old and new binaries alternated, 3 rounds, same machine and load): springs
+   17.2-17.7 / 17.5-17.9 ns before, 17.4-18.6 / 17.0-19.1 after at 1,080 / 10,985
+   tetrahedra, Neo-Hookean 10.7-11.6 ns at 10,985: 1.55 to 1.6 times, not 1.5 (ratio to
+   the bandwidth bound now 2.2-2.5 at 112 bytes: the stream is not what limits it). At
+   96,000 tetrahedra (the harness, tetmesh_beam(2, 1, 1, 40, 20, 20), 3 rounds) 19.7-20.1
+   after against 19.6-21.0 ns before, 1.61-1.69 against 1.62-1.67 times Neo-Hookean: the
+   halved stream shows no gain there either on this machine (its large last-level cache).
+   Kept: a smaller model and no loss.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
