@@ -2439,9 +2439,6 @@ static double heml__x_minus_log1p(double x)
     return u * x - 2.0 * u * u2 * sum;
 }
 
-/* links of the mass-spring law, as (start, end) lanes: v_e = x_end - x_start (sec. 3.1) */
-static const int heml__link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
-
 /* >>laws ------------------------------------------------------------------------------ */
 
 /* The workspace of one block of HEML__W tetrahedra: every stage of a kernel is a loop
