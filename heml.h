@@ -166,7 +166,10 @@
    Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
    those in use), plus a byte per block of 16; only without a Prony series and without
    nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
-   out (each product then recomputes them: see PERFORMANCE for the cost).
+   out (each product then recomputes them: see PERFORMANCE for the cost). Mass-spring
+   materials hold nothing per tetrahedron beyond the rest constants (their rest lengths
+   and stiffnesses are derived from them in each pass; before issue 21's change they held
+   12 reals a slot more).
 
    ERRORS: every fallible function returns 0 or a negative HEML_ERR_* code;
    heml_error_string names it, and the optional desc.log callback receives a detailed
@@ -913,8 +916,8 @@
        bending one, for springs either.
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
-   constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read 96
-   more, a Prony series 72 per term, which it also writes), gathers the displacements of
+   constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read no
+   more since issue 21's second spring change, below; a Prony series 72 per term, which it also writes), gathers the displacements of
    its 4 nodes (96 bytes, mostly cache hits when nodes are numbered with locality: the
    tetrahedra are ordered by their lowest node, see heml__node_order) and adds into their
    forces (96 bytes read and written, likewise). heml_kernel_bytes gives the
@@ -1184,6 +1187,45 @@
    rounds, 18,720 tetrahedra, same machine and load) 1.39-1.49 -> 1.28-1.34 in double,
    1.37-1.40 -> 1.10-1.15 in float. The differential's goal (Mooney-Rivlin's K*v below the
    CSR product at 1e4) is not touched here: 1.03-1.17 in the same bench runs.
+   The spring force's stream (issue 21, again: the bench's kernels.csv of git dbb91aa on an
+   Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs, one thread, double: springs 16.9 / 19.6
+   ns per tetrahedron at 1,080 / 10,985 against Neo-Hookean's 10.1 / 10.25, 208.7 bytes
+   against 112): the law streamed 12 reals per tetrahedron of its own (6 rest lengths, 6
+   stiffnesses k = E Vol / L^2) besides the 10 rest constants it already reads for its
+   rest links. Now heml__spring_tensions derives them: L^2 = |V|^2 from the rest links
+   (3 multiply-adds a link), k from the law's E and Vol, and the tension as
+   t = E Vol (l^2 - L^2) / (L^2 (l^2 + sqrt(L^2 l^2))), so still one square root and one
+   division a link (the differential's dt = s E Vol (v . dv) / (L l^3) reuses L l^3). The
+   stream is the 96 bytes of every law (112 bytes a tetrahedron with the node traffic on
+   the bench's beams, half of the 208.7 before; the spring arrays, 96 bytes a slot in
+   double, are gone from MEMORY). l = L exactly at rest (both from the same V), and the
+   lengths are clamped as before (l^2 at 1e-24 L^2). Measured (harness: heml_compute_forces
+   on tetmesh_beam(2, 1, 1, 12, 6, 6, SPLIT6), 2,592 tetrahedra, 2 % stretch, old and new
+   builds alternated, minimum of 10 rounds of 100 calls, gcc 12 -O3 -march=native, the
+   Xeon above at load about 1): springs / Neo-Hookean 1.51-1.80 after against 1.51-1.66
+   before, springs 19.0-20.0 ns against 18.5-19.2 ns: no gain in cache, where the stream
+   was not the limit. Callgrind (x86-64-v3, the same harness, 20 calls less setup): 246 ->
+   209 instructions per tetrahedron against Neo-Hookean's 158 (1.56 -> 1.32), mostly from
+   heml__spring_J, whose conditional division kept its loop scalar without AVX-512's
+   masks ("control flow in loop"; now a branch-free select). (A first version of the link
+   loop with from/to tables lost vectorisation the same way: 3.3 times the instructions of
+   heml__spring_tensions; the links 4 to 6 now have a loop of their own.) What bounds the
+   spring force in cache is the divider: 6 square roots and 7 divisions per tetrahedron
+   (the J - 1 of the statistics is one) against Neo-Hookean's 2 divisions; replacing the
+   6 tension divisions by products (wrong forces, a timing probe only) took it from 17.6 to
+   15.4 ns (1.63 -> 1.44 times Neo-Hookean, same harness). So 1.5 times the Neo-Hookean
+   force in cache needs the square roots or divisions off the divider (pairs of divisions
+   through one reciprocal, or Newton reciprocal square roots from a bit-trick guess, both
+   bit-reproducible but 1 to 2 ulp instead of correctly rounded): not done. The bench
+   (`build/bench/bench --parts kernels --filter springs --repeats 5` and `--filter
+   neo-hookean`, old and new binaries alternated, 3 rounds, same machine and load): springs
+   17.2-17.7 / 17.5-17.9 ns before, 17.4-18.6 / 17.0-19.1 after at 1,080 / 10,985
+   tetrahedra, Neo-Hookean 10.7-11.6 ns at 10,985: 1.55 to 1.6 times, not 1.5 (ratio to
+   the bandwidth bound now 2.2-2.5 at 112 bytes: the stream is not what limits it). At
+   96,000 tetrahedra (the harness, tetmesh_beam(2, 1, 1, 40, 20, 20), 3 rounds) 19.7-20.1
+   after against 19.6-21.0 ns before, 1.61-1.69 against 1.62-1.67 times Neo-Hookean: the
+   halved stream shows no gain there either on this machine (its large last-level cache).
+   Kept: a smaller model and no loss.
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
@@ -1851,7 +1893,7 @@ HEMLDEF const heml_real *heml_compute_forces(heml_model *m);
    same state read it (bit-identical results). */
 HEMLDEF int heml_apply_stiffness(heml_model *m, const heml_real *dx, heml_real *out);
 /* Bytes one force pass (kernel 0) or one differential pass (kernel 1) must move at least:
-   the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus spring and Prony data)
+   the tetrahedron stream (HEML_KERNEL_BYTES_PER_TET each, plus Prony data)
    and each node's displacement (and dx) read once and force written once; for kernel 1
    the cached tetrahedra (desc.stiffness_cache) stream their 4 indices and 17 (Neo-
    Hookean), 21 (St Venant-Kirchhoff) or 28 (split Mooney-Rivlin) reals of cache instead,
@@ -2056,7 +2098,6 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__GROUPS_MIN 64 /* groups are made smaller until there are this many (or one chunk each) */
 #endif
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
-#define HEML__NS 12         /* spring constants per tetrahedron: 6 rest lengths, 6 stiffnesses */
 #define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
 #define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
 #define HEML__NC_MR 28      /* split Mooney-Rivlin: v, Ah, Nh (21), 7 scalars (heml__diff_mr) */
@@ -2204,7 +2245,6 @@ struct heml_model {
     /* tetrahedra, in blocks of HEML__W slots (structure of arrays inside a block) */
     int *blk_idx;         /* 4 W per block: node j of lane k at [4 W b + W j + k] */
     heml_real *blk_rest;  /* NR W per block */
-    heml_real *blk_spring; /* NS W per block (only when a material is a spring law) */
     int *blk_valid;       /* lanes holding a tetrahedron (the rest is padding) */
     size_t *blk_prony;    /* offset of the block's Prony state, reals */
     int *slot_tet, *tet_slot;
@@ -2424,9 +2464,6 @@ static double heml__x_minus_log1p(double x)
     return u * x - 2.0 * u * u2 * sum;
 }
 
-/* links of the mass-spring law, as (start, end) lanes: v_e = x_end - x_start (sec. 3.1) */
-static const int heml__link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
-
 /* >>laws ------------------------------------------------------------------------------ */
 
 /* The workspace of one block of HEML__W tetrahedra: every stage of a kernel is a loop
@@ -2450,7 +2487,7 @@ struct heml__blk {
                                  the six link tensions */
     heml_real f[9][HEML__W];  /* forces (or differentials) on nodes 1..3 */
     heml_real de[9][HEML__W]; /* differential: the links of dx */
-    heml_real len[6][HEML__W]; /* springs: clamped link lengths */
+    heml_real len[6][HEML__W]; /* springs: L l^3, L the rest and l the clamped link length */
     heml_real dp[HEML__W];    /* differential: the nodal pressure's dp (0 without it), see
                                  NEAR-INCOMPRESSIBLE BODIES */
     heml_real lin[HEML__NC][HEML__W]; /* the uncached Neo-Hookean differential's point values
@@ -3190,46 +3227,68 @@ static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
 }
 
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
-   l^2 - L^2 = 2 V . du + |du|^2 (V the rest link), the lengths l and the tensions
-   t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35) into len and co[0..5]; with
-   `energy`, w (per lane, J) = sum k/2 (l - L)^2. Lengths are clamped at 1e-12 L so
-   coincident nodes give finite forces. The rest links are those of heml__spring_rest_links
-   (V4..V6 the differences of V1..V3), the same in the force, so the energy's gradient is
-   exact. */
-static void heml__spring_tensions(const heml_real *HEML__RESTRICT S, heml__blk *HEML__RESTRICT b, int energy)
+   l^2 - L^2 = 2 V . du + |du|^2 (V the rest link, L^2 = |V|^2), and the tensions
+   t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35), k = E Vol / L^2, as
+       t = E Vol (l^2 - L^2) / (L^2 (l^2 + s)),   s = L l = sqrt(L^2 l^2)
+   (one square root and one division per link) into co[0..5]; len gets l^2 s = L l^3 for
+   the differential (dt = s_p E Vol (v . dv) / (L l^3)); with `energy`, w (per lane, J) =
+   sum k/2 (l - L)^2 = sum E Vol (l^2 - L^2)^2 / (2 L^2 (l^2 + 2 s + L^2)). Lengths are
+   clamped at 1e-12 L (l^2 at 1e-24 L^2) so coincident nodes give finite forces. Every
+   per-link constant comes from the 10 rest constants (the rest links of
+   heml__spring_rest_links, V4..V6 the differences of V1..V3, the same in force, energy and
+   differential, so the energy's gradient is exact, and l = L exactly at rest); `young` the
+   law's E. Padding lanes (Vol = 0, V = 0) get t = 0. */
+static void heml__spring_tensions(heml_real young, const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b,
+                                  int energy)
 {
-    static const int from[6] = {-1, -1, -1, 0, 1, 2}, to[6] = {0, 1, 2, 1, 2, 0}; /* link l = to - from */
-    heml_real dl2[6][HEML__W];
+    heml_real dl2[6][HEML__W], L2[6][HEML__W], q2[6][HEML__W];
     int k, l, r;
-    for (l = 0; l < 6; l++) /* l^2 - L^2 = 2 V . du + |du|^2 (vectorised) */
+    for (l = 0; l < 3; l++) /* L^2 = |V|^2 and l^2 - L^2 = 2 V . du + |du|^2 (vectorised) */
         for (k = 0; k < HEML__W; k++) {
-            heml_real acc = 0;
+            heml_real acc = 0, vv = 0;
             for (r = 0; r < 3; r++) {
-                heml_real V = b->H[3 * to[l] + r][k] - (from[l] < 0 ? 0 : b->H[3 * from[l] + r][k]);
-                heml_real du = b->e[3 * to[l] + r][k] - (from[l] < 0 ? 0 : b->e[3 * from[l] + r][k]);
+                heml_real V = b->H[3 * l + r][k], du = b->e[3 * l + r][k];
                 acc += (2 * V + du) * du;
+                vv += V * V;
             }
             dl2[l][k] = acc;
+            L2[l][k] = vv;
         }
-    for (l = 0; l < 6; l++) /* l^2 (clamped at 0) */
+    for (l = 3; l < 6; l++) /* the links 2 - 1, 3 - 2, 1 - 3 */
         for (k = 0; k < HEML__W; k++) {
-            heml_real L = S[l * HEML__W + k], q = L * L + dl2[l][k];
-            b->len[l][k] = q > 0 ? q : 0;
+            heml_real acc = 0, vv = 0;
+            int a = l - 3, c = l == 5 ? 0 : l - 2;
+            for (r = 0; r < 3; r++) {
+                heml_real V = b->H[3 * c + r][k] - b->H[3 * a + r][k], du = b->e[3 * c + r][k] - b->e[3 * a + r][k];
+                acc += (2 * V + du) * du;
+                vv += V * V;
+            }
+            dl2[l][k] = acc;
+            L2[l][k] = vv;
+        }
+    for (l = 0; l < 6; l++) /* l^2 clamped at 1e-24 L^2, and L^2 l^2 */
+        for (k = 0; k < HEML__W; k++) {
+            heml_real q = L2[l][k] + dl2[l][k], lo = (heml_real)1e-24 * L2[l][k];
+            q = q > lo ? q : lo;
+            q2[l][k] = q;
+            b->len[l][k] = L2[l][k] * q;
         }
     heml__sqrt_lanes(b->len[0], 6 * HEML__W);
     for (l = 0; l < 6; l++)
         for (k = 0; k < HEML__W; k++) {
-            heml_real L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k], len = b->len[l][k];
-            heml_real lo = (heml_real)1e-12 * L, lc = len > lo ? len : lo;
-            b->len[l][k] = lc;
-            b->co[l][k] = kk * dl2[l][k] / ((lc + L) * lc); /* k (l - L) / l */
+            heml_real ev = young * R[9 * HEML__W + k], sl = b->len[l][k], q = q2[l][k];
+            heml_real den = L2[l][k] * (q + sl);
+            den = den > 0 ? den : 1; /* (padding: dl2 = 0; unconditional, so it vectorises) */
+            b->co[l][k] = ev * dl2[l][k] / den; /* k (l - L) / l */
+            b->len[l][k] = q * sl;
         }
     if (energy)
         for (k = 0; k < HEML__W; k++) {
-            double we = 0.0;
+            double we = 0.0, ev = (double)young * (double)R[9 * HEML__W + k];
             for (l = 0; l < 6; l++) {
-                double L = (double)S[l * HEML__W + k], e = (double)dl2[l][k] / ((double)b->len[l][k] + L);
-                we += (double)S[(6 + l) * HEML__W + k] / 2 * e * e;
+                double LL = (double)L2[l][k], q = (double)q2[l][k], sl = sqrt(LL * q), d = (double)dl2[l][k];
+                double den = LL * (q + 2 * sl + LL);
+                if (den > 0) we += ev / 2 * d * d / den;
             }
             b->w[k] = (heml_real)we;
         }
@@ -3303,7 +3362,9 @@ static void heml__spring_J(const heml_real *HEML__RESTRICT R, heml__blk *HEML__R
         heml_real d0 = b->H[6][k] + b->e[6][k], d1 = b->H[7][k] + b->e[7][k];
         heml_real d2 = b->H[8][k] + b->e[8][k], v6 = 6 * R[9 * HEML__W + k];
         heml_real det = a0 * (b1 * d2 - b2 * d1) + a1 * (b2 * d0 - b0 * d2) + a2 * (b0 * d1 - b1 * d0);
-        b->jm1[k] = v6 > 0 ? det / v6 - 1 : 0;
+        heml_real ok = (heml_real)(v6 > 0); /* (no branch: the loop vectorises without
+                                                AVX-512's masks) */
+        b->jm1[k] = ok * (det / (v6 + (1 - ok)) - 1);
     }
 }
 
@@ -4016,10 +4077,9 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
     heml__gather(m, idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
-        const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml__spring_rest_links(R, b);
         heml__spring_J(R, b);
-        heml__spring_tensions(S, b, want_energy);
+        heml__spring_tensions(mt->young, R, b, want_energy);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, prony_write);
         heml__spring_forces(b, b->co);
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
@@ -4147,10 +4207,9 @@ static void heml__block_diff_general(const heml_model *m, const heml__mat *mt, i
     int k;
     sp = mt->prony_count ? m->prony_s[mt - m->mats] : 1;
     if (mt->kind == HEML__K_SPRING) {
-        const heml_real *S = m->blk_spring + (size_t)blk * HEML__NS * HEML__W;
         heml_real dsig[6][HEML__W];
         heml__spring_rest_links(R, b);
-        heml__spring_tensions(S, b, 0);
+        heml__spring_tensions(mt->young, R, b, 0);
         if (mt->prony_count) heml__prony(m, mt, blk, b, 6, 0);
         for (k = 0; k < HEML__W; k++) {
             heml_real v[6][3], dv[6][3];
@@ -4164,10 +4223,9 @@ static void heml__block_diff_general(const heml_model *m, const heml__mat *mt, i
                 dv[4][r] = dv[2][r] - dv[1][r];
                 dv[5][r] = dv[0][r] - dv[2][r];
             }
-            for (l = 0; l < 6; l++) {
-                heml_real lc = b->len[l][k], L = S[l * HEML__W + k], kk = S[(6 + l) * HEML__W + k];
+            for (l = 0; l < 6; l++) { /* len = L l^3 (heml__spring_tensions); 0 on padding */
                 heml_real vdv = v[l][0] * dv[l][0] + v[l][1] * dv[l][1] + v[l][2] * dv[l][2];
-                dsig[l][k] = sp * kk * L * vdv / (lc * lc * lc);
+                dsig[l][k] = b->len[l][k] > 0 ? sp * mt->young * R[9 * HEML__W + k] * vdv / b->len[l][k] : 0;
             }
         }
         heml__spring_dforces(b, b->co, dsig);
@@ -4463,7 +4521,7 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
                     heml__spring_rest_links(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
-                    heml__spring_tensions(m->blk_spring + (size_t)blk * HEML__NS * HEML__W, &b, 1);
+                    heml__spring_tensions(mt->young, m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b, 1);
                 } else {
                     heml__kinematics(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b);
                     heml__clamp_J(m->jm1_0, &b);
@@ -4809,7 +4867,6 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->axes, unsigned char, n);
     HEML__CARVE(c, m->blk_idx, int, 4 * s);
     HEML__CARVE(c, m->blk_rest, heml_real, HEML__NR * s);
-    HEML__CARVE(c, m->blk_spring, heml_real, m->has_springs ? HEML__NS * s : 0);
     HEML__CARVE(c, m->blk_valid, int, B);
     HEML__CARVE(c, m->blk_prony, size_t, B);
     HEML__CARVE(c, m->slot_tet, int, s);
@@ -4878,7 +4935,6 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
     if (!m->nodal) m->diag_dev = NULL;
     if (!m->pagg_count) m->pagg = NULL;
-    if (!m->has_springs) m->blk_spring = NULL;
     if (!m->has_dc) m->dc = NULL, m->dc_gen = NULL;
 }
 
@@ -5327,7 +5383,7 @@ static void heml__set_masks(heml_model *m, int i)
    stiffness diagonal. mass_acc, diag_acc: n and 3n doubles of scratch. */
 static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc, double *diag_acc)
 {
-    int s, blk, k, j, r, l;
+    int s, blk, k, j, r;
     double noise2 = 0.0;
     memset(mass_acc, 0, sizeof(double) * (size_t)m->node_count);
     memset(diag_acc, 0, sizeof(double) * 3 * (size_t)m->node_count);
@@ -5342,8 +5398,6 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
         if (t < 0) { /* padding: all four nodes the first node of lane 0, zero constants */
             for (j = 0; j < 4; j++) idx[j * HEML__W + k] = idx[0];
             for (r = 0; r < HEML__NR; r++) R[r * HEML__W + k] = 0;
-            if (m->blk_spring)
-                for (l = 0; l < HEML__NS; l++) m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = l < 6;
             continue;
         }
         {
@@ -5372,18 +5426,6 @@ static void heml__fill_tets(heml_model *m, const heml_desc *d, double *mass_acc,
                         m->diag_dev[3 * q[j] + r] +=
                             (heml_real)(vol * (mt->small_mu / 3.0 * g[j][r] * g[j][r] + mt->small_mu * gg));
                 }
-            }
-            if (mt->kind == HEML__K_SPRING) {
-                for (l = 0; l < 6; l++) {
-                    const heml_real *pa = m->rest + 3 * q[heml__link[l][0]], *pb = m->rest + 3 * q[heml__link[l][1]];
-                    double dx = (double)pb[0] - pa[0], dy = (double)pb[1] - pa[1], dz = (double)pb[2] - pa[2];
-                    double L2 = dx * dx + dy * dy + dz * dz;
-                    m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = (heml_real)sqrt(L2);
-                    m->blk_spring[((size_t)blk * HEML__NS + 6 + l) * HEML__W + k] =
-                        (heml_real)((double)mt->young * vol / L2);
-                }
-            } else if (m->blk_spring) {
-                for (l = 0; l < HEML__NS; l++) m->blk_spring[((size_t)blk * HEML__NS + l) * HEML__W + k] = l < 6;
             }
             m->blk_valid[blk] = k + 1;
         }
@@ -7631,7 +7673,6 @@ HEMLDEF int heml_kernel_bytes(const heml_model *m, int kernel, size_t *read, siz
     for (i = 0; i < m->chunk_count; i++) {
         const heml__mat *mt = m->mats + m->chunk_material[i];
         size_t slots = (size_t)(m->chunk_end[i] - m->chunk_begin[i]) * HEML__W;
-        if (mt->kind == HEML__K_SPRING) stream += slots * HEML__NS * R;
         prony += slots * HEML__NQ * (size_t)mt->prony_count * R;
     }
     {   /* the differential: cached blocks read the cache and dx, not u */

@@ -416,7 +416,7 @@ static int hm_kernel(void *v, int kernel)
     }
     if (kernel == BENCH_KERNEL_ARITH && !s->m->has_springs) return hm_arith(s);
     if (kernel == BENCH_KERNEL_STEP) return heml_step_ex(s->m, (heml_real)1e-3, HEML_IMPLICIT_EULER);
-    if (kernel == BENCH_KERNEL_MOVE && !s->m->has_springs) { /* (springs stream more) */
+    if (kernel == BENCH_KERNEL_MOVE && !s->m->has_springs) { /* (springs: their own kernels, which move does not model; they stream the same bytes since issue 21) */
         hm_move p;
         p.m = s->m;
         p.out = s->out;
