@@ -4349,7 +4349,7 @@ static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
         heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
         heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
         b->jm1[k] = q * (tr + i2 + det);
-        if (with_d) { /* cof F = (tr H + 1) I - H^T + cof H */
+        { /* (with_d) cof F = (tr H + 1) I - H^T + cof H */
             heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
             heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
             heml_real z0 = b->de[6][k], z1 = b->de[7][k], z2 = b->de[8][k];
@@ -5779,10 +5779,39 @@ static int heml__coarse_prepare(heml_model *m, int coarse, const heml_real *diag
     return coarse;
 }
 
+/* y = L^-1 y (forward) or L^-T y (backward) for a heml__coarse_factor factor L (D x D). */
+static void heml__chol_forward(const double *L, int D, double *y)
+{
+    int i, j;
+    for (i = 0; i < D; i++) {
+        const double *Li = L + (size_t)i * D;
+        double t = y[i];
+        if (Li[i] == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = 0; j < i; j++) t -= Li[j] * y[j];
+        y[i] = t / Li[i];
+    }
+}
+static void heml__chol_backward(const double *L, int D, double *y)
+{
+    int i, j;
+    for (i = D - 1; i >= 0; i--) {
+        double t = y[i], Lii = L[(size_t)i * D + i];
+        if (Lii == 0.0) {
+            y[i] = 0.0;
+            continue;
+        }
+        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
+        y[i] = t / Lii;
+    }
+}
+
 /* z += P A_c^-1 P^T r on the free degrees of freedom. */
 static void heml__coarse_apply(heml_model *m, const double *L, const heml_real *rv, heml_real *z)
 {
-    int A = m->agg_count, D = 6 * A, i, j, r;
+    int A = m->agg_count, D = 6 * A, i, r;
     double *y = m->coarse_rhs;
     memset(y, 0, sizeof(double) * (size_t)D);
     for (i = 0; i < m->node_count; i++) { /* y += P^T r: per node (r, rho x r), rho = X - c (heml__node_modes) */
@@ -5797,25 +5826,8 @@ static void heml__coarse_apply(heml_model *m, const double *L, const heml_real *
         ya[4] += rho[2] * q[0] - rho[0] * q[2];
         ya[5] += rho[0] * q[1] - rho[1] * q[0];
     }
-    for (i = 0; i < D; i++) { /* L y' = y */
-        const double *Li = L + (size_t)i * D;
-        double t = y[i];
-        if (Li[i] == 0.0) {
-            y[i] = 0.0;
-            continue;
-        }
-        for (j = 0; j < i; j++) t -= Li[j] * y[j];
-        y[i] = t / Li[i];
-    }
-    for (i = D - 1; i >= 0; i--) { /* L^T x = y' */
-        double t = y[i], Lii = L[(size_t)i * D + i];
-        if (Lii == 0.0) {
-            y[i] = 0.0;
-            continue;
-        }
-        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
-        y[i] = t / Lii;
-    }
+    heml__chol_forward(L, D, y);  /* L y' = y */
+    heml__chol_backward(L, D, y); /* L^T x = y' */
     for (i = 0; i < m->node_count; i++) { /* z += P y: per node t + w x rho on the free axes */
         const double *c = m->agg_centre + 3 * m->node_agg[i], *ya = y + 6 * m->node_agg[i];
         double rho[3], d[3];
@@ -5857,35 +5869,6 @@ static void heml__pagg_pc_lists(heml_model *m, const heml_desc *d)
                 if (i < W && list[i] < 0) list[i] = A; /* (i < W always: the width counted them) */
             }
         }
-}
-
-/* y = L^-1 y (forward) or L^-T y (backward) for a heml__coarse_factor factor L (D x D). */
-static void heml__chol_forward(const double *L, int D, double *y)
-{
-    int i, j;
-    for (i = 0; i < D; i++) {
-        const double *Li = L + (size_t)i * D;
-        double t = y[i];
-        if (Li[i] == 0.0) {
-            y[i] = 0.0;
-            continue;
-        }
-        for (j = 0; j < i; j++) t -= Li[j] * y[j];
-        y[i] = t / Li[i];
-    }
-}
-static void heml__chol_backward(const double *L, int D, double *y)
-{
-    int i, j;
-    for (i = D - 1; i >= 0; i--) {
-        double t = y[i], Lii = L[(size_t)i * D + i];
-        if (Lii == 0.0) {
-            y[i] = 0.0;
-            continue;
-        }
-        for (j = i + 1; j < D; j++) t -= L[(size_t)j * D + i] * y[j];
-        y[i] = t / Lii;
-    }
 }
 
 /* Whether a static Krylov solve may use the preconditioner: the model has it, and every
