@@ -22,7 +22,7 @@
       cheapest configuration reaching 10 %, 1 % and 0.1 % error.
    1b. race (>>race, alone with --parts race): frames (hexahedral, tetrahedral), heml.h's
       P1 Neo-Hookean and tensormass.h's linear tetrahedra refined level by level on R1 until
-      within 1 %, or --race-budget seconds each (default 40; --quick 0.5): issue 21's
+      within 1 %, or --race-budget seconds each (default 60; --quick 0.5): issue 21's
       same-run comparison. race.csv and a ratio line.
    2. stability: largest stable time step by bisection, Poisson ratio towards 0.5, a
       tetrahedron pushed through zero volume, a 180 degree twist, the scene 1e6 m from the
@@ -2237,7 +2237,7 @@ int main(int argc, char **argv)
         } else usage();
     }
     if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
-    if (o.race_budget < 0) o.race_budget = o.quick ? 0.5 : 40;
+    if (o.race_budget < 0) o.race_budget = o.quick ? 0.5 : 60;
     mkdir(o.out, 0755); /* may exist already; open_csv reports a real failure */
     read_environment();
     for (i = 0; i < (int)(sizeof registry / sizeof registry[0]); i++) {
