@@ -2,7 +2,7 @@
 
    make bench         the full run (about 11 minutes on 2 cores: 672 s on an AMD EPYC Zen 5, 2 vCPUs,
                       2026-12-02; trade 261, stability 67, sweep 104, time 26, coarse 6, kernels 207; the race,
-                      added since, 89-103 s on the Intel Xeon of README under a load of 5-9): bench/results/
+                      added since, 92 s on the Intel Xeon of README under a load of 8-9): bench/results/
    make bench-quick   the smallest sizes (about a minute: 58 s there): build/bench-quick/
 
    build/bench/bench [--quick] [--out DIR] [--parts trade,race,stability,sweep,time,coarse,kernels]
