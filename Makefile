@@ -4,7 +4,8 @@
 #                  line "N passed, N failed" (test cases summed over the matrix)
 #   make examples  the example programs, into build/examples/
 #   make bench     the speed/accuracy trade, stability and kernel throughput, written to
-#                  bench/results/ (about 11 minutes: 672 s on the Zen 5 of 2026-12-02)
+#                  bench/results/ (about 12 minutes: 672 s on the Zen 5 of 2026-12-02, before
+#                  the race part, which adds 92 s on the loaded Intel Xeon of README)
 #   make bench-quick  the same at the smallest sizes (about a minute: 58 s), to build/bench-quick/
 #   make clean     remove build/
 #

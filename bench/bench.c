@@ -1,11 +1,13 @@
 /* bench.c - what each model costs and how accurate it is, on this machine.
 
    make bench         the full run (about 11 minutes on 2 cores: 672 s on an AMD EPYC Zen 5, 2 vCPUs,
-                      2026-12-02; trade 261, stability 67, sweep 104, time 26, coarse 6, kernels 207): bench/results/
+                      2026-12-02; trade 261, stability 67, sweep 104, time 26, coarse 6, kernels 207; the race,
+                      added since, 92 s on the Intel Xeon of README under a load of 8-9): bench/results/
    make bench-quick   the smallest sizes (about a minute: 58 s there): build/bench-quick/
 
-   build/bench/bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,coarse,kernels]
+   build/bench/bench [--quick] [--out DIR] [--parts trade,race,stability,sweep,time,coarse,kernels]
                      [--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]
+                     [--race-budget SECONDS]
 
    --budget: a refinement series stops at the first level whose answer takes longer
    (default 2 s; law variants get a quarter). Raise it to see finer levels.
@@ -18,6 +20,10 @@
       model entry x resolution x integrator: DoF, seconds per step, seconds to the answer,
       error. trade.csv, one SVG per scene (error against time, Pareto front), and the
       cheapest configuration reaching 10 %, 1 % and 0.1 % error.
+   1b. race (>>race, alone with --parts race): frames (hexahedral, tetrahedral), heml.h's
+      P1 Neo-Hookean and tensormass.h's linear tetrahedra refined level by level on R1 until
+      within 1 %, or --race-budget seconds each (default 60; --quick 0.5): issue 21's
+      same-run comparison. race.csv and a ratio line.
    2. stability: largest stable time step by bisection, Poisson ratio towards 0.5, a
       tetrahedron pushed through zero volume, a 180 degree twist, the scene 1e6 m from the
       origin; each outcome classified. stability.csv. Then the stress sweep (>>sweep, also
@@ -102,8 +108,9 @@ typedef struct options {
     int quick, repeats, threads;
     const char *out, *filter;
     const char *scenes; /* --scenes: trade scenes to run (comma list of names; NULL: all) */
-    int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time, 32 coarse */
+    int parts; /* bits: 1 trade, 2 stability, 4 kernels, 8 sweep, 16 time, 32 coarse, 64 race */
     double budget; /* s: a configuration slower than this stops its refinement */
+    double race_budget; /* s: the race's per-entry budget (negative: the default) */
 } options;
 
 static char env_date[32], env_cpu[128], env_compiler[128];
@@ -344,26 +351,32 @@ static int series_done(const trade_row *r, int level_index, const bench_model *m
            r->answer_s * growth > 2 * budget_of(m, o);
 }
 
-/* R1: the steel cantilever 16 x 0.5 x 0.5 m under its own weight, static. */
+/* R1: the steel cantilever 16 x 0.5 x 0.5 m under its own weight, static, k cells across
+   (32k x k x k cells): the solve timed by timed_static (`repeats`), the tip deflection and
+   its error against the converged 3D solid of REFERENCES.md R1 (beam theory is 0.28 % off
+   it), into r. The trade part's R1 rows and the race. */
+static void r1_solve(const bench_model *m, int k, int repeats, trade_row *r)
+{
+    bench_body b = make_body(16, 0.5, 0.5, 32 * k, k, k, 200e9, 0.3, 7800);
+    void *sim = NULL;
+    r->reference = !strcmp(m->law, "linear") || !strcmp(m->law, "springs") ? 0.150169 : 0.150158;
+    r->status = timed_static(m, &b, repeats, &sim, r);
+    if (!r->status) {
+        r->value = tip_deflection(m, sim, &b);
+        r->error = relative_error(r->value, r->reference);
+    }
+    if (sim) m->destroy(sim);
+}
+
 static void trade_r1(const bench_model *m, const options *o)
 {
     static const int levels[] = {1, 2, 3, 4, 6, 8};
     int l, n = o->quick ? 1 : 6;
     if (!(m->integrators & BIT(BENCH_STATIC))) return;
     for (l = 0; l < n; l++) {
-        int k = levels[l];
-        bench_body b = make_body(16, 0.5, 0.5, 32 * k, k, k, 200e9, 0.3, 7800);
-        void *sim = NULL;
-        trade_row *r = new_row("R1", m, "static", k);
+        trade_row *r = new_row("R1", m, "static", levels[l]);
         if (!r) return;
-        /* the converged 3D solid, REFERENCES.md R1 (beam theory is 0.28 % off it) */
-        r->reference = !strcmp(m->law, "linear") || !strcmp(m->law, "springs") ? 0.150169 : 0.150158;
-        r->status = timed_static(m, &b, o->repeats, &sim, r);
-        if (!r->status) {
-            r->value = tip_deflection(m, sim, &b);
-            r->error = relative_error(r->value, r->reference);
-        }
-        if (sim) m->destroy(sim);
+        r1_solve(m, levels[l], o->repeats, r);
         print_row(r);
         if (series_done(r, l, m, o, levels, n)) break;
     }
@@ -883,6 +896,119 @@ static void run_trade(const options *o, const bench_model *const *models, int co
     fclose(f);
     for (s = 0; s < (int)(sizeof scenes / sizeof scenes[0]); s++) plot_scene(o, scenes + s);
     print_cheapest();
+}
+
+/* >>race: issue 21's same-run comparison on R1. Each entry below refines through
+   race_levels (cells across: one at a time to 6, then two at a time, then four; one static
+   solve per level, r1_solve, judged as the trade part judges R1) until its error is within
+   1 %, or its budget (--race-budget, seconds of setup + solve summed over its levels) is
+   spent or would be by the next level (predicted from the last level's seconds, times the
+   larger of the cells' growth and the growth from the level before, extrapolated as a power
+   of the cells across: tensor-mass's solves grew 4.8x from 10 to 12 cells, and the cells'
+   growth alone let a 77 s solve start past a 60 s budget), or a solve fails past the
+   coarsest level. The row kept
+   is the first level within 1 %, else the most accurate one: its solve's seconds (the mesh
+   known beforehand) and the seconds summed up to it (found by refining). race.csv and a
+   ratio line: heml.h's P1 tetrahedra over each frames entry. One run each, no repeats: on a
+   busy machine the seconds are as noisy as the load. */
+
+static const char *const race_entries[][2] = {
+    {"frames", "svk hex8"}, {"frames", "svk tet4"}, {"heml", "neo-hookean"}, {"tensormass", "linear"}};
+#define RACE_COUNT ((int)(sizeof race_entries / sizeof race_entries[0]))
+static const int race_levels[] = {1, 2, 3, 4, 5, 6, 8, 10, 12, 14, 16, 20, 24, 28, 32};
+#define RACE_LEVELS ((int)(sizeof race_levels / sizeof race_levels[0]))
+#define RACE_GOAL 0.01
+
+typedef struct race_result {
+    trade_row row;      /* the first level within RACE_GOAL, else the most accurate */
+    double cumulative;  /* s: setup + solve summed over the levels up to row's */
+    const char *outcome; /* "reached", "budget", "failed" */
+} race_result;
+
+static void race_entry(const bench_model *m, const options *o, race_result *out)
+{
+    double spent = 0, prev_s = 0;
+    int l;
+    memset(out, 0, sizeof *out);
+    out->row.error = HUGE_VAL;
+    out->outcome = "budget";
+    for (l = 0; l < RACE_LEVELS; l++) {
+        int k = race_levels[l];
+        trade_row r;
+        double level_s;
+        memset(&r, 0, sizeof r);
+        strcpy(r.scene, "race");
+        strcpy(r.setting, "static");
+        r.m = m;
+        r.level = k;
+        r.error = r.value = r.measured = NAN;
+        r1_solve(m, k, 1, &r);
+        print_row(&r);
+        level_s = r.setup_s + r.answer_s;
+        spent += level_s;
+        if (!r.status && r.error < out->row.error) out->row = r, out->cumulative = spent;
+        if (!r.status && r.error <= RACE_GOAL) {
+            out->outcome = "reached";
+            return;
+        }
+        if (r.status && k > 1) {
+            out->outcome = "failed";
+            return;
+        }
+        if (l + 1 == RACE_LEVELS) return;
+        {
+            double step = log((double)race_levels[l + 1] / k), growth = exp(3 * step);
+            if (l > 0 && prev_s > 0)
+                growth = fmax(growth, pow(level_s / prev_s, step / log((double)k / race_levels[l - 1])));
+            if (spent + level_s * growth > o->race_budget) return;
+        }
+        prev_s = level_s;
+    }
+}
+
+static void run_race(const options *o, const bench_model *const *models, int count)
+{
+    race_result res[RACE_COUNT];
+    const bench_model *entry[RACE_COUNT];
+    FILE *f;
+    int e, i;
+    printf("\n== race: R1 to 1 %% (issue 21), each entry refined until within 1 %% or %g s spent ==\n",
+           o->race_budget);
+    f = open_csv(o, "race.csv",
+                 "model,variant,precision,budget_s,outcome,level,dof,error,value,reference,setup_s,solve_s,"
+                 "cumulative_s");
+    for (e = 0; e < RACE_COUNT; e++) {
+        entry[e] = NULL;
+        for (i = 0; i < count && !entry[e]; i++)
+            if (!strcmp(models[i]->model, race_entries[e][0]) && !strcmp(models[i]->variant, race_entries[e][1]) &&
+                !strcmp(models[i]->precision, "double") && (models[i]->integrators & BIT(BENCH_STATIC)))
+                entry[e] = models[i];
+        if (!entry[e]) continue;
+        race_entry(entry[e], o, res + e);
+        printf("  race %s %s: %s", entry[e]->model, entry[e]->variant,
+               !strcmp(res[e].outcome, "reached") ? "within 1 %" : "NOT within 1 %, best");
+        if (res[e].row.dof)
+            printf(" at %d cells across (%d dof): error %.3g %%, solve %.3g s, summed %.3g s", res[e].row.level,
+                   res[e].row.dof, 100 * res[e].row.error, res[e].row.answer_s, res[e].cumulative);
+        printf(" (%s)\n", res[e].outcome);
+        csv_prefix(f);
+        fprintf(f, "%s,%s,%s,%g,%s,%d,%d,%.6g,%.9g,%.9g,%.6g,%.6g,%.6g\n", entry[e]->model, entry[e]->variant,
+                entry[e]->precision, o->race_budget, res[e].outcome, res[e].row.level, res[e].row.dof,
+                res[e].row.error, res[e].row.value, res[e].row.reference, res[e].row.setup_s, res[e].row.answer_s,
+                res[e].cumulative);
+    }
+    fclose(f);
+    /* heml neo-hookean (entry 2) against each frames entry (0, 1) */
+    for (e = 0; e < 2; e++) {
+        const race_result *p = res + 2, *q = res + e;
+        int p_in = entry[2] && !strcmp(p->outcome, "reached");
+        if (!entry[2] || !entry[e] || strcmp(q->outcome, "reached") || !strcmp(p->outcome, "failed")) continue;
+        printf("  race ratio, time to 1 %%, heml neo-hookean P1 / frames %s: solve %s%.3g (%.3g s / %.3g s), "
+               "summed %s%.3g (%.3g s / %.3g s)\n",
+               entry[e]->variant, p_in ? "" : ">= ", p->row.answer_s / q->row.answer_s, p->row.answer_s,
+               q->row.answer_s, p_in ? "" : ">= ", (p_in ? p->cumulative : o->race_budget) / q->cumulative,
+               p_in ? p->cumulative : o->race_budget, q->cumulative);
+    }
 }
 
 /* >>stability */
@@ -2083,8 +2209,9 @@ static void run_kernels(const options *o, const bench_model *const *models_in, i
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,stability,sweep,time,coarse,kernels] [--filter TEXT] "
-                    "[--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS]\n");
+    fprintf(stderr, "usage: bench [--quick] [--out DIR] [--parts trade,race,stability,sweep,time,coarse,kernels] "
+                    "[--filter TEXT] [--scenes R1,R3,...] [--repeats N] [--threads N] [--budget SECONDS] "
+                    "[--race-budget SECONDS]\n");
     exit(2);
 }
 
@@ -2093,13 +2220,15 @@ int main(int argc, char **argv)
     options o;
     static const bench_model *models[256], *variants[64];
     int i, count = 0, variant_count = 0;
-    double t0 = now(), tp, part_time[6] = {0, 0, 0, 0, 0, 0}; /* trade, stability, sweep, time, kernels, coarse */
+    /* trade, stability, sweep, time, kernels, coarse, race */
+    double t0 = now(), tp, part_time[7] = {0, 0, 0, 0, 0, 0, 0};
     memset(&o, 0, sizeof o);
     o.repeats = 3;
     o.threads = 2;
     o.out = "bench/results";
-    o.parts = 63;
+    o.parts = 127;
     o.budget = 2;
+    o.race_budget = -1;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) o.quick = 1;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
@@ -2107,14 +2236,17 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--scenes") && i + 1 < argc) o.scenes = argv[++i];
         else if (!strcmp(argv[i], "--repeats") && i + 1 < argc) o.repeats = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--budget") && i + 1 < argc) o.budget = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--race-budget") && i + 1 < argc) o.race_budget = atof(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--parts") && i + 1 < argc) {
             const char *p = argv[++i];
             o.parts = (strstr(p, "trade") ? 1 : 0) | (strstr(p, "stability") ? 2 | 8 : 0) | (strstr(p, "kernels") ? 4 : 0) |
-                      (strstr(p, "sweep") ? 8 : 0) | (strstr(p, "time") ? 16 : 0) | (strstr(p, "coarse") ? 32 : 0);
+                      (strstr(p, "sweep") ? 8 : 0) | (strstr(p, "time") ? 16 : 0) | (strstr(p, "coarse") ? 32 : 0) |
+                      (strstr(p, "race") ? 64 : 0);
         } else usage();
     }
     if (o.repeats < 1 || o.threads < 1 || o.threads > 2 || !o.parts) usage();
+    if (o.race_budget < 0) o.race_budget = o.quick ? 0.5 : 60;
     mkdir(o.out, 0755); /* may exist already; open_csv reports a real failure */
     read_environment();
     for (i = 0; i < (int)(sizeof registry / sizeof registry[0]); i++) {
@@ -2140,6 +2272,7 @@ int main(int argc, char **argv)
     set_threads(1);
     tp = now();
     if (o.parts & 1) run_trade(&o, models, count, variants, variant_count), part_time[0] = now() - tp, tp = now();
+    if (o.parts & 64) run_race(&o, models, count), part_time[6] = now() - tp, tp = now();
     set_threads(1);
     if (o.parts & 2) run_stability(&o, models, count, variants, variant_count), part_time[1] = now() - tp, tp = now();
     set_threads(1);
@@ -2162,8 +2295,8 @@ int main(int argc, char **argv)
         run_kernels(&o, all, n);
     }
     if (o.parts & 4) run_chain(&o), part_time[4] = now() - tp;
-    printf("\nbench: done in %.0f s (trade %.0f, stability %.0f, sweep %.0f, time %.0f, coarse %.0f, kernels %.0f); "
-           "results in %s/\n", now() - t0, part_time[0], part_time[1], part_time[2], part_time[3], part_time[5],
-           part_time[4], o.out);
+    printf("\nbench: done in %.0f s (trade %.0f, race %.0f, stability %.0f, sweep %.0f, time %.0f, coarse %.0f, "
+           "kernels %.0f); results in %s/\n", now() - t0, part_time[0], part_time[6], part_time[1], part_time[2],
+           part_time[3], part_time[5], part_time[4], o.out);
     return 0;
 }

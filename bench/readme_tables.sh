@@ -20,6 +20,8 @@
 # 5. the kernel ratios (kernels.csv, where it has the K*v-csr rows, issue 21): per model entry
 #    and size, 1 thread, the force's share of its bandwidth bound, the force over its
 #    arithmetic floor (arith rows), the differential over the CSR product.
+# 6. the race to 1 % on R1 (race.csv, issue 21): per entry, where it first came within 1 %
+#    (or its best within the budget), the solve's and the summed seconds.
 # Errors are as the bench wrote them: R1 and R3 against the converged 3D solid, R3's
 # frequency corrected for the integrator's phase error (bench.c, integrator_frequency).
 # The prose around the tables quotes figures from them: check it after regenerating.
@@ -253,4 +255,27 @@ if [ -r "$dir/kernels.csv" ] && grep -q ',K\*v-csr,' "$dir/kernels.csv"; then
             printf "| %s | %d | %.1f | %.0f %% | %s | %.1f | %.2f |\n", p[1], p[2], f, 100 * bound[k] / f, fa, kv, kv / c
         }
     }' "$dir/kernels.csv"
+fi
+
+if [ -r "$dir/race.csv" ]; then
+    echo
+    echo "The race to 1 % on R1 (\`race.csv\`, one run, one thread: each entry refined level by level,"
+    echo "1 to 6 cells across, then 8, 10, ..., until within 1 % of the 3D solid or its budget spent;"
+    echo "the solve's seconds, and every level's setup and solve summed up to it):"
+    echo
+    awk -F, "$helpers"'
+    NR == 1 {
+        for (i = 1; i <= NF; i++) col[$i] = i
+        print "| race entry (R1, double) | within 1 % | cells across (DoF) | error | solve | summed |"
+        print "| --- | --- | --- | --- | --- | --- |"
+        next
+    }
+    {
+        o = $col["outcome"]
+        within = o == "reached" ? "yes" : "no (" (o == "budget" ? "budget " $col["budget_s"] " s" : o) "): best"
+        name = $col["model"] " " $col["variant"]
+        if ($col["dof"] + 0 == 0) { printf "| %s | %s | - | - | - | - |\n", name, within; next }
+        printf "| %s | %s | %d (%d) | %s | %s | %s |\n", name, within, $col["level"], $col["dof"], pct($col["error"]),
+               dur($col["solve_s"]), dur($col["cumulative_s"])
+    }' "$dir/race.csv"
 fi
