@@ -487,7 +487,12 @@
        float 11.04 and 10.44 against 7.52 (1.47, 1.39), before 12.26 and 11.64 against 7.47
        (1.64, 1.56). Beyond the caches (24,576 and 105,456 tetrahedra, min of 5 interleaved
        runs, noisy at this load) no loss measured from the kept H (72 bytes per tetrahedron
-       written and read again): 19.0 and 38.8 ns against 18.7 and 46.6 before. The results
+       written and read again): 19.0 and 38.8 ns against 18.7 and 46.6 before. The bench's
+       rows (build/bench/bench --quick --parts kernels --filter heml/neo-hookean --repeats
+       5, 21 runs of each build interleaved, same machine at load 6 to 10) spread 2 to 5
+       times between runs (medians of time slices): their minima, 15.6 ns for nodal-p
+       double against 11.4 plain, 14.4 nodal-agg, are no measure of the ratio at that
+       load; the timing above is. The results
        are those of the code before bit for bit (forces, differential, energy and nodal
        pressures of a two-material Neo-Hookean and Mooney-Rivlin body, both splits,
        nodal_pressure 1 and 2, double and float; tests/test_heml.c
