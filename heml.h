@@ -498,8 +498,8 @@
        nodal_pressure 1 and 2, double and float; tests/test_heml.c
        test_nodal_pressure_kept_h checks the nodal J against a plain computation and the
        kept path against the gathered one). Memory: with a fast_nodal law in use, 9 reals
-       per tetrahedron slot more (the kept H). Before the fast path (the general path: heml__kinematics, the law,
-       heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
+       per tetrahedron slot more (the kept H). Before the fast path (the general path:
+       heml__kinematics, the law, heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
        the sums in a loop with a branch that did not vectorise): force 500 (476),
        differential 730 (705). Tried and dropped here: the sums pass without its
        coloured read-modify-write scatter, each tetrahedron's term stored (plain stores) at

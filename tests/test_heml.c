@@ -1734,7 +1734,8 @@ static void test_nodal_pressure_kept_h(void)
                 heml_model *m = make_model_mt(&mesh, &mt, 1, NULL);
                 int n = mesh.node_count, n3 = 3 * n, i, t, kept = 0;
                 double *x = (double *)malloc(sizeof(double) * n3), *ja = (double *)calloc((size_t)n, sizeof(double));
-                double *va = (double *)calloc((size_t)n, sizeof(double)), jerr = 0.0, ferr = 0.0, fmax = 0.0, serr = 0.0, smax = 0.0;
+                double *va = (double *)calloc((size_t)n, sizeof(double));
+                double jerr = 0.0, ferr = 0.0, fmax = 0.0, serr = 0.0, smax = 0.0;
                 heml_real *f1 = alloc_reals(n3), s1[9], s2[9];
                 const heml_real *f, *u;
                 REQUIRE(m != NULL && x && ja && va);
@@ -1757,10 +1758,10 @@ static void test_nodal_pressure_kept_h(void)
                             E[j][r] = mesh.nodes[3 * q[j + 1] + r] - mesh.nodes[3 * q[0] + r];
                             e[j][r] = E[j][r] + ((double)u[3 * q[j + 1] + r] - (double)u[3 * q[0] + r]);
                         }
-                    v0 = E[0][0] * (E[1][1] * E[2][2] - E[1][2] * E[2][1]) - E[0][1] * (E[1][0] * E[2][2] - E[1][2] * E[2][0]) +
-                         E[0][2] * (E[1][0] * E[2][1] - E[1][1] * E[2][0]);
-                    v1 = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+                    v0 = E[0][0] * (E[1][1] * E[2][2] - E[1][2] * E[2][1]) -
+                         E[0][1] * (E[1][0] * E[2][2] - E[1][2] * E[2][0]) + E[0][2] * (E[1][0] * E[2][1] - E[1][1] * E[2][0]);
+                    v1 = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
                     for (j = 0; j < 4; j++) {
                         ja[q[j]] += v0 / 6 * (v1 / v0 - 1);
                         va[q[j]] += v0 / 6;
