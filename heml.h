@@ -477,8 +477,9 @@
        sums pass, 72 instructions, 0.45 of the plain force alone: the nodal pressure needs
        every tetrahedron's J before any element's force, so the displacements are
        gathered, H formed and J - 1 scattered in a pass of their own; keeping H saves the
-       second gather and H, not that pass. The differential is unchanged: 590 against the
-       plain cached product's 134 (581 for nodal_pressure = 2).
+       second gather and H, not that pass. The differential (its sums pass the same but
+       for the prefetch): 588 (590 before) against the plain cached product's 134 (579,
+       581 before, for nodal_pressure = 2).
        Timed (Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs at load 7 to 9; gcc 12 -O3
        -march=native -ffp-contract=fast, a 6 x 6 x 6 box of six: 1,296 tetrahedra, one
        thread, min over 12 interleaved runs of 20 rounds of 100 forces, against git
