@@ -372,8 +372,9 @@
        fast-path flag (heml__mat.fast_nodal: Neo-Hookean, its incompressible form,
        incompressible Mooney-Rivlin with c2 = 0; no Prony) runs the vectorised Neo-Hookean
        kernel with w_J - U'(J_e) = -2 c1 J^(-1/3) in closed form and the nodes' mean
-       pressure gathered into it (heml__nh_nodal_s0), and its node pass U', U'' in closed
-       form (heml__dilation_nh); its energy and differential, and every other law, the
+       pressure gathered into it (heml__nh_nodal_s0), on the H its sums pass kept
+       (heml__nodal_sums_keep, heml__forces_nh_kept: "Cost" below), and its node pass U',
+       U'' in closed form (heml__dilation_nh); its energy and differential, and every other law, the
        general path. Prony: the nodal pressure enters w_J
        before the filter, so it relaxes with the rest of the stress. Inversion: the
        continued U is restoring below J0 at the nodes; a single tetrahedron's own
@@ -458,33 +459,59 @@
        N = 6 and 9 agree within half a point, +1.7, +1.3, +1.3 %). So the issue's 2-point
        target on the bench's beam (3 cells across: 8.1 points at 0.49, 11.5 at 0.499) is
        not met, and would be from about 15 cells across.
-       Cost (callgrind --dump-instr=no, gcc 12 -O3 -mavx2 -mfma, double, a 12 x 12 x 3 box
-       of six: 2,592 tetrahedra, 676 nodes, Neo-Hookean, 100 heml_compute_forces or
-       heml_apply_stiffness less the creation; instructions per tetrahedron and pass):
-       force 256 against 158 for the plain force (1.62 times; nodal_pressure = 2: 248,
-       1.57), differential 590 against the plain cached product's 134 (581 for
-       nodal_pressure = 2). Where the force's go: the element pass 81 (the plain kernel's
-       70 plus the cube root and the gather of the four pressures) + gather 24 + scatter 47;
-       the sums pass 24 (its gather) + 26 (H and J - 1 again) + 20 (the scalar scatter to
-       the four nodes); the node pass 14. What bounds it above 1.3: the sums pass, 70
-       instructions, 0.44 of the plain force alone: the nodal pressure needs every
-       tetrahedron's J before any element's force, so the displacements are gathered and
-       H formed twice; the issue's "one more scalar gather and scatter" leaves that out.
-       Timed (Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs at load 7; gcc -O3
-       -march=native -ffp-contract=fast, 1,080 tetrahedra, one thread, min of 240 rounds
-       of 200 forces, interleaved with the previous code): double 17.2 ns per tetrahedron
-       against the plain 10.0 (1.71 times; nodal_pressure = 2: 15.9, 1.58), before 29.5
-       and 27.0 (2.95 and 2.70 times); float 12.5 against 7.6 (1.64; 12.0, 1.57), before
-       18.5 and 17.3 (2.48 and 2.32); the bench (build/bench/bench --quick --parts kernels
-       --filter heml/neo-hookean --repeats 5, same machine, best of 4 runs): force 19.2 and
-       17.2 ns against 11.3 in double (1.70, 1.52), 13.6 and 13.6 against 8.6 in float
-       (1.57). Before (the general path: heml__kinematics, the law,
-       heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
+       Cost (callgrind --dump-instr=no, gcc 12 -O3 -mavx2 -mfma (GNU C, so -ffp-contract=
+       fast), a 12 x 12 x 3 box of six: 2,592 tetrahedra, 676 nodes, Neo-Hookean, 100
+       heml_compute_forces or heml_apply_stiffness less the creation; instructions per
+       tetrahedron and pass): force 225 against 160 for the plain force in double (1.41
+       times; nodal_pressure = 2: 217, 1.36), 177 and 173 against 123 in float (1.44, 1.41);
+       with -std=c99 (no contraction) 243 and 234 against 176 in double (1.38, 1.33), 185
+       and 181 against 131 in float (1.41, 1.38). Before this (git f754a39: H formed again in
+       the element pass from a second gather): 256 and 249 against 159 (1.62, 1.57), float
+       201 and 197 against 123 (1.63, 1.60). Where the force's go now (double): the sums
+       pass (heml__nodal_tets, coloured as the force pass) 24 for the gather + 28 for H and
+       J - 1, H stored per slot (heml__nodal_sums_keep) + 20 for the scalar scatter to the
+       four nodes; the node pass 14; the element pass (heml__forces_nh_kept) 72, as the
+       plain kernel's 72 but without a gather (it reads the kept H; the cube root and the
+       gather of the four pressures, heml__nh_nodal_s0, 26, in place of the logarithm),
+       + the scatter 47 as the plain force's. What bounds it above 1.3 (207 in double): the
+       sums pass, 72 instructions, 0.45 of the plain force alone: the nodal pressure needs
+       every tetrahedron's J before any element's force, so the displacements are
+       gathered, H formed and J - 1 scattered in a pass of their own; keeping H saves the
+       second gather and H, not that pass. The differential (its sums pass the same but
+       for the prefetch): 588 (590 before) against the plain cached product's 134 (579,
+       581 before, for nodal_pressure = 2).
+       Timed (Intel Xeon, Sapphire Rapids class, KVM, 2 vCPUs at load 7 to 9; gcc 12 -O3
+       -march=native -ffp-contract=fast, a 6 x 6 x 6 box of six: 1,296 tetrahedra, one
+       thread, min over 12 interleaved runs of 20 rounds of 100 forces, against git
+       f754a39): double 14.95 ns per tetrahedron against the plain 9.92 (1.51 times;
+       nodal_pressure = 2: 13.87, 1.40), before 16.75 and 15.61 against 9.88 (1.69, 1.58);
+       float 11.04 and 10.44 against 7.52 (1.47, 1.39), before 12.26 and 11.64 against 7.47
+       (1.64, 1.56). Beyond the caches (24,576 and 105,456 tetrahedra, min of 5 interleaved
+       runs, noisy at this load) no loss measured from the kept H (72 bytes per tetrahedron
+       written and read again): 19.0 and 38.8 ns against 18.7 and 46.6 before. The bench's
+       rows (build/bench/bench --quick --parts kernels --filter heml/neo-hookean --repeats
+       5, 21 runs of each build interleaved, same machine at load 6 to 10) spread 2 to 5
+       times between runs (medians of time slices): their minima, 15.6 ns for nodal-p
+       double against 11.4 plain, 14.4 nodal-agg, are no measure of the ratio at that
+       load; the timing above is. The results
+       are those of the code before bit for bit (forces, differential, energy and nodal
+       pressures of a two-material Neo-Hookean and Mooney-Rivlin body, both splits,
+       nodal_pressure 1 and 2, double and float; tests/test_heml.c
+       test_nodal_pressure_kept_h checks the nodal J against a plain computation and the
+       kept path against the gathered one). Memory: with a fast_nodal law in use, 9 reals
+       per tetrahedron slot more (the kept H). Before the fast path (the general path:
+       heml__kinematics, the law, heml__dilation's Halley root and the law again at every element, heml__pk1_forces;
        the sums in a loop with a branch that did not vectorise): force 500 (476),
-       differential 730 (705). Not done: keeping H from the sums pass for the element
-       pass (9 reals per tetrahedron more, stored and read back; would save the second
-       gather and H, about 30 instructions, in cache, and cost bandwidth beyond it). Tried
-       and reverted (branch anpcost, commit 9d4b379): the differential on the Neo-Hookean
+       differential 730 (705). Tried and dropped here: the sums pass without its
+       coloured read-modify-write scatter, each tetrahedron's term stored (plain stores) at
+       precomputed places of a node-major table (rows per 16 nodes, padded with zeros,
+       each node's terms in the coloured pass's order: the same sums bit for bit, any
+       order of the tetrahedra) and the rows summed by a vectorised loop: no faster (15.6
+       against 15.1 ns per tetrahedron with H kept, the stores costing what the scatter
+       did) for 4 ints and about 11 reals per tetrahedron more; summing per node over a
+       list of slots instead (CSR order, scalar loads): 1.8 ns per tetrahedron for those
+       sums alone, slower than the scatter (gcc 12 generates no gathers for it here).
+       Tried and reverted (branch anpcost, commit 9d4b379): the differential on the Neo-Hookean
        product with the stiffness cache (w_J as the force's, w_JJ = (2/3) c1 J^(-4/3), dp_e
        / 6 times the cofactor links): exact (against the general path 1.5e-15 in double,
        1.6e-6 in float; the finite-difference tests pass; cached and uncached bit for bit),
@@ -2149,7 +2176,6 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__ABS 5          /* sum of |tetrahedron force| per dof (the round-off floor) */
 #define HEML__DC_FILL 1      /* m->dc_pass: the DIFF pass fills the stiffness cache, */
 #define HEML__DC_USE 2       /* or reads it (heml__diff_run) */
-#define HEML__NODAL_SUMS 6   /* the nodal pressure's sums of Vol (J - 1) / 4 (and Vol dJ / 4) */
 
 /* A material in kernel form. */
 typedef struct heml__mat {
@@ -2161,7 +2187,8 @@ typedef struct heml__mat {
     int fast_mr;                 /* split Mooney-Rivlin without Prony or the nodal pressure: the
                                     force kernel heml__forces_mr */
     int fast_nodal;              /* fast, with desc.nodal_pressure (fast is then 0): the force
-                                    kernel heml__forces_nh with the nodal pressure, and the node
+                                    kernel heml__forces_nh with the nodal pressure (in a force
+                                    pass heml__forces_nh_kept, on the sums' kept H), and the node
                                     pass's heml__dilation_nh (NEAR-INCOMPRESSIBLE BODIES) */
     heml_law law;
     const struct heml__law_ops *ops; /* its law's row of heml__laws */
@@ -2321,6 +2348,12 @@ struct heml_model {
        and sum Vol_e dJ_e / 4 of the current pass, the nodal pressure P_a and its
        differential dP_a; per node chunk its energy */
     heml_real *nod_w, *nod_inv, *nod_j, *nod_dj, *nod_p, *nod_dp;
+    /* with a heml__mat.fast_nodal material in use (nod_keep_h): the force's sums keep each
+       slot's H = grad u (9 rows of HEML__W per block) in tet_h for the element pass of the
+       same pass (heml__forces_nh_kept), nod_hx the x they were formed at, NULL outside that pass */
+    int nod_keep_h;
+    heml_real *tet_h;
+    const heml_real *nod_hx;
     /* nodal_pressure = 2: the pressure aggregates (heml__pressure_aggregates): count, node
        -> aggregate (-1: a node of no tetrahedron), and the node pass's arrays per aggregate
        (weights per material and aggregate, 1 / V_A, the sums, P_A and dP_A) */
@@ -3512,6 +3545,48 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
     heml__p_times_grad(R, b);
 }
 
+/* heml__forces_nh with the nodal pressure on H kept by this pass's sums (heml__nodal_sums_keep,
+   Hk: 9 rows of HEML__W; NEAR-INCOMPRESSIBLE BODIES, "Cost"): no gather and no H, J - 1
+   formed from Hk as there, then heml__nh_nodal_s0 and the same stress and forces. A copy of
+   heml__forces_nh's stages rather than a pointer into them: the plain kernel's code stays
+   as it was (reading H through a pointer there cost it 3 instructions per tetrahedron). */
+static void heml__forces_nh_kept(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                                 const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
+                                 const heml_real *HEML__RESTRICT Hk, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0;
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real H00 = Hk[k], H01 = Hk[HEML__W + k], H02 = Hk[2 * HEML__W + k];
+        heml_real H10 = Hk[3 * HEML__W + k], H11 = Hk[4 * HEML__W + k], H12 = Hk[5 * HEML__W + k];
+        heml_real H20 = Hk[6 * HEML__W + k], H21 = Hk[7 * HEML__W + k], H22 = Hk[8 * HEML__W + k];
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+        b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
+    }
+    heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
+    for (k = 0; k < HEML__W; k++) {
+        heml_real H00 = Hk[k], H01 = Hk[HEML__W + k], H02 = Hk[2 * HEML__W + k];
+        heml_real H10 = Hk[3 * HEML__W + k], H11 = Hk[4 * HEML__W + k], H12 = Hk[5 * HEML__W + k];
+        heml_real H20 = Hk[6 * HEML__W + k], H21 = Hk[7 * HEML__W + k], H22 = Hk[8 * HEML__W + k];
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
+        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
+        heml_real vol = R[9 * HEML__W + k], s0 = b->s0[k], tr = H00 + H11 + H22;
+        heml_real mv = mu * vol, wv = (s0 - p0) * vol, dv = s0 * vol + wv * tr, ev = mv - wv;
+        b->K[0][k] = dv + ev * H00 + wv * c00;
+        b->K[4][k] = dv + ev * H11 + wv * c11;
+        b->K[8][k] = dv + ev * H22 + wv * c22;
+        b->K[1][k] = mv * H01 + wv * (c01 - H10);
+        b->K[2][k] = mv * H02 + wv * (c02 - H20);
+        b->K[3][k] = mv * H10 + wv * (c10 - H01);
+        b->K[5][k] = mv * H12 + wv * (c12 - H21);
+        b->K[6][k] = mv * H20 + wv * (c20 - H02);
+        b->K[7][k] = mv * H21 + wv * (c21 - H12);
+    }
+    heml__p_times_grad(R, b);
+}
+
 /* The split Mooney-Rivlin force kernel (heml__law_split without Prony or the nodal
    pressure: heml__mat.fast_mr), in stages as heml__forces_nh: H, J - 1, C - I and the
    invariants (heml__kinematics' formulas; H and C - I kept, cof F - I formed again later
@@ -4081,6 +4156,10 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
 {
     const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
     const heml_real *HEML__RESTRICT R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+    if (mt->fast_nodal && !want_energy && u == m->nod_hx) { /* (H kept by this pass's sums) */
+        heml__forces_nh_kept(mt, m->jm1_0, R, m->nod_p, idx, m->tet_h + (size_t)blk * 9 * HEML__W, b);
+        return 0.0;
+    }
     heml__gather(m, idx, u, b->e);
     if (mt->kind == HEML__K_SPRING) {
         heml__spring_rest_links(R, b);
@@ -4311,9 +4390,39 @@ static int heml__lane_stress(const heml_model *m, int blk, int k, const heml__bl
     return !(J > 0.0);
 }
 
-/* The nodal pressure's first pass on a block: Vol (J - 1) / 4 into b->jm1 and, with_d,
-   Vol dJ / 4 = Vol cof F : dH / 4 into b->dp (J - 1 formed as in heml__kinematics). */
-static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b, int with_d)
+/* heml__nodal_sums without dJ, keeping H = grad u (9 rows) in Hk for the element pass
+   (heml__forces_nh_kept; heml__forces_nh's expressions, so the same H). */
+static void heml__nodal_sums_keep(const heml_real *HEML__RESTRICT R, const heml__blk *HEML__RESTRICT b,
+                                  heml_real *HEML__RESTRICT jq, heml_real *HEML__RESTRICT Hk)
+{
+    int k;
+    for (k = 0; k < HEML__W; k++) {
+        heml_real g10 = R[k], g11 = R[HEML__W + k], g12 = R[2 * HEML__W + k];
+        heml_real g20 = R[3 * HEML__W + k], g21 = R[4 * HEML__W + k], g22 = R[5 * HEML__W + k];
+        heml_real g30 = R[6 * HEML__W + k], g31 = R[7 * HEML__W + k], g32 = R[8 * HEML__W + k];
+        heml_real q = R[9 * HEML__W + k] / 4;
+        heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
+        heml_real b0 = b->e[3][k], b1 = b->e[4][k], b2 = b->e[5][k];
+        heml_real d0 = b->e[6][k], d1 = b->e[7][k], d2 = b->e[8][k];
+        heml_real H00 = a0 * g10 + b0 * g20 + d0 * g30, H01 = a0 * g11 + b0 * g21 + d0 * g31;
+        heml_real H02 = a0 * g12 + b0 * g22 + d0 * g32, H10 = a1 * g10 + b1 * g20 + d1 * g30;
+        heml_real H11 = a1 * g11 + b1 * g21 + d1 * g31, H12 = a1 * g12 + b1 * g22 + d1 * g32;
+        heml_real H20 = a2 * g10 + b2 * g20 + d2 * g30, H21 = a2 * g11 + b2 * g21 + d2 * g31;
+        heml_real H22 = a2 * g12 + b2 * g22 + d2 * g32;
+        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
+        heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
+        heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
+        jq[k] = q * (tr + i2 + det);
+        Hk[k] = H00, Hk[HEML__W + k] = H01, Hk[2 * HEML__W + k] = H02;
+        Hk[3 * HEML__W + k] = H10, Hk[4 * HEML__W + k] = H11, Hk[5 * HEML__W + k] = H12;
+        Hk[6 * HEML__W + k] = H20, Hk[7 * HEML__W + k] = H21, Hk[8 * HEML__W + k] = H22;
+    }
+}
+
+/* The nodal pressure's first pass on a block: Vol (J - 1) / 4 into jq and, with_d,
+   Vol dJ / 4 = Vol cof F : dH / 4 into dq (J - 1 formed as in heml__kinematics). */
+static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, const heml__blk *HEML__RESTRICT b, int with_d,
+                             heml_real *HEML__RESTRICT jq, heml_real *HEML__RESTRICT dq)
 {
     int k;
     if (!with_d) { /* (a loop of its own, without the branch: it vectorises) */
@@ -4333,7 +4442,7 @@ static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
             heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
             heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
             heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
-            b->jm1[k] = q * (tr + i2 + det);
+            jq[k] = q * (tr + i2 + det);
         }
         return;
     }
@@ -4354,7 +4463,7 @@ static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
         heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
         heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
         heml_real tr = H00 + H11 + H22, i2 = c00 + c11 + c22, det = H00 * c00 + H01 * c01 + H02 * c02;
-        b->jm1[k] = q * (tr + i2 + det);
+        jq[k] = q * (tr + i2 + det);
         { /* (with_d) cof F = (tr H + 1) I - H^T + cof H */
             heml_real x0 = b->de[0][k], x1 = b->de[1][k], x2 = b->de[2][k];
             heml_real y0 = b->de[3][k], y1 = b->de[4][k], y2 = b->de[5][k];
@@ -4364,7 +4473,7 @@ static void heml__nodal_sums(const heml_real *HEML__RESTRICT R, heml__blk *HEML_
             heml_real D11 = x1 * g11 + y1 * g21 + z1 * g31, D12 = x1 * g12 + y1 * g22 + z1 * g32;
             heml_real D20 = x2 * g10 + y2 * g20 + z2 * g30, D21 = x2 * g11 + y2 * g21 + z2 * g31;
             heml_real D22 = x2 * g12 + y2 * g22 + z2 * g32, t1 = 1 + tr;
-            b->dp[k] = q * ((t1 - H00 + c00) * D00 + (c01 - H10) * D01 + (c02 - H20) * D02 + (c10 - H01) * D10 +
+            dq[k] = q * ((t1 - H00 + c00) * D00 + (c01 - H10) * D01 + (c02 - H20) * D02 + (c10 - H01) * D10 +
                             (t1 - H11 + c11) * D11 + (c12 - H21) * D12 + (c20 - H02) * D20 + (c21 - H12) * D21 +
                             (t1 - H22 + c22) * D22);
         }
@@ -4516,13 +4625,6 @@ static void heml__chunks(void *vctx, int begin, int end)
                 heml__block_forces(m, mt, blk, p->x, &b, 0, 0);
                 heml__scatter_abs(idx, b.f, p->out);
                 break;
-            case HEML__NODAL_SUMS:
-                heml__gather(m, idx, p->x, b.e);
-                if (p->dx) heml__gather(m, idx, p->dx, b.de);
-                heml__nodal_sums(m->blk_rest + (size_t)blk * HEML__NR * HEML__W, &b, p->dx != NULL);
-                heml__scatter_lane_values(idx, b.jm1, m->nod_j);
-                if (p->dx) heml__scatter_lane_values(idx, b.dp, m->nod_dj);
-                break;
             case HEML__ENERGY:
                 heml__gather(m, idx, p->x, b.e);
                 if (mt->kind == HEML__K_SPRING) {
@@ -4609,20 +4711,57 @@ static void heml__nodal_chunks(void *vctx, int begin, int end)
     }
 }
 
-static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const heml_real *dx,
-                             heml_real *out, int prony_write, heml_stress_kind kind);
+/* The nodal pressure's tetrahedron pass on the groups [begin, end) of a colour (coloured as
+   the force pass, in its order: the same sums for any thread count): Vol (J - 1) / 4 at x
+   (and Vol dJ / 4 at dx) of each lane scattered into nod_j (nod_dj); with keep, a
+   fast_nodal material's blocks keep H in tet_h for the element pass (heml__forces_nh_kept).
+   The next block's rest constants and indices prefetched as in the force pass. */
+typedef struct heml__sums_ctx {
+    heml_model *m;
+    const heml_real *x, *dx;
+    int colour, keep;
+} heml__sums_ctx;
+
+static void heml__nodal_tets(void *vctx, int begin, int end)
+{
+    const heml__sums_ctx *cx = (const heml__sums_ctx *)vctx;
+    heml_model *m = cx->m;
+    heml__blk b;
+    int g0 = m->colour_start[cx->colour] + begin, g1 = m->colour_start[cx->colour] + end, ci, blk;
+    for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++) {
+        int keep = cx->keep && m->mats[m->chunk_material[ci]].fast_nodal;
+        for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
+            const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+            const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+            if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
+                heml__prefetch_block(R + HEML__NR * HEML__W, HEML__NR, idx + 4 * HEML__W);
+            heml__gather(m, idx, cx->x, b.e);
+            if (cx->dx) heml__gather(m, idx, cx->dx, b.de);
+            if (keep) heml__nodal_sums_keep(R, &b, b.jm1, m->tet_h + (size_t)blk * 9 * HEML__W);
+            else heml__nodal_sums(R, &b, cx->dx != NULL, b.jm1, b.dp);
+            heml__scatter_lane_values(idx, b.jm1, m->nod_j);
+            if (cx->dx) heml__scatter_lane_values(idx, b.dp, m->nod_dj);
+        }
+    }
+}
 
 /* The nodal pressure's first two passes before a pass of `mode` at x (and dx): the sums
-   over the tetrahedra (coloured like the force pass), then the node pass. Returns the
-   nodal energy (ENERGY, FORCE_ENERGY; 0 otherwise). */
+   over the tetrahedra (heml__nodal_tets), then the node pass. Returns the nodal energy
+   (ENERGY, FORCE_ENERGY; 0 otherwise). A FORCE or ABS pass keeps H for its element pass
+   (nod_hx = x until heml__pass_run ends). */
 static double heml__nodal_prepare(heml_model *m, int mode, const heml_real *x, const heml_real *dx)
 {
     heml__nodal_ctx cx;
+    heml__sums_ctx sx;
     double energy = 0.0;
     int c, chunks, diff = mode == HEML__DIFF;
     memset(m->nod_j, 0, sizeof(heml_real) * (size_t)m->node_count);
     if (diff) memset(m->nod_dj, 0, sizeof(heml_real) * (size_t)m->node_count);
-    heml__pass_run(m, HEML__NODAL_SUMS, x, diff ? dx : NULL, NULL, 0, HEML_STRESS_PK1);
+    sx.m = m, sx.x = x, sx.dx = diff ? dx : NULL;
+    sx.keep = m->nod_keep_h && (mode == HEML__FORCE || mode == HEML__ABS);
+    for (sx.colour = 0; sx.colour < m->colour_count; sx.colour++)
+        heml__run(m, m->colour_start[sx.colour + 1] - m->colour_start[sx.colour], heml__nodal_tets, &sx);
+    m->nod_hx = sx.keep ? x : NULL;
     cx.m = m;
     cx.diff = diff;
     cx.energy = mode == HEML__ENERGY || mode == HEML__FORCE_ENERGY;
@@ -4689,7 +4828,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     heml__pass p;
     double energy = 0.0;
     int c, below = 0, inverted = 0;
-    if (m->nodal && mode != HEML__NODAL_SUMS) energy = heml__nodal_prepare(m, mode, x, dx);
+    if (m->nodal) energy = heml__nodal_prepare(m, mode, x, dx);
     p.m = m;
     p.mode = mode;
     p.prony_write = prony_write && m->has_prony;
@@ -4706,6 +4845,7 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
         below += m->chunk_below[c];
         inverted += m->chunk_inverted[c];
     }
+    m->nod_hx = NULL; /* (the kept H belongs to this pass only) */
     if (m->anchor_count && mode != HEML__STRESS) energy += heml__anchor_pass(m, mode, x, dx, out);
     if (mode == HEML__FORCE || mode == HEML__FORCE_ENERGY) {
         m->stats.below_threshold = below;
@@ -4918,6 +5058,7 @@ static void heml__layout(heml_model *m, heml__carver *c)
         HEML__CARVE(c, m->nod_dj, heml_real, nn);
         HEML__CARVE(c, m->nod_p, heml_real, nn);
         HEML__CARVE(c, m->nod_dp, heml_real, nn);
+        HEML__CARVE(c, m->tet_h, heml_real, m->nod_keep_h ? 9 * s : 0);
         HEML__CARVE(c, m->pagg, int, m->pagg_count ? n : 0);
         HEML__CARVE(c, m->pagg_w, heml_real, (size_t)m->pagg_count * M);
         HEML__CARVE(c, m->pagg_inv, heml_real, (size_t)m->pagg_count);
@@ -6176,6 +6317,11 @@ static int heml__create_size(const heml_desc *d, heml_model *tmp, heml__create_t
             tmp->has_dc = 1;
             if (rows > tmp->dc_rows) tmp->dc_rows = rows;
         }
+    }
+    for (i = 0; i < M && tmp->nodal; i++) { /* a fast_nodal material in use: heml__forces_nh's kept H */
+        heml__mat mt;
+        heml__make_mat(src + i, &mt);
+        if (mt.fast && w->counts[i] > 0) tmp->nod_keep_h = 1;
     }
     tmp->nod_chunks = (n + HEML__NODE_CHUNK - 1) / HEML__NODE_CHUNK;
     if (w->pagg) tmp->pagg_count = heml__pressure_aggregates(d, w->pagg, w->pagg + n, w->pagg + 2 * (size_t)n + 1);

@@ -1701,6 +1701,118 @@ static void test_nodal_pressure_fast_force(void)
     tetmesh_free(&mesh);
 }
 
+/* The nodal pressure's force pass on a fast_nodal law keeps H from its sums pass for its
+   element pass (heml__nodal_sums_keep, heml__forces_nh with Hk; issue 13's cost). Checked,
+   for nodal_pressure = 1 and 2, Neo-Hookean, six and five tetrahedra per cell, a moderate
+   state and one with tetrahedra below J0 (rotated and moved: H is not small):
+   - the nodal volume ratios J_a - 1 = nod_j[a] / V_a against a plain computation here, in
+     double, from the rest positions and the model's displacements (J_e = det of the
+     current edges over det of the rest edges, J_a = sum Vol_e J_e / sum Vol_e): round-off
+     alone separates them, about eps |H| with |H| up to 1 (measured up to 7e-16 in double,
+     5e-7 in float), checked at 1e-13 and 2e-6;
+   - the forces with H kept against the same model with the keeping switched off
+     (nod_keep_h = 0: the gathered path, H formed again in heml__forces_nh): the same
+     expressions in both, so equal to round-off (bit for bit with gcc -O2/-O3), checked at
+     1e-13 and 1e-5 of the largest force, room for contractions a compiler may make
+     differently in the two functions;
+   - the kept H is read back only by the pass that formed it: after a force pass and new
+     displacements, heml_tet_stress (no sums pass of its own) equals that of the model
+     without keeping after the same calls.
+   A wrong formula goes red here (measured in double: H_01 kept as H_10: forces off by 0.7
+   to 1.9 times the largest, and test_nodal_pressure_patch fails; the kept J - 1 without
+   its det H term: J_a off by 0.07 to 1.5, with three more nodal tests failing; the kept
+   H left valid after its pass: heml_tet_stress off by 0.02 to 0.1 of the stress). */
+static void test_nodal_pressure_kept_h(void)
+{
+    tetmesh mesh;
+    int split, state;
+    for (split = 0; split < 2; split++) {
+        box_mesh(&mesh, 3, 3, 3, 1, 1, 1, split ? TETMESH_SPLIT5 : TETMESH_SPLIT6);
+        for (g_nodal = 1; g_nodal <= 2; g_nodal++)
+            for (state = 0; state < 2; state++) {
+                heml_material mt = material_of(HEML_NEO_HOOKEAN);
+                heml_model *m = make_model_mt(&mesh, &mt, 1, NULL);
+                int n = mesh.node_count, n3 = 3 * n, i, t, kept = 0;
+                double *x = (double *)malloc(sizeof(double) * n3), *ja = (double *)calloc((size_t)n, sizeof(double));
+                double *va = (double *)calloc((size_t)n, sizeof(double));
+                double jerr = 0.0, ferr = 0.0, fmax = 0.0, serr = 0.0, smax = 0.0;
+                heml_real *f1 = alloc_reals(n3), s1[9], s2[9];
+                const heml_real *f, *u;
+                REQUIRE(m != NULL && x && ja && va);
+                CHECK_INT(1, m->mats[0].fast_nodal);
+                CHECK_INT(1, m->nod_keep_h);
+                deformed_state(&mesh, state ? 0.28 : 0.04, 73u + 5u * (unsigned)split + (unsigned)state, x);
+                set_positions_d(m, x, n);
+                f = heml_compute_forces(m);
+                for (i = 0; i < n3; i++) f1[i] = f[i];
+                for (i = 0; i < 9 * m->slot_count; i++) kept += m->tet_h[i] != 0; /* (the kept path ran) */
+                CHECK(kept > 0);
+                CHECK(m->nod_hx == NULL);
+                u = heml_displacements(m);
+                for (t = 0; t < mesh.tet_count; t++) { /* the plain nodal J */
+                    const int *q = mesh.tets + 4 * t;
+                    double E[3][3], e[3][3], v0, v1;
+                    int j, r;
+                    for (j = 0; j < 3; j++)
+                        for (r = 0; r < 3; r++) {
+                            E[j][r] = mesh.nodes[3 * q[j + 1] + r] - mesh.nodes[3 * q[0] + r];
+                            e[j][r] = E[j][r] + ((double)u[3 * q[j + 1] + r] - (double)u[3 * q[0] + r]);
+                        }
+                    v0 = E[0][0] * (E[1][1] * E[2][2] - E[1][2] * E[2][1]) -
+                         E[0][1] * (E[1][0] * E[2][2] - E[1][2] * E[2][0]) + E[0][2] * (E[1][0] * E[2][1] - E[1][1] * E[2][0]);
+                    v1 = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+                    for (j = 0; j < 4; j++) {
+                        ja[q[j]] += v0 / 6 * (v1 / v0 - 1);
+                        va[q[j]] += v0 / 6;
+                    }
+                }
+                for (i = 0; i < n; i++) {
+                    double d = fabs((double)m->nod_j[i] * (double)m->nod_inv[i] - ja[i] / va[i]);
+                    jerr = d > jerr ? d : jerr;
+                }
+                m->nod_keep_h = 0; /* the gathered path */
+                f = heml_compute_forces(m);
+                for (i = 0; i < n3; i++) {
+                    double d = fabs((double)f[i] - (double)f1[i]);
+                    ferr = d > ferr ? d : ferr;
+                    fmax = fabs((double)f[i]) > fmax ? fabs((double)f[i]) : fmax;
+                }
+                { /* heml_tet_stress after a force pass and new displacements: m (keeping H) and
+                     m2 (not keeping) after the same calls */
+                    heml_model *m2 = make_model_mt(&mesh, &mt, 1, NULL);
+                    REQUIRE(m2 != NULL);
+                    m->nod_keep_h = 1, m2->nod_keep_h = 0;
+                    set_positions_d(m2, x, n);
+                    heml_compute_forces(m), heml_compute_forces(m2); /* (m: H kept at x) */
+                    for (i = 0; i < n; i++) x[3 * i] += 0.03 * mesh.nodes[3 * i + 1]; /* a shear on top */
+                    set_positions_d(m, x, n);
+                    set_positions_d(m2, x, n);
+                    for (t = 0; t < mesh.tet_count; t += 7) {
+                        CHECK_INT(HEML_OK, heml_tet_stress(m, t, HEML_STRESS_PK1, s1));
+                        CHECK_INT(HEML_OK, heml_tet_stress(m2, t, HEML_STRESS_PK1, s2));
+                        for (i = 0; i < 9; i++) {
+                            double d = fabs((double)s1[i] - (double)s2[i]);
+                            serr = d > serr ? d : serr;
+                            smax = fabs((double)s2[i]) > smax ? fabs((double)s2[i]) : smax;
+                        }
+                    }
+                    heml_destroy(m2);
+                }
+                printf("    split %d nodal %d %s: |J_a - plain J_a| = %.2g, |f_kept - f_gathered| / |f| = %.2g, "
+                       "|tet_stress kept - not| / |P| = %.2g\n", split ? 5 : 6, g_nodal, state ? "J < J0  " : "moderate",
+                       jerr, ferr / fmax, serr / smax);
+                CHECK(jerr <= (IS_FLOAT ? 2e-6 : 1e-13));
+                CHECK(fmax > 0 && ferr <= (IS_FLOAT ? 1e-5 : 1e-13) * fmax);
+                CHECK(smax > 0 && serr <= (IS_FLOAT ? 1e-5 : 1e-13) * smax);
+                free(x), free(ja), free(va), free(f1);
+                heml_destroy(m);
+            }
+        tetmesh_free(&mesh);
+    }
+    g_nodal = 0;
+}
+
 /* The split Mooney-Rivlin force kernel (heml__mat.fast_mr: heml__forces_mr) against the
    general path (heml__kinematics, heml__law_split, heml__coefficients, heml__pk1_forces),
    the same model with the flag cleared: c2 != 0 and c2 = 0, a moderate state and one with
@@ -2139,6 +2251,7 @@ static const test_case cases[] = {
     TEST(test_law_table_forces_and_differentials),
     TEST(test_nodal_pressure_gradient_and_differential),
     TEST(test_nodal_pressure_fast_force),
+    TEST(test_nodal_pressure_kept_h),
     TEST(test_mooney_rivlin_fast_force),
     TEST(test_nodal_pressure_patch),
     TEST(test_nodal_pressure_refused),
