@@ -2100,8 +2100,8 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
 #define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
-#define HEML__NC_MR 28      /* split Mooney-Rivlin: v, Ah, Nh (21), 7 scalars (heml__diff_mr) */
-#define HEML__NC 28         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
+#define HEML__NC_MR 26      /* split Mooney-Rivlin: v, Ah, B (21), 5 scalars (heml__diff_mr) */
+#define HEML__NC 26         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
 #define HEML__DK_NH 1       /* heml__mat.dk: the differential kernel of a material (0: the general path) */
 #define HEML__DK_SVK 2
 #define HEML__DK_MR 3
@@ -3924,25 +3924,27 @@ static void heml__diff_mr_point(const heml_model *m, const heml__mat *mt, int bl
         heml_real n11 = g10 * u10 + g11 * u11 + g12 * u12, n22 = g20 * u20 + g21 * u21 + g22 * u22;
         heml_real n33 = g30 * u30 + g31 * u31 + g32 * u32, n12 = g10 * u20 + g11 * u21 + g12 * u22;
         heml_real n13 = g10 * u30 + g11 * u31 + g12 * u32, n23 = g20 * u30 + g21 * u31 + g22 * u32;
+        heml_real za = vol > 0 ? z * a2 : 0, zm = vol > 0 ? z * m2 : 0;
+        heml_real ca2 = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]), cb2 = 2 * rr * b->h[4][k];
+        heml_real be = zm != 0 ? cb2 / zm : 0; /* beta = cb2 / zm = w_2J / (6 Vol w_2): c2 cancels */
         C[9 * HEML__W + k] = z * q11;
         C[10 * HEML__W + k] = z * q22;
         C[11 * HEML__W + k] = z * q33;
         C[12 * HEML__W + k] = z * q12;
         C[13 * HEML__W + k] = z * q13;
         C[14 * HEML__W + k] = z * q23;
-        C[15 * HEML__W + k] = z * n11;
-        C[16 * HEML__W + k] = z * n22;
-        C[17 * HEML__W + k] = z * n33;
-        C[18 * HEML__W + k] = z * n12;
-        C[19 * HEML__W + k] = z * n13;
-        C[20 * HEML__W + k] = z * n23;
-        C[21 * HEML__W + k] = vol > 0 ? z * a2 : 0; /* B = z (2 a Ah - 2 w_2 Nh) */
-        C[22 * HEML__W + k] = vol > 0 ? z * m2 : 0;
-        C[23 * HEML__W + k] = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]);
-        C[24 * HEML__W + k] = 2 * rr * b->h[4][k];
-        C[25 * HEML__W + k] = rr * rr * b->h[5][k];
-        C[26 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
-        C[27 * HEML__W + k] = 4 * w2;
+        /* B = Vol G (2 a I - 2 w_2 (C - I)) G^T = z (2 a Ah - 2 w_2 Nh) = za Ah - zm Nh */
+        C[15 * HEML__W + k] = za * (z * q11) - zm * (z * n11);
+        C[16 * HEML__W + k] = za * (z * q22) - zm * (z * n22);
+        C[17 * HEML__W + k] = za * (z * q33) - zm * (z * n33);
+        C[18 * HEML__W + k] = za * (z * q12) - zm * (z * n12);
+        C[19 * HEML__W + k] = za * (z * q13) - zm * (z * n13);
+        C[20 * HEML__W + k] = za * (z * q23) - zm * (z * n23);
+        C[21 * HEML__W + k] = ca2 - be * za; /* ca2 - beta za */
+        C[22 * HEML__W + k] = be;
+        C[23 * HEML__W + k] = rr * rr * b->h[5][k];
+        C[24 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
+        C[25 * HEML__W + k] = 4 * w2;
     }
 }
 
@@ -3960,20 +3962,17 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
         heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
         heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
-        heml_real N11 = C[15 * HEML__W + k], N22 = C[16 * HEML__W + k], N33 = C[17 * HEML__W + k];
-        heml_real N12 = C[18 * HEML__W + k], N13 = C[19 * HEML__W + k], N23 = C[20 * HEML__W + k];
-        heml_real za = C[21 * HEML__W + k], zm = C[22 * HEML__W + k];
-        heml_real ca2 = C[23 * HEML__W + k], cb2 = C[24 * HEML__W + k], cc = C[25 * HEML__W + k];
-        heml_real s2 = C[26 * HEML__W + k], w4 = C[27 * HEML__W + k];
-        heml_real B11 = za * A11 - zm * N11, B22 = za * A22 - zm * N22, B33 = za * A33 - zm * N33;
-        heml_real B12 = za * A12 - zm * N12, B13 = za * A13 - zm * N13, B23 = za * A23 - zm * N23;
+        heml_real B11 = C[15 * HEML__W + k], B22 = C[16 * HEML__W + k], B33 = C[17 * HEML__W + k];
+        heml_real B12 = C[18 * HEML__W + k], B13 = C[19 * HEML__W + k], B23 = C[20 * HEML__W + k];
+        heml_real cap = C[21 * HEML__W + k], be = C[22 * HEML__W + k], cc = C[23 * HEML__W + k];
+        heml_real s2 = C[24 * HEML__W + k], w4 = C[25 * HEML__W + k];
         heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
         heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
         heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
         heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
         heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
         heml_real al = (X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23);
-        heml_real nu = (X11 * N11 + X22 * N22 + X33 * N33) + 2 * (X12 * N12 + X13 * N13 + X23 * N23);
+        heml_real xb = (X11 * B11 + X22 * B22 + X33 * B33) + 2 * (X12 * B12 + X13 * B13 + X23 * B23);
         /* cof v: c1 = v2 x v3, c2 = v3 x v1, c3 = v1 x v2; g = cof v : dv */
         heml_real c10 = q1 * r2 - q2 * r1, c11 = q2 * r0 - q0 * r2, c12 = q0 * r1 - q1 * r0;
         heml_real c20 = r1 * p2 - r2 * p1, c21 = r2 * p0 - r0 * p2, c22 = r0 * p1 - r1 * p0;
@@ -3985,19 +3984,19 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
         heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
         heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
-        heml_real t = ca2 * al - cb2 * nu + cc * g, kA = ca2 * g + w4 * al, kN = cb2 * g;
+        heml_real t = cap * al + be * xb + cc * g, kA = cap * g + w4 * al, kB = be * g;
         /* T = X Ah, Ah X Ah = Ah T */
         heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
         heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
         heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
         heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
         heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
-        heml_real K11 = kA * A11 - kN * N11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
-        heml_real K22 = kA * A22 - kN * N22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
-        heml_real K33 = kA * A33 - kN * N33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
-        heml_real K12 = kA * A12 - kN * N12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
-        heml_real K13 = kA * A13 - kN * N13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
-        heml_real K23 = kA * A23 - kN * N23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
+        heml_real K11 = kA * A11 + kB * B11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = kA * A22 + kB * B22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = kA * A33 + kB * B33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = kA * A12 + kB * B12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = kA * A13 + kB * B13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = kA * A23 + kB * B23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
         b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13) + t * c10 + s2 * e10);
         b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13) + t * c11 + s2 * e11);
         b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13) + t * c12 + s2 * e12);
