@@ -3831,13 +3831,12 @@ static void heml__diff_svk_apply(const heml__mat *mt, const heml_real *HEML__RES
         heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
         heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
         heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
-        heml_real la = lambda * ((X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23));
-        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric) */
+        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric), la = lambda X : Ah = lambda tr T */
         heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
         heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
         heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
         heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
-        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33, la = lambda * (T11 + T22 + T33);
         heml_real K11 = la * A11 + mu2 * (A11 * T11 + A12 * T21 + A13 * T31);
         heml_real K22 = la * A22 + mu2 * (A12 * T12 + A22 * T22 + A23 * T32);
         heml_real K33 = la * A33 + mu2 * (A13 * T13 + A23 * T23 + A33 * T33);
@@ -3971,7 +3970,6 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
         heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
         heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
-        heml_real al = (X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23);
         heml_real xb = (X11 * B11 + X22 * B22 + X33 * B33) + 2 * (X12 * B12 + X13 * B13 + X23 * B23);
         /* cof v: c1 = v2 x v3, c2 = v3 x v1, c3 = v1 x v2; g = cof v : dv */
         heml_real c10 = q1 * r2 - q2 * r1, c11 = q2 * r0 - q0 * r2, c12 = q0 * r1 - q1 * r0;
@@ -3984,13 +3982,13 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
         heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
         heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
-        heml_real t = cap * al + be * xb + cc * g, kA = cap * g + w4 * al, kB = be * g;
-        /* T = X Ah, Ah X Ah = Ah T */
+        /* T = X Ah, Ah X Ah = Ah T, al = X : Ah = tr T */
         heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
         heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
         heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
         heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
-        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33, al = T11 + T22 + T33;
+        heml_real t = cap * al + be * xb + cc * g, kA = cap * g + w4 * al, kB = be * g;
         heml_real K11 = kA * A11 + kB * B11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
         heml_real K22 = kA * A22 + kB * B22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
         heml_real K33 = kA * A33 + kB * B33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
