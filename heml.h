@@ -163,7 +163,7 @@
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
    incompressible Mooney-Rivlin with c2 = 0), 21 (168 / 84 bytes) when one is St Venant-
-   Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
+   Kirchhoff, 26 (208 / 104 bytes) when one is the split Mooney-Rivlin (the largest of
    those in use), plus a byte per block of 16; only without a Prony series and without
    nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
    out (each product then recomputes them: see PERFORMANCE for the cost). Mass-spring
@@ -1695,7 +1695,7 @@ typedef struct heml_desc {
     int stiffness_cache;             /* 1 (default): the Neo-Hookean, St Venant-Kirchhoff and
                                         Mooney-Rivlin stiffness products cache per tetrahedron
                                         what their linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 17, 21 or 28 reals a tetrahedron); 0: no cache,
+                                        MEMORY: 17, 21 or 26 reals a tetrahedron); 0: no cache,
                                         no memory */
 
     /* dynamics */
@@ -3882,9 +3882,15 @@ static int heml__diff_svk(const heml_model *m, const heml__mat *mt, int blk, hem
        K = (2 ca g + 4 w_2 al) Ah - 2 cb g Nh - 4 w_2 Ah X Ah,
        t = 2 ca al - 2 cb nu + cc g,
    al = X : Ah, nu = X : Nh, g = cof v : dv, ca = r (w_1J + (I1 - 1) w_2J), cb = r w_2J,
-   cc = r^2 w_JJ. The point values: v (9), Ah, Nh (6 each), 2 a z, 2 w_2 z, 2 ca, 2 cb, cc,
-   w_J / 6, 4 w_2: HEML__NC_MR = 28 reals (B stored instead of its two scalars, 32 reals,
-   measured no faster); a product about 290 operations. The law and the stress
+   cc = r^2 w_JJ. Nh enters only with B: with za = 2 a z, zm = 2 w_2 z (B = za Ah - zm Nh)
+   and beta = 2 cb / zm = w_2J / (6 Vol w_2) (the law's c2 cancels; 0 where w_2 = 0, which
+   has cb = 0 too), 2 cb Nh = beta (za Ah - B) and 2 cb nu = beta (za al - X : B), so
+       K = (ca' g + 4 w_2 al) Ah + beta g B - 4 w_2 Ah X Ah,   t = ca' al + beta X : B + cc g,
+   ca' = 2 ca - beta za (the two beta za terms are of the size of 2 ca's: no cancellation
+   beyond round-off). The point values: v (9), Ah, B (6 each), ca', beta, cc, w_J / 6,
+   4 w_2: HEML__NC_MR = 26 reals (until issue 21's fourth part Nh and its two scalars, 28
+   reals and 12 operations more a product; B stored besides them, 32 reals, was measured
+   no faster); a product about 250 operations, al = tr(X Ah) from T = X Ah. The law and the stress
    coefficients at the point come from heml__law_split and heml__coefficients themselves
    (the general path's kinematics), so the continuation below J0 needs no fallback; Prony
    and the nodal pressure take the general path (mt->dk = 0). */
