@@ -1153,6 +1153,50 @@
    force's stages): 214 instructions against 203, no gain measurable. The bench's CSR rows for the laws on the general path were
    slowed 5 to 7 times at small sizes by subnormal garbage: its adapter left the
    differential's dp uninitialised (fixed there).
+   Issue 21, fourth part (the split Mooney-Rivlin product at 1e4 tetrahedra; Intel Xeon,
+   Sapphire Rapids class, KVM, 2 vCPUs shared with other jobs at load 4 to 9): the cache
+   keeps B = za Ah - zm Nh in place of Nh and its two scalars, 26 reals (the beta form,
+   heml__diff_mr_point), and both kernels take X : Ah as tr(X Ah) from the T they form
+   anyway. Callgrind (x86-64-v3, 10,985 tetrahedra, per tetrahedron and product):
+   Mooney-Rivlin 198 -> 193 instructions in double, 142 -> 139 in float, St Venant-
+   Kirchhoff 150 -> 148 and 118 -> 117 (Neo-Hookean's 135 and 111; the CSR product 165
+   in double). Timed with bench/model_heml.c's adapter for the code before and after in
+   one program, old, new and the CSR product of the same tangent interleaved, minimum of
+   60 to 100 rounds of short batches (about 2 ms: longer ones are all preempted by the other
+   jobs, and their minima were 2x these and moved by 20 %), one thread, K*v / CSR at 1e3,
+   1e4, 1e5, 1e6 tetrahedra:
+       Mooney-Rivlin, double        before 0.91-0.92  1.05-1.10  1.08  1.04 (4 runs at 1e3, 1e4)
+                                    after  0.85-0.91  1.00-1.05  0.89  0.92
+       Mooney-Rivlin, float         before 0.70-0.72  0.77-0.78  0.69  0.78
+                                    after  0.67-0.68  0.73-0.75  0.65  0.69
+       St Venant-Kirchhoff, double  before 0.67-0.74  0.74-0.79  0.66-0.71  0.82-0.84
+                                    after  0.66-0.76  0.72-0.76  0.65-0.70  0.77-0.78
+       St Venant-Kirchhoff, float   before 0.56  0.62-0.64  0.47  0.51
+                                    after  0.56-0.60  0.61-0.62  0.47  0.49
+   So St Venant-Kirchhoff's product beats the CSR product at every size in both
+   precisions by this measure (the full bench's 1.01 at 1e5 was its medians' noise), and
+   Mooney-Rivlin's does in float and at 1e3, 1e5, 1e6 in double, but at 1e4 in double it
+   is at par (1.00-1.05: the goal is not met there). What bounds it: 13.2 ns a tetrahedron
+   at 1e3 (its arithmetic: the product is about 250 operations against Neo-Hookean's 115)
+   but 16.6 at 1e4, where the CSR product takes 15-17 ns at both sizes: beyond the 2 MB of
+   L2 its stream (208 bytes of cache and 16 of indices a tetrahedron) moves at about the
+   rate that bounds the CSR product's 276 bytes, so it needs fewer bytes and fewer
+   instructions at once. Tried and dropped (same method):
+   - the cache as the symmetric 9 x 9 matrix of the product in the links (45 reals, filled
+     by applying the product to the nine unit links; a product is 81 multiply-adds, 122
+     instructions a tetrahedron against 193): 0.69 of the 26-real product's time at 1e3
+     (0.56 of the CSR product), 1.02-1.05 at 1e4, 2.7 at 1e5 and 1.2 at 1e6 (376 bytes a
+     tetrahedron with the indices);
+   - v not cached but formed again from two gathers (the rest positions and the point's
+     displacements: 17 reals, 152 bytes a tetrahedron with the indices, as Neo-Hookean's):
+     249 instructions, 1.28-1.37 times the 26-real product at 1e3 and 1.08-1.16 at 1e4;
+   - the St Venant-Kirchhoff and Mooney-Rivlin lane loops compiled for 512-bit vectors
+     (gcc target("prefer-vector-width=512"), half the instructions of the loops): 0.89 to
+     1.09 of the 256-bit code, noise (as for the Neo-Hookean force above);
+   - the Mooney-Rivlin apply in two loops again (K and t, then the product): 410 static
+     instructions against 417 in the x86-64-v3 loop, 386 against 354 with AVX-512's 32
+     registers; prefetching two blocks ahead: 1.00 and 1.09 of one ahead at 1e4 and 1e5;
+     one prefetch per 128 bytes instead of per 64: 195 -> 194 instructions. None kept.
    Forces, against the Neo-Hookean force (unchanged here; callgrind, the same mesh, per
    tetrahedron): St Venant-Kirchhoff 207, Mooney-Rivlin 231, springs 248 against 160
    instructions in double (1.29, 1.44, 1.55), 160, 171, 200 against 128 in float (1.25,
