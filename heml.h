@@ -163,7 +163,7 @@
    float: the model's largest array, against 80 / 40 of rest constants) when a material in
    use takes the vectorised Neo-Hookean kernels (Neo-Hookean, its incompressible variant,
    incompressible Mooney-Rivlin with c2 = 0), 21 (168 / 84 bytes) when one is St Venant-
-   Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
+   Kirchhoff, 26 (208 / 104 bytes) when one is the split Mooney-Rivlin (the largest of
    those in use), plus a byte per block of 16; only without a Prony series and without
    nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
    out (each product then recomputes them: see PERFORMANCE for the cost). Mass-spring
@@ -1186,6 +1186,50 @@
    force's stages): 214 instructions against 203, no gain measurable. The bench's CSR rows for the laws on the general path were
    slowed 5 to 7 times at small sizes by subnormal garbage: its adapter left the
    differential's dp uninitialised (fixed there).
+   Issue 21, fourth part (the split Mooney-Rivlin product at 1e4 tetrahedra; Intel Xeon,
+   Sapphire Rapids class, KVM, 2 vCPUs shared with other jobs at load 4 to 9): the cache
+   keeps B = za Ah - zm Nh in place of Nh and its two scalars, 26 reals (the beta form,
+   heml__diff_mr_point), and both kernels take X : Ah as tr(X Ah) from the T they form
+   anyway. Callgrind (x86-64-v3, 10,985 tetrahedra, per tetrahedron and product):
+   Mooney-Rivlin 198 -> 193 instructions in double, 142 -> 139 in float, St Venant-
+   Kirchhoff 150 -> 148 and 118 -> 117 (Neo-Hookean's 135 and 111; the CSR product 165
+   in double). Timed with bench/model_heml.c's adapter for the code before and after in
+   one program, old, new and the CSR product of the same tangent interleaved, minimum of
+   60 to 100 rounds of short batches (about 2 ms: longer ones are all preempted by the other
+   jobs, and their minima were 2x these and moved by 20 %), one thread, K*v / CSR at 1e3,
+   1e4, 1e5, 1e6 tetrahedra:
+       Mooney-Rivlin, double        before 0.91-0.92  1.05-1.10  1.08  1.04 (4 runs at 1e3, 1e4)
+                                    after  0.85-0.91  1.00-1.05  0.89  0.92
+       Mooney-Rivlin, float         before 0.70-0.72  0.77-0.78  0.69  0.78
+                                    after  0.67-0.68  0.73-0.75  0.65  0.69
+       St Venant-Kirchhoff, double  before 0.67-0.74  0.74-0.79  0.66-0.71  0.82-0.84
+                                    after  0.66-0.76  0.72-0.76  0.65-0.70  0.77-0.78
+       St Venant-Kirchhoff, float   before 0.56  0.62-0.64  0.47  0.51
+                                    after  0.56-0.60  0.61-0.62  0.47  0.49
+   So St Venant-Kirchhoff's product beats the CSR product at every size in both
+   precisions by this measure (the full bench's 1.01 at 1e5 was its medians' noise), and
+   Mooney-Rivlin's does in float and at 1e3, 1e5, 1e6 in double, but at 1e4 in double it
+   is at par (1.00-1.05: the goal is not met there). What bounds it: 13.2 ns a tetrahedron
+   at 1e3 (its arithmetic: the product is about 250 operations against Neo-Hookean's 115)
+   but 16.6 at 1e4, where the CSR product takes 15-17 ns at both sizes: beyond the 2 MB of
+   L2 its stream (208 bytes of cache and 16 of indices a tetrahedron) moves at about the
+   rate that bounds the CSR product's 276 bytes, so it needs fewer bytes and fewer
+   instructions at once. Tried and dropped (same method):
+   - the cache as the symmetric 9 x 9 matrix of the product in the links (45 reals, filled
+     by applying the product to the nine unit links; a product is 81 multiply-adds, 122
+     instructions a tetrahedron against 193): 0.69 of the 26-real product's time at 1e3
+     (0.56 of the CSR product), 1.02-1.05 at 1e4, 2.7 at 1e5 and 1.2 at 1e6 (376 bytes a
+     tetrahedron with the indices);
+   - v not cached but formed again from two gathers (the rest positions and the point's
+     displacements: 17 reals, 152 bytes a tetrahedron with the indices, as Neo-Hookean's):
+     249 instructions, 1.28-1.37 times the 26-real product at 1e3 and 1.08-1.16 at 1e4;
+   - the St Venant-Kirchhoff and Mooney-Rivlin lane loops compiled for 512-bit vectors
+     (gcc target("prefer-vector-width=512"), half the instructions of the loops): 0.89 to
+     1.09 of the 256-bit code, noise (as for the Neo-Hookean force above);
+   - the Mooney-Rivlin apply in two loops again (K and t, then the product): 410 static
+     instructions against 417 in the x86-64-v3 loop, 386 against 354 with AVX-512's 32
+     registers; prefetching two blocks ahead: 1.00 and 1.09 of one ahead at 1e4 and 1e5;
+     one prefetch per 128 bytes instead of per 64: 195 -> 194 instructions. None kept.
    Forces, against the Neo-Hookean force (unchanged here; callgrind, the same mesh, per
    tetrahedron): St Venant-Kirchhoff 207, Mooney-Rivlin 231, springs 248 against 160
    instructions in double (1.29, 1.44, 1.55), 160, 171, 200 against 128 in float (1.25,
@@ -1728,7 +1772,7 @@ typedef struct heml_desc {
     int stiffness_cache;             /* 1 (default): the Neo-Hookean, St Venant-Kirchhoff and
                                         Mooney-Rivlin stiffness products cache per tetrahedron
                                         what their linearisation point fixes (PERFORMANCE,
-                                        MEMORY: 17, 21 or 28 reals a tetrahedron); 0: no cache,
+                                        MEMORY: 17, 21 or 26 reals a tetrahedron); 0: no cache,
                                         no memory */
 
     /* dynamics */
@@ -2133,8 +2177,8 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
 #define HEML__NR 10         /* rest constants per tetrahedron: grad N_1, grad N_2, grad N_3, Vol */
 #define HEML__NC_NH 17      /* stiffness cache per tetrahedron, Neo-Hookean: v (9), A (6), s1, s2 (heml__diff_nh) */
 #define HEML__NC_SVK 21     /* St Venant-Kirchhoff: v (9), A / sqrt(Vol) (6), Vol G S G^T (6) (heml__diff_svk) */
-#define HEML__NC_MR 28      /* split Mooney-Rivlin: v, Ah, Nh (21), 7 scalars (heml__diff_mr) */
-#define HEML__NC 28         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
+#define HEML__NC_MR 26      /* split Mooney-Rivlin: v, Ah, B (21), 5 scalars (heml__diff_mr) */
+#define HEML__NC 26         /* the largest of them (the uncached kernels' workspace, heml__blk.lin) */
 #define HEML__DK_NH 1       /* heml__mat.dk: the differential kernel of a material (0: the general path) */
 #define HEML__DK_SVK 2
 #define HEML__DK_MR 3
@@ -3912,13 +3956,12 @@ static void heml__diff_svk_apply(const heml__mat *mt, const heml_real *HEML__RES
         heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
         heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
         heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
-        heml_real la = lambda * ((X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23));
-        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric) */
+        /* T = X Ah, K = la Ah + 2 mu Ah T (symmetric), la = lambda X : Ah = lambda tr T */
         heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
         heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
         heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
         heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
-        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33, la = lambda * (T11 + T22 + T33);
         heml_real K11 = la * A11 + mu2 * (A11 * T11 + A12 * T21 + A13 * T31);
         heml_real K22 = la * A22 + mu2 * (A12 * T12 + A22 * T22 + A23 * T32);
         heml_real K33 = la * A33 + mu2 * (A13 * T13 + A23 * T23 + A33 * T33);
@@ -3964,9 +4007,15 @@ static int heml__diff_svk(const heml_model *m, const heml__mat *mt, int blk, hem
        K = (2 ca g + 4 w_2 al) Ah - 2 cb g Nh - 4 w_2 Ah X Ah,
        t = 2 ca al - 2 cb nu + cc g,
    al = X : Ah, nu = X : Nh, g = cof v : dv, ca = r (w_1J + (I1 - 1) w_2J), cb = r w_2J,
-   cc = r^2 w_JJ. The point values: v (9), Ah, Nh (6 each), 2 a z, 2 w_2 z, 2 ca, 2 cb, cc,
-   w_J / 6, 4 w_2: HEML__NC_MR = 28 reals (B stored instead of its two scalars, 32 reals,
-   measured no faster); a product about 290 operations. The law and the stress
+   cc = r^2 w_JJ. Nh enters only with B: with za = 2 a z, zm = 2 w_2 z (B = za Ah - zm Nh)
+   and beta = 2 cb / zm = w_2J / (6 Vol w_2) (the law's c2 cancels; 0 where w_2 = 0, which
+   has cb = 0 too), 2 cb Nh = beta (za Ah - B) and 2 cb nu = beta (za al - X : B), so
+       K = (ca' g + 4 w_2 al) Ah + beta g B - 4 w_2 Ah X Ah,   t = ca' al + beta X : B + cc g,
+   ca' = 2 ca - beta za (the two beta za terms are of the size of 2 ca's: no cancellation
+   beyond round-off). The point values: v (9), Ah, B (6 each), ca', beta, cc, w_J / 6,
+   4 w_2: HEML__NC_MR = 26 reals (until issue 21's fourth part Nh and its two scalars, 28
+   reals and 12 operations more a product; B stored besides them, 32 reals, was measured
+   no faster); a product about 250 operations, al = tr(X Ah) from T = X Ah. The law and the stress
    coefficients at the point come from heml__law_split and heml__coefficients themselves
    (the general path's kinematics), so the continuation below J0 needs no fallback; Prony
    and the nodal pressure take the general path (mt->dk = 0). */
@@ -4005,25 +4054,27 @@ static void heml__diff_mr_point(const heml_model *m, const heml__mat *mt, int bl
         heml_real n11 = g10 * u10 + g11 * u11 + g12 * u12, n22 = g20 * u20 + g21 * u21 + g22 * u22;
         heml_real n33 = g30 * u30 + g31 * u31 + g32 * u32, n12 = g10 * u20 + g11 * u21 + g12 * u22;
         heml_real n13 = g10 * u30 + g11 * u31 + g12 * u32, n23 = g20 * u30 + g21 * u31 + g22 * u32;
+        heml_real za = vol > 0 ? z * a2 : 0, zm = vol > 0 ? z * m2 : 0;
+        heml_real ca2 = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]), cb2 = 2 * rr * b->h[4][k];
+        heml_real be = zm != 0 ? cb2 / zm : 0; /* beta = cb2 / zm = w_2J / (6 Vol w_2): c2 cancels */
         C[9 * HEML__W + k] = z * q11;
         C[10 * HEML__W + k] = z * q22;
         C[11 * HEML__W + k] = z * q33;
         C[12 * HEML__W + k] = z * q12;
         C[13 * HEML__W + k] = z * q13;
         C[14 * HEML__W + k] = z * q23;
-        C[15 * HEML__W + k] = z * n11;
-        C[16 * HEML__W + k] = z * n22;
-        C[17 * HEML__W + k] = z * n33;
-        C[18 * HEML__W + k] = z * n12;
-        C[19 * HEML__W + k] = z * n13;
-        C[20 * HEML__W + k] = z * n23;
-        C[21 * HEML__W + k] = vol > 0 ? z * a2 : 0; /* B = z (2 a Ah - 2 w_2 Nh) */
-        C[22 * HEML__W + k] = vol > 0 ? z * m2 : 0;
-        C[23 * HEML__W + k] = 2 * rr * (b->h[2][k] + I1m1 * b->h[4][k]);
-        C[24 * HEML__W + k] = 2 * rr * b->h[4][k];
-        C[25 * HEML__W + k] = rr * rr * b->h[5][k];
-        C[26 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
-        C[27 * HEML__W + k] = 4 * w2;
+        /* B = Vol G (2 a I - 2 w_2 (C - I)) G^T = z (2 a Ah - 2 w_2 Nh) = za Ah - zm Nh */
+        C[15 * HEML__W + k] = za * (z * q11) - zm * (z * n11);
+        C[16 * HEML__W + k] = za * (z * q22) - zm * (z * n22);
+        C[17 * HEML__W + k] = za * (z * q33) - zm * (z * n33);
+        C[18 * HEML__W + k] = za * (z * q12) - zm * (z * n12);
+        C[19 * HEML__W + k] = za * (z * q13) - zm * (z * n13);
+        C[20 * HEML__W + k] = za * (z * q23) - zm * (z * n23);
+        C[21 * HEML__W + k] = ca2 - be * za; /* ca2 - beta za */
+        C[22 * HEML__W + k] = be;
+        C[23 * HEML__W + k] = rr * rr * b->h[5][k];
+        C[24 * HEML__W + k] = b->co[2][k] * (heml_real)(1.0 / 6.0);
+        C[25 * HEML__W + k] = 4 * w2;
     }
 }
 
@@ -4041,20 +4092,16 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real r0 = C[6 * HEML__W + k], r1 = C[7 * HEML__W + k], r2 = C[8 * HEML__W + k]; /* v3 */
         heml_real A11 = C[9 * HEML__W + k], A22 = C[10 * HEML__W + k], A33 = C[11 * HEML__W + k];
         heml_real A12 = C[12 * HEML__W + k], A13 = C[13 * HEML__W + k], A23 = C[14 * HEML__W + k];
-        heml_real N11 = C[15 * HEML__W + k], N22 = C[16 * HEML__W + k], N33 = C[17 * HEML__W + k];
-        heml_real N12 = C[18 * HEML__W + k], N13 = C[19 * HEML__W + k], N23 = C[20 * HEML__W + k];
-        heml_real za = C[21 * HEML__W + k], zm = C[22 * HEML__W + k];
-        heml_real ca2 = C[23 * HEML__W + k], cb2 = C[24 * HEML__W + k], cc = C[25 * HEML__W + k];
-        heml_real s2 = C[26 * HEML__W + k], w4 = C[27 * HEML__W + k];
-        heml_real B11 = za * A11 - zm * N11, B22 = za * A22 - zm * N22, B33 = za * A33 - zm * N33;
-        heml_real B12 = za * A12 - zm * N12, B13 = za * A13 - zm * N13, B23 = za * A23 - zm * N23;
+        heml_real B11 = C[15 * HEML__W + k], B22 = C[16 * HEML__W + k], B33 = C[17 * HEML__W + k];
+        heml_real B12 = C[18 * HEML__W + k], B13 = C[19 * HEML__W + k], B23 = C[20 * HEML__W + k];
+        heml_real cap = C[21 * HEML__W + k], be = C[22 * HEML__W + k], cc = C[23 * HEML__W + k];
+        heml_real s2 = C[24 * HEML__W + k], w4 = C[25 * HEML__W + k];
         heml_real X11 = p0 * x0 + p1 * x1 + p2 * x2, X22 = q0 * y0 + q1 * y1 + q2 * y2;
         heml_real X33 = r0 * z0 + r1 * z1 + r2 * z2;
         heml_real X12 = ((p0 * y0 + p1 * y1 + p2 * y2) + (q0 * x0 + q1 * x1 + q2 * x2)) / 2;
         heml_real X13 = ((p0 * z0 + p1 * z1 + p2 * z2) + (r0 * x0 + r1 * x1 + r2 * x2)) / 2;
         heml_real X23 = ((q0 * z0 + q1 * z1 + q2 * z2) + (r0 * y0 + r1 * y1 + r2 * y2)) / 2;
-        heml_real al = (X11 * A11 + X22 * A22 + X33 * A33) + 2 * (X12 * A12 + X13 * A13 + X23 * A23);
-        heml_real nu = (X11 * N11 + X22 * N22 + X33 * N33) + 2 * (X12 * N12 + X13 * N13 + X23 * N23);
+        heml_real xb = (X11 * B11 + X22 * B22 + X33 * B33) + 2 * (X12 * B12 + X13 * B13 + X23 * B23);
         /* cof v: c1 = v2 x v3, c2 = v3 x v1, c3 = v1 x v2; g = cof v : dv */
         heml_real c10 = q1 * r2 - q2 * r1, c11 = q2 * r0 - q0 * r2, c12 = q0 * r1 - q1 * r0;
         heml_real c20 = r1 * p2 - r2 * p1, c21 = r2 * p0 - r0 * p2, c22 = r0 * p1 - r1 * p0;
@@ -4066,19 +4113,19 @@ static void heml__diff_mr_apply(const heml_real *HEML__RESTRICT C, heml__blk *HE
         heml_real e22 = (z0 * p1 - z1 * p0) + (r0 * x1 - r1 * x0);
         heml_real e30 = (x1 * q2 - x2 * q1) + (p1 * y2 - p2 * y1), e31 = (x2 * q0 - x0 * q2) + (p2 * y0 - p0 * y2);
         heml_real e32 = (x0 * q1 - x1 * q0) + (p0 * y1 - p1 * y0);
-        heml_real t = ca2 * al - cb2 * nu + cc * g, kA = ca2 * g + w4 * al, kN = cb2 * g;
-        /* T = X Ah, Ah X Ah = Ah T */
+        /* T = X Ah, Ah X Ah = Ah T, al = X : Ah = tr T */
         heml_real T11 = X11 * A11 + X12 * A12 + X13 * A13, T12 = X11 * A12 + X12 * A22 + X13 * A23;
         heml_real T13 = X11 * A13 + X12 * A23 + X13 * A33, T21 = X12 * A11 + X22 * A12 + X23 * A13;
         heml_real T22 = X12 * A12 + X22 * A22 + X23 * A23, T23 = X12 * A13 + X22 * A23 + X23 * A33;
         heml_real T31 = X13 * A11 + X23 * A12 + X33 * A13, T32 = X13 * A12 + X23 * A22 + X33 * A23;
-        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33;
-        heml_real K11 = kA * A11 - kN * N11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
-        heml_real K22 = kA * A22 - kN * N22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
-        heml_real K33 = kA * A33 - kN * N33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
-        heml_real K12 = kA * A12 - kN * N12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
-        heml_real K13 = kA * A13 - kN * N13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
-        heml_real K23 = kA * A23 - kN * N23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
+        heml_real T33 = X13 * A13 + X23 * A23 + X33 * A33, al = T11 + T22 + T33;
+        heml_real t = cap * al + be * xb + cc * g, kA = cap * g + w4 * al, kB = be * g;
+        heml_real K11 = kA * A11 + kB * B11 - w4 * (A11 * T11 + A12 * T21 + A13 * T31);
+        heml_real K22 = kA * A22 + kB * B22 - w4 * (A12 * T12 + A22 * T22 + A23 * T32);
+        heml_real K33 = kA * A33 + kB * B33 - w4 * (A13 * T13 + A23 * T23 + A33 * T33);
+        heml_real K12 = kA * A12 + kB * B12 - w4 * (A11 * T12 + A12 * T22 + A13 * T32);
+        heml_real K13 = kA * A13 + kB * B13 - w4 * (A11 * T13 + A12 * T23 + A13 * T33);
+        heml_real K23 = kA * A23 + kB * B23 - w4 * (A12 * T13 + A22 * T23 + A23 * T33);
         b->f[0][k] = -((x0 * B11 + y0 * B12 + z0 * B13) + (p0 * K11 + q0 * K12 + r0 * K13) + t * c10 + s2 * e10);
         b->f[1][k] = -((x1 * B11 + y1 * B12 + z1 * B13) + (p1 * K11 + q1 * K12 + r1 * K13) + t * c11 + s2 * e11);
         b->f[2][k] = -((x2 * B11 + y2 * B12 + z2 * B13) + (p2 * K11 + q2 * K12 + r2 * K13) + t * c12 + s2 * e12);

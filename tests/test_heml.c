@@ -1867,6 +1867,70 @@ static void test_mooney_rivlin_fast_force(void)
     tetmesh_free(&mesh);
 }
 
+/* The St Venant-Kirchhoff and split Mooney-Rivlin differential kernels (heml__diff_svk,
+   heml__diff_mr: their stiffness cache and its products) against the general path
+   (heml__block_diff_general, the same model with the material's dk set to 0), at a moderate
+   state and at one with tetrahedra below J0 (there the St Venant-Kirchhoff blocks take the
+   general path themselves), Mooney-Rivlin also with c2 = 0: the first product (which fills
+   the cache) and the next (which reads it). Both are the exact differential, computed in a
+   different order (the kernels in the links, the general path through F and the law's
+   second derivatives), so they agree to round-off: the check allows 1e-12 (double) and
+   2e-5 (float) of the product's largest entry, a few hundred units of round-off of the
+   sums of about 30 terms of both signs that make an entry; a wrong term (any of the
+   kernels' formulas broken) moves the products by its own size, 1e-3 of it and more.
+   The finite-difference tests hold both to dF/dx only to 1e-9. */
+static void test_fast_differentials_match_general(void)
+{
+    tetmesh mesh;
+    int li, state;
+    box_mesh(&mesh, 3, 3, 3, 1, 1, 1, TETMESH_SPLIT6);
+    for (li = 0; li < 3; li++)
+        for (state = 0; state < 2; state++) {
+            heml_material mt = material_of(li == 0 ? HEML_STVK : HEML_MOONEY_RIVLIN);
+            heml_model *mf, *m;
+            int n3 = 3 * mesh.node_count, i, r, general = 0;
+            double *x = (double *)malloc(sizeof(double) * n3), err = 0.0, kmax = 0.0;
+            heml_real *dx = alloc_reals(n3), *kf = alloc_reals(n3), *kg = alloc_reals(n3);
+            unsigned seed = 71u + 5u * (unsigned)li + (unsigned)state;
+            if (li == 2) { /* Mooney-Rivlin with c2 = 0 */
+                mt.c1 = (heml_real)(mt.c1 + mt.c2);
+                mt.c2 = 0;
+            }
+            mf = make_model_mt(&mesh, &mt, 1, NULL);
+            m = make_model_mt(&mesh, &mt, 1, NULL);
+            REQUIRE(mf != NULL && m != NULL);
+            CHECK_INT(li == 0 ? HEML__DK_SVK : HEML__DK_MR, mf->mats[0].dk);
+            CHECK(mf->has_dc);
+            m->mats[0].dk = 0; /* (the general path) */
+            deformed_state(&mesh, state ? (li == 0 ? 0.2 : 0.28) : 0.04, seed, x);
+            set_positions_d(mf, x, mesh.node_count);
+            set_positions_d(m, x, mesh.node_count);
+            (void)heml_compute_forces(mf); /* (its statistics: tetrahedra below J0) */
+            for (i = 0; i < n3; i++) dx[i] = (heml_real)rnd(&seed);
+            for (r = 0; r < 2; r++) { /* fill, then read */
+                CHECK_INT(HEML_OK, heml_apply_stiffness(mf, dx, kf));
+                CHECK_INT(HEML_OK, heml_apply_stiffness(m, dx, kg));
+                for (i = 0; i < n3; i++) {
+                    double e = fabs((double)kf[i] - (double)kg[i]);
+                    err = e > err ? e : err;
+                    kmax = fabs((double)kg[i]) > kmax ? fabs((double)kg[i]) : kmax;
+                }
+                CHECK(r == 1 || mf->dc_key == heml_displacements(mf));
+            }
+            for (i = 0; i < mf->block_count; i++) general += mf->dc_gen[i];
+            if (state) CHECK(heml_last_stats(mf)->below_threshold > 0);
+            printf("    %-22s %s (%d of %d blocks general): |K dx (kernel) - K dx (general)| / |K dx| = %.2g\n",
+                   li == 0 ? "st venant-kirchhoff" : li == 1 ? "mooney-rivlin c2 != 0" : "mooney-rivlin c2 = 0",
+                   state ? "J < J0  " : "moderate", general, mf->block_count, err / kmax);
+            CHECK(general < mf->block_count); /* (the kernel ran) */
+            CHECK(kmax > 0 && err <= (IS_FLOAT ? 2e-5 : 1e-12) * kmax);
+            free(x), free(dx), free(kf), free(kg);
+            heml_destroy(mf);
+            heml_destroy(m);
+        }
+    tetmesh_free(&mesh);
+}
+
 /* Patch test: an unstructured mesh (a 3 x 3 x 3 box of five-tetrahedron cells whose
    interior nodes are moved at random by up to 0.3 of a cell) under a homogeneous F, placed
    1e3 m from the origin: every tetrahedron's first Piola-Kirchhoff stress is the law's
@@ -2253,6 +2317,7 @@ static const test_case cases[] = {
     TEST(test_nodal_pressure_fast_force),
     TEST(test_nodal_pressure_kept_h),
     TEST(test_mooney_rivlin_fast_force),
+    TEST(test_fast_differentials_match_general),
     TEST(test_nodal_pressure_patch),
     TEST(test_nodal_pressure_refused),
     TEST(test_inv_cbrt_accuracy),
