@@ -723,6 +723,23 @@
        and K v pair mode 59 against 28 ns with and without it (tetrahedra, one sample each,
        4 neighbours: 93 against 74 and 48 against 41 ns); block products unchanged.
        On the reference machine of REFERENCES.md (4.2 GHz, 40 GB/s) expect about half.
+       Float and subnormal numbers (issue 21): at the bench's kernel state (a clamped cube
+       after one step of 10 us under gravity) the float force pass took 400 to 1300 ns a
+       pair on an Intel Xeon (Sapphire Rapids class, KVM) against 35 to 38 in double: the
+       quaternions held components of 1e-18 to 1e-29 (rotations about axes the load
+       leaves alone) and their products, and the strains' and stresses' products after
+       them, were subnormal, which Intel's cores compute by microcode assists (the AMD
+       Zen 5 at full speed: 52-62 ns). Float builds now flush what lies below eps^2 of its
+       scale (FRM_TINY, >>kernels): on that machine, loaded, interleaved minima, 110,592
+       pairs: force 1080 -> 52 ns a pair (the old code with the FTZ/DAZ flags set: 39),
+       K v 139 -> 17 ns, an implicit step of the cube at 1,728 pairs 17-25 -> 2.3 ms
+       (double 2.4); float's
+       difference from double unchanged (forces 1.4e-4 of the largest at that state,
+       2e-6 after 20 steps of 1 ms, before and after); double builds unchanged bit for
+       bit. The linearisation (prepare, assembly) and the implicit residual's conversion
+       still meet a few subnormals at that state (the stabilisation's F T^T, frames that
+       barely move); they cost nothing measurable. The library never sets FTZ/DAZ (the
+       caller's floating-point environment is the caller's).
        FRM_STIFFNESS_AUTO assembles when the previous solve's iteration count (50 before
        any) times the pair mode's cost exceeds the assembly plus the block products
        (measured per-item costs above): with 8 neighbours, beyond about 30 iterations.
