@@ -730,10 +730,11 @@
        leaves alone) and their products, and the strains' and stresses' products after
        them, were subnormal, which Intel's cores compute by microcode assists (the AMD
        Zen 5 at full speed: 52-62 ns). Float builds now flush what lies below eps^2 of its
-       scale (FRM_TINY, >>kernels): on that machine, loaded, interleaved minima, 110,592
-       pairs: force 1080 -> 52 ns a pair (the old code with the FTZ/DAZ flags set: 39),
-       K v 139 -> 17 ns, an implicit step of the cube at 1,728 pairs 17-25 -> 2.3 ms
-       (double 2.4); float's
+       scale (FRM_TINY, >>kernels). The bench's rows on that machine (build/bench/bench
+       --parts kernels --filter "svk hex8/float", old and new code alternated, minima of
+       3 rounds, load about 2 on its 2 vCPUs), 1,728 to 1e6 pairs: force 405-538 ->
+       33.7-37.3 ns a pair (double 30.2-41.2, unchanged), K v 62-73 -> 15.4-19.6 ns; an
+       implicit step of the cube at 1,728 pairs 17-25 -> 2.3 ms (double 2.4); float's
        difference from double unchanged (forces 1.4e-4 of the largest at that state,
        2e-6 after 20 steps of 1 ms, before and after); double builds unchanged bit for
        bit. The linearisation (prepare, assembly) and the implicit residual's conversion
