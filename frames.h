@@ -723,6 +723,24 @@
        and K v pair mode 59 against 28 ns with and without it (tetrahedra, one sample each,
        4 neighbours: 93 against 74 and 48 against 41 ns); block products unchanged.
        On the reference machine of REFERENCES.md (4.2 GHz, 40 GB/s) expect about half.
+       Float and subnormal numbers (issue 21): at the bench's kernel state (a clamped cube
+       after one step of 10 us under gravity) the float force pass took 400 to 1300 ns a
+       pair on an Intel Xeon (Sapphire Rapids class, KVM) against 35 to 38 in double: the
+       quaternions held components of 1e-18 to 1e-29 (rotations about axes the load
+       leaves alone) and their products, and the strains' and stresses' products after
+       them, were subnormal, which Intel's cores compute by microcode assists (the AMD
+       Zen 5 at full speed: 52-62 ns). Float builds now flush what lies below eps^2 of its
+       scale (FRM_TINY, >>kernels). The bench's rows on that machine (build/bench/bench
+       --parts kernels --filter "svk hex8/float", old and new code alternated, minima of
+       3 rounds, load about 2 on its 2 vCPUs), 1,728 to 1e6 pairs: force 405-538 ->
+       33.7-37.3 ns a pair (double 30.2-41.2, unchanged), K v 62-73 -> 15.4-19.6 ns; an
+       implicit step of the cube at 1,728 pairs 17-25 -> 2.3 ms (double 2.4); float's
+       difference from double unchanged (forces 1.4e-4 of the largest at that state,
+       2e-6 after 20 steps of 1 ms, before and after); double builds unchanged bit for
+       bit. The linearisation (prepare, assembly) and the implicit residual's conversion
+       still meet a few subnormals at that state (the stabilisation's F T^T, frames that
+       barely move); they cost nothing measurable. The library never sets FTZ/DAZ (the
+       caller's floating-point environment is the caller's).
        FRM_STIFFNESS_AUTO assembles when the previous solve's iteration count (50 before
        any) times the pair mode's cost exceeds the assembly plus the block products
        (measured per-item costs above): with 8 neighbours, beyond about 30 iterations.
@@ -2811,7 +2829,36 @@ FRMDEF int frm_chain_link_compliance(frm_model *m, const int *end_a, int na, con
    ====================================================================================== */
 #if (defined(FRAMES_IMPLEMENTATION) || defined(FRAMES_KERNELS)) && !defined(FRAMES_KERNELS_ONCE)
 #define FRAMES_KERNELS_ONCE
+#include <float.h>
 #include <math.h>
+
+/* Subnormal guard (issue 21), float builds only: FRM_TINY = eps^2 (1.4e-14), and the
+   flush of a value below a threshold to zero. The state's quaternions (unit: a component
+   below eps^2 turns the frame by less than 2 eps^2 rad, an eps-th of one rounding of R's
+   unit entries), each sample's displacement gradient H,
+   Green strain E and the minors of det(I + H) keep no component below eps^2; the
+   stabilisation's sums Y and D none below eps^2 times the largest gradient (an eps-th of
+   one rounding of their terms), the stress P that the pairs read none below eps max|P|
+   (one rounding of its largest entry: Q - I keeps second-order entries of 1e-23 at small
+   rotations, whose products with P's eps^2-level entries were still subnormal; Q - I
+   itself is not flushed: that moved a float Newton of test_i14_thin_tet, marginal at its
+   third step, past its line search). Products of the survivors (squares, H^T H, E : E,
+   Q P) stay far above the smallest normal float (FLT_MIN = 1.2e-38; eps^4 = 2e-28 leaves
+   10 decades for the model's scales). Without it a float
+   state at rest about some axes carries components of 1e-20 to 1e-29 (rotations about
+   axes the load leaves alone, a solver's rounding noise, second-order terms of small
+   rotations) whose products are subnormal, which Intel's x86 cores handle by microcode
+   assists: the bench's force pass took 400-1300 ns a pair instead of 36 (PERFORMANCE).
+   A comparison, not a change of the caller's floating-point environment (FTZ/DAZ); NaN
+   passes unchanged. Double builds compile it away (results bit for bit as before): their
+   noise of 1e-31 squares to 1e-62, some 250 decades above DBL_MIN. */
+#define FRM__FLUSH_ON (sizeof(frm_real) == sizeof(float))
+#define FRM_TINY ((frm_real)(FRM__FLUSH_ON ? (double)FLT_EPSILON * FLT_EPSILON : 0))
+FRM_HOSTDEV static inline frm_real frm_flush_below(frm_real x, frm_real t)
+{
+    return FRM__FLUSH_ON && fabsf((float)x) < (float)t ? (frm_real)0 : x; /* float only: no double on a GPU */
+}
+FRM_HOSTDEV static inline frm_real frm_flush_tiny(frm_real x) { return frm_flush_below(x, FRM_TINY); }
 
 /* Values per sample of a law's tangent data (frm_material_stress). */
 #define FRM_LAW_CACHE 7
@@ -2878,6 +2925,10 @@ FRM_HOSTDEV static inline void frm_quat_integrate(frm_real q[4], const frm_real 
     q[1] = (frm_real)(q[1] / n);
     q[2] = (frm_real)(q[2] / n);
     q[3] = (frm_real)(q[3] / n);
+    q[0] = frm_flush_tiny(q[0]); /* |q| = 1: components below eps^2 turn it by less than 2 eps^2 rad */
+    q[1] = frm_flush_tiny(q[1]);
+    q[2] = frm_flush_tiny(q[2]);
+    q[3] = frm_flush_tiny(q[3]);
 }
 
 /* Per frame: R from q, Q = R Rbar^T (the rotation since the rest pose; it maps the rest
@@ -2956,6 +3007,7 @@ FRM_HOSTDEV static inline void frm_sample_deformation(int n, const int *frame, c
             for (r = 0; r < 3; r++) offset[3 * k + r] -= p[r];
     if (position)
         for (r = 0; r < 3; r++) position[r] = sample_rest[r] + (frame_disp[3 * i0 + r] + da0[r] + p[r]);
+    for (r = 0; r < 9; r++) H[r] = frm_flush_tiny(H[r]); /* strain below eps^2: FRM_TINY */
 }
 
 /* det(I + H) - 1 by the invariants, without cancellation: tr H + (tr(H)^2 - tr(H^2))/2 + det H. */
@@ -2963,7 +3015,11 @@ FRM_HOSTDEV static inline frm_real frm_det_minus_one(const frm_real H[9])
 {
     frm_real tr = H[0] + H[4] + H[8];
     frm_real tr2 = H[0] * H[0] + H[4] * H[4] + H[8] * H[8] + 2 * (H[1] * H[3] + H[2] * H[6] + H[5] * H[7]);
-    frm_real det = H[0] * (H[4] * H[8] - H[5] * H[7]) - H[1] * (H[3] * H[8] - H[5] * H[6]) + H[2] * (H[3] * H[7] - H[4] * H[6]);
+    /* the minors flushed (FRM_TINY): the cubic term stays normal; it moves by less than
+       3 eps^2 max|H|, an eps-th of the rounding of tr */
+    frm_real m0 = frm_flush_tiny(H[4] * H[8] - H[5] * H[7]), m1 = frm_flush_tiny(H[3] * H[8] - H[5] * H[6]),
+             m2 = frm_flush_tiny(H[3] * H[7] - H[4] * H[6]);
+    frm_real det = H[0] * m0 - H[1] * m1 + H[2] * m2;
     return tr + (frm_real)0.5 * (tr * tr - tr2) + det;
 }
 
@@ -3011,6 +3067,7 @@ FRM_HOSTDEV static inline int frm_material_stress(int law, frm_real mu, frm_real
     E[3] = (frm_real)0.5 * (H[5] + H[7] + H[1] * H[2] + H[4] * H[5] + H[7] * H[8]);
     E[4] = (frm_real)0.5 * (H[2] + H[6] + H[0] * H[2] + H[3] * H[5] + H[6] * H[8]);
     E[5] = (frm_real)0.5 * (H[1] + H[3] + H[0] * H[1] + H[3] * H[4] + H[6] * H[7]);
+    for (k = 0; k < 6; k++) E[k] = frm_flush_tiny(E[k]); /* E : E stays normal: FRM_TINY */
     tr = E[0] + E[1] + E[2];
     if (law == FRM_LAW_NEO_HOOKEAN) {
         frm_real jm1 = frm_det_minus_one(H), J = 1 + jm1, lnJ, inv_det, C[6], ci[9], e[9], x[9];
@@ -3528,20 +3585,28 @@ FRM_HOSTDEV static inline double frm_pass1_stab_force(const frm_view *w, int s, 
 {
     int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, i;
     frm_real v = w->s_volume[s], c = w->s_mu[s] * v, g = w->s_hstab[s], Y[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D = 0, Dall[9];
-    frm_real sD, Z[9];
+    frm_real sD, Z[9], gmax = 0;
     double energy = 0;
     for (r = 0; r < 9; r++) Dall[r] = 0;
     for (k = 0; k < n; k++) { /* Z_k: Y over the plain pairs, Dall over the others */
+        const frm_real *gk = w->p_grad + 3 * (size_t)(b + k);
         i = w->p_frame[b + k];
-        frm_stab_direction(w->relm + 9 * i, w->p_grad + 3 * (size_t)(b + k), Z);
+        frm_stab_direction(w->relm + 9 * i, gk, Z);
         for (r = 0; r < 9; r++) {
             if (w->f_stab_on[i]) Dall[r] += Z[r];
             else Y[r] += Z[r];
         }
+        for (r = 0; r < 3; r++) gmax = gk[r] > gmax ? gk[r] : -gk[r] > gmax ? -gk[r] : gmax;
     }
+    /* Y and D sum terms of the size of the gradients (the [g]x parts cancel, sum g_k = 0):
+       parts below eps^2 max|g| are an eps-th of their rounding, flushed (FRM_TINY) so that
+       sD Y stays normal at rest */
+    gmax *= FRM_TINY;
+    for (r = 0; r < 9; r++) Y[r] = frm_flush_below(Y[r], gmax);
     for (r = 0; r < 9; r++) Dall[r] += Y[r];
     D = (frm_real)0.5 * (Dall[0] + Dall[4] + Dall[8] + Dall[0] * H[0] + Dall[1] * H[1] + Dall[2] * H[2] + Dall[3] * H[3] +
                          Dall[4] * H[4] + Dall[5] * H[5] + Dall[6] * H[6] + Dall[7] * H[7] + Dall[8] * H[8]);
+    D = frm_flush_below(D, gmax);
     energy += 0.5 * (double)c * (double)g * (double)D * (double)D;
     sD = (frm_real)0.5 * c * g * D;
     for (r = 0; r < 9; r++) P[r] += sD * Y[r] / v;
@@ -3614,7 +3679,11 @@ FRM_HOSTDEV static inline void frm_pass1_force_pairs(const frm_view *w, int s, c
                                                      int linearize, double *energy)
 {
     int b = w->s_start[s], n = w->s_start[s + 1] - b, k, r, stab = w->s_stab[s];
-    frm_real v = w->s_volume[s];
+    frm_real v = w->s_volume[s], Pf[9], top = 0;
+    for (r = 0; r < 9; r++) top = P[r] > top ? P[r] : -P[r] > top ? -P[r] : top;
+    top *= FRM_TINY / FLT_EPSILON; /* P's entries below eps max|P|, one rounding of its largest: FRM_TINY */
+    for (r = 0; r < 9; r++) Pf[r] = frm_flush_below(P[r], top);
+    P = Pf;
     for (k = 0; k < n; k++) {
         int p = b + k, i = w->p_frame[p];
         frm_real lever[3], T[9], stq[3], *out = w->p_out + 6 * (size_t)p;
@@ -4248,7 +4317,7 @@ static void frm__quat_normalized(const frm_real *q, frm_real *out)
 {
     double n = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
     int k;
-    for (k = 0; k < 4; k++) out[k] = (frm_real)(q[k] / n);
+    for (k = 0; k < 4; k++) out[k] = frm_flush_tiny((frm_real)(q[k] / n)); /* as frm_quat_integrate */
 }
 
 /* >>laws -------------------------------------------------------------------------------- */
