@@ -3229,8 +3229,12 @@ static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link, L^2 = |V|^2), and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35), k = E Vol / L^2, as
-       t = E Vol (l^2 - L^2) / (L^2 (l^2 + s)),   s = L l = sqrt(L^2 l^2)
-   (one square root and one division per link) into co[0..5]; len gets l^2 s = L l^3 for
+       t = E Vol (l^2 - L^2) / d,   d = L^2 (l^2 + s),   s = L l = sqrt(L^2 l^2)
+   (one square root per link; in double the six divisions 1 / d through one, 1 / (d1 ... d6)
+   and 15 multiplications that back out each 1 / d, within a few ulps of the quotients,
+   and six divisions for a lane whose product leaves [DBL_MIN, DBL_MAX / 4], d ~ L^4 off
+   1e-13 m to 1e13 m or clamped lengths; float keeps the six divisions, whose product,
+   L^24, would leave its range on millimetre meshes) into co[0..5]; len gets l^2 s = L l^3 for
    the differential (dt = s_p E Vol (v . dv) / (L l^3)); with `energy`, w (per lane, J) =
    sum k/2 (l - L)^2 = sum E Vol (l^2 - L^2)^2 / (2 L^2 (l^2 + 2 s + L^2)). Lengths are
    clamped at 1e-12 L (l^2 at 1e-24 L^2) so coincident nodes give finite forces. Every
@@ -3241,7 +3245,7 @@ static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
 static void heml__spring_tensions(heml_real young, const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b,
                                   int energy)
 {
-    heml_real dl2[6][HEML__W], L2[6][HEML__W], q2[6][HEML__W];
+    heml_real dl2[6][HEML__W], L2[6][HEML__W], q2[6][HEML__W], dn[6][HEML__W];
     int k, l, r;
     for (l = 0; l < 3; l++) /* L^2 = |V|^2 and l^2 - L^2 = 2 V . du + |du|^2 (vectorised) */
         for (k = 0; k < HEML__W; k++) {
@@ -3274,14 +3278,37 @@ static void heml__spring_tensions(heml_real young, const heml_real *HEML__RESTRI
             b->len[l][k] = L2[l][k] * q;
         }
     heml__sqrt_lanes(b->len[0], 6 * HEML__W);
-    for (l = 0; l < 6; l++)
+    for (l = 0; l < 6; l++) /* the denominators L^2 (l^2 + L l) into dn, l^2 L l = L l^3 into len */
         for (k = 0; k < HEML__W; k++) {
-            heml_real ev = young * R[9 * HEML__W + k], sl = b->len[l][k], q = q2[l][k];
-            heml_real den = L2[l][k] * (q + sl);
-            den = den > 0 ? den : 1; /* (padding: dl2 = 0; unconditional, so it vectorises) */
-            b->co[l][k] = ev * dl2[l][k] / den; /* k (l - L) / l */
+            heml_real sl = b->len[l][k], q = q2[l][k], den = L2[l][k] * (q + sl);
+            dn[l][k] = den > 0 ? den : 1; /* (padding: dl2 = 0; unconditional, so it vectorises) */
             b->len[l][k] = q * sl;
         }
+    if (sizeof(heml_real) > sizeof(float)) { /* double: the six 1 / den through one division */
+        heml_real inv[6][HEML__W], bad[HEML__W];
+        int nbad = 0;
+        for (k = 0; k < HEML__W; k++) {
+            heml_real d0 = dn[0][k], d1 = dn[1][k], d2 = dn[2][k], d3 = dn[3][k], d4 = dn[4][k], d5 = dn[5][k];
+            heml_real p01 = d0 * d1, p23 = d2 * d3, p45 = d4 * d5, p0123 = p01 * p23, P = p0123 * p45;
+            heml_real iP = 1 / P, i45 = p0123 * iP, i0123 = p45 * iP, i01 = p23 * i0123, i23 = p01 * i0123;
+            inv[0][k] = d1 * i01;
+            inv[1][k] = d0 * i01;
+            inv[2][k] = d3 * i23;
+            inv[3][k] = d2 * i23;
+            inv[4][k] = d5 * i45;
+            inv[5][k] = d4 * i45;
+            bad[k] = (heml_real)((P < (heml_real)DBL_MIN) | (P > (heml_real)(DBL_MAX / 4)));
+        }
+        for (k = 0; k < HEML__W; k++) nbad += bad[k] != 0;
+        if (nbad) /* (a product out of range: lengths far from 1 m, or clamped) */
+            for (k = 0; k < HEML__W; k++)
+                if (bad[k] != 0)
+                    for (l = 0; l < 6; l++) inv[l][k] = 1 / dn[l][k];
+        for (l = 0; l < 6; l++)
+            for (k = 0; k < HEML__W; k++) b->co[l][k] = young * R[9 * HEML__W + k] * dl2[l][k] * inv[l][k];
+    } else
+        for (l = 0; l < 6; l++)
+            for (k = 0; k < HEML__W; k++) b->co[l][k] = young * R[9 * HEML__W + k] * dl2[l][k] / dn[l][k];
     if (energy)
         for (k = 0; k < HEML__W; k++) {
             double we = 0.0, ev = (double)young * (double)R[9 * HEML__W + k];
