@@ -917,7 +917,8 @@
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read no
-   more since issue 21's second spring change, below; a Prony series 72 per term, which it also writes), gathers the displacements of
+   more since issue 21's second spring change, below, and share their six divisions since
+   the third; a Prony series 72 per term, which it also writes), gathers the displacements of
    its 4 nodes (96 bytes, mostly cache hits when nodes are numbered with locality: the
    tetrahedra are ordered by their lowest node, see heml__node_order) and adds into their
    forces (96 bytes read and written, likewise). heml_kernel_bytes gives the
@@ -1226,6 +1227,49 @@
    after against 19.6-21.0 ns before, 1.61-1.69 against 1.62-1.67 times Neo-Hookean: the
    halved stream shows no gain there either on this machine (its large last-level cache).
    Kept: a smaller model and no loss.
+   The spring force's divider (issue 21, a third spring change): in double the six
+   tension divisions of a tetrahedron now go through one, 1 / (d1 ... d6) and 15
+   multiplications that back out each 1 / d (heml__spring_tensions; a lane whose product
+   leaves [DBL_MIN, DBL_MAX / 4], cells below about 1e-13 m or above 1e13 m, divides six
+   times as before). Float keeps its six divisions: d ~ L^4, so the product of six would
+   leave float's range on millimetre meshes, and float's springs were already within 1.2
+   times its Neo-Hookean force. The divider now runs 6 square roots and 2 divisions a
+   tetrahedron in double instead of 6 and 7; forces move by round-off (tests/test_heml.c
+   test_spring_roundoff: 4 to 19 eps of the terms' magnitude against a long-double
+   reference, tolerance 64, the fallback included). Measured in a harness (heml_compute_forces
+   on the bench's cubes of n^3 cells of 5 tetrahedra, 2 % stretch and noise; old, new and
+   the Neo-Hookean force compiled into one program and alternated, minimum of 300 rounds
+   of about 1 ms, 30 single calls at 1e6; gcc 12 -O3 -march=native; Intel Xeon, Sapphire
+   Rapids class, KVM, 2 vCPUs at load 4 to 8 from other jobs; several runs), double, ns per
+   tetrahedron and springs / Neo-Hookean in the same run:
+       1,080 tetrahedra       16.6-18.8 -> 15.5-16.7     1.66-1.77 -> 1.57-1.69
+       10,985                 16.7-16.9 -> 15.7-15.9     1.59-1.66 -> 1.50-1.56
+       109,760                18.4-19.3 -> 17.2-17.4     1.50-1.61 -> 1.41-1.45
+       1,026,895              20.8-21.5 -> 19.0-19.6     1.35-1.40 -> 1.35-1.44
+   and float 1.10-1.21 (unchanged). The bench (`--parts kernels --filter heml/springs/` and
+   `heml/neo-hookean/`, `--repeats 5`, old and new binaries alternated, minimum of 6
+   rounds, same machine): springs / Neo-Hookean 1.84 -> 1.74 and 1.64 -> 1.51 at 1,080 and
+   10,985 tetrahedra in double (its medians run 2 to 3 times the harness's minima on this
+   loaded machine), float 0.96 -> 1.10 and 1.08 -> 1.11 (noise: the float code did not
+   change). Callgrind (-march=x86-64-v3, 10,985 tetrahedra, instructions a tetrahedron and
+   force): springs 209 -> 221 in double against Neo-Hookean's 158, 144 in float (122). So
+   the goal of 1.5 holds at 1e5 and 1e6 in double and at every size in float, not at 1e3
+   and 1e4 in double (1.50-1.69): not met. Timing probes (wrong forces): without the square
+   roots the new force takes 13.2-14.8 ns (1.24-1.33), without square roots and divisions
+   11.2-13.5 (1.08-1.21): the denominators still cost about 4 ns of the 15.5. Tried and not
+   kept, same harness: Newton reciprocal square roots r = 1 / (L l) from a float bit-trick
+   guess (4 steps in double, 3 in float, vectorised) with x = 1 + L / l and t = E Vol
+   (l^2 - L^2) r^2 / x, the six 1 / x through two divisions: no square root and 2 divisions
+   a tetrahedron, but 249 instructions and slower (1.70-1.83 against 1.67-1.75 before; float
+   1.3-2.0 against 1.1); the same with AVX-512's vrsqrt14pd and two Newton steps, for all
+   six links or for links 1 to 3 with 4 to 6 by square roots (the divider and the
+   multiply-add units sharing the work): 15.6-16.5 / 15.9-16.1 / 16.9-17.0 ns against
+   15.8 / 16.3 / 17.3 for the shared division in the same run at 1e3 / 1e4 / 1e5, no gain
+   for an intrinsic path; the
+   statistics' J - 1 with det V^-1 in place of its division (4 more instructions): 15.7-16.8
+   against 15.5 ns; 512-bit square roots in heml__sqrt_lanes: slower (16.8 against 15.3 ns);
+   the denominators, the shared reciprocal and the tensions in one lane loop: 1 to 7 %
+   faster with -march=native, but that loop stays scalar for AVX2 (292 instructions).
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
