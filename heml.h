@@ -950,7 +950,8 @@
 
    PERFORMANCE: per tetrahedron the force kernel reads 4 int node indices and the 10 rest
    constants (HEML_KERNEL_BYTES_PER_TET: 96 bytes in double, 56 in float; springs read no
-   more since issue 21's second spring change, below; a Prony series 72 per term, which it also writes), gathers the displacements of
+   more since issue 21's second spring change, below, and share their six divisions since
+   the third; a Prony series 72 per term, which it also writes), gathers the displacements of
    its 4 nodes (96 bytes, mostly cache hits when nodes are numbered with locality: the
    tetrahedra are ordered by their lowest node, see heml__node_order) and adds into their
    forces (96 bytes read and written, likewise). heml_kernel_bytes gives the
@@ -1303,6 +1304,49 @@
    after against 19.6-21.0 ns before, 1.61-1.69 against 1.62-1.67 times Neo-Hookean: the
    halved stream shows no gain there either on this machine (its large last-level cache).
    Kept: a smaller model and no loss.
+   The spring force's divider (issue 21, a third spring change): in double the six
+   tension divisions of a tetrahedron now go through one, 1 / (d1 ... d6) and 15
+   multiplications that back out each 1 / d (heml__spring_tensions; a lane whose product
+   leaves [DBL_MIN, DBL_MAX / 4], cells below about 1e-13 m or above 1e13 m, divides six
+   times as before). Float keeps its six divisions: d ~ L^4, so the product of six would
+   leave float's range on millimetre meshes, and float's springs were already within 1.2
+   times its Neo-Hookean force. The divider now runs 6 square roots and 2 divisions a
+   tetrahedron in double instead of 6 and 7; forces move by round-off (tests/test_heml.c
+   test_spring_roundoff: 4 to 19 eps of the terms' magnitude against a long-double
+   reference, tolerance 64, the fallback included). Measured in a harness (heml_compute_forces
+   on the bench's cubes of n^3 cells of 5 tetrahedra, 2 % stretch and noise; old, new and
+   the Neo-Hookean force compiled into one program and alternated, minimum of 300 rounds
+   of about 1 ms, 30 single calls at 1e6; gcc 12 -O3 -march=native; Intel Xeon, Sapphire
+   Rapids class, KVM, 2 vCPUs at load 4 to 8 from other jobs; several runs), double, ns per
+   tetrahedron and springs / Neo-Hookean in the same run:
+       1,080 tetrahedra       16.6-18.8 -> 15.5-16.7     1.66-1.77 -> 1.57-1.69
+       10,985                 16.7-16.9 -> 15.7-15.9     1.59-1.66 -> 1.50-1.56
+       109,760                18.4-19.3 -> 17.2-17.4     1.50-1.61 -> 1.41-1.45
+       1,026,895              20.8-21.5 -> 19.0-19.6     1.35-1.40 -> 1.35-1.44
+   and float 1.10-1.21 (unchanged). The bench (`--parts kernels --filter heml/springs/` and
+   `heml/neo-hookean/`, `--repeats 5`, old and new binaries alternated, minimum of 6
+   rounds, same machine): springs / Neo-Hookean 1.84 -> 1.74 and 1.64 -> 1.51 at 1,080 and
+   10,985 tetrahedra in double (its medians run 2 to 3 times the harness's minima on this
+   loaded machine), float 0.96 -> 1.10 and 1.08 -> 1.11 (noise: the float code did not
+   change). Callgrind (-march=x86-64-v3, 10,985 tetrahedra, instructions a tetrahedron and
+   force): springs 209 -> 221 in double against Neo-Hookean's 158, 144 in float (122). So
+   the goal of 1.5 holds at 1e5 and 1e6 in double and at every size in float, not at 1e3
+   and 1e4 in double (1.50-1.69): not met. Timing probes (wrong forces): without the square
+   roots the new force takes 13.2-14.8 ns (1.24-1.33), without square roots and divisions
+   11.2-13.5 (1.08-1.21): the denominators still cost about 4 ns of the 15.5. Tried and not
+   kept, same harness: Newton reciprocal square roots r = 1 / (L l) from a float bit-trick
+   guess (4 steps in double, 3 in float, vectorised) with x = 1 + L / l and t = E Vol
+   (l^2 - L^2) r^2 / x, the six 1 / x through two divisions: no square root and 2 divisions
+   a tetrahedron, but 249 instructions and slower (1.70-1.83 against 1.67-1.75 before; float
+   1.3-2.0 against 1.1); the same with AVX-512's vrsqrt14pd and two Newton steps, for all
+   six links or for links 1 to 3 with 4 to 6 by square roots (the divider and the
+   multiply-add units sharing the work): 15.6-16.5 / 15.9-16.1 / 16.9-17.0 ns against
+   15.8 / 16.3 / 17.3 for the shared division in the same run at 1e3 / 1e4 / 1e5, no gain
+   for an intrinsic path; the
+   statistics' J - 1 with det V^-1 in place of its division (4 more instructions): 15.7-16.8
+   against 15.5 ns; 512-bit square roots in heml__sqrt_lanes: slower (16.8 against 15.3 ns);
+   the denominators, the shared reciprocal and the tensions in one lane loop: 1 to 7 %
+   faster with -march=native, but that loop stays scalar for AVX2 (292 instructions).
    What the force's remaining gap needs (not done): more independent chains per block in
    double (HEML__W = 32: a change of the chunk structure, so of every sum's order).
    Why the force cost twice the cached differential out of cache (issue 21: the bench's
@@ -3312,8 +3356,12 @@ static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
 /* Mass-spring (sec. 5.3): the change of the squared link lengths without cancellation,
    l^2 - L^2 = 2 V . du + |du|^2 (V the rest link, L^2 = |V|^2), and the tensions
    t = k (l - L) / l = k (l^2 - L^2) / ((l + L) l) (eq. 35), k = E Vol / L^2, as
-       t = E Vol (l^2 - L^2) / (L^2 (l^2 + s)),   s = L l = sqrt(L^2 l^2)
-   (one square root and one division per link) into co[0..5]; len gets l^2 s = L l^3 for
+       t = E Vol (l^2 - L^2) / d,   d = L^2 (l^2 + s),   s = L l = sqrt(L^2 l^2)
+   (one square root per link; in double the six divisions 1 / d through one, 1 / (d1 ... d6)
+   and 15 multiplications that back out each 1 / d, within a few ulps of the quotients,
+   and six divisions for a lane whose product leaves [DBL_MIN, DBL_MAX / 4], d ~ L^4 off
+   1e-13 m to 1e13 m or clamped lengths; float keeps the six divisions, whose product,
+   L^24, would leave its range on millimetre meshes) into co[0..5]; len gets l^2 s = L l^3 for
    the differential (dt = s_p E Vol (v . dv) / (L l^3)); with `energy`, w (per lane, J) =
    sum k/2 (l - L)^2 = sum E Vol (l^2 - L^2)^2 / (2 L^2 (l^2 + 2 s + L^2)). Lengths are
    clamped at 1e-12 L (l^2 at 1e-24 L^2) so coincident nodes give finite forces. Every
@@ -3324,7 +3372,7 @@ static void heml__sqrt_lanes(heml_real *HEML__RESTRICT x, int n)
 static void heml__spring_tensions(heml_real young, const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b,
                                   int energy)
 {
-    heml_real dl2[6][HEML__W], L2[6][HEML__W], q2[6][HEML__W];
+    heml_real dl2[6][HEML__W], L2[6][HEML__W], q2[6][HEML__W], dn[6][HEML__W];
     int k, l, r;
     for (l = 0; l < 3; l++) /* L^2 = |V|^2 and l^2 - L^2 = 2 V . du + |du|^2 (vectorised) */
         for (k = 0; k < HEML__W; k++) {
@@ -3357,14 +3405,37 @@ static void heml__spring_tensions(heml_real young, const heml_real *HEML__RESTRI
             b->len[l][k] = L2[l][k] * q;
         }
     heml__sqrt_lanes(b->len[0], 6 * HEML__W);
-    for (l = 0; l < 6; l++)
+    for (l = 0; l < 6; l++) /* the denominators L^2 (l^2 + L l) into dn, l^2 L l = L l^3 into len */
         for (k = 0; k < HEML__W; k++) {
-            heml_real ev = young * R[9 * HEML__W + k], sl = b->len[l][k], q = q2[l][k];
-            heml_real den = L2[l][k] * (q + sl);
-            den = den > 0 ? den : 1; /* (padding: dl2 = 0; unconditional, so it vectorises) */
-            b->co[l][k] = ev * dl2[l][k] / den; /* k (l - L) / l */
+            heml_real sl = b->len[l][k], q = q2[l][k], den = L2[l][k] * (q + sl);
+            dn[l][k] = den > 0 ? den : 1; /* (padding: dl2 = 0; unconditional, so it vectorises) */
             b->len[l][k] = q * sl;
         }
+    if (sizeof(heml_real) > sizeof(float)) { /* double: the six 1 / den through one division */
+        heml_real inv[6][HEML__W], bad[HEML__W];
+        int nbad = 0;
+        for (k = 0; k < HEML__W; k++) {
+            heml_real d0 = dn[0][k], d1 = dn[1][k], d2 = dn[2][k], d3 = dn[3][k], d4 = dn[4][k], d5 = dn[5][k];
+            heml_real p01 = d0 * d1, p23 = d2 * d3, p45 = d4 * d5, p0123 = p01 * p23, P = p0123 * p45;
+            heml_real iP = 1 / P, i45 = p0123 * iP, i0123 = p45 * iP, i01 = p23 * i0123, i23 = p01 * i0123;
+            inv[0][k] = d1 * i01;
+            inv[1][k] = d0 * i01;
+            inv[2][k] = d3 * i23;
+            inv[3][k] = d2 * i23;
+            inv[4][k] = d5 * i45;
+            inv[5][k] = d4 * i45;
+            bad[k] = (heml_real)((P < (heml_real)DBL_MIN) | (P > (heml_real)(DBL_MAX / 4)));
+        }
+        for (k = 0; k < HEML__W; k++) nbad += bad[k] != 0;
+        if (nbad) /* (a product out of range: lengths far from 1 m, or clamped) */
+            for (k = 0; k < HEML__W; k++)
+                if (bad[k] != 0)
+                    for (l = 0; l < 6; l++) inv[l][k] = 1 / dn[l][k];
+        for (l = 0; l < 6; l++)
+            for (k = 0; k < HEML__W; k++) b->co[l][k] = young * R[9 * HEML__W + k] * dl2[l][k] * inv[l][k];
+    } else
+        for (l = 0; l < 6; l++)
+            for (k = 0; k < HEML__W; k++) b->co[l][k] = young * R[9 * HEML__W + k] * dl2[l][k] / dn[l][k];
     if (energy)
         for (k = 0; k < HEML__W; k++) {
             double we = 0.0, ev = (double)young * (double)R[9 * HEML__W + k];

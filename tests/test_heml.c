@@ -1077,6 +1077,106 @@ static void test_mass_spring_is_classical_springs(void)
     tetmesh_free(&mesh);
 }
 
+/* One state of test_spring_roundoff: a box of 3 x 2 x 2 cells of size `scale` (m), every
+   node moved by up to amp * scale, the model's forces against the classical spring force
+   t = k (l - L) / l (eq. 35), k = E Vol / L^2, evaluated straightforwardly in long double
+   from the displacements and rest positions the model holds (l - L as (l^2 - L^2) / (l + L),
+   l^2 - L^2 = (2 D + du) . du, so that the reference keeps its precision at small strains).
+   *worst: the largest |f_heml - f_ref| per component over EPS times the sum of the |t v|
+   terms that meet in that component (the sum's condition: the error a kernel with a few
+   roundings per term can make, whatever the cancellation between links). */
+static void spring_roundoff_case(double scale, double amp, unsigned seed, double *worst)
+{
+    static const int link[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {2, 3}, {3, 1}};
+    tetmesh mesh;
+    heml_model *m;
+    heml_material mt = material_of(HEML_MASS_SPRING);
+    heml_real *u;
+    const heml_real *fh, *X0, *U;
+    long double *f, *S;
+    int n3, i, t, l, a;
+    *worst = 1e30; /* (what a failed REQUIRE leaves) */
+    box_mesh(&mesh, 3, 2, 2, 3 * scale, 2 * scale, 2 * scale, TETMESH_SPLIT6);
+    m = make_model(&mesh, HEML_MASS_SPRING);
+    REQUIRE(m != NULL);
+    n3 = 3 * mesh.node_count;
+    u = alloc_reals(n3);
+    f = (long double *)calloc((size_t)n3, sizeof(long double));
+    S = (long double *)calloc((size_t)n3, sizeof(long double));
+    REQUIRE(f && S);
+    for (i = 0; i < n3; i++) u[i] = (heml_real)(amp * scale * rnd(&seed));
+    REQUIRE(heml_set_displacements(m, u) == HEML_OK);
+    fh = heml_compute_forces(m);
+    REQUIRE(fh != NULL);
+    X0 = heml_rest_positions(m);
+    U = heml_displacements(m);
+    for (t = 0; t < mesh.tet_count; t++) {
+        const int *q = mesh.tets + 4 * t;
+        const double *p[4];
+        double g[4][3], V;
+        for (a = 0; a < 4; a++) p[a] = mesh.nodes + 3 * q[a];
+        V = fem_gradients(p, g);
+        for (l = 0; l < 6; l++) {
+            int na = q[link[l][0]], nb = q[link[l][1]];
+            long double D[3], du[3], L2 = 0, dl2 = 0, len, L, k, ten;
+            for (a = 0; a < 3; a++) {
+                D[a] = (long double)X0[3 * nb + a] - (long double)X0[3 * na + a];
+                du[a] = (long double)U[3 * nb + a] - (long double)U[3 * na + a];
+                L2 += D[a] * D[a];
+                dl2 += (2 * D[a] + du[a]) * du[a];
+            }
+            len = sqrtl(L2 + dl2);
+            L = sqrtl(L2);
+            k = (long double)mt.young_modulus * (long double)V / L2;
+            ten = k * dl2 / ((len + L) * len);
+            for (a = 0; a < 3; a++) {
+                long double term = ten * (D[a] + du[a]);
+                f[3 * na + a] += term;
+                f[3 * nb + a] -= term;
+                S[3 * na + a] += fabsl(term);
+                S[3 * nb + a] += fabsl(term);
+            }
+        }
+    }
+    *worst = 0.0;
+    for (i = 0; i < n3; i++) {
+        double e = (double)fabsl((long double)fh[i] - f[i]) / (EPS * (double)S[i]);
+        *worst = e > *worst ? e : *worst;
+    }
+    free(u);
+    free(f);
+    free(S);
+    heml_destroy(m);
+    tetmesh_free(&mesh);
+}
+
+/* The spring force to round-off (issue 21: heml__spring_tensions takes the six tensions'
+   divisions in double through one shared reciprocal, 1 / (d1 ... d6) and products, with a
+   per-link fallback where that product leaves double's range; float keeps six divisions),
+   at small and large strains and, in double, on meshes of 1e-14 m and 1e13 m cells, where
+   every block takes the fallback. Tolerance 64 EPS of the terms' magnitude: the kernel's
+   tension has about 12 roundings (the rest links from the rest gradients, 4 to 5; L^2 and
+   l^2 - L^2, 3; the square root, the denominator and the shared reciprocal, 5 for the
+   three products that back out each 1 / d), the force 2 more per term; 64 leaves a factor
+   4 over that budget and stays 1e4 times below an error of one part in 1e-12 (double) that
+   a wrong factor anywhere would make. */
+static void test_spring_roundoff(void)
+{
+    double w1, w2, w3, w4;
+    spring_roundoff_case(0.5, 1e-3, 11u, &w1);
+    spring_roundoff_case(0.5, 0.15, 12u, &w2);
+    printf("    worst |f - f_ref| / (eps sum |t v|): small strain %.3g, 15 %% %.3g\n", w1, w2);
+    CHECK(w1 <= 64);
+    CHECK(w2 <= 64);
+    if (!IS_FLOAT) { /* (float cannot hold these lengths' fourth powers) */
+        spring_roundoff_case(1e-14, 0.15, 13u, &w3);
+        spring_roundoff_case(1e13, 0.15, 14u, &w4);
+        printf("    on 1e-14 m cells %.3g, on 1e13 m cells %.3g\n", w3, w4);
+        CHECK(w3 <= 64);
+        CHECK(w4 <= 64);
+    }
+}
+
 /* ---- tests: inversion (sec. 4.4) --------------------------------------------------- */
 
 /* One tetrahedron with its base (nodes 0, 1, 2) pinned: node 3 is driven through the base
@@ -2308,6 +2408,7 @@ static const test_case cases[] = {
     TEST(test_rest_and_small_strains),
     TEST(test_rigid_motion_zero_force),
     TEST(test_mass_spring_is_classical_springs),
+    TEST(test_spring_roundoff),
     TEST(test_inversion_recovers),
     TEST(test_uniaxial_closed_forms),
     TEST(test_prony_relaxation),
