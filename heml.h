@@ -2072,6 +2072,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
    HEML_NO_SIMD forces the portable scalar code. */
 #if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
 #include <immintrin.h>
+#include <stdint.h> /* (uintptr_t: heml__gather_vecf8) */
 #define HEML__AVX 1
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #define HEML__AVX512 1 /* the gather's masked node loads with AVX-512 masks (else AVX's vmaskmov) */
@@ -2233,6 +2234,9 @@ struct heml_model {
 
     /* nodes; the state is the displacement u (disp), pos = rest + u is kept for rendering */
     heml_real *rest, *pos, *disp, *vel, *force, *ext, *target, *mass, *inv_mass;
+    heml_real *force4;                     /* float builds with AVX: the Neo-Hookean force pass's
+                                              node forces padded to 4 components (heml__pass_run;
+                                              NULL elsewhere) */
     heml_real *free_mask, *pin_mask; /* per degree of freedom: 1 free / 1 pinned */
     heml_real *diag;                 /* per degree of freedom: small-strain stiffness diagonal */
     double energy_noise;             /* J: round-off of the energy of user laws (static line search) */
@@ -2934,10 +2938,50 @@ static void heml__scatter_scalar(const int *HEML__RESTRICT idx, heml_real (*HEML
 #define HEML__LOAD3D(p) _mm256_maskload_pd((p), _mm256_set_epi64x(0, -1, -1, -1))
 #define HEML__LOAD3F(p) _mm_maskload_ps((p), _mm_set_epi32(0, -1, -1, -1))
 #endif
+#if defined(HEML__AVX512)
+/* The float gather with AVX-512 VL masks, 8 lanes at a time in 256-bit registers: register q
+   holds lane q in its low half and lane 4 + q in its high half (a zeroing 3-element load,
+   then a merging one at the node's address minus 16 bytes with mask bits 4 to 6: masked-off
+   elements never fault), so one 4 x 4 transpose per half moves 8 lanes at once: half the
+   shuffles, subtractions and stores of 4 lanes in 128-bit registers. */
+static void heml__gather_vecf8(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                               heml_real (*HEML__RESTRICT e)[HEML__W])
+{
+    const float *xf = (const float *)(const void *)x;
+    float *row = (float *)(void *)e[0];
+    int h, j, q;
+#define HEML__LOAD8F(i, l)                                                                                        \
+    _mm256_mask_loadu_ps(_mm256_maskz_loadu_ps((__mmask8)7, xf + 3 * (size_t)(i)[l]), (__mmask8)0x70,            \
+                         (const float *)(const void *)((uintptr_t)(xf + 3 * (size_t)(i)[(l) + 4]) - 16))
+    for (h = 0; h < HEML__W; h += 8) {
+        __m256 n0[4];
+        for (q = 0; q < 4; q++) n0[q] = HEML__LOAD8F(idx, h + q);
+        for (j = 1; j < 4; j++) {
+            __m256 d[4], t0, t1, t2, t3;
+            for (q = 0; q < 4; q++) d[q] = _mm256_sub_ps(HEML__LOAD8F(idx + j * HEML__W, h + q), n0[q]);
+            t0 = _mm256_unpacklo_ps(d[0], d[1]); /* x0 x1 y0 y1 in each half */
+            t1 = _mm256_unpackhi_ps(d[0], d[1]); /* z0 z1 .. */
+            t2 = _mm256_unpacklo_ps(d[2], d[3]);
+            t3 = _mm256_unpackhi_ps(d[2], d[3]);
+            _mm256_storeu_ps(row + 3 * (j - 1) * HEML__W + h, _mm256_shuffle_ps(t0, t2, 0x44));
+            _mm256_storeu_ps(row + (3 * (j - 1) + 1) * HEML__W + h, _mm256_shuffle_ps(t0, t2, 0xEE));
+            _mm256_storeu_ps(row + (3 * (j - 1) + 2) * HEML__W + h, _mm256_shuffle_ps(t1, t3, 0x44));
+        }
+    }
+#undef HEML__LOAD8F
+}
+#endif
+
 static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
                              heml_real (*HEML__RESTRICT e)[HEML__W])
 {
     int k, j, l;
+#if defined(HEML__AVX512)
+    if (sizeof(heml_real) != sizeof(double)) {
+        heml__gather_vecf8(idx, x, e);
+        return;
+    }
+#endif
     for (k = 0; k < HEML__W; k += 4) {
         if (sizeof(heml_real) == sizeof(double)) {
             const double *xd = (const double *)(const void *)x;
@@ -2977,12 +3021,126 @@ static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEM
     }
 }
 
+/* Two floats (8 bytes, any 4-byte alignment) into a register's low half and back: memcpy
+   through a double, which compilers turn into one 8-byte move (a cast pointer would be a
+   misaligned double access). */
+HEML__INLINE __m128 heml__ld2f(const float *p)
+{
+    double t;
+    memcpy(&t, p, sizeof t);
+    return _mm_castpd_ps(_mm_set_sd(t));
+}
+
+HEML__INLINE void heml__st2f(float *p, __m128 v)
+{
+    double t = _mm_cvtsd_f64(_mm_castps_pd(v));
+    memcpy(p, &t, sizeof t);
+}
+
+/* The float scatter: per 8 lanes and node two unpacks interleave the rows x and y into
+   (x, y) pairs (a buffer), and each lane's (x, y) and z go to its node by an 8-byte and a
+   4-byte read-modify-write, z read straight from its row: 1 shuffle per tetrahedron where
+   4 x 4 transposes and z extractions took 12. Lanes in order, the scalar path's sums. */
+static void heml__scatter_vecf(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                               heml_real *HEML__RESTRICT out)
+{
+    /* lane l's pair in a node's buffer: unpacklo holds lanes 0 1 4 5, unpackhi 2 3 6 7 of 8 */
+    static const int at[16] = {0, 2, 8, 10, 4, 6, 12, 14, 16, 18, 24, 26, 20, 22, 28, 30};
+    const float *fr = (const float *)(const void *)f[0];
+    float *of = (float *)(void *)out;
+    float xy[4][2 * HEML__W], z0[HEML__W];
+    int j, h, l;
+    for (j = 0; j < 4; j++)
+        for (h = 0; h < HEML__W; h += 8) {
+            __m256 X, Y;
+            if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                X = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + h), _mm256_loadu_ps(fr + 3 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 6 * HEML__W + h));
+                Y = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + HEML__W + h), _mm256_loadu_ps(fr + 4 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 7 * HEML__W + h));
+                _mm256_storeu_ps(z0 + h, _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + 2 * HEML__W + h),
+                                                                     _mm256_loadu_ps(fr + 5 * HEML__W + h)),
+                                                       _mm256_loadu_ps(fr + 8 * HEML__W + h)));
+            } else {
+                X = _mm256_loadu_ps(fr + 3 * (j - 1) * HEML__W + h);
+                Y = _mm256_loadu_ps(fr + (3 * (j - 1) + 1) * HEML__W + h);
+            }
+            _mm256_storeu_ps(xy[j] + 2 * h, _mm256_unpacklo_ps(X, Y));
+            _mm256_storeu_ps(xy[j] + 2 * h + 8, _mm256_unpackhi_ps(X, Y));
+        }
+    for (l = 0; l < HEML__W; l++) { /* lanes in order: shared nodes see the scalar order */
+        size_t o;
+        for (j = 1; j < 4; j++) {
+            o = 3 * (size_t)idx[j * HEML__W + l];
+            heml__st2f(of + o, _mm_add_ps(heml__ld2f(of + o), heml__ld2f(xy[j] + at[l])));
+            of[o + 2] += fr[(3 * (j - 1) + 2) * HEML__W + l];
+        }
+        o = 3 * (size_t)idx[l];
+        heml__st2f(of + o, _mm_sub_ps(heml__ld2f(of + o), heml__ld2f(xy[0] + at[l])));
+        of[o + 2] -= z0[l];
+    }
+}
+
+/* The float scatter into nodes padded to 4 components (m->force4, 16-byte aligned): per 8
+   lanes and node a 4 x 4 transpose in each 128-bit half turns the rows x, y, z into the
+   lanes' (x, y, z, z) (a buffer), and each lane's goes to its node by one aligned 16-byte
+   read-modify-write (the fourth component is padding, never read back). The same sums in
+   the same order as the scalar loop: heml__pass_run copies x, y, z to the 3n forces. */
+static void heml__scatter_vecf4(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                                heml_real *HEML__RESTRICT out4)
+{
+    const float *fr = (const float *)(const void *)f[0];
+    /* lane l's (x, y, z, z) in a node's buffer: 8 (l & 3) + 4 ((l >> 2) & 1) + 32 (l >> 3) */
+    static const int at[16] = {0, 8, 16, 24, 4, 12, 20, 28, 32, 40, 48, 56, 36, 44, 52, 60};
+    float *of = (float *)(void *)out4;
+    float q[4][4 * HEML__W];
+    int j, h, l;
+    for (j = 0; j < 4; j++)
+        for (h = 0; h < HEML__W; h += 8) {
+            __m256 X, Y, Z, t0, t1, t2, t3;
+            if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                X = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + h), _mm256_loadu_ps(fr + 3 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 6 * HEML__W + h));
+                Y = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + HEML__W + h), _mm256_loadu_ps(fr + 4 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 7 * HEML__W + h));
+                Z = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + 2 * HEML__W + h), _mm256_loadu_ps(fr + 5 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 8 * HEML__W + h));
+            } else {
+                X = _mm256_loadu_ps(fr + 3 * (j - 1) * HEML__W + h);
+                Y = _mm256_loadu_ps(fr + (3 * (j - 1) + 1) * HEML__W + h);
+                Z = _mm256_loadu_ps(fr + (3 * (j - 1) + 2) * HEML__W + h);
+            }
+            t0 = _mm256_unpacklo_ps(X, Y); /* x0 y0 x1 y1 | x4 y4 x5 y5 */
+            t1 = _mm256_unpackhi_ps(X, Y); /* x2 y2 x3 y3 | x6 y6 x7 y7 */
+            t2 = _mm256_unpacklo_ps(Z, Z);
+            t3 = _mm256_unpackhi_ps(Z, Z);
+            _mm256_storeu_ps(q[j] + 4 * h, _mm256_shuffle_ps(t0, t2, 0x44));      /* lanes 0 | 4 */
+            _mm256_storeu_ps(q[j] + 4 * h + 8, _mm256_shuffle_ps(t0, t2, 0xEE));  /* lanes 1 | 5 */
+            _mm256_storeu_ps(q[j] + 4 * h + 16, _mm256_shuffle_ps(t1, t3, 0x44)); /* lanes 2 | 6 */
+            _mm256_storeu_ps(q[j] + 4 * h + 24, _mm256_shuffle_ps(t1, t3, 0xEE)); /* lanes 3 | 7 */
+        }
+    for (l = 0; l < HEML__W; l++) { /* lanes in order: shared nodes see the scalar order */
+        const int a = at[l];
+        float *o;
+        for (j = 1; j < 4; j++) {
+            o = of + 4 * (size_t)idx[j * HEML__W + l];
+            _mm_store_ps(o, _mm_add_ps(_mm_load_ps(o), _mm_loadu_ps(q[j] + a)));
+        }
+        o = of + 4 * (size_t)idx[l];
+        _mm_store_ps(o, _mm_sub_ps(_mm_load_ps(o), _mm_loadu_ps(q[0] + a)));
+    }
+}
+
 static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
                               heml_real *HEML__RESTRICT out)
 {
     int k, j, l;
+    if (sizeof(heml_real) != sizeof(double)) {
+        heml__scatter_vecf(idx, f, out);
+        return;
+    }
     for (k = 0; k < HEML__W; k += 4) {
-        if (sizeof(heml_real) == sizeof(double)) {
+        { /* (double) */
             double *od = (double *)(void *)out;
             __m128d xy[4][4]; /* [node][lane] */
             double zz[4][4];
@@ -3022,38 +3180,6 @@ static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__R
                     o[2] -= zz[0][l];
                 }
             }
-        } else {
-            float *of = (float *)(void *)out;
-            __m128 v[4][4];
-            for (j = 0; j < 4; j++) {
-                __m128 X, Y, Z, W = _mm_setzero_ps();
-                if (j == 0) {
-                    const float *f0 = (const float *)(const void *)f[0] + k;
-                    X = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0), _mm_loadu_ps(f0 + 3 * HEML__W)),
-                                   _mm_loadu_ps(f0 + 6 * HEML__W));
-                    Y = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + HEML__W), _mm_loadu_ps(f0 + 4 * HEML__W)),
-                                   _mm_loadu_ps(f0 + 7 * HEML__W));
-                    Z = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + 2 * HEML__W), _mm_loadu_ps(f0 + 5 * HEML__W)),
-                                   _mm_loadu_ps(f0 + 8 * HEML__W));
-                } else {
-                    const float *fj = (const float *)(const void *)f[3 * (j - 1)] + k;
-                    X = _mm_loadu_ps(fj);
-                    Y = _mm_loadu_ps(fj + HEML__W);
-                    Z = _mm_loadu_ps(fj + 2 * HEML__W);
-                }
-                _MM_TRANSPOSE4_PS(X, Y, Z, W);
-                v[j][0] = X, v[j][1] = Y, v[j][2] = Z, v[j][3] = W;
-            }
-            for (l = 0; l < 4; l++) {
-                for (j = 0; j < 4; j++) {
-                    float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
-                    __m128 xyo = _mm_castpd_ps(_mm_load_sd((const double *)(const void *)o)), r;
-                    r = j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]);
-                    _mm_store_sd((double *)(void *)o, _mm_castps_pd(r));
-                    o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
-                             : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
-                }
-            }
         }
     }
 }
@@ -3082,6 +3208,26 @@ static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HE
 #endif
     (void)m;
     heml__scatter_scalar(idx, f, out);
+}
+
+/* The same as calls (never inlined): the pipelined Neo-Hookean force (heml__forces_nh)
+   issues them between its stages, and inlined they would change the stages' code. */
+HEML__NOINLINE static void heml__gather_call(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
+{
+    heml__gather(m, idx, x, e);
+}
+
+HEML__NOINLINE static void heml__scatter_call(const heml_model *m, const int *idx, heml_real (*f)[HEML__W], heml_real *out,
+                                              int four)
+{
+#if defined(HEML__AVX)
+    if (four) { /* (m->force4: heml__pass_run) */
+        heml__scatter_vecf4(idx, f, out);
+        return;
+    }
+#endif
+    (void)four;
+    heml__scatter(m, idx, f, out);
 }
 
 /* The same with absolute values (the size of the terms each node's force sums). */
@@ -3444,7 +3590,8 @@ static void heml__nh_nodal_s0(const heml__mat *mt, heml_real jm1_0, const heml_r
    heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). */
 static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
                             const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
-                            heml__blk *HEML__RESTRICT b)
+                            heml__blk *HEML__RESTRICT b, const heml_model *m, const int *pend,
+                            heml_real *out, int four, const int *next, const heml_real *x)
 {
     const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
@@ -3473,6 +3620,8 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         b->H[8][k] = H22;
         b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
     }
+    if (next) /* the next block's links, into b->e now that H is formed */
+        heml__gather_call(m, next, x, b->e);
     if (np) /* the nodal pressure (NEAR-INCOMPRESSIBLE BODIES): heml__nh_nodal_s0 */
         heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
     else
@@ -3484,6 +3633,8 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
             heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
             b->s0[k] = s0;
         }
+    if (pend) /* the previous block's scatter, from b->f before this block overwrites it */
+        heml__scatter_call(m, pend, b->f, out, four);
     for (k = 0; k < HEML__W; k++) {
         heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
         heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
@@ -4085,11 +4236,11 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
-        heml__forces_nh(mt, m->jm1_0, R, NULL, idx, b);
+        heml__forces_nh(mt, m->jm1_0, R, NULL, idx, b, m, NULL, NULL, 0, NULL, NULL);
         return 0.0;
     }
     if (mt->fast_nodal && !want_energy) {
-        heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b);
+        heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b, m, NULL, NULL, 0, NULL, NULL);
         return 0.0;
     }
     if (mt->fast_mr && !want_energy) {
@@ -4413,6 +4564,7 @@ typedef struct heml__pass {
     heml_stress_kind kind;
     const heml_real *x, *dx;
     heml_real *out;
+    heml_real *out4; /* the force pass into m->force4 (heml__pass_run), or NULL */
 } heml__pass;
 
 /* Software prefetch of a block's streams: its stiffness cache (the cached product) or its
@@ -4450,6 +4602,8 @@ static void heml__chunks(void *vctx, int begin, int end)
     heml_model *m = p->m;
     heml__blk b;
     const heml_real jm1_0 = m->jm1_0;
+    const int *pend = NULL; /* the pipelined force's block whose forces wait in b.f for their scatter */
+    const int *gathered = NULL; /* the block whose links b.e holds already */
     int g0 = m->colour_start[p->colour] + begin, g1 = m->colour_start[p->colour] + end, ci, blk, k;
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++) {
         const heml__mat *mt = m->mats + m->chunk_material[ci];
@@ -4466,9 +4620,20 @@ static void heml__chunks(void *vctx, int begin, int end)
                 if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
                     heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR,
                                          idx + 4 * HEML__W);
-                energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
-                          (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
-                heml__scatter(m, idx, b.f, p->out);
+                if (p->mode == HEML__FORCE && mt->fast && mt->kind != HEML__K_SPRING) {
+                    /* software-pipelined: this block's arithmetic scatters the previous one's forces */
+                    const int *next = blk + 1 < m->chunk_end[ci] ? idx + 4 * HEML__W : NULL;
+                    if (idx != gathered) heml__gather(m, idx, p->x, b.e);
+                    heml__forces_nh(mt, jm1_0, m->blk_rest + (size_t)blk * HEML__NR * HEML__W, NULL, idx, &b, m,
+                                    pend, p->out4 ? p->out4 : p->out, p->out4 != NULL, next, p->x);
+                    pend = idx;
+                    gathered = next;
+                } else {
+                    if (pend) heml__scatter(m, pend, b.f, p->out), pend = NULL;
+                    energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
+                              (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
+                    heml__scatter(m, idx, b.f, p->out);
+                }
                 heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
@@ -4546,6 +4711,8 @@ static void heml__chunks(void *vctx, int begin, int end)
         m->chunk_below[ci] = below;
         m->chunk_inverted[ci] = inverted;
     }
+    if (pend) /* (the last pipelined block's) */
+        heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
 }
 
 /* The node pass of the nodal pressure on node chunks [begin, end): J_a - 1 = inv_a sum Vol
@@ -4691,10 +4858,23 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     p.x = x;
     p.dx = dx;
     p.out = out;
-    if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
+    p.out4 = NULL;
+    if (mode == HEML__FORCE && m->force4 && m->simd) { /* every block pipelined: nodes padded to 4 */
+        for (c = 0; c < m->material_count && m->mats[c].fast && m->mats[c].kind != HEML__K_SPRING; c++) continue;
+        if (c == m->material_count) p.out4 = m->force4;
+    }
+    if (p.out4)
+        memset(p.out4, 0, sizeof(heml_real) * 4 * (size_t)m->node_count);
+    else if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
         memset(out, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (p.colour = 0; p.colour < m->colour_count; p.colour++)
         heml__run(m, m->colour_start[p.colour + 1] - m->colour_start[p.colour], heml__chunks, &p);
+    if (p.out4) {
+        const heml_real *HEML__RESTRICT f4 = p.out4;
+        heml_real *HEML__RESTRICT o3 = out;
+        size_t i, n = (size_t)m->node_count;
+        for (i = 0; i < n; i++) o3[3 * i] = f4[4 * i], o3[3 * i + 1] = f4[4 * i + 1], o3[3 * i + 2] = f4[4 * i + 2];
+    }
     for (c = 0; c < m->chunk_count; c++) {
         energy += m->chunk_energy[c];
         below += m->chunk_below[c];
@@ -4857,6 +5037,9 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->disp, heml_real, 3 * n);
     HEML__CARVE(c, m->vel, heml_real, 3 * n);
     HEML__CARVE(c, m->force, heml_real, 3 * n);
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(float)) HEML__CARVE(c, m->force4, heml_real, 4 * n);
+#endif
     HEML__CARVE(c, m->ext, heml_real, 3 * n);
     HEML__CARVE(c, m->target, heml_real, 3 * n);
     HEML__CARVE(c, m->mass, heml_real, n);
