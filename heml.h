@@ -4629,7 +4629,6 @@ static void heml__chunks(void *vctx, int begin, int end)
                     pend = idx;
                     gathered = next;
                 } else {
-                    if (pend) heml__scatter(m, pend, b.f, p->out), pend = NULL;
                     energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
                               (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
                     heml__scatter(m, idx, b.f, p->out);
@@ -4703,6 +4702,10 @@ static void heml__chunks(void *vctx, int begin, int end)
                 break;
             }
         }
+        if (pend) { /* the chunk's last pipelined block (a chunk has one material: none waits across chunks) */
+            heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
+            pend = NULL;
+        }
         for (k = 0; k < HEML__W; k++) { /* (exact: at most HEML__CHUNK per lane) */
             below += (int)below_l[k];
             inverted += (int)inverted_l[k];
@@ -4711,8 +4714,6 @@ static void heml__chunks(void *vctx, int begin, int end)
         m->chunk_below[ci] = below;
         m->chunk_inverted[ci] = inverted;
     }
-    if (pend) /* (the last pipelined block's) */
-        heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
 }
 
 /* The node pass of the nodal pressure on node chunks [begin, end): J_a - 1 = inv_a sum Vol
