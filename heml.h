@@ -166,7 +166,9 @@
    Kirchhoff, 28 (224 / 112 bytes) when one is the split Mooney-Rivlin (the largest of
    those in use), plus a byte per block of 16; only without a Prony series and without
    nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
-   out (each product then recomputes them: see PERFORMANCE for the cost). Mass-spring
+   out (each product then recomputes them: see PERFORMANCE for the cost). Float builds
+   compiled for AVX hold the Neo-Hookean force pass's node forces padded to 4 components as
+   well (16 bytes a node; PERFORMANCE, issue 21). Mass-spring
    materials hold nothing per tetrahedron beyond the rest constants (their rest lengths
    and stiffnesses are derived from them in each pass; before issue 21's change they held
    12 reals a slot more).
@@ -1058,7 +1060,9 @@
      stores (they would write a neighbour node's x, a race with another colour group).
      AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
      conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
-     (tests compare both, bit for bit, every law).
+     (tests compare both, bit for bit, every law). Float builds now differ (below, "The
+     float force against its arithmetic floor"): pairs (x, y) by two unpacks, nodes padded
+     to 4 in the Neo-Hookean force pass, and with AVX-512 VL a gather of 8 lanes a register.
    - tried and not kept then: software prefetch of the next block's nodes and the rest
      constants of the block after (large meshes): no difference measurable above this
      machine's noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns
@@ -1273,6 +1277,67 @@
    attribute. What is left in cache is the arithmetic (70 of 157
    instructions per tetrahedron), the scatter (47: per lane and node a 16-byte and an
    8-byte read-modify-write) and the gather (24), run one after the other per block.
+   The float force against its arithmetic floor (issue 21's goal: at most 2 times the
+   `arith` row in cache; the bench's last full run on the Intel Xeon below: 2.04 to 2.45 in
+   float, 1.69 to 1.95 in double). In float the arithmetic runs on twice the lanes of a
+   register, so the gather and scatter, which move the same 8 node accesses per
+   tetrahedron as in double, weigh twice as much. Changed (bit-identical to the scalar path,
+   tests/test_heml.c test_vector_paths_match_scalar in the float and double builds):
+   - the Neo-Hookean force pass is software-pipelined (heml__chunks, fast materials, plain
+     force): heml__forces_nh's three stages are functions of their own, and between them
+     the pass gathers the next block's links (after the first stage, which consumes b->e)
+     and scatters the previous block's forces (after the volumetric stage, before the last
+     stage overwrites b->f); a chunk's last block is scattered at the chunk's end. The
+     scatters keep their order, so the sums are the same.
+   - in float builds with AVX, when every material takes that kernel, the pass scatters into
+     m->force4 (nodes padded to 4 components, 16-byte aligned: MEMORY) with one aligned
+     16-byte read-modify-write per lane and node (heml__scatter_vecf4: a 4 x 4 transpose per
+     128-bit half gives 8 lanes' (x, y, z, z) at once), then copies x, y, z to the 3n
+     forces; the other float scatters (products, other laws) take (x, y) pairs from two
+     unpacks per 8 lanes (heml__scatter_vecf: 1 shuffle per tetrahedron where 4 x 4
+     transposes and the z extractions took 12).
+   - with AVX-512 VL the float gather puts lanes q and 4 + q in the halves of one 256-bit
+     register (a zeroing masked load, then a merging one 16 bytes below the node with mask
+     bits 4 to 6), so a transpose per half moves 8 lanes (heml__gather_vecf8).
+   Measured (a harness on the bench's adapter: heml_compute_forces and the adapter's arith
+   row on the bench's 5-tetrahedron cubes after its step, old and new builds alternated,
+   minimum of 6 rounds of 3 x 2e6 tetrahedron evaluations; Intel Xeon, Sapphire Rapids
+   class, KVM, 2 vCPUs, gcc 12 -O3 -march=native, load 5 to 7 from other jobs), ns per
+   tetrahedron at 1,080 / 10,985 tetrahedra, force (arith), force / arith:
+                   before                          after
+       float       7.59 (3.28) / 7.62 (3.22)       6.54 (3.34) / 6.58 (3.29)
+                   2.31 / 2.37                     1.96 / 2.00
+       double      9.78 (5.11) / 10.12 (5.11)      9.64 (5.16) / 9.77 (5.14)
+                   1.91 / 1.98                     1.87 / 1.90
+   (a second series, 10 rounds of one: float 2.29 / 2.36 -> 1.98 / 2.03, double 1.82 /
+   1.77 -> 1.73 / 1.76). So the float force is 13 to 14 % faster and at 1.96 to 2.03 times
+   its floor: the goal is reached at 1e3 and at its edge at 1e4, with no margin; double is
+   unchanged within the noise (0.97 to 1.01). The arith row rose by 2 % with the split of
+   heml__forces_nh into three functions (it calls the same three: the floor is the force's
+   own arithmetic, so the force paid the same 2 %). Instructions (callgrind, x86-64-v3,
+   which has no AVX-512, 10,985 tetrahedra, per tetrahedron): float force 123 -> 114 (the
+   scatter 54 -> 42), arith 38 -> 39; double force 159 -> 160, arith 77 -> 79. Steps, in
+   the same harness, float force: the pair scatter alone 7.6-8.0 -> 7.3-7.5 ns with the
+   pipelining, the padded scatter 7.05-7.24 -> 6.55-6.85, the 8-lane gather 1 to 2 % more
+   (gather alone 1.42-1.46 -> 1.28-1.37 ns). Tried and not kept: vgatherdps (16 lanes, 12
+   gathers a block): the gather alone 1.6-1.7 against 1.45 ns but the force 10.1-10.4
+   against 7.9-8.1 ns, the 512-bit instructions slowing the arithmetic around them (its
+   arith row 3.6 -> 3.7-4.0 in the same program); 4 lanes a 512-bit register by masked
+   merging loads: gather 2.0-2.2 ns, force 10.4 (the same); masked 3-component stores in
+   the float scatter (AVX-512 VL): scatter 9.2-9.5 against 2.9 ns (no store forwarding from
+   masked stores to the next lane's load, as on the Zen 5); the pair read as 16 bytes folded
+   into the add (4 instructions a tetrahedron fewer): no faster (the reads that straddle
+   two buffer stores miss store forwarding); node offsets 3 idx formed per block by vector
+   adds: scatter 3.0-3.1 against 2.75-2.9 ns; the scatter before the volumetric stage, or
+   the gather after it: 1 to 3 % slower. Conflicts are not what bounds the scatter: on the
+   bench's beams a lane's node is shared by 5 of the block's 64 (lane, node) slots on
+   average (33 at most), yet an index set with 64 distinct nodes in every block scatters in
+   the same time. The force now runs at about 5 instructions a cycle in cache, so what is
+   left is the count of node moves (about 75 of the 114 instructions): fewer would need the
+   node traffic of a block cut (a node shared by 5 slots moves 5 times; accumulating a
+   block's shared nodes needs a per-block table and changes the sums' order) or nodes
+   padded in the state itself (u as 4n: an interface change). Not done; double's scatter
+   into padded nodes (32 bytes a node more) was not tried.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -1386,6 +1451,12 @@
              default automatic; stats.coarse_solves, coarse_factors; IMPLICIT COARSE
              CORRECTION): 3 to 15 times fewer CG iterations on slender bodies at large
              dt, answers within the solve tolerances; up to 2.4 MB more per model.
+       unreleased (issue 21) the Neo-Hookean force pass software-pipelined (the next
+             block's gather and the previous block's scatter between the stages); in
+             float with AVX its scatter into nodes padded to 4 (16 bytes a node more) and
+             pairs (x, y) elsewhere, and with AVX-512 VL an 8-lane gather: the float force
+             13 % faster in cache, at 1.96 to 2.03 times its arithmetic floor; results
+             bit-identical. See PERFORMANCE.
        unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
              masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
              spring force 15x faster (no differential terms on an unset workspace) and its
@@ -3210,8 +3281,9 @@ static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HE
     heml__scatter_scalar(idx, f, out);
 }
 
-/* The same as calls (never inlined): the pipelined Neo-Hookean force (heml__forces_nh)
-   issues them between its stages, and inlined they would change the stages' code. */
+/* The same as calls (never inlined), for the pipelined Neo-Hookean force pass between
+   heml__forces_nh's stages (heml__chunks); with `four` the scatter goes to nodes padded to
+   4 components (m->force4, heml__pass_run). Inlined or not measured the same. */
 HEML__NOINLINE static void heml__gather_call(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
 {
     heml__gather(m, idx, x, e);
@@ -3587,13 +3659,13 @@ static void heml__nh_nodal_s0(const heml__mat *mt, heml_real jm1_0, const heml_r
    stress and one for the product (12,000 tetrahedra, arithmetic alone); one loop for all
    of it spills the 16 AVX2 registers and was slower still. With np (the nodal pressures
    P_a, heml__mat.fast_nodal; idx the block's nodes) the volumetric stage is
-   heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). */
-static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
-                            const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
-                            heml__blk *HEML__RESTRICT b, const heml_model *m, const int *pend,
-                            heml_real *out, int four, const int *next, const heml_real *x)
+   heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). The
+   stages are functions of their own, never inlined (heml__forces_nh_h, _s, _p): the force
+   pass calls them with the next block's gather and the previous block's scatter between
+   them (heml__chunks, PERFORMANCE), the bench's arith row through heml__forces_nh, so both
+   run the same machine code for the arithmetic. */
+HEML__NOINLINE static void heml__forces_nh_h(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
-    const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
@@ -3620,8 +3692,13 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         b->H[8][k] = H22;
         b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
     }
-    if (next) /* the next block's links, into b->e now that H is formed */
-        heml__gather_call(m, next, x, b->e);
+}
+
+HEML__NOINLINE static void heml__forces_nh_s(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT np,
+                                             const int *HEML__RESTRICT idx, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real p0 = mt->p0, kappa = mt->kappa;
+    int k;
     if (np) /* the nodal pressure (NEAR-INCOMPRESSIBLE BODIES): heml__nh_nodal_s0 */
         heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
     else
@@ -3633,8 +3710,13 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
             heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
             b->s0[k] = s0;
         }
-    if (pend) /* the previous block's scatter, from b->f before this block overwrites it */
-        heml__scatter_call(m, pend, b->f, out, four);
+}
+
+HEML__NOINLINE static void heml__forces_nh_p(const heml__mat *mt, const heml_real *HEML__RESTRICT R,
+                                             heml__blk *HEML__RESTRICT b)
+{
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0;
+    int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
         heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
@@ -3655,6 +3737,15 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         b->K[7][k] = mv * H21 + wv * (c21 - H12);
     }
     heml__p_times_grad(R, b);
+}
+
+static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                            const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
+                            heml__blk *HEML__RESTRICT b)
+{
+    heml__forces_nh_h(R, b);
+    heml__forces_nh_s(mt, jm1_0, np, idx, b);
+    heml__forces_nh_p(mt, R, b);
 }
 
 /* The split Mooney-Rivlin force kernel (heml__law_split without Prony or the nodal
@@ -4236,11 +4327,11 @@ static double heml__block_forces(const heml_model *m, const heml__mat *mt, int b
         return want_energy ? heml__lanes_energy(m, mt, blk, b) : 0.0;
     }
     if (mt->fast && !want_energy) { /* (the law's fast_path flag: heml__laws) */
-        heml__forces_nh(mt, m->jm1_0, R, NULL, idx, b, m, NULL, NULL, 0, NULL, NULL);
+        heml__forces_nh(mt, m->jm1_0, R, NULL, idx, b);
         return 0.0;
     }
     if (mt->fast_nodal && !want_energy) {
-        heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b, m, NULL, NULL, 0, NULL, NULL);
+        heml__forces_nh(mt, m->jm1_0, R, m->nod_p, idx, b);
         return 0.0;
     }
     if (mt->fast_mr && !want_energy) {
@@ -4623,9 +4714,14 @@ static void heml__chunks(void *vctx, int begin, int end)
                 if (p->mode == HEML__FORCE && mt->fast && mt->kind != HEML__K_SPRING) {
                     /* software-pipelined: this block's arithmetic scatters the previous one's forces */
                     const int *next = blk + 1 < m->chunk_end[ci] ? idx + 4 * HEML__W : NULL;
+                    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
                     if (idx != gathered) heml__gather(m, idx, p->x, b.e);
-                    heml__forces_nh(mt, jm1_0, m->blk_rest + (size_t)blk * HEML__NR * HEML__W, NULL, idx, &b, m,
-                                    pend, p->out4 ? p->out4 : p->out, p->out4 != NULL, next, p->x);
+                    heml__forces_nh_h(R, &b); /* (heml__forces_nh's stages) */
+                    if (next) heml__gather_call(m, next, p->x, b.e); /* the next block's links, now that H is formed */
+                    heml__forces_nh_s(mt, jm1_0, NULL, idx, &b);
+                    if (pend) /* the previous block's forces, before this block overwrites them */
+                        heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
+                    heml__forces_nh_p(mt, R, &b);
                     pend = idx;
                     gathered = next;
                 } else {

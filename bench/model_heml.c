@@ -335,8 +335,7 @@ static int hm_arith(hm_sim *s)
             for (o = 0; blk + 1 < m->chunk_end[ci] && o < HEML__NR * HEML__W * sizeof(heml_real); o += 64)
                 __builtin_prefetch((const char *)(R + HEML__NR * HEML__W) + o); /* (the force pass's prefetch) */
             if (mt->fast || mt->fast_nodal) /* (nodal: the element pass alone, at the pressures last computed) */
-                heml__forces_nh(mt, m->jm1_0, R, mt->fast_nodal ? m->nod_p : NULL, m->blk_idx + (size_t)blk * 4 * HEML__W, b,
-                                m, NULL, NULL, 0, NULL, NULL);
+                heml__forces_nh(mt, m->jm1_0, R, mt->fast_nodal ? m->nod_p : NULL, m->blk_idx + (size_t)blk * 4 * HEML__W, b);
             else {
                 heml__block_stress(m, mt, blk, b, 0, 0);
                 heml__pk1_forces(R, b);
