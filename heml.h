@@ -4687,22 +4687,50 @@ HEML__NOINLINE static void heml__count_lanes(const heml_real *HEML__RESTRICT jm1
     }
 }
 
+/* The Neo-Hookean force of one chunk (heml__mat.fast, the plain force pass), software-
+   pipelined: between heml__forces_nh's stages a block gathers the next block's links (its
+   first stage has consumed b->e) and scatters the previous block's forces (before its last
+   stage overwrites b->f); the chunk's last block is scattered after the loop. The
+   scatters keep their order, so the sums are those of the plain loop. With `four`, out is
+   m->force4 (nodes padded to 4 components, heml__pass_run). PERFORMANCE, issue 21. */
+HEML__NOINLINE static void heml__chunk_forces_nh(const heml_model *m, const heml__mat *mt, int ci, const heml_real *x,
+                                                 heml_real *out, int four, heml__blk *HEML__RESTRICT b,
+                                                 heml_real *HEML__RESTRICT below_l, heml_real *HEML__RESTRICT inverted_l)
+{
+    const int b0 = m->chunk_begin[ci], b1 = m->chunk_end[ci];
+    int blk;
+    if (b1 > b0) heml__gather(m, m->blk_idx + (size_t)b0 * 4 * HEML__W, x, b->e);
+    for (blk = b0; blk < b1; blk++) {
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+        if (blk + 1 < b1) /* the next block's streams (PERFORMANCE) */
+            heml__prefetch_block(R + HEML__NR * HEML__W, HEML__NR, idx + 4 * HEML__W);
+        heml__forces_nh_h(R, b);
+        if (blk + 1 < b1) heml__gather_call(m, idx + 4 * HEML__W, x, b->e);
+        heml__forces_nh_s(mt, m->jm1_0, NULL, idx, b);
+        if (blk > b0) heml__scatter_call(m, idx - 4 * HEML__W, b->f, out, four);
+        heml__forces_nh_p(mt, R, b);
+        heml__count_lanes(b->jm1, m->jm1_0, below_l, inverted_l);
+    }
+    if (b1 > b0) heml__scatter_call(m, m->blk_idx + (size_t)(b1 - 1) * 4 * HEML__W, b->f, out, four);
+}
+
 static void heml__chunks(void *vctx, int begin, int end)
 {
     const heml__pass *p = (const heml__pass *)vctx;
     heml_model *m = p->m;
     heml__blk b;
     const heml_real jm1_0 = m->jm1_0;
-    const int *pend = NULL; /* the pipelined force's block whose forces wait in b.f for their scatter */
-    const int *gathered = NULL; /* the block whose links b.e holds already */
     int g0 = m->colour_start[p->colour] + begin, g1 = m->colour_start[p->colour] + end, ci, blk, k;
     for (ci = m->group_start[g0]; ci < m->group_start[g1]; ci++) {
         const heml__mat *mt = m->mats + m->chunk_material[ci];
         double energy = 0.0;
         int below = 0, inverted = 0;
         heml_real below_l[HEML__W], inverted_l[HEML__W]; /* the force's counts per lane (a loop that vectorises) */
+        const int nh = p->mode == HEML__FORCE && mt->fast && mt->kind != HEML__K_SPRING; /* (the Neo-Hookean kernel) */
         for (k = 0; k < HEML__W; k++) below_l[k] = inverted_l[k] = 0;
-        for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
+        if (nh) heml__chunk_forces_nh(m, mt, ci, p->x, p->out4 ? p->out4 : p->out, p->out4 != NULL, &b, below_l, inverted_l);
+        for (blk = nh ? m->chunk_end[ci] : m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) { /* (the other kernels) */
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             int valid = m->blk_valid[blk];
             switch (p->mode) {
@@ -4711,24 +4739,9 @@ static void heml__chunks(void *vctx, int begin, int end)
                 if (blk + 1 < m->chunk_end[ci]) /* the next block's streams (PERFORMANCE) */
                     heml__prefetch_block(m->blk_rest + (size_t)(blk + 1) * HEML__NR * HEML__W, HEML__NR,
                                          idx + 4 * HEML__W);
-                if (p->mode == HEML__FORCE && mt->fast && mt->kind != HEML__K_SPRING) {
-                    /* software-pipelined: this block's arithmetic scatters the previous one's forces */
-                    const int *next = blk + 1 < m->chunk_end[ci] ? idx + 4 * HEML__W : NULL;
-                    const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
-                    if (idx != gathered) heml__gather(m, idx, p->x, b.e);
-                    heml__forces_nh_h(R, &b); /* (heml__forces_nh's stages) */
-                    if (next) heml__gather_call(m, next, p->x, b.e); /* the next block's links, now that H is formed */
-                    heml__forces_nh_s(mt, jm1_0, NULL, idx, &b);
-                    if (pend) /* the previous block's forces, before this block overwrites them */
-                        heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
-                    heml__forces_nh_p(mt, R, &b);
-                    pend = idx;
-                    gathered = next;
-                } else {
-                    energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
-                              (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
-                    heml__scatter(m, idx, b.f, p->out);
-                }
+                energy += heml__block_forces(m, mt, blk, p->x, &b, p->prony_write, p->mode == HEML__FORCE_ENERGY) *
+                          (mt->prony_count ? (double)m->prony_s[mt - m->mats] : 1.0);
+                heml__scatter(m, idx, b.f, p->out);
                 heml__count_lanes(b.jm1, jm1_0, below_l, inverted_l);
                 break;
             case HEML__DIFF:
@@ -4797,10 +4810,6 @@ static void heml__chunks(void *vctx, int begin, int end)
                                                   p->out + 9 * (size_t)m->slot_tet[blk * HEML__W + k]);
                 break;
             }
-        }
-        if (pend) { /* the chunk's last pipelined block (a chunk has one material: none waits across chunks) */
-            heml__scatter_call(m, pend, b.f, p->out4 ? p->out4 : p->out, p->out4 != NULL);
-            pend = NULL;
         }
         for (k = 0; k < HEML__W; k++) { /* (exact: at most HEML__CHUNK per lane) */
             below += (int)below_l[k];
@@ -5134,9 +5143,6 @@ static void heml__layout(heml_model *m, heml__carver *c)
     HEML__CARVE(c, m->disp, heml_real, 3 * n);
     HEML__CARVE(c, m->vel, heml_real, 3 * n);
     HEML__CARVE(c, m->force, heml_real, 3 * n);
-#if defined(HEML__AVX)
-    if (sizeof(heml_real) == sizeof(float)) HEML__CARVE(c, m->force4, heml_real, 4 * n);
-#endif
     HEML__CARVE(c, m->ext, heml_real, 3 * n);
     HEML__CARVE(c, m->target, heml_real, 3 * n);
     HEML__CARVE(c, m->mass, heml_real, n);
@@ -5213,6 +5219,9 @@ static void heml__layout(heml_model *m, heml__carver *c)
     }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? (size_t)m->dc_rows * s : 0);
     HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(float)) HEML__CARVE(c, m->force4, heml_real, 4 * n); /* (last: the others keep their offsets) */
+#endif
     if (!m->nodal) m->diag_dev = NULL;
     if (!m->pagg_count) m->pagg = NULL;
     if (!m->has_dc) m->dc = NULL, m->dc_gen = NULL;
