@@ -1060,9 +1060,9 @@
      stores (they would write a neighbour node's x, a race with another colour group).
      AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
      conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
-     (tests compare both, bit for bit, every law). Float builds now differ (below, "The
-     float force against its arithmetic floor"): pairs (x, y) by two unpacks, nodes padded
-     to 4 in the Neo-Hookean force pass, and with AVX-512 VL a gather of 8 lanes a register.
+     (tests compare both, bit for bit, every law). The float Neo-Hookean force pass now
+     differs (below, "The float force against its arithmetic floor"): nodes padded to 4
+     components, and with AVX-512 VL a gather of 8 lanes a register.
    - tried and not kept then: software prefetch of the next block's nodes and the rest
      constants of the block after (large meshes): no difference measurable above this
      machine's noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns
@@ -1283,45 +1283,60 @@
    register, so the gather and scatter, which move the same 8 node accesses per
    tetrahedron as in double, weigh twice as much. Changed (bit-identical to the scalar path,
    tests/test_heml.c test_vector_paths_match_scalar in the float and double builds):
-   - the Neo-Hookean force pass is software-pipelined (heml__chunks, fast materials, plain
-     force): heml__forces_nh's three stages are functions of their own, and between them
-     the pass gathers the next block's links (after the first stage, which consumes b->e)
-     and scatters the previous block's forces (after the volumetric stage, before the last
-     stage overwrites b->f); a chunk's last block is scattered at the chunk's end. The
-     scatters keep their order, so the sums are the same.
+   - the Neo-Hookean force pass is software-pipelined (heml__chunk_forces_nh, a chunk at a
+     time, for the fast materials in the plain force pass): heml__forces_nh's three stages
+     are functions of their own, and between them a block gathers the next block's links
+     (after the first stage, which consumes b->e) and scatters the previous block's forces
+     (after the volumetric stage, before the last stage overwrites b->f); a chunk's last
+     block is scattered after its loop. The scatters keep their order, so the sums are the
+     same.
    - in float builds with AVX, when every material takes that kernel, the pass scatters into
      m->force4 (nodes padded to 4 components, 16-byte aligned: MEMORY) with one aligned
      16-byte read-modify-write per lane and node (heml__scatter_vecf4: a 4 x 4 transpose per
      128-bit half gives 8 lanes' (x, y, z, z) at once), then copies x, y, z to the 3n
-     forces; the other float scatters (products, other laws) take (x, y) pairs from two
-     unpacks per 8 lanes (heml__scatter_vecf: 1 shuffle per tetrahedron where 4 x 4
-     transposes and the z extractions took 12).
-   - with AVX-512 VL the float gather puts lanes q and 4 + q in the halves of one 256-bit
-     register (a zeroing masked load, then a merging one 16 bytes below the node with mask
-     bits 4 to 6), so a transpose per half moves 8 lanes (heml__gather_vecf8).
-   Measured (a harness on the bench's adapter: heml_compute_forces and the adapter's arith
-   row on the bench's 5-tetrahedron cubes after its step, old and new builds alternated,
-   minimum of 6 rounds of 3 x 2e6 tetrahedron evaluations; Intel Xeon, Sapphire Rapids
-   class, KVM, 2 vCPUs, gcc 12 -O3 -march=native, load 5 to 7 from other jobs), ns per
-   tetrahedron at 1,080 / 10,985 tetrahedra, force (arith), force / arith:
+     forces.
+   - with AVX-512 VL the pass's float gather puts lanes q and 4 + q in the halves of one
+     256-bit register (a zeroing masked load, then a merging one 16 bytes below the node
+     with mask bits 4 to 6), so a transpose per half moves 8 lanes (heml__gather_vecf8).
+     The other passes keep the 4-lane gather: in the stiffness product this one cost 3 to
+     5 % (5.96-5.97 -> 6.27-6.33 ns at 1e3-1e4 in float).
+   - the float scatter's 8-byte (x, y) moves go through memcpy (heml__ld2f, heml__st2f):
+     the cast double pointers they replace were misaligned accesses (UBSan, in a
+     sanitizer build for the native target; the Makefile's sanitizer build targets generic
+     x86-64 and never compiled this code).
+   Measured (a harness on the bench's adapter: heml_compute_forces, the adapter's arith row
+   and heml_apply_stiffness on the bench's 5-tetrahedron cubes after its step, old and new
+   builds alternated, minimum of 10 rounds of 3 x 2e6 tetrahedron evaluations; Intel Xeon,
+   Sapphire Rapids class, KVM, 2 vCPUs, gcc 12 -O3 -march=native, load about 1 from other
+   jobs), ns per tetrahedron at 1,080 / 10,985 tetrahedra, force (arith), force / arith:
                    before                          after
-       float       7.59 (3.28) / 7.62 (3.22)       6.54 (3.34) / 6.58 (3.29)
-                   2.31 / 2.37                     1.96 / 2.00
-       double      9.78 (5.11) / 10.12 (5.11)      9.64 (5.16) / 9.77 (5.14)
-                   1.91 / 1.98                     1.87 / 1.90
-   (a second series, 10 rounds of one: float 2.29 / 2.36 -> 1.98 / 2.03, double 1.82 /
-   1.77 -> 1.73 / 1.76). So the float force is 13 to 14 % faster and at 1.96 to 2.03 times
-   its floor: the goal is reached at 1e3 and at its edge at 1e4, with no margin; double is
-   unchanged within the noise (0.97 to 1.01). The arith row rose by 2 % with the split of
-   heml__forces_nh into three functions (it calls the same three: the floor is the force's
-   own arithmetic, so the force paid the same 2 %). Instructions (callgrind, x86-64-v3,
-   which has no AVX-512, 10,985 tetrahedra, per tetrahedron): float force 123 -> 114 (the
-   scatter 54 -> 42), arith 38 -> 39; double force 159 -> 160, arith 77 -> 79. Steps, in
-   the same harness, float force: the pair scatter alone 7.6-8.0 -> 7.3-7.5 ns with the
-   pipelining, the padded scatter 7.05-7.24 -> 6.55-6.85, the 8-lane gather 1 to 2 % more
-   (gather alone 1.42-1.46 -> 1.28-1.37 ns). Tried and not kept: vgatherdps (16 lanes, 12
-   gathers a block): the gather alone 1.6-1.7 against 1.45 ns but the force 10.1-10.4
-   against 7.9-8.1 ns, the 512-bit instructions slowing the arithmetic around them (its
+       float       7.40 (3.19) / 7.43 (3.15)       6.26 (3.27) / 6.34 (3.22)
+                   2.32 / 2.36                     1.91 / 1.97
+       double      9.55 (5.44) / 9.77 (5.00)       9.29 (5.56) / 9.37 (5.02)
+                   1.76 / 1.95                     1.67 / 1.87
+   (per round, float: 2.31-2.36 / 2.35-2.43 before, 1.87-1.93 / 1.96-1.98 after; earlier
+   states of the change at load 5 to 7: 1.92-1.98 / 1.97-2.03). The stiffness product in
+   the same series: float 5.93 / 5.96 -> 5.97 / 6.04, double 8.36 / 8.72 -> 8.20 / 8.73
+   (unchanged). The bench itself (`build/bench/bench --parts kernels --filter
+   heml/neo-hookean/ --threads 1 --repeats 5`, its medians, old and new alternated, 2 runs
+   each, load about 1): float force / arith 2.34 / 2.39 -> 1.93 / 1.94 and 1.93 / 2.00 at
+   1e3 / 1e4 (2.46-2.48 -> 2.07-2.12 at 1e5, 2.36-2.53 -> 2.18-2.28 at 1e6, where the padded
+   nodes move a third more bytes: the force still 4 to 7 % faster there), double 1.92-1.93 /
+   2.04-2.07 -> 1.84-1.86 / 1.91-1.93. So the float force is 15 % faster in cache and at
+   1.9 to 2.0 times its floor: the goal is met at 1e3 and at its edge at 1e4, with no
+   margin; double 3 % faster. The arith row rose by 2 % with the split of heml__forces_nh
+   into three functions (it calls the same three: the floor is the force's own arithmetic,
+   so the force paid the same 2 %). Instructions (callgrind, x86-64-v3, which has no
+   AVX-512, 10,985 tetrahedra, per tetrahedron): float force 123 -> 111 (the scatter 54 ->
+   42), arith 38 -> 39; double force 159 -> 157, arith 77 -> 79. Steps, in the same
+   harness, float force: a scatter of (x, y) pairs by two unpacks (1 shuffle a tetrahedron
+   where the transposes and z extractions take 12) with the pipelining 7.6-8.0 -> 7.3-7.5
+   ns (that scatter then dropped: no gain left in the stiffness product, whose scatter it
+   was), the padded scatter 7.05-7.24 -> 6.55-6.85, the 8-lane gather 1 to 2 % more (gather
+   alone 1.42-1.46 -> 1.28-1.37 ns), the pipelined loop as a function per chunk
+   (heml__chunks' own loop left as it was) 2 % more. Tried and not kept: vgatherdps (16
+   lanes, 12 gathers a block): the gather alone 1.6-1.7 against 1.45 ns but the force
+   10.1-10.4 against 7.9-8.1 ns, the 512-bit instructions slowing the arithmetic around them (its
    arith row 3.6 -> 3.7-4.0 in the same program); 4 lanes a 512-bit register by masked
    merging loads: gather 2.0-2.2 ns, force 10.4 (the same); masked 3-component stores in
    the float scatter (AVX-512 VL): scatter 9.2-9.5 against 2.9 ns (no store forwarding from
@@ -1333,7 +1348,7 @@
    bench's beams a lane's node is shared by 5 of the block's 64 (lane, node) slots on
    average (33 at most), yet an index set with 64 distinct nodes in every block scatters in
    the same time. The force now runs at about 5 instructions a cycle in cache, so what is
-   left is the count of node moves (about 75 of the 114 instructions): fewer would need the
+   left is the count of node moves (about 72 of the 111 instructions): fewer would need the
    node traffic of a block cut (a node shared by 5 slots moves 5 times; accumulating a
    block's shared nodes needs a per-block table and changes the sums' order) or nodes
    padded in the state itself (u as 4n: an interface change). Not done; double's scatter
@@ -1453,10 +1468,9 @@
              dt, answers within the solve tolerances; up to 2.4 MB more per model.
        unreleased (issue 21) the Neo-Hookean force pass software-pipelined (the next
              block's gather and the previous block's scatter between the stages); in
-             float with AVX its scatter into nodes padded to 4 (16 bytes a node more) and
-             pairs (x, y) elsewhere, and with AVX-512 VL an 8-lane gather: the float force
-             13 % faster in cache, at 1.96 to 2.03 times its arithmetic floor; results
-             bit-identical. See PERFORMANCE.
+             float with AVX its scatter into nodes padded to 4 (16 bytes a node more), and
+             with AVX-512 VL an 8-lane gather: the float force 15 % faster in cache, at 1.9
+             to 2.0 times its arithmetic floor; results bit-identical. See PERFORMANCE.
        unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
              masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
              spring force 15x faster (no differential terms on an unset workspace) and its
@@ -3047,12 +3061,6 @@ static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEM
                              heml_real (*HEML__RESTRICT e)[HEML__W])
 {
     int k, j, l;
-#if defined(HEML__AVX512)
-    if (sizeof(heml_real) != sizeof(double)) {
-        heml__gather_vecf8(idx, x, e);
-        return;
-    }
-#endif
     for (k = 0; k < HEML__W; k += 4) {
         if (sizeof(heml_real) == sizeof(double)) {
             const double *xd = (const double *)(const void *)x;
@@ -3106,50 +3114,6 @@ HEML__INLINE void heml__st2f(float *p, __m128 v)
 {
     double t = _mm_cvtsd_f64(_mm_castps_pd(v));
     memcpy(p, &t, sizeof t);
-}
-
-/* The float scatter: per 8 lanes and node two unpacks interleave the rows x and y into
-   (x, y) pairs (a buffer), and each lane's (x, y) and z go to its node by an 8-byte and a
-   4-byte read-modify-write, z read straight from its row: 1 shuffle per tetrahedron where
-   4 x 4 transposes and z extractions took 12. Lanes in order, the scalar path's sums. */
-static void heml__scatter_vecf(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
-                               heml_real *HEML__RESTRICT out)
-{
-    /* lane l's pair in a node's buffer: unpacklo holds lanes 0 1 4 5, unpackhi 2 3 6 7 of 8 */
-    static const int at[16] = {0, 2, 8, 10, 4, 6, 12, 14, 16, 18, 24, 26, 20, 22, 28, 30};
-    const float *fr = (const float *)(const void *)f[0];
-    float *of = (float *)(void *)out;
-    float xy[4][2 * HEML__W], z0[HEML__W];
-    int j, h, l;
-    for (j = 0; j < 4; j++)
-        for (h = 0; h < HEML__W; h += 8) {
-            __m256 X, Y;
-            if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
-                X = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + h), _mm256_loadu_ps(fr + 3 * HEML__W + h)),
-                                  _mm256_loadu_ps(fr + 6 * HEML__W + h));
-                Y = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + HEML__W + h), _mm256_loadu_ps(fr + 4 * HEML__W + h)),
-                                  _mm256_loadu_ps(fr + 7 * HEML__W + h));
-                _mm256_storeu_ps(z0 + h, _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + 2 * HEML__W + h),
-                                                                     _mm256_loadu_ps(fr + 5 * HEML__W + h)),
-                                                       _mm256_loadu_ps(fr + 8 * HEML__W + h)));
-            } else {
-                X = _mm256_loadu_ps(fr + 3 * (j - 1) * HEML__W + h);
-                Y = _mm256_loadu_ps(fr + (3 * (j - 1) + 1) * HEML__W + h);
-            }
-            _mm256_storeu_ps(xy[j] + 2 * h, _mm256_unpacklo_ps(X, Y));
-            _mm256_storeu_ps(xy[j] + 2 * h + 8, _mm256_unpackhi_ps(X, Y));
-        }
-    for (l = 0; l < HEML__W; l++) { /* lanes in order: shared nodes see the scalar order */
-        size_t o;
-        for (j = 1; j < 4; j++) {
-            o = 3 * (size_t)idx[j * HEML__W + l];
-            heml__st2f(of + o, _mm_add_ps(heml__ld2f(of + o), heml__ld2f(xy[j] + at[l])));
-            of[o + 2] += fr[(3 * (j - 1) + 2) * HEML__W + l];
-        }
-        o = 3 * (size_t)idx[l];
-        heml__st2f(of + o, _mm_sub_ps(heml__ld2f(of + o), heml__ld2f(xy[0] + at[l])));
-        of[o + 2] -= z0[l];
-    }
 }
 
 /* The float scatter into nodes padded to 4 components (m->force4, 16-byte aligned): per 8
@@ -3206,12 +3170,8 @@ static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__R
                               heml_real *HEML__RESTRICT out)
 {
     int k, j, l;
-    if (sizeof(heml_real) != sizeof(double)) {
-        heml__scatter_vecf(idx, f, out);
-        return;
-    }
     for (k = 0; k < HEML__W; k += 4) {
-        { /* (double) */
+        if (sizeof(heml_real) == sizeof(double)) {
             double *od = (double *)(void *)out;
             __m128d xy[4][4]; /* [node][lane] */
             double zz[4][4];
@@ -3251,6 +3211,37 @@ static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__R
                     o[2] -= zz[0][l];
                 }
             }
+        } else {
+            float *of = (float *)(void *)out;
+            __m128 v[4][4];
+            for (j = 0; j < 4; j++) {
+                __m128 X, Y, Z, W = _mm_setzero_ps();
+                if (j == 0) {
+                    const float *f0 = (const float *)(const void *)f[0] + k;
+                    X = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0), _mm_loadu_ps(f0 + 3 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 6 * HEML__W));
+                    Y = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + HEML__W), _mm_loadu_ps(f0 + 4 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 7 * HEML__W));
+                    Z = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(f0 + 2 * HEML__W), _mm_loadu_ps(f0 + 5 * HEML__W)),
+                                   _mm_loadu_ps(f0 + 8 * HEML__W));
+                } else {
+                    const float *fj = (const float *)(const void *)f[3 * (j - 1)] + k;
+                    X = _mm_loadu_ps(fj);
+                    Y = _mm_loadu_ps(fj + HEML__W);
+                    Z = _mm_loadu_ps(fj + 2 * HEML__W);
+                }
+                _MM_TRANSPOSE4_PS(X, Y, Z, W);
+                v[j][0] = X, v[j][1] = Y, v[j][2] = Z, v[j][3] = W;
+            }
+            for (l = 0; l < 4; l++) {
+                for (j = 0; j < 4; j++) {
+                    float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
+                    __m128 xyo = heml__ld2f(o);
+                    heml__st2f(o, j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]));
+                    o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
+                             : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
+                }
+            }
         }
     }
 }
@@ -3282,10 +3273,18 @@ static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HE
 }
 
 /* The same as calls (never inlined), for the pipelined Neo-Hookean force pass between
-   heml__forces_nh's stages (heml__chunks); with `four` the scatter goes to nodes padded to
-   4 components (m->force4, heml__pass_run). Inlined or not measured the same. */
+   heml__forces_nh's stages (heml__chunk_forces_nh); with `four` the scatter goes to nodes
+   padded to 4 components (m->force4, heml__pass_run). Inlined or not measured the same.
+   The float gather of 8 lanes a register (AVX-512 VL) serves this pass only: 1 to 2 %
+   faster force, but a 3 to 5 % slower stiffness product (PERFORMANCE). */
 HEML__NOINLINE static void heml__gather_call(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
 {
+#if defined(HEML__AVX512)
+    if (m->simd && sizeof(heml_real) != sizeof(double)) { /* (here only: it slowed the stiffness product) */
+        heml__gather_vecf8(idx, x, e);
+        return;
+    }
+#endif
     heml__gather(m, idx, x, e);
 }
 
@@ -4699,7 +4698,7 @@ HEML__NOINLINE static void heml__chunk_forces_nh(const heml_model *m, const heml
 {
     const int b0 = m->chunk_begin[ci], b1 = m->chunk_end[ci];
     int blk;
-    if (b1 > b0) heml__gather(m, m->blk_idx + (size_t)b0 * 4 * HEML__W, x, b->e);
+    if (b1 > b0) heml__gather_call(m, m->blk_idx + (size_t)b0 * 4 * HEML__W, x, b->e);
     for (blk = b0; blk < b1; blk++) {
         const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
         const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
