@@ -1319,8 +1319,8 @@
    the same series: float 5.93 / 5.96 -> 5.97 / 6.04, double 8.36 / 8.72 -> 8.20 / 8.73
    (unchanged). The bench itself (`build/bench/bench --parts kernels --filter
    heml/neo-hookean/ --threads 1 --repeats 5`, its medians, old and new alternated, 2 runs
-   each, load about 1): float force / arith 2.34 / 2.39 -> 1.93 / 1.94 and 1.93 / 2.00 at
-   1e3 / 1e4 (2.46-2.48 -> 2.07-2.12 at 1e5, 2.36-2.53 -> 2.18-2.28 at 1e6, where the padded
+   each, load about 1, and once more with the final code): float force / arith 2.34-2.39 /
+   2.37-2.39 -> 1.93 / 1.94-2.00 at 1e3 / 1e4 (2.46-2.48 -> 2.07-2.12 at 1e5, 2.36-2.53 -> 2.18-2.28 at 1e6, where the padded
    nodes move a third more bytes: the force still 4 to 7 % faster there), double 1.92-1.93 /
    2.04-2.07 -> 1.84-1.86 / 1.91-1.93. So the float force is 15 % faster in cache and at
    1.9 to 2.0 times its floor: the goal is met at 1e3 and at its edge at 1e4, with no
