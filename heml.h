@@ -166,7 +166,9 @@
    Kirchhoff, 26 (208 / 104 bytes) when one is the split Mooney-Rivlin (the largest of
    those in use), plus a byte per block of 16; only without a Prony series and without
    nodal pressure; none otherwise (springs, user laws); desc.stiffness_cache = 0 leaves it
-   out (each product then recomputes them: see PERFORMANCE for the cost). Mass-spring
+   out (each product then recomputes them: see PERFORMANCE for the cost). Float builds
+   compiled for AVX hold the Neo-Hookean force pass's node forces padded to 4 components as
+   well (16 bytes a node; PERFORMANCE, issue 21). Mass-spring
    materials hold nothing per tetrahedron beyond the rest constants (their rest lengths
    and stiffnesses are derived from them in each pass; before issue 21's change they held
    12 reals a slot more).
@@ -1092,7 +1094,9 @@
      stores (they would write a neighbour node's x, a race with another colour group).
      AVX-512 gather/scatter instructions were not tried (slow on AMD; the scatter needs
      conflict handling for nodes shared inside a block). m->simd = 0 runs the scalar path
-     (tests compare both, bit for bit, every law).
+     (tests compare both, bit for bit, every law). The float Neo-Hookean force pass now
+     differs (below, "The float force against its arithmetic floor"): nodes padded to 4
+     components, and with AVX-512 VL a gather of 8 lanes a register.
    - tried and not kept then: software prefetch of the next block's nodes and the rest
      constants of the block after (large meshes): no difference measurable above this
      machine's noise at 975,000 tetrahedra (force 27 -> 15 ns and differential 24 -> 29 ns
@@ -1394,6 +1398,82 @@
    attribute. What is left in cache is the arithmetic (70 of 157
    instructions per tetrahedron), the scatter (47: per lane and node a 16-byte and an
    8-byte read-modify-write) and the gather (24), run one after the other per block.
+   The float force against its arithmetic floor (issue 21's goal: at most 2 times the
+   `arith` row in cache; the bench's last full run on the Intel Xeon below: 2.04 to 2.45 in
+   float, 1.69 to 1.95 in double). In float the arithmetic runs on twice the lanes of a
+   register, so the gather and scatter, which move the same 8 node accesses per
+   tetrahedron as in double, weigh twice as much. Changed (bit-identical to the scalar path,
+   tests/test_heml.c test_vector_paths_match_scalar in the float and double builds):
+   - the Neo-Hookean force pass is software-pipelined (heml__chunk_forces_nh, a chunk at a
+     time, for the fast materials in the plain force pass): heml__forces_nh's three stages
+     are functions of their own, and between them a block gathers the next block's links
+     (after the first stage, which consumes b->e) and scatters the previous block's forces
+     (after the volumetric stage, before the last stage overwrites b->f); a chunk's last
+     block is scattered after its loop. The scatters keep their order, so the sums are the
+     same.
+   - in float builds with AVX, when every material takes that kernel, the pass scatters into
+     m->force4 (nodes padded to 4 components, 16-byte aligned: MEMORY) with one aligned
+     16-byte read-modify-write per lane and node (heml__scatter_vecf4: a 4 x 4 transpose per
+     128-bit half gives 8 lanes' (x, y, z, z) at once), then copies x, y, z to the 3n
+     forces.
+   - with AVX-512 VL the pass's float gather puts lanes q and 4 + q in the halves of one
+     256-bit register (a zeroing masked load, then a merging one 16 bytes below the node
+     with mask bits 4 to 6), so a transpose per half moves 8 lanes (heml__gather_vecf8).
+     The other passes keep the 4-lane gather: in the stiffness product this one cost 3 to
+     5 % (5.96-5.97 -> 6.27-6.33 ns at 1e3-1e4 in float).
+   - the float scatter's 8-byte (x, y) moves go through memcpy (heml__ld2f, heml__st2f):
+     the cast double pointers they replace were misaligned accesses (UBSan, in a
+     sanitizer build for the native target; the Makefile's sanitizer build targets generic
+     x86-64 and never compiled this code).
+   Measured (a harness on the bench's adapter: heml_compute_forces, the adapter's arith row
+   and heml_apply_stiffness on the bench's 5-tetrahedron cubes after its step, old and new
+   builds alternated, minimum of 10 rounds of 3 x 2e6 tetrahedron evaluations; Intel Xeon,
+   Sapphire Rapids class, KVM, 2 vCPUs, gcc 12 -O3 -march=native, load about 1 from other
+   jobs), ns per tetrahedron at 1,080 / 10,985 tetrahedra, force (arith), force / arith:
+                   before                          after
+       float       7.40 (3.19) / 7.43 (3.15)       6.26 (3.27) / 6.34 (3.22)
+                   2.32 / 2.36                     1.91 / 1.97
+       double      9.55 (5.44) / 9.77 (5.00)       9.29 (5.56) / 9.37 (5.02)
+                   1.76 / 1.95                     1.67 / 1.87
+   (per round, float: 2.31-2.36 / 2.35-2.43 before, 1.87-1.93 / 1.96-1.98 after; earlier
+   states of the change at load 5 to 7: 1.92-1.98 / 1.97-2.03). The stiffness product in
+   the same series: float 5.93 / 5.96 -> 5.97 / 6.04, double 8.36 / 8.72 -> 8.20 / 8.73
+   (unchanged). The bench itself (`build/bench/bench --parts kernels --filter
+   heml/neo-hookean/ --threads 1 --repeats 5`, its medians, old and new alternated, 2 runs
+   each, load about 1, and once more with the final code): float force / arith 2.34-2.39 /
+   2.37-2.39 -> 1.93 / 1.94-2.00 at 1e3 / 1e4 (2.46-2.48 -> 2.07-2.12 at 1e5, 2.36-2.53 -> 2.18-2.28 at 1e6, where the padded
+   nodes move a third more bytes: the force still 4 to 7 % faster there), double 1.92-1.93 /
+   2.04-2.07 -> 1.84-1.86 / 1.91-1.93. So the float force is 15 % faster in cache and at
+   1.9 to 2.0 times its floor: the goal is met at 1e3 and at its edge at 1e4, with no
+   margin; double 3 % faster. The arith row rose by 2 % with the split of heml__forces_nh
+   into three functions (it calls the same three: the floor is the force's own arithmetic,
+   so the force paid the same 2 %). Instructions (callgrind, x86-64-v3, which has no
+   AVX-512, 10,985 tetrahedra, per tetrahedron): float force 123 -> 111 (the scatter 54 ->
+   42), arith 38 -> 39; double force 159 -> 157, arith 77 -> 79. Steps, in the same
+   harness, float force: a scatter of (x, y) pairs by two unpacks (1 shuffle a tetrahedron
+   where the transposes and z extractions take 12) with the pipelining 7.6-8.0 -> 7.3-7.5
+   ns (that scatter then dropped: no gain left in the stiffness product, whose scatter it
+   was), the padded scatter 7.05-7.24 -> 6.55-6.85, the 8-lane gather 1 to 2 % more (gather
+   alone 1.42-1.46 -> 1.28-1.37 ns), the pipelined loop as a function per chunk
+   (heml__chunks' own loop left as it was) 2 % more. Tried and not kept: vgatherdps (16
+   lanes, 12 gathers a block): the gather alone 1.6-1.7 against 1.45 ns but the force
+   10.1-10.4 against 7.9-8.1 ns, the 512-bit instructions slowing the arithmetic around them (its
+   arith row 3.6 -> 3.7-4.0 in the same program); 4 lanes a 512-bit register by masked
+   merging loads: gather 2.0-2.2 ns, force 10.4 (the same); masked 3-component stores in
+   the float scatter (AVX-512 VL): scatter 9.2-9.5 against 2.9 ns (no store forwarding from
+   masked stores to the next lane's load, as on the Zen 5); the pair read as 16 bytes folded
+   into the add (4 instructions a tetrahedron fewer): no faster (the reads that straddle
+   two buffer stores miss store forwarding); node offsets 3 idx formed per block by vector
+   adds: scatter 3.0-3.1 against 2.75-2.9 ns; the scatter before the volumetric stage, or
+   the gather after it: 1 to 3 % slower. Conflicts are not what bounds the scatter: on the
+   bench's beams a lane's node is shared by 5 of the block's 64 (lane, node) slots on
+   average (33 at most), yet an index set with 64 distinct nodes in every block scatters in
+   the same time. The force now runs at about 5 instructions a cycle in cache, so what is
+   left is the count of node moves (about 72 of the 111 instructions): fewer would need the
+   node traffic of a block cut (a node shared by 5 slots moves 5 times; accumulating a
+   block's shared nodes needs a per-block table and changes the sums' order) or nodes
+   padded in the state itself (u as 4n: an interface change). Not done; double's scatter
+   into padded nodes (32 bytes a node more) was not tried.
    Static solve (bench/, R1 steel cantilever, Neo-Hookean, double, 5-tetrahedron cells):
    3 ms at 32 x 1 x 1 cells (396 dof), 74 ms at 128 x 4 x 4, 1.0 s at 256 x 8 x 8 (62,451
    dof), 4 Newton iterations each; R2 (large deformation) 2.1 s at 96 x 6 x 6 (14,259
@@ -1507,6 +1587,11 @@
              default automatic; stats.coarse_solves, coarse_factors; IMPLICIT COARSE
              CORRECTION): 3 to 15 times fewer CG iterations on slender bodies at large
              dt, answers within the solve tolerances; up to 2.4 MB more per model.
+       unreleased (issue 21) the Neo-Hookean force pass software-pipelined (the next
+             block's gather and the previous block's scatter between the stages); in
+             float with AVX its scatter into nodes padded to 4 (16 bytes a node more), and
+             with AVX-512 VL an 8-lane gather: the float force 15 % faster in cache, at 1.9
+             to 2.0 times its arithmetic floor; results bit-identical. See PERFORMANCE.
        unreleased (issue 21) vector gather and scatter where the target has AVX (AVX-512 VL
              masks where present; HEML_NO_SIMD for the scalar path), bit-identical; the
              spring force 15x faster (no differential terms on an unset workspace) and its
@@ -2193,6 +2278,7 @@ HEMLDEF void heml_modal_destroy(heml_modal *md);
    HEML_NO_SIMD forces the portable scalar code. */
 #if !defined(HEML_NO_SIMD) && (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__)
 #include <immintrin.h>
+#include <stdint.h> /* (uintptr_t: heml__gather_vecf8) */
 #define HEML__AVX 1
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #define HEML__AVX512 1 /* the gather's masked node loads with AVX-512 masks (else AVX's vmaskmov) */
@@ -2354,6 +2440,9 @@ struct heml_model {
 
     /* nodes; the state is the displacement u (disp), pos = rest + u is kept for rendering */
     heml_real *rest, *pos, *disp, *vel, *force, *ext, *target, *mass, *inv_mass;
+    heml_real *force4;                     /* float builds with AVX: the Neo-Hookean force pass's
+                                              node forces padded to 4 components (heml__pass_run;
+                                              NULL elsewhere) */
     heml_real *free_mask, *pin_mask; /* per degree of freedom: 1 free / 1 pinned */
     heml_real *diag;                 /* per degree of freedom: small-strain stiffness diagonal */
     double energy_noise;             /* J: round-off of the energy of user laws (static line search) */
@@ -3061,6 +3150,40 @@ static void heml__scatter_scalar(const int *HEML__RESTRICT idx, heml_real (*HEML
 #define HEML__LOAD3D(p) _mm256_maskload_pd((p), _mm256_set_epi64x(0, -1, -1, -1))
 #define HEML__LOAD3F(p) _mm_maskload_ps((p), _mm_set_epi32(0, -1, -1, -1))
 #endif
+#if defined(HEML__AVX512)
+/* The float gather with AVX-512 VL masks, 8 lanes at a time in 256-bit registers: register q
+   holds lane q in its low half and lane 4 + q in its high half (a zeroing 3-element load,
+   then a merging one at the node's address minus 16 bytes with mask bits 4 to 6: masked-off
+   elements never fault), so one 4 x 4 transpose per half moves 8 lanes at once: half the
+   shuffles, subtractions and stores of 4 lanes in 128-bit registers. */
+static void heml__gather_vecf8(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
+                               heml_real (*HEML__RESTRICT e)[HEML__W])
+{
+    const float *xf = (const float *)(const void *)x;
+    float *row = (float *)(void *)e[0];
+    int h, j, q;
+#define HEML__LOAD8F(i, l)                                                                                        \
+    _mm256_mask_loadu_ps(_mm256_maskz_loadu_ps((__mmask8)7, xf + 3 * (size_t)(i)[l]), (__mmask8)0x70,            \
+                         (const float *)(const void *)((uintptr_t)(xf + 3 * (size_t)(i)[(l) + 4]) - 16))
+    for (h = 0; h < HEML__W; h += 8) {
+        __m256 n0[4];
+        for (q = 0; q < 4; q++) n0[q] = HEML__LOAD8F(idx, h + q);
+        for (j = 1; j < 4; j++) {
+            __m256 d[4], t0, t1, t2, t3;
+            for (q = 0; q < 4; q++) d[q] = _mm256_sub_ps(HEML__LOAD8F(idx + j * HEML__W, h + q), n0[q]);
+            t0 = _mm256_unpacklo_ps(d[0], d[1]); /* x0 x1 y0 y1 in each half */
+            t1 = _mm256_unpackhi_ps(d[0], d[1]); /* z0 z1 .. */
+            t2 = _mm256_unpacklo_ps(d[2], d[3]);
+            t3 = _mm256_unpackhi_ps(d[2], d[3]);
+            _mm256_storeu_ps(row + 3 * (j - 1) * HEML__W + h, _mm256_shuffle_ps(t0, t2, 0x44));
+            _mm256_storeu_ps(row + (3 * (j - 1) + 1) * HEML__W + h, _mm256_shuffle_ps(t0, t2, 0xEE));
+            _mm256_storeu_ps(row + (3 * (j - 1) + 2) * HEML__W + h, _mm256_shuffle_ps(t1, t3, 0x44));
+        }
+    }
+#undef HEML__LOAD8F
+}
+#endif
+
 static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEML__RESTRICT x,
                              heml_real (*HEML__RESTRICT e)[HEML__W])
 {
@@ -3101,6 +3224,72 @@ static void heml__gather_vec(const int *HEML__RESTRICT idx, const heml_real *HEM
                 _mm_storeu_ps(row + 2 * HEML__W + k, d2);
             }
         }
+    }
+}
+
+/* Two floats (8 bytes, any 4-byte alignment) into a register's low half and back: memcpy
+   through a double, which compilers turn into one 8-byte move (a cast pointer would be a
+   misaligned double access). */
+HEML__INLINE __m128 heml__ld2f(const float *p)
+{
+    double t;
+    memcpy(&t, p, sizeof t);
+    return _mm_castpd_ps(_mm_set_sd(t));
+}
+
+HEML__INLINE void heml__st2f(float *p, __m128 v)
+{
+    double t = _mm_cvtsd_f64(_mm_castps_pd(v));
+    memcpy(p, &t, sizeof t);
+}
+
+/* The float scatter into nodes padded to 4 components (m->force4, 16-byte aligned): per 8
+   lanes and node a 4 x 4 transpose in each 128-bit half turns the rows x, y, z into the
+   lanes' (x, y, z, z) (a buffer), and each lane's goes to its node by one aligned 16-byte
+   read-modify-write (the fourth component is padding, never read back). The same sums in
+   the same order as the scalar loop: heml__pass_run copies x, y, z to the 3n forces. */
+static void heml__scatter_vecf4(const int *HEML__RESTRICT idx, heml_real (*HEML__RESTRICT f)[HEML__W],
+                                heml_real *HEML__RESTRICT out4)
+{
+    const float *fr = (const float *)(const void *)f[0];
+    /* lane l's (x, y, z, z) in a node's buffer: 8 (l & 3) + 4 ((l >> 2) & 1) + 32 (l >> 3) */
+    static const int at[16] = {0, 8, 16, 24, 4, 12, 20, 28, 32, 40, 48, 56, 36, 44, 52, 60};
+    float *of = (float *)(void *)out4;
+    float q[4][4 * HEML__W];
+    int j, h, l;
+    for (j = 0; j < 4; j++)
+        for (h = 0; h < HEML__W; h += 8) {
+            __m256 X, Y, Z, t0, t1, t2, t3;
+            if (j == 0) { /* node 0: (a + b) + c of the other three, as the scalar loop */
+                X = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + h), _mm256_loadu_ps(fr + 3 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 6 * HEML__W + h));
+                Y = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + HEML__W + h), _mm256_loadu_ps(fr + 4 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 7 * HEML__W + h));
+                Z = _mm256_add_ps(_mm256_add_ps(_mm256_loadu_ps(fr + 2 * HEML__W + h), _mm256_loadu_ps(fr + 5 * HEML__W + h)),
+                                  _mm256_loadu_ps(fr + 8 * HEML__W + h));
+            } else {
+                X = _mm256_loadu_ps(fr + 3 * (j - 1) * HEML__W + h);
+                Y = _mm256_loadu_ps(fr + (3 * (j - 1) + 1) * HEML__W + h);
+                Z = _mm256_loadu_ps(fr + (3 * (j - 1) + 2) * HEML__W + h);
+            }
+            t0 = _mm256_unpacklo_ps(X, Y); /* x0 y0 x1 y1 | x4 y4 x5 y5 */
+            t1 = _mm256_unpackhi_ps(X, Y); /* x2 y2 x3 y3 | x6 y6 x7 y7 */
+            t2 = _mm256_unpacklo_ps(Z, Z);
+            t3 = _mm256_unpackhi_ps(Z, Z);
+            _mm256_storeu_ps(q[j] + 4 * h, _mm256_shuffle_ps(t0, t2, 0x44));      /* lanes 0 | 4 */
+            _mm256_storeu_ps(q[j] + 4 * h + 8, _mm256_shuffle_ps(t0, t2, 0xEE));  /* lanes 1 | 5 */
+            _mm256_storeu_ps(q[j] + 4 * h + 16, _mm256_shuffle_ps(t1, t3, 0x44)); /* lanes 2 | 6 */
+            _mm256_storeu_ps(q[j] + 4 * h + 24, _mm256_shuffle_ps(t1, t3, 0xEE)); /* lanes 3 | 7 */
+        }
+    for (l = 0; l < HEML__W; l++) { /* lanes in order: shared nodes see the scalar order */
+        const int a = at[l];
+        float *o;
+        for (j = 1; j < 4; j++) {
+            o = of + 4 * (size_t)idx[j * HEML__W + l];
+            _mm_store_ps(o, _mm_add_ps(_mm_load_ps(o), _mm_loadu_ps(q[j] + a)));
+        }
+        o = of + 4 * (size_t)idx[l];
+        _mm_store_ps(o, _mm_sub_ps(_mm_load_ps(o), _mm_loadu_ps(q[0] + a)));
     }
 }
 
@@ -3174,9 +3363,8 @@ static void heml__scatter_vec(const int *HEML__RESTRICT idx, heml_real (*HEML__R
             for (l = 0; l < 4; l++) {
                 for (j = 0; j < 4; j++) {
                     float *o = of + 3 * (size_t)idx[j * HEML__W + k + l];
-                    __m128 xyo = _mm_castpd_ps(_mm_load_sd((const double *)(const void *)o)), r;
-                    r = j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]);
-                    _mm_store_sd((double *)(void *)o, _mm_castps_pd(r));
+                    __m128 xyo = heml__ld2f(o);
+                    heml__st2f(o, j ? _mm_add_ps(xyo, v[j][l]) : _mm_sub_ps(xyo, v[j][l]));
                     o[2] = j ? o[2] + _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2))
                              : o[2] - _mm_cvtss_f32(_mm_shuffle_ps(v[j][l], v[j][l], 2));
                 }
@@ -3209,6 +3397,35 @@ static void heml__scatter(const heml_model *m, const int *idx, heml_real (*f)[HE
 #endif
     (void)m;
     heml__scatter_scalar(idx, f, out);
+}
+
+/* The same as calls (never inlined), for the pipelined Neo-Hookean force pass between
+   heml__forces_nh's stages (heml__chunk_forces_nh); with `four` the scatter goes to nodes
+   padded to 4 components (m->force4, heml__pass_run). Inlined or not measured the same.
+   The float gather of 8 lanes a register (AVX-512 VL) serves this pass only: 1 to 2 %
+   faster force, but a 3 to 5 % slower stiffness product (PERFORMANCE). */
+HEML__NOINLINE static void heml__gather_call(const heml_model *m, const int *idx, const heml_real *x, heml_real (*e)[HEML__W])
+{
+#if defined(HEML__AVX512)
+    if (m->simd && sizeof(heml_real) != sizeof(double)) { /* (here only: it slowed the stiffness product) */
+        heml__gather_vecf8(idx, x, e);
+        return;
+    }
+#endif
+    heml__gather(m, idx, x, e);
+}
+
+HEML__NOINLINE static void heml__scatter_call(const heml_model *m, const int *idx, heml_real (*f)[HEML__W], heml_real *out,
+                                              int four)
+{
+#if defined(HEML__AVX)
+    if (four) { /* (m->force4: heml__pass_run) */
+        heml__scatter_vecf4(idx, f, out);
+        return;
+    }
+#endif
+    (void)four;
+    heml__scatter(m, idx, f, out);
 }
 
 /* The same with absolute values (the size of the terms each node's force sums). */
@@ -3595,12 +3812,13 @@ static void heml__nh_nodal_s0(const heml__mat *mt, heml_real jm1_0, const heml_r
    stress and one for the product (12,000 tetrahedra, arithmetic alone); one loop for all
    of it spills the 16 AVX2 registers and was slower still. With np (the nodal pressures
    P_a, heml__mat.fast_nodal; idx the block's nodes) the volumetric stage is
-   heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). */
-static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
-                            const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
-                            heml__blk *HEML__RESTRICT b)
+   heml__nh_nodal_s0 instead and the rest is unchanged (w_J = s0 - p0 there too). The
+   stages are functions of their own, never inlined (heml__forces_nh_h, _s, _p): the force
+   pass calls them with the next block's gather and the previous block's scatter between
+   them (heml__chunks, PERFORMANCE), the bench's arith row through heml__forces_nh, so both
+   run the same machine code for the arithmetic. */
+HEML__NOINLINE static void heml__forces_nh_h(const heml_real *HEML__RESTRICT R, heml__blk *HEML__RESTRICT b)
 {
-    const heml_real mu = 2 * mt->c1, p0 = mt->p0, kappa = mt->kappa;
     int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real a0 = b->e[0][k], a1 = b->e[1][k], a2 = b->e[2][k];
@@ -3627,6 +3845,13 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
         b->H[8][k] = H22;
         b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
     }
+}
+
+HEML__NOINLINE static void heml__forces_nh_s(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT np,
+                                             const int *HEML__RESTRICT idx, heml__blk *HEML__RESTRICT b)
+{
+    const heml_real p0 = mt->p0, kappa = mt->kappa;
+    int k;
     if (np) /* the nodal pressure (NEAR-INCOMPRESSIBLE BODIES): heml__nh_nodal_s0 */
         heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
     else
@@ -3638,6 +3863,13 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
             heml_real s0 = (kappa * L + p0 * jc1) * iJ + hh * d;
             b->s0[k] = s0;
         }
+}
+
+HEML__NOINLINE static void heml__forces_nh_p(const heml__mat *mt, const heml_real *HEML__RESTRICT R,
+                                             heml__blk *HEML__RESTRICT b)
+{
+    const heml_real mu = 2 * mt->c1, p0 = mt->p0;
+    int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
         heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
@@ -3700,6 +3932,15 @@ static void heml__forces_nh_kept(const heml__mat *mt, heml_real jm1_0, const hem
         b->K[7][k] = mv * H21 + wv * (c21 - H12);
     }
     heml__p_times_grad(R, b);
+}
+
+static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
+                            const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
+                            heml__blk *HEML__RESTRICT b)
+{
+    heml__forces_nh_h(R, b);
+    heml__forces_nh_s(mt, jm1_0, np, idx, b);
+    heml__forces_nh_p(mt, R, b);
 }
 
 /* The split Mooney-Rivlin force kernel (heml__law_split without Prony or the nodal
@@ -4646,6 +4887,7 @@ typedef struct heml__pass {
     heml_stress_kind kind;
     const heml_real *x, *dx;
     heml_real *out;
+    heml_real *out4; /* the force pass into m->force4 (heml__pass_run), or NULL */
 } heml__pass;
 
 /* Software prefetch of a block's streams: its stiffness cache (the cached product) or its
@@ -4677,6 +4919,34 @@ HEML__NOINLINE static void heml__count_lanes(const heml_real *HEML__RESTRICT jm1
     }
 }
 
+/* The Neo-Hookean force of one chunk (heml__mat.fast, the plain force pass), software-
+   pipelined: between heml__forces_nh's stages a block gathers the next block's links (its
+   first stage has consumed b->e) and scatters the previous block's forces (before its last
+   stage overwrites b->f); the chunk's last block is scattered after the loop. The
+   scatters keep their order, so the sums are those of the plain loop. With `four`, out is
+   m->force4 (nodes padded to 4 components, heml__pass_run). PERFORMANCE, issue 21. */
+HEML__NOINLINE static void heml__chunk_forces_nh(const heml_model *m, const heml__mat *mt, int ci, const heml_real *x,
+                                                 heml_real *out, int four, heml__blk *HEML__RESTRICT b,
+                                                 heml_real *HEML__RESTRICT below_l, heml_real *HEML__RESTRICT inverted_l)
+{
+    const int b0 = m->chunk_begin[ci], b1 = m->chunk_end[ci];
+    int blk;
+    if (b1 > b0) heml__gather_call(m, m->blk_idx + (size_t)b0 * 4 * HEML__W, x, b->e);
+    for (blk = b0; blk < b1; blk++) {
+        const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
+        const heml_real *R = m->blk_rest + (size_t)blk * HEML__NR * HEML__W;
+        if (blk + 1 < b1) /* the next block's streams (PERFORMANCE) */
+            heml__prefetch_block(R + HEML__NR * HEML__W, HEML__NR, idx + 4 * HEML__W);
+        heml__forces_nh_h(R, b);
+        if (blk + 1 < b1) heml__gather_call(m, idx + 4 * HEML__W, x, b->e);
+        heml__forces_nh_s(mt, m->jm1_0, NULL, idx, b);
+        if (blk > b0) heml__scatter_call(m, idx - 4 * HEML__W, b->f, out, four);
+        heml__forces_nh_p(mt, R, b);
+        heml__count_lanes(b->jm1, m->jm1_0, below_l, inverted_l);
+    }
+    if (b1 > b0) heml__scatter_call(m, m->blk_idx + (size_t)(b1 - 1) * 4 * HEML__W, b->f, out, four);
+}
+
 static void heml__chunks(void *vctx, int begin, int end)
 {
     const heml__pass *p = (const heml__pass *)vctx;
@@ -4689,8 +4959,10 @@ static void heml__chunks(void *vctx, int begin, int end)
         double energy = 0.0;
         int below = 0, inverted = 0;
         heml_real below_l[HEML__W], inverted_l[HEML__W]; /* the force's counts per lane (a loop that vectorises) */
+        const int nh = p->mode == HEML__FORCE && mt->fast && mt->kind != HEML__K_SPRING; /* (the Neo-Hookean kernel) */
         for (k = 0; k < HEML__W; k++) below_l[k] = inverted_l[k] = 0;
-        for (blk = m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) {
+        if (nh) heml__chunk_forces_nh(m, mt, ci, p->x, p->out4 ? p->out4 : p->out, p->out4 != NULL, &b, below_l, inverted_l);
+        for (blk = nh ? m->chunk_end[ci] : m->chunk_begin[ci]; blk < m->chunk_end[ci]; blk++) { /* (the other kernels) */
             const int *idx = m->blk_idx + (size_t)blk * 4 * HEML__W;
             int valid = m->blk_valid[blk];
             switch (p->mode) {
@@ -4954,10 +5226,23 @@ static double heml__pass_run(heml_model *m, int mode, const heml_real *x, const 
     p.x = x;
     p.dx = dx;
     p.out = out;
-    if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
+    p.out4 = NULL;
+    if (mode == HEML__FORCE && m->force4 && m->simd) { /* every block pipelined: nodes padded to 4 */
+        for (c = 0; c < m->material_count && m->mats[c].fast && m->mats[c].kind != HEML__K_SPRING; c++) continue;
+        if (c == m->material_count) p.out4 = m->force4;
+    }
+    if (p.out4)
+        memset(p.out4, 0, sizeof(heml_real) * 4 * (size_t)m->node_count);
+    else if (mode == HEML__FORCE || mode == HEML__DIFF || mode == HEML__FORCE_ENERGY || mode == HEML__ABS)
         memset(out, 0, sizeof(heml_real) * 3 * (size_t)m->node_count);
     for (p.colour = 0; p.colour < m->colour_count; p.colour++)
         heml__run(m, m->colour_start[p.colour + 1] - m->colour_start[p.colour], heml__chunks, &p);
+    if (p.out4) {
+        const heml_real *HEML__RESTRICT f4 = p.out4;
+        heml_real *HEML__RESTRICT o3 = out;
+        size_t i, n = (size_t)m->node_count;
+        for (i = 0; i < n; i++) o3[3 * i] = f4[4 * i], o3[3 * i + 1] = f4[4 * i + 1], o3[3 * i + 2] = f4[4 * i + 2];
+    }
     for (c = 0; c < m->chunk_count; c++) {
         energy += m->chunk_energy[c];
         below += m->chunk_below[c];
@@ -5198,6 +5483,9 @@ static void heml__layout(heml_model *m, heml__carver *c)
     }
     HEML__CARVE(c, m->dc, heml_real, m->has_dc ? (size_t)m->dc_rows * s : 0);
     HEML__CARVE(c, m->dc_gen, unsigned char, m->has_dc ? B : 0);
+#if defined(HEML__AVX)
+    if (sizeof(heml_real) == sizeof(float)) HEML__CARVE(c, m->force4, heml_real, 4 * n); /* (last: the others keep their offsets) */
+#endif
     if (!m->nodal) m->diag_dev = NULL;
     if (!m->pagg_count) m->pagg = NULL;
     if (!m->has_dc) m->dc = NULL, m->dc_gen = NULL;
