@@ -63,6 +63,18 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
     } else {
         tetmesh mesh;
         if (bench_body_mesh(b, &mesh)) return FRM_ERR_ALLOC;
+        if (getenv("BENCH_SHUFFLE_TETS")) { /* measurements only: the tetrahedra in a shuffled order
+                                               (fixed seed), so no grid order is left to use */
+            unsigned seed = 12345u;
+            for (i = mesh.tet_count - 1; i > 0; i--) {
+                int j, t[4];
+                seed = seed * 1664525u + 1013904223u;
+                j = (int)((seed >> 8) % (unsigned)(i + 1));
+                memcpy(t, mesh.tets + 4 * i, sizeof t);
+                memcpy(mesh.tets + 4 * i, mesh.tets + 4 * j, sizeof t);
+                memcpy(mesh.tets + 4 * j, t, sizeof t);
+            }
+        }
         n = mesh.node_count;
         x = (frm_real *)malloc(sizeof(frm_real) * 3 * (size_t)n);
         if (!x) return tetmesh_free(&mesh), FRM_ERR_ALLOC;
@@ -85,7 +97,9 @@ static int fr_sampling(const bench_body *b, int hex, frm_sampling *s, double **r
 
 /* vol: the volumetric treatment (issue 13): 0 none, 1 FRM_VOLUMETRIC_CELLS (hexahedra: a
    hexahedral cell; tetrahedra: the 5 tetrahedra of a grid cell, the bench's TETMESH_SPLIT5
-   mesh emits them cell by cell), 2 FRM_VOLUMETRIC_FRAMES (nodal averaging) */
+   mesh emits them cell by cell), 2 FRM_VOLUMETRIC_FRAMES (nodal averaging), 3
+   FRM_VOLUMETRIC_PATCHES (patches the library builds from the neighbour table; the
+   environment variable BENCH_PATCH_SIZE sets desc.volumetric_patch_size for measurements) */
 static int fr_create_vol(const bench_body *b, int hex, frm_law law, int vol, void **out);
 static int fr_create(const bench_body *b, int hex, frm_law law, void **out) { return fr_create_vol(b, hex, law, 0, out); }
 
@@ -124,7 +138,11 @@ static int fr_create_vol(const bench_body *b, int hex, frm_law law, int vol, voi
     d.cg_max_iterations = 20000; /* stiff slender beams need many CG iterations */
     if (vol == 1 && !hex) /* macro-cells: the 5 tetrahedra of each grid cell */
         for (i = 0; i < smp.sample_count; i++) smp.sample_cells[i] = i / 5;
-    d.volumetric = vol == 1 ? FRM_VOLUMETRIC_CELLS : vol == 2 ? FRM_VOLUMETRIC_FRAMES : FRM_VOLUMETRIC_NONE;
+    d.volumetric = vol == 1   ? FRM_VOLUMETRIC_CELLS
+                   : vol == 2 ? FRM_VOLUMETRIC_FRAMES
+                   : vol == 3 ? FRM_VOLUMETRIC_PATCHES
+                              : FRM_VOLUMETRIC_NONE;
+    if (vol == 3 && getenv("BENCH_PATCH_SIZE")) d.volumetric_patch_size = atoi(getenv("BENCH_PATCH_SIZE"));
     err = frm_model_create(&d, &s->m);
     frm_sampling_free(&smp);
     if (err) {
@@ -151,6 +169,7 @@ static int fr_create_nh_tet(const bench_body *b, void **out) { return fr_create(
 #ifndef BENCH_FLOAT
 static int fr_create_svk_hex_cells(const bench_body *b, void **out) { return fr_create_vol(b, 1, FRM_LAW_SVK, 1, out); }
 static int fr_create_svk_tet_cells(const bench_body *b, void **out) { return fr_create_vol(b, 0, FRM_LAW_SVK, 1, out); }
+static int fr_create_svk_tet_patches(const bench_body *b, void **out) { return fr_create_vol(b, 0, FRM_LAW_SVK, 3, out); }
 #endif
 
 static void fr_destroy(void *v)
@@ -379,9 +398,11 @@ static const bench_model fr_models[] = {
     {"frames", "nh tet4", "neo-hookean", BENCH_PRECISION, FR_ALL, 1, 0, "pair", fr_create_nh_tet, FR_FUNCTIONS},
 #ifndef BENCH_FLOAT /* issue 13: the volumetric treatment, Poisson rows only (primary -1), double; the
                        nodal averaging (vol = 2) of tetrahedral frames measured +8.8, -4.2, -7.1 %
-                       at nu = 0.3, 0.49, 0.499 (k = 3), left out for the bench's time */
+                       at nu = 0.3, 0.49, 0.499 (k = 3), left out for the bench's time; vol=patches:
+                       FRM_VOLUMETRIC_PATCHES, the cells built by the library from any mesh */
     {"frames", "svk hex8 vol=cells", "svk", BENCH_PRECISION, FR_ALL, 1, -1, "pair", fr_create_svk_hex_cells, FR_FUNCTIONS},
     {"frames", "svk tet4 vol=cells5", "svk", BENCH_PRECISION, FR_ALL, 1, -1, "pair", fr_create_svk_tet_cells, FR_FUNCTIONS},
+    {"frames", "svk tet4 vol=patches", "svk", BENCH_PRECISION, FR_ALL, 1, -1, "pair", fr_create_svk_tet_patches, FR_FUNCTIONS},
 #endif
 };
 

@@ -2073,18 +2073,18 @@ static unsigned long long vol_run(int mode, int threads, int workers, frm_alloca
 /* Issue 13, the volumetric averaging (tests/test_frames_elem.c test_vol_* test its math).
    With the option on: bit-identical results for 1 and 2 OpenMP threads and job systems
    splitting in 2 and 3 parts run in reverse (the averages run serially in entry order, the
-   sample passes in fixed chunks), and nothing allocates after creation (static solve,
-   steps, Newton step, forces, energy, stiffness products). */
+   sample passes in fixed chunks; PATCHES' patches are built serially at creation), for
+   every averaging mode (PATCHES only in quick builds), and nothing allocates after
+   creation (static solve, steps, Newton step, forces, energy, stiffness products). */
 static void test_vol_threads_allocation(void)
 {
     int mode;
-#ifdef TEST_QUICK /* one mode in the quick builds (the OpenMP build runs both) */
-    const int last = FRM_VOLUMETRIC_CELLS;
-#else
-    const int last = FRM_VOLUMETRIC_FRAMES;
-#endif
-    for (mode = FRM_VOLUMETRIC_CELLS; mode <= last; mode++) {
+    for (mode = FRM_VOLUMETRIC_CELLS; mode <= FRM_VOLUMETRIC_PATCHES; mode++) {
         counting_allocator c = {0, 0, 0, 0};
+#ifdef TEST_QUICK /* the quick builds run PATCHES only: its passes are CELLS' (the averaging
+                     differs in data only), its patches are built at creation */
+        if (mode != FRM_VOLUMETRIC_PATCHES) continue;
+#endif
         frm_allocator a;
         unsigned long long h1 = vol_run(mode, 1, 0, NULL, NULL), h2 = vol_run(mode, 2, 0, NULL, NULL), h3 = h1, h4 = h1, h5;
         int after = -1;
@@ -2097,7 +2097,8 @@ static void test_vol_threads_allocation(void)
         a.user = &c;
         h5 = vol_run(mode, 1, 0, &a, &after);
         printf("    %s: hashes 1 thread %016llx, 2 threads %016llx, 2 tasks %016llx, 3 tasks %016llx; %d allocations "
-               "after creation\n", mode == FRM_VOLUMETRIC_CELLS ? "cells" : "frames", h1, h2, h3, h4, after);
+               "after creation\n", mode == FRM_VOLUMETRIC_CELLS ? "cells" : mode == FRM_VOLUMETRIC_FRAMES ? "frames" : "patches",
+               h1, h2, h3, h4, after);
         CHECK(h1 != 0);
         CHECK(h1 == h2);
         CHECK(h1 == h3);
