@@ -3865,15 +3865,16 @@ HEML__NOINLINE static void heml__forces_nh_s(const heml__mat *mt, heml_real jm1_
         }
 }
 
+/* (H: 9 rows of HEML__W, b->H[0] or the nodal pressure's kept H) */
 HEML__NOINLINE static void heml__forces_nh_p(const heml__mat *mt, const heml_real *HEML__RESTRICT R,
-                                             heml__blk *HEML__RESTRICT b)
+                                             const heml_real *HEML__RESTRICT H, heml__blk *HEML__RESTRICT b)
 {
     const heml_real mu = 2 * mt->c1, p0 = mt->p0;
     int k;
     for (k = 0; k < HEML__W; k++) {
-        heml_real H00 = b->H[0][k], H01 = b->H[1][k], H02 = b->H[2][k];
-        heml_real H10 = b->H[3][k], H11 = b->H[4][k], H12 = b->H[5][k];
-        heml_real H20 = b->H[6][k], H21 = b->H[7][k], H22 = b->H[8][k];
+        heml_real H00 = H[k], H01 = H[HEML__W + k], H02 = H[2 * HEML__W + k];
+        heml_real H10 = H[3 * HEML__W + k], H11 = H[4 * HEML__W + k], H12 = H[5 * HEML__W + k];
+        heml_real H20 = H[6 * HEML__W + k], H21 = H[7 * HEML__W + k], H22 = H[8 * HEML__W + k];
         heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
         heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
         heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
@@ -3894,14 +3895,11 @@ HEML__NOINLINE static void heml__forces_nh_p(const heml__mat *mt, const heml_rea
 
 /* heml__forces_nh with the nodal pressure on H kept by this pass's sums (heml__nodal_sums_keep,
    Hk: 9 rows of HEML__W; NEAR-INCOMPRESSIBLE BODIES, "Cost"): no gather and no H, J - 1
-   formed from Hk as there, then heml__nh_nodal_s0 and the same stress and forces. A copy of
-   heml__forces_nh's stages rather than a pointer into them: the plain kernel's code stays
-   as it was (reading H through a pointer there cost it 3 instructions per tetrahedron). */
+   formed from Hk as heml__forces_nh_h does, then the same stages _s (nodal) and _p on Hk. */
 static void heml__forces_nh_kept(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
                                  const heml_real *HEML__RESTRICT np, const int *HEML__RESTRICT idx,
                                  const heml_real *HEML__RESTRICT Hk, heml__blk *HEML__RESTRICT b)
 {
-    const heml_real mu = 2 * mt->c1, p0 = mt->p0;
     int k;
     for (k = 0; k < HEML__W; k++) {
         heml_real H00 = Hk[k], H01 = Hk[HEML__W + k], H02 = Hk[2 * HEML__W + k];
@@ -3911,27 +3909,8 @@ static void heml__forces_nh_kept(const heml__mat *mt, heml_real jm1_0, const hem
         heml_real c11 = H00 * H22 - H02 * H20, c22 = H00 * H11 - H01 * H10;
         b->jm1[k] = (H00 + H11 + H22) + (c00 + c11 + c22) + (H00 * c00 + H01 * c01 + H02 * c02);
     }
-    heml__nh_nodal_s0(mt, jm1_0, np, idx, b);
-    for (k = 0; k < HEML__W; k++) {
-        heml_real H00 = Hk[k], H01 = Hk[HEML__W + k], H02 = Hk[2 * HEML__W + k];
-        heml_real H10 = Hk[3 * HEML__W + k], H11 = Hk[4 * HEML__W + k], H12 = Hk[5 * HEML__W + k];
-        heml_real H20 = Hk[6 * HEML__W + k], H21 = Hk[7 * HEML__W + k], H22 = Hk[8 * HEML__W + k];
-        heml_real c00 = H11 * H22 - H12 * H21, c01 = H12 * H20 - H10 * H22, c02 = H10 * H21 - H11 * H20;
-        heml_real c10 = H02 * H21 - H01 * H22, c11 = H00 * H22 - H02 * H20, c12 = H01 * H20 - H00 * H21;
-        heml_real c20 = H01 * H12 - H02 * H11, c21 = H02 * H10 - H00 * H12, c22 = H00 * H11 - H01 * H10;
-        heml_real vol = R[9 * HEML__W + k], s0 = b->s0[k], tr = H00 + H11 + H22;
-        heml_real mv = mu * vol, wv = (s0 - p0) * vol, dv = s0 * vol + wv * tr, ev = mv - wv;
-        b->K[0][k] = dv + ev * H00 + wv * c00;
-        b->K[4][k] = dv + ev * H11 + wv * c11;
-        b->K[8][k] = dv + ev * H22 + wv * c22;
-        b->K[1][k] = mv * H01 + wv * (c01 - H10);
-        b->K[2][k] = mv * H02 + wv * (c02 - H20);
-        b->K[3][k] = mv * H10 + wv * (c10 - H01);
-        b->K[5][k] = mv * H12 + wv * (c12 - H21);
-        b->K[6][k] = mv * H20 + wv * (c20 - H02);
-        b->K[7][k] = mv * H21 + wv * (c21 - H12);
-    }
-    heml__p_times_grad(R, b);
+    heml__forces_nh_s(mt, jm1_0, np, idx, b);
+    heml__forces_nh_p(mt, R, Hk, b);
 }
 
 static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_real *HEML__RESTRICT R,
@@ -3940,7 +3919,7 @@ static void heml__forces_nh(const heml__mat *mt, heml_real jm1_0, const heml_rea
 {
     heml__forces_nh_h(R, b);
     heml__forces_nh_s(mt, jm1_0, np, idx, b);
-    heml__forces_nh_p(mt, R, b);
+    heml__forces_nh_p(mt, R, b->H[0], b);
 }
 
 /* The split Mooney-Rivlin force kernel (heml__law_split without Prony or the nodal
@@ -4941,7 +4920,7 @@ HEML__NOINLINE static void heml__chunk_forces_nh(const heml_model *m, const heml
         if (blk + 1 < b1) heml__gather_call(m, idx + 4 * HEML__W, x, b->e);
         heml__forces_nh_s(mt, m->jm1_0, NULL, idx, b);
         if (blk > b0) heml__scatter_call(m, idx - 4 * HEML__W, b->f, out, four);
-        heml__forces_nh_p(mt, R, b);
+        heml__forces_nh_p(mt, R, b->H[0], b);
         heml__count_lanes(b->jm1, m->jm1_0, below_l, inverted_l);
     }
     if (b1 > b0) heml__scatter_call(m, m->blk_idx + (size_t)(b1 - 1) * 4 * HEML__W, b->f, out, four);
